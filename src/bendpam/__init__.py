@@ -1,0 +1,59 @@
+"""bendpam: models, tests and design tools for bending pneumatic artificial muscles.
+
+Units inside the library: mm, N, MPa (N/mm^2), N*mm, 1/mm and radians.  Interfaces that users
+type (the CLI, TOML files, Actuator fields) carry the unit in the name (``pressure_kpa``,
+``alpha0_deg``).
+
+Quick start::
+
+    import bendpam
+    a = bendpam.presets.be_pam()
+    bendpam.blocked_moment(a, 0.2)                # N*mm at 200 kPa
+    bendpam.free_curvature(a, [0.1, 0.2]).angle_deg
+"""
+
+from __future__ import annotations
+
+from . import kinematics as _kinematics_module  # noqa: F401
+from . import material, models, presets
+from .actuator import NEUTRAL_ANGLE_DEG, Actuator
+from .kinematics import CurvatureLimits, Kinematics, curvature_limits
+from .material import MooneyRivlin
+from .predict import (
+    BranchInfo,
+    FreeBending,
+    active_pressure,
+    blocked_moment,
+    branch_info,
+    free_curvature,
+    internal_stresses,
+    kinematics,
+    moment,
+    moment_terms,
+    tangent_stiffness,
+)
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "Actuator",
+    "NEUTRAL_ANGLE_DEG",
+    "MooneyRivlin",
+    "Kinematics",
+    "CurvatureLimits",
+    "BranchInfo",
+    "FreeBending",
+    "active_pressure",
+    "blocked_moment",
+    "branch_info",
+    "curvature_limits",
+    "free_curvature",
+    "internal_stresses",
+    "kinematics",
+    "material",
+    "models",
+    "moment",
+    "moment_terms",
+    "presets",
+    "tangent_stiffness",
+]

@@ -1,0 +1,353 @@
+r"""Braid kinematics of a bending PAM (paper eq 1-5, with NOTES.md items 1-3).
+
+Coordinates: ``Phi = 0`` lies at the frame; the distance of a point of the braid circle from the
+frame is ``h = R (1 - cos Phi)`` with ``R`` the *deformed* radius.  With the frame curvature
+``k'`` (positive toward the frame) and ``u = k' R``:
+
+* axial stretch of the braid and bladder, eq 3 / 34:  ``lambda1(Phi) = 1 + u (1 - cos Phi)``
+* inextensible fibres, eq 2 / 4:  ``cos^2 a0 lambda1^2 + sin^2 a0 lambda2^2 = 1``, so the local
+  braid angle is ``cos alpha(Phi) = lambda1 cos a0`` and
+  ``lambda2(Phi) = sqrt(1 - c^2 lambda1^2) / sin a0`` (c = cos a0, s = sin a0)
+* radius, eq 5 (implicit, because ``u`` contains ``R``)::
+
+      eta = R / R0 = (2 pi / s) / \int_0^{2pi} (1 - c^2 lambda1^2)^{-1/2} dPhi = xi(u)
+
+  We write ``xi(u) = 1 / (s Ibar(u))`` with ``Ibar`` the circle mean of ``(1 - c^2 lambda1^2)^{-1/2}``
+  and solve ``q(u) = u / xi(u) = u s Ibar(u) = k' R0`` for ``u``.  ``q`` is strictly increasing on
+  the admissible interval, so a bracketed (safeguarded) Newton iteration converges for every point;
+  it runs on whole arrays at once.
+* ``dR/dk'`` by implicit differentiation:  ``R = R0 xi(u)``, ``u = k' R`` gives
+  ``dR/dk' = R0 xi'(u) R / (1 - R0 xi'(u) k')`` with ``xi' = -xi Ibar'/Ibar``.
+* axis curvature, eq 1: ``k = k' / (1 + k' R)``; bending angle ``theta = k' L0``; axis length
+  ``L = L0 (1 + k' R)``.
+
+Every integrand is even about ``Phi = pi``, so the integrals use fixed-order Gauss-Legendre nodes on
+``[0, pi]`` (default 32 nodes, i.e. 64 on the full circle); the convergence is exponential, see
+``tests/test_kinematics.py``.
+
+All lengths are mm and curvatures 1/mm.  ``R0`` and ``t0`` here are the prestrain-corrected
+``R0_start`` and ``t0_start`` of the actuator (eq 51-52).
+
+Admissible curvature range ("braid lock-up")
+-------------------------------------------
+* ``k' > 0``: the far-side fibres straighten, ``cos a0 (1 + 2u) -> 1`` at
+  ``u_lock = (1/cos a0 - 1)/2``, where ``R -> 0`` logarithmically.  Before that the bladder lumen
+  closes (``R = t_bar``).  The upper limit is the first of: the lumen closing, or ``u`` reaching
+  ``LOCK_FRACTION * u_lock`` (99 %), beyond which the circular-section model has no meaning and
+  the integrand is nearly singular.
+* ``k' < 0``: the far-side axial stretch ``lambda1(pi) = 1 + 2u`` falls to zero at ``u = -1/2``
+  (fibres fully circumferential).  The lower limit is ``lambda1(pi) = MIN_FAR_STRETCH`` (1 %), or
+  the lumen closing, whichever comes first.
+
+A curvature outside ``[k_min, k_max]`` raises ``ValueError`` naming the limit.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+from scipy.optimize import brentq
+
+__all__ = [
+    "DEFAULT_ORDER",
+    "Kinematics",
+    "CurvatureLimits",
+    "gauss_nodes",
+    "kinematics",
+    "curvature_limits",
+    "solve_u",
+    "LOCK_FRACTION",
+    "MIN_FAR_STRETCH",
+]
+
+DEFAULT_ORDER = 32
+LOCK_FRACTION = 0.99
+MIN_FAR_STRETCH = 0.01
+_NEWTON_MAXITER = 60
+
+
+@lru_cache(maxsize=32)
+def gauss_nodes(order: int = DEFAULT_ORDER) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Legendre nodes ``phi`` on [0, pi] and weights normalised to a circle *mean*.
+
+    For an integrand ``f`` even about ``pi``::
+
+        (1 / 2pi) \\int_0^{2pi} f dPhi = sum(wbar * f(phi))
+
+    Returns read-only arrays ``(phi, wbar)`` of length ``order``.
+    """
+    order = int(order)
+    if order < 4 or order > 1024:
+        raise ValueError(f"quadrature order = {order} is outside the allowed range [4, 1024]")
+    x, w = np.polynomial.legendre.leggauss(order)
+    phi = (x + 1.0) * (np.pi / 2.0)
+    wbar = w / 2.0  # (pi/2 * w) / pi
+    phi.setflags(write=False)
+    wbar.setflags(write=False)
+    return phi, wbar
+
+
+def _ibar(u, c, omc, wbar):
+    """Circle means Ibar(u) and dIbar/du; ``u`` has shape S, ``omc = 1 - cos(phi)`` shape (n,)."""
+    lam1 = 1.0 + u[..., None] * omc
+    cl = c * lam1
+    g = 1.0 - cl * cl
+    inv = 1.0 / np.sqrt(g)
+    ib = inv @ wbar
+    dib = ((c * cl * omc) * (inv / g)) @ wbar
+    return ib, dib
+
+
+def solve_u(q_target, alpha0: float, order: int = DEFAULT_ORDER, u_bounds: tuple[float, float] | None = None):
+    """Solve eq 5 for ``u = k' R`` given ``q = k' R0`` (vectorised safeguarded Newton).
+
+    Parameters
+    ----------
+    q_target : array_like
+        Dimensionless curvature ``k' R0``.
+    alpha0 : float
+        Initial braid angle, rad.
+    order : int
+        Gauss-Legendre order on [0, pi].
+    u_bounds : (float, float), optional
+        Bracket for ``u``; defaults to ``(-1/2, u_lock)``.  Each target must lie inside
+        ``q(u_bounds)``; callers check the curvature limits first.
+
+    Returns
+    -------
+    u, ibar, dibar : ndarray
+        The root, and the circle mean ``Ibar(u)`` and its derivative at the root.
+    """
+    q = np.asarray(q_target, dtype=float)
+    c, s = math.cos(alpha0), math.sin(alpha0)
+    phi, wbar = gauss_nodes(order)
+    omc = 1.0 - np.cos(phi)
+    if u_bounds is None:
+        u_bounds = (-0.5, (1.0 / c - 1.0) / 2.0)
+    lo = np.where(q >= 0.0, 0.0, u_bounds[0])
+    hi = np.where(q >= 0.0, u_bounds[1], 0.0)
+    # start from a monotone interpolation of the inverse q -> u (tabulated once per alpha0)
+    qt, ut = _inverse_table(float(alpha0), int(order))
+    eps = 1e-9 * (hi - lo)
+    u = np.where(q == 0.0, 0.0, np.clip(np.interp(q, qt, ut), lo + eps, hi - eps))
+    for _ in range(_NEWTON_MAXITER):
+        ib, dib = _ibar(u, c, omc, wbar)
+        f = s * u * ib - q
+        # maintain the bracket (q is increasing in u)
+        lo = np.where(f < 0.0, u, lo)
+        hi = np.where(f > 0.0, u, hi)
+        step = f / (s * (ib + u * dib))
+        un = u - step
+        outside = ~((un >= lo) & (un <= hi))
+        un = np.where(outside, 0.5 * (lo + hi), un)
+        done = (np.abs(un - u) <= 1e-14 * np.abs(u)) | (f == 0.0)
+        u = np.where(f == 0.0, u, un)
+        if np.all(done):
+            break
+    ib, dib = _ibar(u, c, omc, wbar)
+    return u, ib, dib
+
+
+@lru_cache(maxsize=64)
+def _inverse_table(alpha0: float, order: int) -> tuple[np.ndarray, np.ndarray]:
+    """Table ``(q(u), u)`` on (-1/2, u_lock), increasing, for Newton starting values."""
+    c, s = math.cos(alpha0), math.sin(alpha0)
+    u_lock = (1.0 / c - 1.0) / 2.0
+    t = np.linspace(0.0, 1.0, 257)
+    u = np.concatenate([-0.5 * (1.0 - (1.0 - t[::-1]) ** 2)[:-1] * 0.9999, u_lock * (1.0 - (1.0 - t) ** 2) * 0.9999])
+    phi, wbar = gauss_nodes(order)
+    ib, _ = _ibar(u, c, 1.0 - np.cos(phi), wbar)
+    q = s * u * ib
+    q.setflags(write=False)
+    u.setflags(write=False)
+    return q, u
+
+
+@dataclass(frozen=True)
+class CurvatureLimits:
+    """Admissible range of the frame curvature k' for one actuator (1/mm), with the reasons."""
+
+    k_min: float
+    k_max: float
+    reason_min: str
+    reason_max: str
+    u_min: float
+    u_max: float
+
+    def check(self, curvature, *, name: str = "curvature") -> None:
+        """Raise ``ValueError`` if any curvature is outside ``[k_min, k_max]`` or not finite."""
+        k = np.asarray(curvature, dtype=float)
+        if k.size == 0:
+            return
+        if not np.all(np.isfinite(k)):
+            bad = np.flatnonzero(~np.isfinite(k.ravel()))[0]
+            raise ValueError(f"{name} has a non-finite value {k.ravel()[bad]!r} at index {int(bad)}")
+        kmin, kmax = float(k.min()), float(k.max())
+        if kmax > self.k_max:
+            raise ValueError(
+                f"{name} k' = {kmax:.6g} 1/mm is beyond the braid lock-up limit k'_max = {self.k_max:.6g} 1/mm "
+                f"({self.reason_max}); allowed range [{self.k_min:.6g}, {self.k_max:.6g}] 1/mm"
+            )
+        if kmin < self.k_min:
+            raise ValueError(
+                f"{name} k' = {kmin:.6g} 1/mm is beyond the braid lock-up limit k'_min = {self.k_min:.6g} 1/mm "
+                f"({self.reason_min}); allowed range [{self.k_min:.6g}, {self.k_max:.6g}] 1/mm"
+            )
+
+
+@lru_cache(maxsize=256)
+def _limits(alpha0: float, R0: float, t0: float, order: int) -> CurvatureLimits:
+    c, s = math.cos(alpha0), math.sin(alpha0)
+    u_lock = (1.0 / c - 1.0) / 2.0
+    phi, wbar = gauss_nodes(order)
+    omc = 1.0 - np.cos(phi)
+
+    def xi(u):
+        ib, _ = _ibar(np.atleast_1d(float(u)), c, omc, wbar)
+        return 1.0 / (s * ib[0])
+
+    def lumen(u):  # R - t_bar, scaled: R0 xi^2 (1+u) - t0  (t_bar = t0 / ((1+u) xi))
+        x = xi(u)
+        return R0 * x * x * (1.0 + u) - t0
+
+    def first_root(a, b):
+        """First sign change of lumen() going from a toward b (a has lumen > 0)."""
+        grid = np.linspace(a, b, 201)
+        vals = np.array([lumen(g) for g in grid])
+        neg = np.flatnonzero(vals <= 0.0)
+        if neg.size == 0:
+            return None
+        j = neg[0]
+        return brentq(lumen, grid[j - 1], grid[j], xtol=1e-15, rtol=1e-14)
+
+    # positive side
+    u_hi = LOCK_FRACTION * u_lock
+    reason_max = (
+        f"braid lock-up: far-side fibres within {100 * (1 - LOCK_FRACTION):g}% of straight "
+        f"(u = k'R = {u_hi:.4g} of u_lock = {u_lock:.4g})"
+    )
+    r = first_root(0.0, u_hi)
+    if r is not None:
+        u_hi = r
+        reason_max = f"bladder lumen closes (R = t_bar) at u = k'R = {r:.4g}, before braid lock-up u_lock = {u_lock:.4g}"
+    # negative side
+    u_lo = -0.5 * (1.0 - MIN_FAR_STRETCH)
+    reason_min = (
+        f"braid lock-up: far-side axial stretch lambda1(pi) = 1 + 2k'R falls to {MIN_FAR_STRETCH:g} "
+        "(fibres fully circumferential)"
+    )
+    r = first_root(0.0, u_lo)
+    if r is not None:
+        u_lo = r
+        reason_min = f"bladder lumen closes (R = t_bar) at u = k'R = {r:.4g}"
+    k_max = u_hi / (R0 * xi(u_hi))
+    k_min = u_lo / (R0 * xi(u_lo))
+    return CurvatureLimits(k_min=k_min, k_max=k_max, reason_min=reason_min, reason_max=reason_max, u_min=u_lo, u_max=u_hi)
+
+
+def curvature_limits(actuator, order: int = DEFAULT_ORDER) -> CurvatureLimits:
+    """The braid lock-up limits ``[k'_min, k'_max]`` of ``actuator`` (1/mm), cached per geometry."""
+    return _limits(actuator.alpha0, actuator.R0_start, actuator.t0_start, int(order))
+
+
+@dataclass(frozen=True)
+class Kinematics:
+    """Kinematic state at frame curvatures ``curvature`` (any shape S).
+
+    Scalar-per-section fields have shape S; fields around the section have shape ``S + (n,)``
+    at the quadrature angles ``phi`` (rad, in [0, pi]; the section is symmetric about ``pi``).
+
+    Attributes
+    ----------
+    curvature : k' (1/mm), frame curvature, positive toward the frame.
+    u : k' R, dimensionless.
+    radius : R (mm), deformed braid radius (eq 5).
+    dradius : dR/dk' (mm^2), implicit derivative of eq 5.
+    eta : R / R0_start (eq 5; also the bladder hoop stretch lambda_bl,2, eq 17/38).
+    axis_curvature : k = k'/(1 + k'R) (1/mm), eq 1.
+    angle : theta = k' L0 (rad).
+    axis_length : L = L0 (1 + k'R) (mm).
+    mean_axial_stretch : lambda1_bar = 1 + k'R (eq 39).
+    mean_thickness : t_bar = t0_start / (lambda1_bar eta) (mm), eq 40 with NOTES.md item 10.
+    phi : quadrature angles (rad), shape (n,).
+    weights : circle-mean weights, shape (n,).
+    lambda1 : axial stretch around the section (eq 3/34), shape S + (n,).
+    lambda2_braid : braid circumferential stretch (eq 4), shape S + (n,).
+    braid_angle : local braid angle alpha(Phi) (rad), cos alpha = lambda1 cos alpha0, shape S + (n,).
+    """
+
+    curvature: np.ndarray
+    u: np.ndarray
+    radius: np.ndarray
+    dradius: np.ndarray
+    eta: np.ndarray
+    axis_curvature: np.ndarray
+    angle: np.ndarray
+    axis_length: np.ndarray
+    mean_axial_stretch: np.ndarray
+    mean_thickness: np.ndarray
+    phi: np.ndarray
+    weights: np.ndarray
+    lambda1: np.ndarray
+    lambda2_braid: np.ndarray
+    braid_angle: np.ndarray
+
+    @property
+    def angle_deg(self) -> np.ndarray:
+        return np.degrees(self.angle)
+
+    @property
+    def volume(self) -> np.ndarray:
+        """Enclosed volume V = pi R^2 L0 (1 + k'R) (mm^3), the volume used by eq 13."""
+        return np.pi * self.radius**2 * self.axis_length
+
+
+def radius_terms(kprime, alpha0: float, R0: float, order: int = DEFAULT_ORDER):
+    """Core of eq 5 for the models: ``u, R, dR/dk', Ibar`` at ``kprime`` (no limit checks)."""
+    k = np.asarray(kprime, dtype=float)
+    s = math.sin(alpha0)
+    u, ib, dib = solve_u(k * R0, alpha0, order)
+    xi = 1.0 / (s * ib)
+    R = R0 * xi
+    dxi = -xi * dib / ib
+    dR = R0 * dxi * R / (1.0 - R0 * dxi * k)
+    return u, R, dR
+
+
+def kinematics(actuator, curvature, order: int = DEFAULT_ORDER) -> Kinematics:
+    """Kinematics (eq 1-5) of ``actuator`` at frame curvature(s) ``curvature`` (1/mm).
+
+    Raises ``ValueError`` if a curvature lies beyond the braid lock-up limits
+    (see :func:`curvature_limits`).
+    """
+    k = np.asarray(curvature, dtype=float)
+    curvature_limits(actuator, order).check(k)
+    a0 = actuator.alpha0
+    R0 = actuator.R0_start
+    u, R, dR = radius_terms(k, a0, R0, order)
+    phi, wbar = gauss_nodes(order)
+    lam1 = 1.0 + u[..., None] * (1.0 - np.cos(phi))
+    cl = np.clip(math.cos(a0) * lam1, -1.0, 1.0)
+    lam2b = np.sqrt(1.0 - cl * cl) / math.sin(a0)
+    eta = R / R0
+    lbar = 1.0 + u
+    return Kinematics(
+        curvature=k,
+        u=u,
+        radius=R,
+        dradius=dR,
+        eta=eta,
+        axis_curvature=k / (1.0 + u),
+        angle=k * actuator.L0,
+        axis_length=actuator.L0 * lbar,
+        mean_axial_stretch=lbar,
+        mean_thickness=actuator.t0_start / (lbar * eta),
+        phi=phi,
+        weights=wbar,
+        lambda1=lam1,
+        lambda2_braid=lam2b,
+        braid_angle=np.arccos(cl),
+    )

@@ -1,0 +1,101 @@
+r"""Energy (virtual-work) model of the output moment, paper eq 9-21.
+
+For a unit body of reference length ``dl0`` the work balance (eq 9-12) gives, per unit bending
+angle ``theta = k' L0``::
+
+    M_load = M_air - M_bl - M_f                                                   (eq 15, 21)
+
+* ``M_air = P dV/dtheta = pi P [(2R + 3 k' R^2) dR/dk' + R^3]``  (eq 13, with the printed ``k``
+  read as ``k'``, NOTES.md item 4).  It follows from ``V = pi R^2 L0 (1 + k'R)``.
+* ``M_f = E_f I_f k'`` (eq 16).
+* ``M_bl = (1 + k'R) dU_bl/dk'`` (eq 19) with ``U_bl`` the bladder's stored energy per unit
+  reference length, ``U_bl = \int_A W(lambda1(Phi), lambda2) dA`` over the reference annulus.  The
+  bladder's hoop stretch ``lambda2 = R/R0`` is uniform (eq 17), so material and spatial angles
+  coincide and ``U_bl = A_bl * mean_Phi W``.  ``dU_bl/dk'`` is the *total* derivative: it includes
+  the ``dR/dk'`` terms through both stretches (NOTES.md item 5).
+
+  The factor ``(1 + k'R)`` is kept as printed (``eq19_factor=True``, the default); a strict reading
+  of ``dU/dtheta = (1/L0) dU/dk'`` per unit reference length has no such factor, so it can be
+  switched off (``eq19_factor=False``).  Dropping it moves the BE-PAM's free-bending angle at
+  200 kPa by about 15 deg (tested).
+
+With the corrections of section 3.3 (eq 50-52), ``P`` is the active pressure ``max(P - P_start, 0)``
+and ``R0, t0`` are ``R0_start, t0_start``.  ``M`` is affine in the active pressure::
+
+    M(P, k') = P_active * A(k') - B(k'),   A = pi[(2R + 3k'R^2) R' + R^3],   B = M_bl + M_f
+
+which is what :func:`coefficients` returns; the kinematics are computed once per curvature.
+"""
+
+from __future__ import annotations
+
+
+import numpy as np
+
+from ..kinematics import DEFAULT_ORDER, gauss_nodes, radius_terms
+
+__all__ = ["coefficients", "terms", "bladder_energy"]
+
+
+def _state(actuator, k, order):
+    R0 = actuator.R0_start
+    u, R, dR = radius_terms(k, actuator.alpha0, R0, order)
+    phi, wbar = gauss_nodes(order)
+    omc = 1.0 - np.cos(phi)
+    lam1 = 1.0 + u[..., None] * omc
+    return u, R, dR, omc, wbar, lam1
+
+
+def _air_coefficient(k, R, dR):
+    return np.pi * ((2.0 * R + 3.0 * k * R * R) * dR + R**3)
+
+
+def _bladder_moment(actuator, k, u, R, dR, omc, wbar, lam1, eq19_factor):
+    mat = actuator.material
+    eta = (R / actuator.R0_start)[..., None]
+    dl1 = (R + k * dR)[..., None] * omc  # d lambda1 / dk'
+    dl2 = (dR / actuator.R0_start)[..., None]  # d lambda2 / dk'
+    dW = mat.dW_dl1(lam1, eta) * dl1 + mat.dW_dl2(lam1, eta) * dl2
+    dU = actuator.bladder_area * (dW @ wbar)
+    return (1.0 + u) * dU if eq19_factor else dU
+
+
+def coefficients(actuator, curvature, *, order: int = DEFAULT_ORDER, eq19_factor: bool = True):
+    """``(A, B)`` with ``M = P_active A - B`` (N*mm/MPa and N*mm), shape of ``curvature``.
+
+    No range checks: callers validate the curvature against the lock-up limits.
+    """
+    k = np.asarray(curvature, dtype=float)
+    u, R, dR, omc, wbar, lam1 = _state(actuator, k, order)
+    A = _air_coefficient(k, R, dR)
+    B = _bladder_moment(actuator, k, u, R, dR, omc, wbar, lam1, eq19_factor) + actuator.frame_stiffness * k
+    return A, B
+
+
+def terms(actuator, p_active, curvature, *, order: int = DEFAULT_ORDER, eq19_factor: bool = True):
+    """The parts of eq 21 in N*mm: ``M_load``, ``M_air`` (eq 13), ``M_bl`` (eq 19), ``M_f`` (eq 16).
+
+    ``p_active`` is ``max(P - P_start, 0)`` in MPa and broadcasts against ``curvature``.
+    """
+    k = np.asarray(curvature, dtype=float)
+    u, R, dR, omc, wbar, lam1 = _state(actuator, k, order)
+    m_air = np.asarray(p_active, dtype=float) * _air_coefficient(k, R, dR)
+    m_bl = _bladder_moment(actuator, k, u, R, dR, omc, wbar, lam1, eq19_factor)
+    m_f = actuator.frame_stiffness * k
+    m_bl, m_f = np.broadcast_arrays(m_bl, m_f)
+    m_air, m_bl, m_f = np.broadcast_arrays(m_air, m_bl, m_f)
+    return {"M_load": m_air - m_bl - m_f, "M_air": m_air, "M_bl": m_bl, "M_f": m_f}
+
+
+def bladder_energy(actuator, curvature, *, order: int = DEFAULT_ORDER):
+    """Stored bladder energy per unit reference length ``U_bl(k')`` (N*mm/mm = N), eq 18.
+
+    ``dU_bl/dk'`` is the bladder moment of eq 19 without its ``(1 + k'R)`` factor; the tests check
+    :func:`terms` against a finite difference of this function.
+    """
+    k = np.asarray(curvature, dtype=float)
+    u, R, dR, omc, wbar, lam1 = _state(actuator, k, order)
+    eta = (R / actuator.R0_start)[..., None]
+    return actuator.bladder_area * (actuator.material.energy(lam1, eta) @ wbar)
+
+

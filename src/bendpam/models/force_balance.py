@@ -1,0 +1,141 @@
+r"""Force-balance model of the output moment, paper eq 22-49.
+
+Axial moment balance of a unit body about the frame (eq 23, 28)::
+
+    M_load = M_p - M_frame - M_bl - M_br
+
+* ``M_p = pi R^3 P`` as in eq 49.  Eq 49 writes ``pi R^3 P`` for the pressure term instead of eq
+  26's ``pi (R - t)^2 P R``; the difference is the hydrostatic part ``-P`` of the bladder's axial
+  stress acting over the wall (``pi R (R-t)^2 + 2 pi R^2 t ~ pi R^3``).  We follow eq 49 and
+  therefore leave ``-P`` out of the bladder term (NOTES.md item 7).
+* ``M_frame = E_f I_f k'`` (eq 27).
+* ``M_bl = \int sigma_bl,1^el h dA`` with ``h = R (1 - cos Phi)``, ``dA = t_bar R dPhi`` and the
+  elastic part of eq 43::
+
+      sigma_bl,1^el(Phi) = 2C10 (lambda1^2 - 1/(lbar^2 eta^2)) - 2C01 (1/lambda1^2 - lbar^2 eta^2)
+
+  where ``lbar = 1 + k'R`` (eq 39), ``eta = R/R0`` and ``t_bar = t0 / (lbar eta)`` (eq 40,
+  NOTES.md item 10).  Its Phi-independent part integrates to
+  ``-2 pi R^2 t_bar (2C10/(lbar^2 eta^2) - 2C01 lbar^2 eta^2)``, so in ``M_load`` it enters with a
+  *plus* sign.  Eq 49 prints a minus: a misprint (NOTES.md item 8).  With the sign derived here the
+  C10 and C01 terms cancel at ``k' = 0`` and both models give the same blocked moment.
+* ``M_br = \int sigma_br,1 h dA_br``.  The braid hoop stress is ``sigma_br,2 = P_e R / t_br``
+  (eq 31), the fibre angle gives ``sigma_br,1 / sigma_br,2 = cot^2 alpha`` with
+  ``cot^2 alpha = c^2 lambda1^2 / (1 - c^2 lambda1^2)`` (eq 46-47; alpha is measured from the axis,
+  NOTES.md item 9) and the interfacial pressure is eq 45::
+
+      P_e R = P (R - t_bar) - sigma_bl,2 t_bar = P R - sigma_bl,2^el t_bar
+
+  so ``M_br = (P R - sigma_bl,2^el t_bar) R^2 c^2 J`` with
+  ``J = \int_0^{2pi} lambda1^2 (1 - cos Phi) / (1 - c^2 lambda1^2) dPhi``; ``t_br`` cancels.
+
+With the corrections of section 3.3, ``P`` is the active pressure ``max(P - P_start, 0)`` and
+``R0, t0`` are ``R0_start, t0_start``.  As in the energy model, ``M = P_active A(k') - B(k')`` with::
+
+    A = R^3 (pi - c^2 J),   B = E_f I_f k' + M_bl - sigma_bl,2^el t_bar R^2 c^2 J
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..kinematics import DEFAULT_ORDER, gauss_nodes, radius_terms
+
+__all__ = ["coefficients", "terms", "stress_state"]
+
+
+def _state(actuator, k, order):
+    R0 = actuator.R0_start
+    u, R, dR = radius_terms(k, actuator.alpha0, R0, order)
+    phi, wbar = gauss_nodes(order)
+    omc = 1.0 - np.cos(phi)
+    lam1 = 1.0 + u[..., None] * omc
+    c = math.cos(actuator.alpha0)
+    lbar = 1.0 + u
+    eta = R / R0
+    tbar = actuator.t0_start / (lbar * eta)
+    cl2 = (c * lam1) ** 2
+    J = 2.0 * np.pi * ((lam1 * lam1 * omc / (1.0 - cl2)) @ wbar)
+    C1, C2 = actuator.C10, actuator.C01
+    le2 = (lbar * eta) ** 2
+    # elastic (pressure-free) parts of eq 43 and eq 44
+    const1 = -2.0 * C1 / le2 + 2.0 * C2 * le2  # Phi-independent part of sigma_bl,1^el
+    sig2e = 2.0 * C1 * (eta * eta - 1.0 / le2) - 2.0 * C2 * (1.0 / (eta * eta) - le2)
+    varpart = 2.0 * np.pi * (((2.0 * C1 * lam1 * lam1 - 2.0 * C2 / (lam1 * lam1)) * omc) @ wbar)
+    m_bl = tbar * R * R * (varpart + 2.0 * np.pi * const1)
+    return dict(u=u, R=R, lam1=lam1, c=c, lbar=lbar, eta=eta, tbar=tbar, J=J, sig2e=sig2e, const1=const1, m_bl=m_bl)
+
+
+def coefficients(actuator, curvature, *, order: int = DEFAULT_ORDER, **_ignored):
+    """``(A, B)`` with ``M = P_active A - B`` (N*mm/MPa and N*mm), shape of ``curvature``."""
+    k = np.asarray(curvature, dtype=float)
+    st = _state(actuator, k, order)
+    R, c, J = st["R"], st["c"], st["J"]
+    A = R**3 * (np.pi - c * c * J)
+    B = actuator.frame_stiffness * k + st["m_bl"] - st["sig2e"] * st["tbar"] * R * R * c * c * J
+    return A, B
+
+
+def terms(actuator, p_active, curvature, *, order: int = DEFAULT_ORDER, **_ignored):
+    """The parts of eq 49 in N*mm: ``M_load``, ``M_p``, ``M_frame``, ``M_bl``, ``M_br``."""
+    k = np.asarray(curvature, dtype=float)
+    p = np.asarray(p_active, dtype=float)
+    st = _state(actuator, k, order)
+    R, c, J = st["R"], st["c"], st["J"]
+    m_p = p * np.pi * R**3
+    m_frame = actuator.frame_stiffness * k
+    m_bl = st["m_bl"]
+    m_br = (p * R - st["sig2e"] * st["tbar"]) * R * R * c * c * J
+    m_p, m_frame, m_bl, m_br = np.broadcast_arrays(m_p, m_frame, m_bl, m_br)
+    return {"M_load": m_p - m_frame - m_bl - m_br, "M_p": m_p, "M_frame": m_frame, "M_bl": m_bl, "M_br": m_br}
+
+
+def stress_state(actuator, p_active, curvature, phi, *, order: int = DEFAULT_ORDER):
+    """Internal stresses of the force-balance model at angles ``phi`` (rad) around the section.
+
+    ``p_active`` and ``curvature`` are scalars or arrays broadcasting to a shape S; ``phi`` is
+    1-D (n,).  Returns a dict of arrays (MPa unless noted):
+
+    * ``sigma_bl1`` (S, n): bladder axial stress, eq 43 (including ``-P``).
+    * ``sigma_bl2`` (S): bladder hoop stress, eq 44.
+    * ``sigma_bl3`` (S): bladder radial stress, ``-P`` (eq 37).
+    * ``P_e`` (S): interfacial pressure between bladder and braid, eq 45.
+    * ``N_br1`` (S, n): braid axial line tension ``sigma_br,1 t_br`` (N/mm), eq 48 times ``t_br``.
+    * ``N_br2`` (S): braid hoop line tension ``P_e R`` (N/mm), eq 31 times ``t_br``.
+    * ``sigma_br1`` (S, n), ``sigma_br2`` (S): nominal braid stresses with the actuator's
+      ``braid_thickness_mm`` (eq 48, 31).
+    * ``braid_angle`` (S, n): local braid angle alpha(Phi), rad.
+    * ``t_bar`` (S): mean bladder thickness (mm), eq 40; ``R`` (S): radius (mm).
+    """
+    k = np.asarray(curvature, dtype=float)
+    p = np.asarray(p_active, dtype=float)
+    k, p = np.broadcast_arrays(k, p)
+    st = _state(actuator, k, order)
+    phi = np.asarray(phi, dtype=float)
+    lam1 = 1.0 + st["u"][..., None] * (1.0 - np.cos(phi))
+    C1, C2 = actuator.C10, actuator.C01
+    c = st["c"]
+    sig1 = 2.0 * C1 * lam1**2 - 2.0 * C2 / lam1**2 + st["const1"][..., None] - p[..., None]
+    sig2 = st["sig2e"] - p
+    R, tbar = st["R"], st["tbar"]
+    Pe = (p * R - st["sig2e"] * tbar) / R
+    cl2 = (c * lam1) ** 2
+    cot2 = cl2 / (1.0 - cl2)
+    n2 = Pe * R
+    n1 = cot2 * n2[..., None]
+    tb = actuator.braid_thickness_mm
+    return {
+        "sigma_bl1": sig1,
+        "sigma_bl2": sig2,
+        "sigma_bl3": -p,
+        "P_e": Pe,
+        "N_br1": n1,
+        "N_br2": n2,
+        "sigma_br1": n1 / tb,
+        "sigma_br2": n2 / tb,
+        "braid_angle": np.arccos(np.clip(c * lam1, -1.0, 1.0)),
+        "t_bar": tbar,
+        "R": R,
+    }
