@@ -30,6 +30,7 @@ from .predict import (
     kinematics,
     moment,
     moment_terms,
+    prediction_table,
     tangent_stiffness,
 )
 
@@ -54,6 +55,7 @@ __all__ = [
     "models",
     "moment",
     "moment_terms",
+    "prediction_table",
     "presets",
     "tangent_stiffness",
 ]

@@ -310,9 +310,11 @@ def radius_terms(kprime, alpha0: float, R0: float, order: int = DEFAULT_ORDER):
     k = np.asarray(kprime, dtype=float)
     s = math.sin(alpha0)
     u, ib, dib = solve_u(k * R0, alpha0, order)
-    xi = 1.0 / (s * ib)
+    # eta(0) = 1 and xi'(0) = -cot^2 alpha0 hold exactly; don't let quadrature rounding blur them
+    at0 = u == 0.0
+    xi = np.where(at0, 1.0, 1.0 / (s * ib))
     R = R0 * xi
-    dxi = -xi * dib / ib
+    dxi = np.where(at0, -1.0 / math.tan(alpha0) ** 2, -xi * dib / ib)
     dR = R0 * dxi * R / (1.0 - R0 * dxi * k)
     return u, R, dR
 

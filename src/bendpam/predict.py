@@ -43,6 +43,7 @@ __all__ = [
     "internal_stresses",
     "kinematics",
     "active_pressure",
+    "prediction_table",
 ]
 
 
@@ -471,3 +472,32 @@ def internal_stresses(actuator, pressure, curvature, *, n_phi: int = 181, order:
         ds.attrs["curvature_per_mm"] = float(k)
     ds.attrs.update(model="force_balance", actuator=act.name or act.kind, P_start_kpa=act.P_start_kpa)
     return ds
+
+
+# ------------------------------------------------------------------------------------------------
+# tables
+# ------------------------------------------------------------------------------------------------
+def prediction_table(actuator, pressure_kpa, model: str = "energy", *, order: int = DEFAULT_ORDER,
+                     eq19_factor: bool = True):
+    """Blocked moment and free bending at each pressure, as a :class:`pandas.DataFrame`.
+
+    Columns: ``pressure_kpa``, ``blocked_moment_nmm``, ``free_curvature_per_mm``,
+    ``free_angle_deg``, ``status`` and ``note`` (the reason where there is no equilibrium).
+    Signs follow the paper: k' > 0 toward the frame, so BC-PAM values are negative.
+    """
+    import pandas as pd
+
+    P_kpa = np.atleast_1d(np.asarray(pressure_kpa, dtype=float))
+    P = _pressure(P_kpa * 1e-3, "pressure")
+    bm = blocked_moment(actuator, P, model, order=order, eq19_factor=eq19_factor)
+    fb = free_curvature(actuator, P, model, order=order, eq19_factor=eq19_factor)
+    return pd.DataFrame(
+        {
+            "pressure_kpa": P_kpa,
+            "blocked_moment_nmm": bm,
+            "free_curvature_per_mm": fb.curvature,
+            "free_angle_deg": fb.angle_deg,
+            "status": fb.status,
+            "note": fb.reason,
+        }
+    )

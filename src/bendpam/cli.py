@@ -1,0 +1,331 @@
+"""The ``bendpam`` command line.  It parses and prints; the logic lives in the library.
+
+Every error (unknown preset, bad TOML, negative pressure, unknown option ...) is printed as one
+line ``bendpam: error: ...`` on stderr with exit code 2, never a traceback.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+import time
+from enum import Enum
+from pathlib import Path
+from typing import Annotated, Optional
+
+import numpy as np
+import typer
+
+from . import presets as _presets
+from ._io import atomic_write_text
+from .actuator import Actuator
+from .kinematics import curvature_limits
+
+# Typer >= 0.20 vendors click; find its exception base class without importing click directly.
+_ClickException = next(c for c in typer.BadParameter.__mro__ if c.__name__ == "ClickException")
+
+app = typer.Typer(
+    add_completion=False,
+    no_args_is_help=True,
+    pretty_exceptions_enable=False,
+    rich_markup_mode=None,
+    help="bendpam: models, tests and design tools for bending pneumatic artificial muscles.",
+)
+
+
+class UserError(Exception):
+    """An error caused by the user's input; printed as one line, exit code 2."""
+
+
+class Model(str, Enum):
+    energy = "energy"
+    force_balance = "force-balance"
+
+
+class Preset(str, Enum):
+    be_pam = "be-pam"
+    bc_pam = "bc-pam"
+
+
+# ---- shared option parsing ----------------------------------------------------------------------
+def parse_values(tokens: list[str] | None, name: str) -> list[float]:
+    """Parse numbers given as separate tokens, comma lists or ranges ``start:stop:count``."""
+    out: list[float] = []
+    for tok in tokens or []:
+        for part in str(tok).replace(",", " ").split():
+            if ":" in part:
+                bits = part.split(":")
+                if len(bits) != 3:
+                    raise UserError(f"{name}: range {part!r} must be start:stop:count")
+                try:
+                    a, b, n = float(bits[0]), float(bits[1]), int(bits[2])
+                except ValueError:
+                    raise UserError(f"{name}: range {part!r} must be start:stop:count with numbers") from None
+                if n < 1:
+                    raise UserError(f"{name}: range {part!r} needs a count >= 1")
+                out.extend(np.linspace(a, b, n).tolist())
+            else:
+                try:
+                    v = float(part)
+                except ValueError:
+                    raise UserError(f"{name}: {part!r} is not a number") from None
+                if not math.isfinite(v):
+                    raise UserError(f"{name}: {part!r} is not finite")
+                out.append(v)
+    return out
+
+
+def pressures_kpa(first: list[str] | None, more: list[str] | None) -> list[float]:
+    if more and not first:
+        raise UserError(f"unexpected argument(s) {' '.join(more)!r}; pressures go after --pressure-kpa")
+    values = parse_values((first or []) + (more or []), "--pressure-kpa")
+    if not values:
+        raise UserError("give at least one pressure with --pressure-kpa (kPa), e.g. --pressure-kpa 100 150 200")
+    for v in values:
+        if v < 0:
+            raise UserError(f"--pressure-kpa: {v:g} kPa is below zero; pressures are gauge pressures >= 0 kPa")
+    return values
+
+
+def load_actuator(preset: Preset | None, actuator: Path | None, model: Model) -> Actuator:
+    if preset is not None and actuator is not None:
+        raise UserError("give either --preset or --actuator, not both")
+    if preset is None and actuator is None:
+        raise UserError("give an actuator: --preset be-pam|bc-pam or --actuator FILE.toml")
+    if preset is not None:
+        return _presets.get(preset.value, model_name(model))
+    return Actuator.from_toml(actuator)
+
+
+def model_name(model: Model) -> str:
+    return _presets.normalise_model(model.value)
+
+
+def _num(x: float, fmt: str) -> str:
+    width = int(fmt.split(".")[0])
+    return "—".rjust(width) if x is None or not np.isfinite(x) else format(x, fmt)
+
+
+def format_prediction_table(df, title: str) -> str:
+    lines = [title, f"{'P (kPa)':>8}  {'M_blocked (N·mm)':>16}  {'k_free (1/mm)':>13}  {'θ_free (deg)':>12}  note"]
+    for r in df.itertuples():
+        lines.append(
+            f"{r.pressure_kpa:8.4g}  {_num(r.blocked_moment_nmm, '16.2f')}  {_num(r.free_curvature_per_mm, '13.5f')}  "
+            f"{_num(r.free_angle_deg, '12.2f')}  {r.note}"
+        )
+    return "\n".join(lines)
+
+
+def _jsonable(x):
+    if isinstance(x, float | np.floating):
+        return float(x) if np.isfinite(x) else None
+    return x
+
+
+# ---- commands -------------------------------------------------------------------------------------
+PresetOpt = Annotated[Optional[Preset], typer.Option("--preset", help="Built-in actuator from the paper.")]
+ActuatorOpt = Annotated[
+    Optional[Path], typer.Option("--actuator", help="Actuator TOML file (see `bendpam actuator --preset be-pam`).")
+]
+ModelOpt = Annotated[Model, typer.Option("--model", help="Moment model.")]
+PressureOpt = Annotated[
+    Optional[list[str]],
+    typer.Option("--pressure-kpa", help="Gauge pressure(s) in kPa: '100 150 200', '100,150' or '100:200:5'."),
+]
+MorePressures = Annotated[Optional[list[str]], typer.Argument(hidden=True, metavar="[P ...]")]
+
+
+@app.command()
+def predict(
+    more: MorePressures = None,
+    preset: PresetOpt = None,
+    actuator: ActuatorOpt = None,
+    model: ModelOpt = Model.energy,
+    pressure_kpa: PressureOpt = None,
+    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object instead of a table.")] = False,
+):
+    """Blocked moment and free bending curvature/angle at each pressure."""
+    from .predict import branch_info, prediction_table
+
+    act = load_actuator(preset, actuator, model)
+    P = pressures_kpa(pressure_kpa, more)
+    mname = model_name(model)
+    df = prediction_table(act, P, mname)
+    br = branch_info(act, mname)
+    if as_json:
+        obj = {
+            "model": mname,
+            "actuator": act.to_dict() | act.derived(),
+            "max_equilibrium_pressure_kpa": _jsonable(br.max_pressure * 1e3),
+            "branch_end": br.kind,
+            "units": {"pressure_kpa": "kPa", "blocked_moment_nmm": "N*mm", "free_curvature_per_mm": "1/mm",
+                      "free_angle_deg": "deg"},
+            "results": [
+                {
+                    "pressure_kpa": _jsonable(r.pressure_kpa),
+                    "blocked_moment_nmm": _jsonable(r.blocked_moment_nmm),
+                    "free_curvature_per_mm": _jsonable(r.free_curvature_per_mm),
+                    "free_angle_deg": _jsonable(r.free_angle_deg),
+                    "note": r.note or None,
+                }
+                for r in df.itertuples()
+            ],
+        }
+        typer.echo(json.dumps(obj, indent=2))
+        return
+    typer.echo(format_prediction_table(df, f"{act.name or act.kind} — {mname.replace('_', '-')} model"))
+    if math.isfinite(br.max_pressure):
+        typer.echo(f"highest pressure with a free-bending equilibrium: {br.max_pressure * 1e3:.4g} kPa ({br.kind})")
+
+
+@app.command()
+def curve(
+    more: MorePressures = None,
+    preset: PresetOpt = None,
+    actuator: ActuatorOpt = None,
+    model: ModelOpt = Model.energy,
+    pressure_kpa: PressureOpt = None,
+    out: Annotated[Optional[Path], typer.Option("--out", help="Output FILE.csv, or a figure FILE.png/.pdf/.svg.")] = None,
+    k_max: Annotated[
+        Optional[float],
+        typer.Option("--k-max", help="End of the curvature range (1/mm, magnitude along the bending direction); "
+                     "default: 15% past free bending."),
+    ] = None,
+    points: Annotated[int, typer.Option("--points", min=2, max=100000, help="Curvature points per curve.")] = 200,
+):
+    """Moment-curvature curves M(P, k') as CSV or a figure."""
+    from .plots import moment_curves, plot_moment_curvature, save_figure
+
+    if out is None:
+        raise UserError("give an output file with --out FILE.csv or --out FILE.png")
+    suffix = out.suffix.lower()
+    if suffix not in {".csv", ".png", ".pdf", ".svg"}:
+        raise UserError(f"--out {str(out)!r}: unknown format {suffix or '(none)'}; use .csv, .png, .pdf or .svg")
+    act = load_actuator(preset, actuator, model)
+    P = np.asarray(pressures_kpa(pressure_kpa, more)) * 1e-3
+    mname = model_name(model)
+    if suffix == ".csv":
+        k, M = moment_curves(act, P, mname, k_max, points)
+        rows = ["pressure_kpa,curvature_per_mm,moment_nmm"]
+        for i, p in enumerate(P):
+            rows.extend(f"{p * 1e3:.10g},{kk:.10g},{mm:.10g}" for kk, mm in zip(k, M[i]))
+        atomic_write_text(out, "\n".join(rows) + "\n")
+    else:
+        import matplotlib.pyplot as plt
+
+        fig, ax = plt.subplots(figsize=(6.5, 4.5))
+        plot_moment_curvature(ax, act, P, mname, k_max, points)
+        fig.tight_layout()
+        save_figure(fig, out)
+    typer.echo(f"wrote {out}")
+
+
+@app.command()
+def stresses(
+    preset: PresetOpt = None,
+    actuator: ActuatorOpt = None,
+    pressure_kpa: Annotated[float, typer.Option("--pressure-kpa", help="Gauge pressure, kPa.")] = 200.0,
+    curvature: Annotated[float, typer.Option("--curvature", help="Frame curvature k', 1/mm.")] = 0.0,
+    out: Annotated[Optional[Path], typer.Option("--out", help="Figure (.png/.pdf/.svg) or data (.nc/.csv).")] = None,
+):
+    """Force-balance internal stresses around the cross-section (eq 37-48)."""
+    from .predict import internal_stresses
+
+    act = load_actuator(preset, actuator, Model.force_balance)
+    if pressure_kpa < 0:
+        raise UserError(f"--pressure-kpa: {pressure_kpa:g} kPa is below zero")
+    if out is None:
+        raise UserError("give an output file with --out FILE.png (figure), FILE.nc or FILE.csv (data)")
+    suffix = out.suffix.lower()
+    if suffix in {".png", ".pdf", ".svg"}:
+        from .plots import plot_internal_stresses, save_figure
+
+        save_figure(plot_internal_stresses(act, pressure_kpa * 1e-3, curvature), out)
+    elif suffix == ".nc":
+        from ._io import atomic_path
+
+        ds = internal_stresses(act, pressure_kpa * 1e-3, curvature)
+        with atomic_path(out) as tmp:
+            ds.to_netcdf(tmp)
+    elif suffix == ".csv":
+        ds = internal_stresses(act, pressure_kpa * 1e-3, curvature)
+        atomic_write_text(out, ds.to_dataframe().to_csv())
+    else:
+        raise UserError(f"--out {str(out)!r}: unknown format {suffix or '(none)'}; use .png, .pdf, .svg, .nc or .csv")
+    typer.echo(f"wrote {out}")
+
+
+@app.command("actuator")
+def actuator_cmd(
+    preset: PresetOpt = None,
+    actuator: ActuatorOpt = None,
+    model: ModelOpt = Model.energy,
+    out: Annotated[Optional[Path], typer.Option("--out", help="Write the actuator as TOML here.")] = None,
+):
+    """Show an actuator (TOML, derived values, lock-up limits) or save it as an editable TOML file."""
+    act = load_actuator(preset, actuator, model)
+    text = act.to_toml()
+    if out is not None:
+        act.to_toml(out)
+        typer.echo(f"wrote {out}")
+        return
+    lim = curvature_limits(act)
+    typer.echo(text.rstrip())
+    typer.echo("\n# derived")
+    for k, v in act.derived().items():
+        typer.echo(f"# {k} = {v:.6g}")
+    typer.echo(f"# curvature range (braid lock-up) = [{lim.k_min:.6g}, {lim.k_max:.6g}] 1/mm")
+
+
+@app.command()
+def demo(
+    out: Annotated[Path, typer.Option("--out", help="Moment-curvature figure to write.")] = Path("bendpam-demo.png"),
+):
+    """Predictions for the paper's BE-PAM and BC-PAM with both models, and a moment-curvature figure."""
+    from .plots import demo_figure, save_figure
+    from .predict import branch_info, prediction_table
+
+    t0 = time.perf_counter()
+    cases = [("be-pam", [100, 125, 150, 175, 200]), ("bc-pam", [40, 60, 80, 100, 120, 140])]
+    items = []
+    for name, P in cases:
+        for mname in ("energy", "force_balance"):
+            act = _presets.get(name, mname)
+            df = prediction_table(act, P, mname)
+            typer.echo(format_prediction_table(df, f"\n{act.name} — {mname.replace('_', '-')} model"))
+            br = branch_info(act, mname)
+            if br.kind == "fold":
+                typer.echo(f"fold: no free-bending equilibrium above {br.max_pressure * 1e3:.4g} kPa")
+            items.append((act, np.asarray(P) * 1e-3, mname))
+    save_figure(demo_figure(items), out)
+    typer.echo(f"\nwrote {out}  ({time.perf_counter() - t0:.1f} s)")
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point: run the app, turning every user error into one line and exit code 2."""
+    args = list(sys.argv[1:] if argv is None else argv)
+    if not args:
+        args = ["--help"]
+    try:
+        app(args=args, prog_name="bendpam", standalone_mode=False)
+    except typer.Exit as exc:
+        return exc.exit_code
+    except typer.Abort:
+        typer.echo("bendpam: aborted", err=True)
+        return 1
+    except _ClickException as exc:
+        typer.echo(f"bendpam: error: {exc.format_message()}", err=True)
+        return 2
+    except (UserError, ValueError, FileNotFoundError, PermissionError, IsADirectoryError) as exc:
+        msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        typer.echo(f"bendpam: error: {msg}", err=True)
+        return 2
+    except OSError as exc:
+        typer.echo(f"bendpam: error: {exc.strerror or exc}: {exc.filename or ''}".rstrip(": "), err=True)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,147 @@
+"""Figures: moment-curvature maps and the force-balance model's internal stresses.
+
+Every function draws on a matplotlib ``Axes``/``Figure`` and returns it; ``save_figure`` writes
+atomically.  The non-interactive Agg backend is used unless the caller already chose one.
+"""
+
+from __future__ import annotations
+
+import os
+
+import matplotlib
+
+if not os.environ.get("MPLBACKEND"):
+    matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from ._io import atomic_path  # noqa: E402
+from .kinematics import curvature_limits  # noqa: E402
+from .predict import active_pressure, free_curvature, internal_stresses, moment  # noqa: E402
+
+__all__ = ["curve_range", "moment_curves", "plot_moment_curvature", "plot_internal_stresses", "save_figure", "demo_figure"]
+
+
+def curve_range(actuator, pressures_mpa, model: str = "energy", k_max: float | None = None, n: int = 200) -> np.ndarray:
+    """Curvature grid (1/mm) from 0 toward the bending direction, to ``k_max`` (magnitude).
+
+    The default end is 15 % past the largest free-bending curvature at the given pressures (or past
+    the fold curvature where there is no equilibrium), clipped to the lock-up limit.
+    """
+    lim = curvature_limits(actuator)
+    sgn = actuator.bend_sign or 1
+    k_lim = lim.k_max if sgn > 0 else lim.k_min
+    if k_max is None:
+        fb = free_curvature(actuator, pressures_mpa, model)
+        ks = np.abs(fb.curvature[np.isfinite(fb.curvature)])
+        end = ks.max() if ks.size else 0.0
+        if np.any(~fb.ok):
+            end = max(end, abs(fb.branch.k_end))
+        if end <= 0.0:
+            end = 0.1 * abs(k_lim)
+        end = min(1.15 * end, abs(k_lim))
+    else:
+        end = float(k_max)
+        if not np.isfinite(end) or end <= 0.0:
+            raise ValueError(f"k_max = {k_max!r} 1/mm must be a positive number (magnitude along the bending direction)")
+        if end > abs(k_lim):
+            raise ValueError(
+                f"k_max = {end:g} 1/mm is beyond the braid lock-up limit |k'| = {abs(k_lim):.6g} 1/mm for this actuator"
+            )
+    return sgn * np.linspace(0.0, end, int(n))
+
+
+def moment_curves(actuator, pressures_mpa, model: str = "energy", k_max: float | None = None, n: int = 200):
+    """Moment-curvature curves: returns ``(k, M)`` with ``M`` of shape (n_pressures, n), N*mm."""
+    P = np.atleast_1d(np.asarray(pressures_mpa, dtype=float))
+    k = curve_range(actuator, P, model, k_max, n)
+    return k, moment(actuator, P[:, None], k[None, :], model)
+
+
+def plot_moment_curvature(ax, actuator, pressures_mpa, model: str = "energy", k_max: float | None = None, n: int = 200,
+                          title: str | None = None):
+    """Draw M(P, k') curves and the free-bending points on ``ax``.  Returns ``ax``."""
+    P = np.atleast_1d(np.asarray(pressures_mpa, dtype=float))
+    k, M = moment_curves(actuator, P, model, k_max, n)
+    fb = free_curvature(actuator, P, model)
+    colors = plt.cm.viridis(np.linspace(0.0, 0.9, P.size))
+    for i, p in enumerate(P):
+        ax.plot(k, M[i], color=colors[i], label=f"{p * 1e3:g} kPa")
+        if fb.status[i] == "ok" and np.isfinite(fb.curvature[i]):
+            ax.plot([fb.curvature[i]], [0.0], "o", color=colors[i], ms=4)
+    ax.axhline(0.0, color="0.6", lw=0.8)
+    ax.set_xlabel("frame curvature k' (1/mm)")
+    ax.set_ylabel("moment M (N·mm)")
+    ax.set_title(title or f"{actuator.name or actuator.kind}\n{model.replace('_', '-')} model", fontsize=9)
+    ax.legend(fontsize=7, ncol=2)
+    if np.any(~fb.ok):
+        ax.text(0.02, 0.02, f"no equilibrium above {fb.max_pressure * 1e3:.4g} kPa (fold)", transform=ax.transAxes,
+                fontsize=7, color="crimson")
+    return ax
+
+
+def plot_internal_stresses(actuator, pressure_mpa: float, curvature: float, *, fig=None):
+    """Force-balance internal state (eq 37-48) around the cross-section at one (P, k').
+
+    Left: the section, frame at the bottom (Phi = 0), with the bladder axial stress and braid
+    axial line tension drawn as polar curves.  Right: the same fields unrolled over Phi, with the
+    uniform hoop stress, radial stress and interfacial pressure as horizontal lines.
+    """
+    ds = internal_stresses(actuator, float(pressure_mpa), float(curvature), n_phi=361)
+    fig = fig or plt.figure(figsize=(10, 4.2))
+    ax0 = fig.add_subplot(1, 2, 1, projection="polar")
+    ax1 = fig.add_subplot(1, 2, 2)
+    phi = np.radians(ds["phi_deg"].values)
+    s1 = ds["sigma_bl1"].values
+    n1 = ds["N_br1"].values
+    # polar plot with Phi = 0 (frame) at the bottom
+    ax0.set_theta_zero_location("S")
+    ax0.plot(phi, s1 * 1e3, label="σ_bl,1 (kPa)")
+    ax0.plot(phi, n1, label="N_br,1 (N/mm)")
+    ax0.plot([0.0], [0.0], "ks", ms=6)
+    ax0.set_title("around the section (frame at bottom)", fontsize=9)
+    ax0.legend(fontsize=7, loc="upper right", bbox_to_anchor=(1.35, 1.1))
+    deg = ds["phi_deg"].values
+    ax1.plot(deg, s1 * 1e3, label="σ_bl,1 bladder axial (kPa)")
+    ax1.axhline(float(ds["sigma_bl2"]) * 1e3, color="C2", ls="--", label="σ_bl,2 bladder hoop (kPa)")
+    ax1.axhline(float(ds["P_e"]) * 1e3, color="C3", ls=":", label="P_e interfacial (kPa)")
+    ax1.axhline(float(ds["sigma_bl3"]) * 1e3, color="C4", ls="-.", label="σ_bl,3 = -P (kPa)")
+    ax2 = ax1.twinx()
+    ax2.plot(deg, n1, color="C1", label="N_br,1 braid axial tension (N/mm)")
+    ax2.set_ylabel("braid line tension (N/mm)")
+    ax1.set_xlabel("Φ (deg), 0 at the frame")
+    ax1.set_ylabel("stress (kPa)")
+    ax1.set_xlim(0, 360)
+    h1, l1 = ax1.get_legend_handles_labels()
+    h2, l2 = ax2.get_legend_handles_labels()
+    ax1.legend(h1 + h2, l1 + l2, fontsize=7, loc="best")
+    pa = float(active_pressure(actuator, pressure_mpa))
+    fig.suptitle(
+        f"{actuator.name or actuator.kind}: force-balance internal state at P = {pressure_mpa * 1e3:g} kPa "
+        f"(active {pa * 1e3:g} kPa), k' = {curvature:g} 1/mm",
+        fontsize=10,
+    )
+    fig.tight_layout()
+    return fig
+
+
+def demo_figure(items):
+    """A grid of moment-curvature plots; ``items`` is a list of ``(actuator, pressures_mpa, model)``."""
+    n = len(items)
+    ncol = 2
+    nrow = (n + 1) // 2
+    fig, axes = plt.subplots(nrow, ncol, figsize=(11, 4.2 * nrow), squeeze=False)
+    for ax, (act, P, model) in zip(axes.ravel(), items):
+        plot_moment_curvature(ax, act, P, model)
+    for ax in axes.ravel()[n:]:
+        ax.set_visible(False)
+    fig.tight_layout()
+    return fig
+
+
+def save_figure(fig, path, dpi: int = 130) -> None:
+    """Save ``fig`` atomically to ``path`` (format from the suffix) and close it."""
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=dpi)
+    plt.close(fig)
