@@ -209,7 +209,7 @@ def curve(
         k, M = moment_curves(act, P, mname, k_max, points)
         rows = ["pressure_kpa,curvature_per_mm,moment_nmm"]
         for i, p in enumerate(P):
-            rows.extend(f"{p * 1e3:.10g},{kk:.10g},{mm:.10g}" for kk, mm in zip(k, M[i]))
+            rows.extend(f"{p * 1e3:.10g},{kk:.12g},{mm:.12g}" for kk, mm in zip(k, M[i]))
         atomic_write_text(out, "\n".join(rows) + "\n")
     else:
         import matplotlib.pyplot as plt

@@ -81,29 +81,50 @@ def plot_moment_curvature(ax, actuator, pressures_mpa, model: str = "energy", k_
     return ax
 
 
+def _section_panel(ax, phi, R, values, label, unit, color):
+    """Draw the section (circle of radius R, frame at the bottom) with ``values`` as a radial band."""
+    vmax = float(np.max(np.abs(values))) or 1.0
+    r = R * (1.0 + 0.45 * values / vmax)
+    # Phi = 0 (frame) at the bottom: x = R sin(Phi), y = -R cos(Phi)
+    x0, y0 = R * np.sin(phi), -R * np.cos(phi)
+    x1, y1 = r * np.sin(phi), -r * np.cos(phi)
+    ax.plot(x0, y0, color="0.3", lw=1.2)
+    ax.plot(x1, y1, color=color, lw=1.5)
+    for j in range(0, phi.size, max(phi.size // 48, 1)):
+        ax.plot([x0[j], x1[j]], [y0[j], y1[j]], color=color, lw=0.6, alpha=0.6)
+    ax.plot([-0.35 * R, 0.35 * R], [-R, -R], color="k", lw=4, solid_capstyle="butt")
+    ax.annotate("frame (Φ = 0)", (0, -R), xytext=(0, -1.75 * R), ha="center", fontsize=7,
+                arrowprops=dict(arrowstyle="-", lw=0.5))
+    j = int(np.argmax(np.abs(values)))
+    ax.annotate(f"{values[j]:.3g} {unit}", (x1[j], y1[j]), fontsize=7, color=color)
+    ax.set_aspect("equal")
+    ax.set_xlim(-1.9 * R, 1.9 * R)
+    ax.set_ylim(-1.9 * R, 1.9 * R)
+    ax.axis("off")
+    ax.set_title(f"{label}\n(radial band: value / max, circle = 0)", fontsize=8)
+
+
 def plot_internal_stresses(actuator, pressure_mpa: float, curvature: float, *, fig=None):
     """Force-balance internal state (eq 37-48) around the cross-section at one (P, k').
 
-    Left: the section, frame at the bottom (Phi = 0), with the bladder axial stress and braid
-    axial line tension drawn as polar curves.  Right: the same fields unrolled over Phi, with the
-    uniform hoop stress, radial stress and interfacial pressure as horizontal lines.
+    Left two panels: the section (frame at the bottom, Phi = 0) with the bladder axial stress
+    sigma_bl,1(Phi) and the braid axial line tension N_br,1(Phi) drawn as radial bands.  Right: the
+    same fields unrolled over Phi, with the uniform hoop stress sigma_bl,2, radial stress
+    sigma_bl,3 = -P and interfacial pressure P_e as horizontal lines.
     """
     ds = internal_stresses(actuator, float(pressure_mpa), float(curvature), n_phi=361)
-    fig = fig or plt.figure(figsize=(10, 4.2))
-    ax0 = fig.add_subplot(1, 2, 1, projection="polar")
-    ax1 = fig.add_subplot(1, 2, 2)
+    fig = fig or plt.figure(figsize=(13, 4.4))
+    ax_a = fig.add_subplot(1, 3, 1)
+    ax_b = fig.add_subplot(1, 3, 2)
+    ax1 = fig.add_subplot(1, 3, 3)
     phi = np.radians(ds["phi_deg"].values)
-    s1 = ds["sigma_bl1"].values
+    R = float(ds["R"])
+    s1 = ds["sigma_bl1"].values * 1e3
     n1 = ds["N_br1"].values
-    # polar plot with Phi = 0 (frame) at the bottom
-    ax0.set_theta_zero_location("S")
-    ax0.plot(phi, s1 * 1e3, label="σ_bl,1 (kPa)")
-    ax0.plot(phi, n1, label="N_br,1 (N/mm)")
-    ax0.plot([0.0], [0.0], "ks", ms=6)
-    ax0.set_title("around the section (frame at bottom)", fontsize=9)
-    ax0.legend(fontsize=7, loc="upper right", bbox_to_anchor=(1.35, 1.1))
+    _section_panel(ax_a, phi, R, s1, "bladder axial stress σ_bl,1 (kPa)", "kPa", "C0")
+    _section_panel(ax_b, phi, R, n1, "braid axial line tension N_br,1 (N/mm)", "N/mm", "C1")
     deg = ds["phi_deg"].values
-    ax1.plot(deg, s1 * 1e3, label="σ_bl,1 bladder axial (kPa)")
+    ax1.plot(deg, s1, color="C0", label="σ_bl,1 bladder axial (kPa)")
     ax1.axhline(float(ds["sigma_bl2"]) * 1e3, color="C2", ls="--", label="σ_bl,2 bladder hoop (kPa)")
     ax1.axhline(float(ds["P_e"]) * 1e3, color="C3", ls=":", label="P_e interfacial (kPa)")
     ax1.axhline(float(ds["sigma_bl3"]) * 1e3, color="C4", ls="-.", label="σ_bl,3 = -P (kPa)")
@@ -115,11 +136,11 @@ def plot_internal_stresses(actuator, pressure_mpa: float, curvature: float, *, f
     ax1.set_xlim(0, 360)
     h1, l1 = ax1.get_legend_handles_labels()
     h2, l2 = ax2.get_legend_handles_labels()
-    ax1.legend(h1 + h2, l1 + l2, fontsize=7, loc="best")
+    ax1.legend(h1 + h2, l1 + l2, fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.15), ncol=2)
     pa = float(active_pressure(actuator, pressure_mpa))
     fig.suptitle(
         f"{actuator.name or actuator.kind}: force-balance internal state at P = {pressure_mpa * 1e3:g} kPa "
-        f"(active {pa * 1e3:g} kPa), k' = {curvature:g} 1/mm",
+        f"(active {pa * 1e3:g} kPa), k' = {curvature:g} 1/mm, R = {R:.3g} mm, t̄ = {float(ds['t_bar']):.3g} mm",
         fontsize=10,
     )
     fig.tight_layout()
