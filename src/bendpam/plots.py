@@ -20,7 +20,15 @@ from ._io import atomic_path  # noqa: E402
 from .kinematics import curvature_limits  # noqa: E402
 from .predict import active_pressure, free_curvature, internal_stresses, moment  # noqa: E402
 
-__all__ = ["curve_range", "moment_curves", "plot_moment_curvature", "plot_internal_stresses", "save_figure", "demo_figure"]
+__all__ = [
+    "curve_range",
+    "moment_curves",
+    "plot_moment_curvature",
+    "plot_internal_stresses",
+    "save_figure",
+    "demo_figure",
+    "figure4",
+]
 
 
 def curve_range(actuator, pressures_mpa, model: str = "energy", k_max: float | None = None, n: int = 200) -> np.ndarray:
@@ -166,3 +174,55 @@ def save_figure(fig, path, dpi: int = 130) -> None:
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=dpi)
     plt.close(fig)
+
+
+def figure4(processed, title: str = ""):
+    """A figure like the paper's Figure 4 for a :class:`~bendpam.testdata.processing.ProcessedSet`.
+
+    (a) the filtered loops at each pressure (moment against curvature, every cycle), with the
+    hysteresis-free mean curve dashed; (b) blocked moment against pressure with standard-error bars
+    and the deadband fit line; (c) free-bending curvature against pressure with standard-error bars.
+    """
+    from .testdata.processing import deadband_fit
+
+    res = processed.results
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.5))
+    ax = axes[0]
+    colors = plt.cm.viridis(np.linspace(0.0, 0.9, len(res)))
+    for c, r in zip(colors, res):
+        if r.series is not None:
+            sel = r.series[r.series.cycle > 0]
+            ax.plot(sel.curvature_per_mm, sel.moment_nmm, color=c, lw=0.7, alpha=0.8)
+        else:
+            for ci in range(r.n_cycles):
+                ax.plot(r.curvature_grid, r.branches[ci, 0], color=c, lw=0.7)
+                ax.plot(r.curvature_grid, r.branches[ci, 1], color=c, lw=0.7)
+        ax.plot(r.curvature_grid, r.mean_curve, "--", color=c, lw=1.2, label=f"{r.pressure_kpa:g} kPa")
+    ax.set_xlabel("curvature |k'| (1/mm)")
+    ax.set_ylabel("moment |M| (N·mm)")
+    ax.set_title("(a) cyclic loops (dashed: mean of the branches)", fontsize=9)
+    ax.legend(fontsize=7)
+    P = processed.pressures_kpa
+    bm = np.array([r.blocked_moment for r in res])
+    kf = np.array([r.free_curvature for r in res])
+    ax = axes[1]
+    ax.errorbar(P, bm[:, 0], yerr=np.nan_to_num(bm[:, 1]), fmt="o", capsize=3, label="max moment per cycle (mean ± SE)")
+    p0, se, a, b = deadband_fit(P, bm[:, 0])
+    if np.isfinite(a):
+        xx = np.linspace(min(p0 if np.isfinite(p0) else P.min(), P.min()), P.max(), 50)
+        ax.plot(xx, a * xx + b, "-", color="C1",
+                label=f"linear fit, deadband {p0:.3g} ± {se:.2g} kPa" if np.isfinite(se) else f"linear fit, deadband {p0:.3g} kPa")
+    ax.axhline(0, color="0.6", lw=0.8)
+    ax.set_xlabel("pressure (kPa)")
+    ax.set_ylabel("blocked moment (N·mm)")
+    ax.set_title("(b) blocked moment", fontsize=9)
+    ax.legend(fontsize=7)
+    ax = axes[2]
+    ax.errorbar(P, kf[:, 0], yerr=np.nan_to_num(kf[:, 1]), fmt="s", capsize=3, color="C2")
+    ax.set_xlabel("pressure (kPa)")
+    ax.set_ylabel("free-bending curvature |k'| (1/mm)")
+    ax.set_title("(c) free-bending curvature", fontsize=9)
+    if title:
+        fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    return fig

@@ -1,0 +1,251 @@
+"""A virtual testing machine: raw four-point-bending cyclic tests from a model (section 2.2).
+
+At each pressure the virtual machine
+
+1. finds the free position as the real one does: it releases the actuator from the blocked state
+   until the force falls to the detection load (0.2 N), on the *unloading* branch of the loop;
+2. runs ``cycles`` triangular cycles blocked -> free -> blocked at ``speed_mm_min``, sampled at
+   ``rate_hz``, with an optional dwell at each end;
+3. computes the moment from the quasi-static model plus a smooth hysteresis loop
+   (:class:`bendpam.hysteresis.DahlLaw`): ``M = M_model(P, k') - A z``, with the amplitude
+   ``A = hysteresis * |M_model(P, 0)| + hysteresis_offset_nmm``; the loop's energy-loss ratio is
+   about ``4 A / |M_blocked|`` for a nearly linear curve, so ``hysteresis = 0.06`` gives the
+   paper's ~24 % (Table 2);
+4. converts the moment to the machine force and the curvature to the stroke with eq 6-8, and
+   adds Gaussian force noise (``noise_n``) and stroke noise (``noise_stroke_mm``).
+
+The record starts at the blocked state just after a loading (``z = -1``).  The returned *truth*
+holds the values that processing should recover, computed from the noiseless loop with the same
+definitions (per-cycle maximum moment, curvature at the free turning point, loop area / area
+under the cycle's mean curve) and the model's own values (blocked moment, free curvature, P_start).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from scipy.optimize import brentq
+
+from .._io import atomic_write_text
+from ..fixture import PAPER_FIXTURE, Fixture
+from ..hysteresis import DahlLaw
+from ..kinematics import curvature_limits
+from ..predict import blocked_moment, free_curvature, moment
+from ..presets import normalise_model
+
+__all__ = ["SimulationSettings", "simulate_test", "simulate_tests", "DIALECT_SUFFIX"]
+
+DIALECT_SUFFIX = {"csv": ".csv", "testxpert": ".txt", "bluehill": ".csv", "mts": ".txt"}
+
+
+@dataclass(frozen=True)
+class SimulationSettings:
+    """Settings of the virtual testing machine (units in the names)."""
+
+    cycles: int = 3
+    speed_mm_min: float = 30.0
+    rate_hz: float = 20.0
+    noise_n: float = 0.05
+    noise_stroke_mm: float = 0.002
+    hysteresis: float = 0.06
+    hysteresis_offset_nmm: float = 0.0
+    hysteresis_angle_deg: float = 5.0
+    detection_load_n: float = 0.2
+    dwell_s: float = 0.0
+    stroke_offset_mm: float = 0.0
+    seed: int | None = None
+
+    def __post_init__(self) -> None:
+        checks = [
+            ("cycles", self.cycles, 1, 1000),
+            ("speed_mm_min", self.speed_mm_min, 1e-6, 1e6),
+            ("rate_hz", self.rate_hz, 1e-3, 1e6),
+            ("noise_n", self.noise_n, 0.0, 1e6),
+            ("noise_stroke_mm", self.noise_stroke_mm, 0.0, 1e3),
+            ("hysteresis", self.hysteresis, 0.0, 10.0),
+            ("hysteresis_offset_nmm", self.hysteresis_offset_nmm, 0.0, 1e9),
+            ("hysteresis_angle_deg", self.hysteresis_angle_deg, 1e-6, 360.0),
+            ("detection_load_n", self.detection_load_n, 0.0, 1e6),
+            ("dwell_s", self.dwell_s, 0.0, 1e6),
+            ("stroke_offset_mm", self.stroke_offset_mm, -1e6, 1e6),
+        ]
+        for name, v, lo, hi in checks:
+            try:
+                fv = float(v)
+            except (TypeError, ValueError):
+                raise ValueError(f"{name} = {v!r} is not a number") from None
+            if not (math.isfinite(fv) and lo <= fv <= hi):
+                raise ValueError(f"{name} = {v!r} is outside the allowed range [{lo:g}, {hi:g}]")
+
+
+def _signed(actuator):
+    return actuator.bend_sign or 1
+
+
+def simulate_test(actuator, pressure_kpa: float, model: str = "energy", *, fixture: Fixture = PAPER_FIXTURE,
+                  settings: SimulationSettings | None = None, rng: np.random.Generator | None = None):
+    """Simulate one cyclic test.  Returns ``(data, truth)``.
+
+    ``data`` is a DataFrame with ``time_s``, ``stroke_mm``, ``force_n`` as a machine records them;
+    ``truth`` is a dict of the values processing should recover (magnitudes).
+    """
+    st = settings or SimulationSettings()
+    model = normalise_model(model)
+    rng = rng if rng is not None else np.random.default_rng(st.seed)
+    P = float(pressure_kpa) * 1e-3
+    if not math.isfinite(P) or P < 0:
+        raise ValueError(f"pressure_kpa = {pressure_kpa!r} must be >= 0 kPa")
+    sgn = _signed(actuator)
+    L0 = fixture.L0_mm
+    Mb = abs(float(blocked_moment(actuator, P, model)))
+    if Mb <= 0.0:
+        raise ValueError(
+            f"pressure {pressure_kpa:g} kPa is at or below P_start = {actuator.P_start_kpa:g} kPa: "
+            "the actuator produces no moment to test"
+        )
+    A = st.hysteresis * Mb + st.hysteresis_offset_nmm
+    law = DahlLaw(math.radians(st.hysteresis_angle_deg))
+    lim = curvature_limits(actuator)
+    k_lim = 0.999 * (lim.k_max if sgn > 0 else -lim.k_min)
+
+    def m_qs(k):  # model moment magnitude at curvature magnitude k
+        return sgn * moment(actuator, P, sgn * np.asarray(k, dtype=float), model)
+
+    # 1. free position: unloading from the blocked state (z0 = -1) until F = detection load
+    def force_unloading(k):
+        th = k * L0
+        z = 1.0 - 2.0 * math.exp(-th / law.theta_c_rad)
+        beta = fixture.curvature_to_beta(k)
+        return float((m_qs(k) - A * z) / fixture.lever(beta)) - st.detection_load_n
+
+    k_hi = min(k_lim, 2.0 * math.atan(1e3) / L0 * 0.999)  # beta < pi/2
+    grid = np.linspace(0.0, k_hi, 400)
+    fvals = np.array([force_unloading(k) for k in grid])
+    cross = np.flatnonzero(fvals <= 0.0)
+    if fvals[0] <= 0.0 or cross.size == 0:
+        fb = free_curvature(actuator, P, model)
+        why = fb.reason.item() if fb.status.item() == "no-equilibrium" else "the unloading force never falls that low"
+        raise ValueError(
+            f"at {pressure_kpa:g} kPa there is no free state: the force does not fall to "
+            f"{st.detection_load_n:g} N before the lock-up limit ({why})"
+        )
+    j = cross[0]
+    k_f = brentq(force_unloading, grid[j - 1], grid[j], xtol=1e-14)
+    s_f = float(fixture.curvature_to_stroke(k_f))
+
+    # 2. triangular stroke path, sampled at rate_hz
+    t_ramp = s_f / (st.speed_mm_min / 60.0)
+    legs = []
+    for _ in range(st.cycles):
+        legs += [("ramp", 0.0, s_f), ("dwell", s_f, s_f), ("ramp", s_f, 0.0), ("dwell", 0.0, 0.0)]
+    knots_t, knots_s = [0.0], [0.0]
+    for kind, a, b in legs:
+        dur = t_ramp if kind == "ramp" else st.dwell_s
+        if dur <= 0:
+            continue
+        knots_t.append(knots_t[-1] + dur)
+        knots_s.append(b)
+    T = knots_t[-1]
+    t = np.arange(0.0, T + 0.5 / st.rate_hz, 1.0 / st.rate_hz)
+    s = np.interp(t, knots_t, knots_s)
+    force, M, k = _machine(actuator, P, model, fixture, law, A, s, m_qs)
+    truth_cycles = _truth(actuator, P, model, fixture, law, A, s_f, st.cycles, m_qs)
+    data = pd.DataFrame({
+        "time_s": t,
+        "stroke_mm": s + st.stroke_offset_mm + rng.normal(0.0, st.noise_stroke_mm, t.size),
+        "force_n": force + rng.normal(0.0, st.noise_n, t.size),
+    })
+    fb = free_curvature(actuator, P, model)
+    truth = {
+        "pressure_kpa": float(pressure_kpa),
+        "free_stroke_mm": s_f,
+        "free_curvature_per_mm": k_f,
+        "blocked_moment_nmm": truth_cycles["blocked_moment_nmm"],
+        "energy_loss_ratio": truth_cycles["energy_loss_ratio"],
+        "hysteresis_amplitude_nmm": A,
+        "model_blocked_moment_nmm": Mb,
+        "model_free_curvature_per_mm": abs(float(fb.curvature)) if fb.status.item() == "ok" else None,
+        "samples": int(t.size),
+        "duration_s": float(T),
+    }
+    return data, truth
+
+
+def _machine(actuator, P, model, fixture, law, A, stroke, m_qs):
+    beta = fixture.stroke_to_beta(stroke)
+    k = fixture.beta_to_curvature(beta)
+    z = law.z_path(k * fixture.L0_mm, z0=-1.0)
+    M = m_qs(k) - A * z
+    return fixture.moment_to_force(M, beta), M, k
+
+
+def _truth(actuator, P, model, fixture, law, A, s_f, cycles, m_qs):
+    """Per-cycle blocked moment and energy-loss ratio of the noiseless loop (dense path)."""
+    n = 4000
+    s_up = np.linspace(0.0, s_f, n)
+    one = np.concatenate([s_up, s_up[::-1]])  # the repeated turning sample is a zero step: z unchanged
+    _, M, k = _machine(actuator, P, model, fixture, law, A, np.tile(one, cycles), m_qs)
+    bms, ratios = [], []
+    for c in range(cycles):
+        seg_M, seg_k = M[2 * n * c: 2 * n * (c + 1)], k[2 * n * c: 2 * n * (c + 1)]
+        up_k, up_M = seg_k[:n], seg_M[:n]  # unloading (lower branch), k increasing
+        dn_k, dn_M = seg_k[n:][::-1], seg_M[n:][::-1]  # loading (upper branch), re-ordered by k
+        th = up_k * fixture.L0_mm
+        upper = np.interp(up_k, dn_k, dn_M)
+        loss = np.trapezoid(upper - up_M, th)
+        stored = np.trapezoid(0.5 * (upper + up_M), th)
+        bms.append(float(seg_M.max()))
+        ratios.append(float(loss / stored))
+    return {"blocked_moment_nmm": float(np.mean(bms)), "energy_loss_ratio": float(np.mean(ratios)),
+            "cycles_blocked_moment_nmm": bms, "cycles_energy_loss_ratio": ratios}
+
+
+def simulate_tests(actuator, pressures_kpa, out_dir, model: str = "energy", *, dialect: str = "csv",
+                   fixture: Fixture = PAPER_FIXTURE, settings: SimulationSettings | None = None,
+                   prefix: str | None = None) -> dict:
+    """Simulate tests at several pressures and write one raw file each plus ``truth.json``.
+
+    Files are named ``{prefix}_{P}kPa{suffix}`` with the dialect's usual suffix and carry a
+    ``Pressure`` metadata line.  Returns the truth dictionary that is also written to
+    ``truth.json`` (atomically).
+    """
+    from .writers import write_test
+
+    st = settings or SimulationSettings()
+    model = normalise_model(model)
+    if dialect not in DIALECT_SUFFIX:
+        raise ValueError(f"format {dialect!r} is not known; choose one of: {', '.join(DIALECT_SUFFIX)}")
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    rng = np.random.default_rng(st.seed)
+    prefix = prefix or (actuator.kind.lower())
+    truths = []
+    files = []
+    for p in pressures_kpa:
+        data, truth = simulate_test(actuator, p, model, fixture=fixture, settings=st, rng=rng)
+        name = f"{prefix}_{p:g}kPa{DIALECT_SUFFIX[dialect]}"
+        meta = {"Actuator": actuator.name or actuator.kind, "Test speed": f"{st.speed_mm_min:g} mm/min",
+                "Generator": "bendpam simulate-test"}
+        write_test(out / name, data, dialect, metadata=meta, pressure_kpa=float(p),
+                   force_unit="kN" if dialect == "mts" else "N")
+        truth["file"] = name
+        truths.append(truth)
+        files.append(name)
+    result = {
+        "model": model,
+        "actuator": actuator.to_dict(),
+        "format": dialect,
+        "fixture": asdict(fixture),
+        "settings": asdict(st),
+        "deadband_kpa": actuator.P_start_kpa,
+        "pressures": truths,
+        "files": files,
+        "units": {"moment": "N*mm", "curvature": "1/mm", "pressure": "kPa", "sign": "magnitudes"},
+    }
+    atomic_write_text(out / "truth.json", json.dumps(result, indent=2))
+    return result
