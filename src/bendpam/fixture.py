@@ -85,12 +85,12 @@ class Fixture:
         a = np.abs(s)
         c, d = self.c, self.d_mm
         e = a + c
-        qa = c * c - d * d
         qb = 2.0 * d * e
         qc = c * c - e * e  # <= 0
         # numerically stable root of qa x^2 + qb x + qc = 0 with x >= 0 and e - d x >= 0:
         # x = -2 qc / (qb + sqrt(qb^2 - 4 qa qc))   (the '+' root, written without cancellation)
-        disc = np.sqrt(np.maximum(qb * qb - 4.0 * qa * qc, 0.0))
+        # qb^2 - 4 qa qc simplifies to 4 c^2 (e^2 + d^2 - c^2): no cancellation
+        disc = 2.0 * c * np.sqrt(e * e + d * d - c * c)
         den = qb + disc
         x = np.divide(-2.0 * qc, den, out=np.zeros_like(den), where=den > 0.0)
         return np.sign(s) * np.arctan(x)

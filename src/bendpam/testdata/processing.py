@@ -281,17 +281,17 @@ def process_series(
     s_f = _lowpass(s_raw, fs, cutoff, int(opt.filter_order))
     f_f = _lowpass(f_raw, fs, cutoff, int(opt.filter_order))
 
+    rng = float(np.ptp(s_f))
+    if rng <= 0:
+        raise ProcessingError(f"{source}: the stroke does not move; no cycles to process")
     # orientation: force positive at the blocked state, stroke growing toward the free state
     if np.median(f_f) < 0:
         f_f = -f_f
         notes.append("force sign flipped (compression recorded as negative)")
-    if np.corrcoef(s_f, f_f)[0, 1] > 0:
+    if np.ptp(f_f) > 0 and np.corrcoef(s_f, f_f)[0, 1] > 0:
         s_f = -s_f
         notes.append("stroke direction flipped (stroke recorded as decreasing toward the free state)")
 
-    rng = float(np.ptp(s_f))
-    if rng <= 0:
-        raise ProcessingError(f"{source}: the stroke does not move; no cycles to process")
     tp, is_max = find_turning_points(s_f, opt.reversal_fraction * rng)
     vals = s_f[tp]
     mins = np.flatnonzero(~is_max)

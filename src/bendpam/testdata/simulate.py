@@ -40,6 +40,9 @@ from ..presets import normalise_model
 
 __all__ = ["SimulationSettings", "simulate_test", "simulate_tests", "DIALECT_SUFFIX"]
 
+#: The fixture's plates cannot pitch beyond this (deg); the free state must be found before it.
+MAX_BETA_DEG = 80.0
+
 DIALECT_SUFFIX = {"csv": ".csv", "testxpert": ".txt", "bluehill": ".csv", "mts": ".txt"}
 
 
@@ -123,7 +126,7 @@ def simulate_test(actuator, pressure_kpa: float, model: str = "energy", *, fixtu
         beta = fixture.curvature_to_beta(k)
         return float((m_qs(k) - A * z) / fixture.lever(beta)) - st.detection_load_n
 
-    k_hi = min(k_lim, 2.0 * math.atan(1e3) / L0 * 0.999)  # beta < pi/2
+    k_hi = min(k_lim, float(fixture.beta_to_curvature(math.radians(MAX_BETA_DEG))))
     grid = np.linspace(0.0, k_hi, 400)
     fvals = np.array([force_unloading(k) for k in grid])
     cross = np.flatnonzero(fvals <= 0.0)
@@ -132,7 +135,8 @@ def simulate_test(actuator, pressure_kpa: float, model: str = "energy", *, fixtu
         why = fb.reason.item() if fb.status.item() == "no-equilibrium" else "the unloading force never falls that low"
         raise ValueError(
             f"at {pressure_kpa:g} kPa there is no free state: the force does not fall to "
-            f"{st.detection_load_n:g} N before the lock-up limit ({why})"
+            f"{st.detection_load_n:g} N before the lock-up limit or the fixture's {MAX_BETA_DEG:g} deg plate "
+            f"pitch ({why})"
         )
     j = cross[0]
     k_f = brentq(force_unloading, grid[j - 1], grid[j], xtol=1e-14)
