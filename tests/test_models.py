@@ -218,3 +218,18 @@ def test_property_models_finite_and_blocked_equal(a, P, frac, model):
     assert bendpam.blocked_moment(a, P, "force_balance") == pytest.approx(closed_form(a, P), rel=1e-10, abs=1e-10)
     t = bendpam.moment_terms(a, P, k, model)
     assert all(np.isfinite(v) for v in t.values())
+
+
+def test_linear_basis_reproduces_the_moment(preset_model, span):
+    # M = P_a A - E_f I_f k' - C10 b10 - C01 b01: the decomposition identification relies on
+    a, model = preset_model
+    mod = get_model(model)
+    k = span(a, 0.9, 13)
+    A, b10, b01 = mod.basis(a, k)
+    pa = 0.15 - a.P_start
+    M = pa * A - a.frame_stiffness * k - a.C10 * b10 - a.C01 * b01
+    assert_allclose(M, bendpam.moment(a, 0.15, k, model), rtol=1e-12, atol=1e-9)
+    # and b10, b01 are the responses to unit constants
+    b = a.replace(C10_kpa=1000.0, C01_kpa=0.0)
+    _, B = mod.coefficients(b, k)
+    assert_allclose(B - b.frame_stiffness * k, b10, rtol=1e-12, atol=1e-9)

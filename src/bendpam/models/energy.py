@@ -33,8 +33,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..kinematics import DEFAULT_ORDER, gauss_nodes, radius_terms
+from ..material import MooneyRivlin
 
-__all__ = ["coefficients", "terms", "bladder_energy"]
+__all__ = ["basis", "coefficients", "terms", "bladder_energy"]
 
 
 def _state(actuator, k, order):
@@ -50,14 +51,33 @@ def _air_coefficient(k, R, dR):
     return np.pi * ((2.0 * R + 3.0 * k * R * R) * dR + R**3)
 
 
-def _bladder_moment(actuator, k, u, R, dR, omc, wbar, lam1, eq19_factor):
-    mat = actuator.material
+_UNIT10 = MooneyRivlin(1.0, 0.0)
+_UNIT01 = MooneyRivlin(0.0, 1.0)
+
+
+def _bladder_basis(actuator, k, u, R, dR, omc, wbar, lam1, eq19_factor):
+    """Bladder moment per unit C10 and per unit C01 (N*mm/MPa): M_bl = C10 b10 + C01 b01 (eq 19)."""
     eta = (R / actuator.R0_start)[..., None]
     dl1 = (R + k * dR)[..., None] * omc  # d lambda1 / dk'
     dl2 = (dR / actuator.R0_start)[..., None]  # d lambda2 / dk'
-    dW = mat.dW_dl1(lam1, eta) * dl1 + mat.dW_dl2(lam1, eta) * dl2
-    dU = actuator.bladder_area * (dW @ wbar)
-    return (1.0 + u) * dU if eq19_factor else dU
+    fac = actuator.bladder_area * ((1.0 + u) if eq19_factor else 1.0)
+    out = []
+    for mat in (_UNIT10, _UNIT01):
+        dW = mat.dW_dl1(lam1, eta) * dl1 + mat.dW_dl2(lam1, eta) * dl2
+        out.append(fac * (dW @ wbar))
+    return out
+
+
+def basis(actuator, curvature, *, order: int = DEFAULT_ORDER, eq19_factor: bool = True):
+    """Linear decomposition ``M = P_active A - E_f I_f k' - C10 b10 - C01 b01`` (C in MPa).
+
+    Returns ``(A, b10, b01)``; they depend only on the kinematics (alpha0, R0_start, t0_start), so
+    identification can solve for C10, C01, E_f and P_start by linear least squares.
+    """
+    k = np.asarray(curvature, dtype=float)
+    u, R, dR, omc, wbar, lam1 = _state(actuator, k, order)
+    b10, b01 = _bladder_basis(actuator, k, u, R, dR, omc, wbar, lam1, eq19_factor)
+    return _air_coefficient(k, R, dR), b10, b01
 
 
 def coefficients(actuator, curvature, *, order: int = DEFAULT_ORDER, eq19_factor: bool = True):
@@ -66,10 +86,8 @@ def coefficients(actuator, curvature, *, order: int = DEFAULT_ORDER, eq19_factor
     No range checks: callers validate the curvature against the lock-up limits.
     """
     k = np.asarray(curvature, dtype=float)
-    u, R, dR, omc, wbar, lam1 = _state(actuator, k, order)
-    A = _air_coefficient(k, R, dR)
-    B = _bladder_moment(actuator, k, u, R, dR, omc, wbar, lam1, eq19_factor) + actuator.frame_stiffness * k
-    return A, B
+    A, b10, b01 = basis(actuator, k, order=order, eq19_factor=eq19_factor)
+    return A, actuator.C10 * b10 + actuator.C01 * b01 + actuator.frame_stiffness * k
 
 
 def terms(actuator, p_active, curvature, *, order: int = DEFAULT_ORDER, eq19_factor: bool = True):
@@ -80,7 +98,8 @@ def terms(actuator, p_active, curvature, *, order: int = DEFAULT_ORDER, eq19_fac
     k = np.asarray(curvature, dtype=float)
     u, R, dR, omc, wbar, lam1 = _state(actuator, k, order)
     m_air = np.asarray(p_active, dtype=float) * _air_coefficient(k, R, dR)
-    m_bl = _bladder_moment(actuator, k, u, R, dR, omc, wbar, lam1, eq19_factor)
+    b10, b01 = _bladder_basis(actuator, k, u, R, dR, omc, wbar, lam1, eq19_factor)
+    m_bl = actuator.C10 * b10 + actuator.C01 * b01
     m_f = actuator.frame_stiffness * k
     m_bl, m_f = np.broadcast_arrays(m_bl, m_f)
     m_air, m_bl, m_f = np.broadcast_arrays(m_air, m_bl, m_f)

@@ -43,7 +43,7 @@ import numpy as np
 
 from ..kinematics import DEFAULT_ORDER, gauss_nodes, radius_terms
 
-__all__ = ["coefficients", "terms", "stress_state"]
+__all__ = ["basis", "coefficients", "terms", "stress_state"]
 
 
 def _state(actuator, k, order):
@@ -65,17 +65,33 @@ def _state(actuator, k, order):
     sig2e = 2.0 * C1 * (eta * eta - 1.0 / le2) - 2.0 * C2 * (1.0 / (eta * eta) - le2)
     varpart = 2.0 * np.pi * (((2.0 * C1 * lam1 * lam1 - 2.0 * C2 / (lam1 * lam1)) * omc) @ wbar)
     m_bl = tbar * R * R * (varpart + 2.0 * np.pi * const1)
-    return dict(u=u, R=R, lam1=lam1, c=c, lbar=lbar, eta=eta, tbar=tbar, J=J, sig2e=sig2e, const1=const1, m_bl=m_bl)
+    return dict(u=u, R=R, lam1=lam1, c=c, lbar=lbar, eta=eta, tbar=tbar, J=J, sig2e=sig2e, const1=const1, m_bl=m_bl,
+                omc=omc, wbar=wbar)
+
+
+def basis(actuator, curvature, *, order: int = DEFAULT_ORDER, **_ignored):
+    """Linear decomposition ``M = P_active A - E_f I_f k' - C10 b10 - C01 b01`` (C in MPa).
+
+    ``B = M_bl - sigma_bl,2^el t_bar R^2 c^2 J`` is linear in C10 and C01; ``b10`` and ``b01`` are
+    its coefficients.  Returns ``(A, b10, b01)``.
+    """
+    k = np.asarray(curvature, dtype=float)
+    st = _state(actuator, k, order)
+    R, c, J, tb, lam1, omc, wbar = st["R"], st["c"], st["J"], st["tbar"], st["lam1"], st["omc"], st["wbar"]
+    le2 = (st["lbar"] * st["eta"]) ** 2
+    e2 = st["eta"] ** 2
+    w = tb * R * R
+    br = w * c * c * J  # sigma_bl,2^el enters as - sigma2e * t_bar R^2 c^2 J
+    b10 = w * 2.0 * np.pi * (((2.0 * lam1 * lam1) * omc) @ wbar - 2.0 / le2) - 2.0 * (e2 - 1.0 / le2) * br
+    b01 = w * 2.0 * np.pi * (((-2.0 / (lam1 * lam1)) * omc) @ wbar + 2.0 * le2) + 2.0 * (1.0 / e2 - le2) * br
+    return R**3 * (np.pi - c * c * J), b10, b01
 
 
 def coefficients(actuator, curvature, *, order: int = DEFAULT_ORDER, **_ignored):
     """``(A, B)`` with ``M = P_active A - B`` (N*mm/MPa and N*mm), shape of ``curvature``."""
     k = np.asarray(curvature, dtype=float)
-    st = _state(actuator, k, order)
-    R, c, J = st["R"], st["c"], st["J"]
-    A = R**3 * (np.pi - c * c * J)
-    B = actuator.frame_stiffness * k + st["m_bl"] - st["sig2e"] * st["tbar"] * R * R * c * c * J
-    return A, B
+    A, b10, b01 = basis(actuator, k, order=order)
+    return A, actuator.C10 * b10 + actuator.C01 * b01 + actuator.frame_stiffness * k
 
 
 def terms(actuator, p_active, curvature, *, order: int = DEFAULT_ORDER, **_ignored):
