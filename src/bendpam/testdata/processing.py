@@ -188,6 +188,32 @@ def _lowpass(x: np.ndarray, fs: float, cutoff: float, order: int) -> np.ndarray:
     return signal.sosfiltfilt(sos, x, padlen=padlen)
 
 
+def _segment_lowpass(x: np.ndarray, tp: np.ndarray, fs: float, cutoff: float, order: int,
+                     fallback: np.ndarray) -> np.ndarray:
+    """Zero-phase low-pass of each segment ``[tp[j], tp[j+1]]`` separately; shared end points averaged.
+
+    Segments too short for the filter keep the values of ``fallback`` (the whole-record filter).
+    """
+    if cutoff <= 0.0:
+        return x.copy()
+    sos = signal.butter(order, cutoff, btype="low", fs=fs, output="sos")
+    edges = np.unique(np.concatenate([tp, [x.size - 1]]))
+    out = fallback.copy()
+    acc = np.zeros(x.size)
+    cnt = np.zeros(x.size)
+    need = 3 * (2 * sos.shape[0] + 1)
+    for a, b in zip(edges[:-1], edges[1:]):
+        seg = x[a: b + 1]
+        if seg.size <= need:
+            continue
+        y = signal.sosfiltfilt(sos, seg, padtype="odd", padlen=min(seg.size - 1, max(need, int(3 * fs / cutoff))))
+        acc[a: b + 1] += y
+        cnt[a: b + 1] += 1
+    done = cnt > 0
+    out[done] = acc[done] / cnt[done]
+    return out
+
+
 def find_turning_points(stroke: np.ndarray, threshold: float) -> tuple[np.ndarray, np.ndarray]:
     """Alternating extrema of ``stroke`` by a zig-zag rule with a ``threshold`` hysteresis.
 
@@ -286,13 +312,18 @@ def process_series(
         raise ProcessingError(f"{source}: the stroke does not move; no cycles to process")
     # orientation: force positive at the blocked state, stroke growing toward the free state
     if np.median(f_f) < 0:
-        f_f = -f_f
+        f_f, f_raw = -f_f, -f_raw
         notes.append("force sign flipped (compression recorded as negative)")
     if np.ptp(f_f) > 0 and np.corrcoef(s_f, f_f)[0, 1] > 0:
-        s_f = -s_f
+        s_f, s_raw = -s_f, -s_raw
         notes.append("stroke direction flipped (stroke recorded as decreasing toward the free state)")
 
     tp, is_max = find_turning_points(s_f, opt.reversal_fraction * rng)
+    # Filter each monotone segment between turning points on its own (odd padding continues a
+    # ramp linearly), so the corners of the triangular stroke are not rounded: a filter across a
+    # reversal would lift the blocked stroke and lower the free one, shifting every curvature.
+    s_f = _segment_lowpass(s_raw, tp, fs, cutoff, int(opt.filter_order), s_f)
+    f_f = _segment_lowpass(f_raw, tp, fs, cutoff, int(opt.filter_order), f_f)
     vals = s_f[tp]
     mins = np.flatnonzero(~is_max)
     s0 = float(np.median(vals[mins])) if (opt.zero_stroke and mins.size) else 0.0

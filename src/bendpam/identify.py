@@ -1,0 +1,699 @@
+"""Parameter identification from processed cyclic tests (paper section 3.4, eq 53-55, Table 3).
+
+:func:`fit` identifies any subset of alpha0, C10, C01, P_start, E_f and R0_start for either model
+from the hysteresis-free mean curves of all pressures at once.
+
+Objective
+    Weighted least squares whose sum of squares *is* the paper's cycle metric (eq 53)::
+
+        r_ij = sqrt(K_i / sum K) / (M_max,i sqrt(n_i)) * (M_model(P_i, k_ij) - M_data,ij)
+        sum r^2 = NRMSE_cycles^2
+
+    with ``K_i`` the test's maximum curvature (its free curvature) and ``M_max,i`` its maximum
+    moment (its blocked moment).  Data are magnitudes; the model is evaluated on the actuator's
+    bending side (``k' = bend_sign * |k|``).
+
+Method (variable projection)
+    Both models are linear in C10, C01, E_f and P_start for fixed kinematics
+    (``M = (P - P_start) A(k') - E_f I_f k' - C10 b10(k') - C01 b01(k')``, see
+    ``bendpam.models.*.basis``), and the kinematics depend only on alpha0 and R0_start.  For every
+    trial (alpha0, R0_start) the linear parameters are therefore solved exactly by bounded linear
+    least squares (``scipy.optimize.lsq_linear``).
+
+    1. Global stage: a grid scan over the nonlinear parameters (41 alpha0 values across their
+       bounds, 9 R0_start values), so the answer does not depend on a lucky start.
+    2. Local stage: ``scipy.optimize.least_squares`` (trust-region reflective, bounds) on the
+       projected problem from the best grid point, then one joint polish over all free parameters.
+    3. Uncertainty: a sandwich covariance ``(J^T J)^-1 (sum_i s_i^2 f_i J_i^T J_i) (J^T J)^-1``
+       from the Jacobian at the optimum.  The eq-53 weights normalise the curves but are not
+       inverse noise variances, so each pressure's curve ``i`` gets its own residual variance
+       ``s_i^2`` and an inflation ``f_i = (1 + rho_i) / (1 - rho_i)`` for the lag-1 autocorrelation
+       of its residuals (serially correlated residuals carry less information than their count
+       suggests).  Standard errors and the correlation matrix follow; pairs with
+       ``|corr| > 0.95`` are flagged as poorly identifiable (C10 and C01 often are).
+
+    When both C10 and C01 are free the solver works with ``S = C10 + C01`` (bounded > 0, the
+    initial shear modulus must be positive) and C01, and maps the covariance back.
+
+Bounds: alpha0 within +-10 % of its nominal value (as in the paper) and on the actuator's side of
+54.74 deg; C10, C01 in [-5000, 5000] kPa with C10 + C01 >= 1 kPa; P_start in [0, 0.98 min(P_i)];
+E_f in [0.1, 10] x nominal; R0_start in [R0, 1.5 R0].  Any bound can be overridden.
+
+Starting values: the linear parameters need none (they are solved exactly).  Parameters held fixed
+keep the actuator's values, or the tension-test values of C10 and C01 when ``tension`` is given
+(``bendpam fit-material``); the paper's own start was C10 = 114 kPa, C01 = 300 kPa.
+
+The fold of the BC-PAM does not affect the fit (it compares moments at measured curvatures, no
+root finding); it only makes the free-curvature metric skip pressures without an equilibrium,
+which are counted and reported.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from scipy.optimize import least_squares, lsq_linear
+
+from ._io import atomic_write_text
+from .actuator import NEUTRAL_ANGLE_DEG, Actuator
+from .models import get_model
+from .predict import free_curvature
+from .presets import normalise_model
+
+__all__ = ["PARAMETERS", "Parameter", "FitResult", "Metrics", "fit", "score", "fit_tension", "TensionFit",
+           "parse_free", "developed_range", "tension_from_test"]
+
+#: Identifiable parameters: short name -> (Actuator field, unit).
+PARAMETERS = {
+    "alpha0": ("alpha0_deg", "deg"),
+    "C10": ("C10_kpa", "kPa"),
+    "C01": ("C01_kpa", "kPa"),
+    "P_start": ("P_start_kpa", "kPa"),
+    "E_f": ("frame_modulus_mpa", "MPa"),
+    "R0_start": ("R0_start_mm", "mm"),
+}
+_ALIASES = {
+    "alpha0": "alpha0", "alpha0_deg": "alpha0", "a0": "alpha0", "alpha": "alpha0",
+    "c10": "C10", "c10_kpa": "C10", "c1": "C10",
+    "c01": "C01", "c01_kpa": "C01", "c2": "C01",
+    "p_start": "P_start", "pstart": "P_start", "p_start_kpa": "P_start",
+    "e_f": "E_f", "ef": "E_f", "frame_modulus_mpa": "E_f", "frame_modulus": "E_f",
+    "r0_start": "R0_start", "r0start": "R0_start", "r0_start_mm": "R0_start",
+}
+_NONLINEAR = ("alpha0", "R0_start")
+_ORDER = ("alpha0", "C10", "C01", "P_start", "E_f", "R0_start")
+
+
+def parse_free(free) -> list[str]:
+    """Normalise a list (or comma string) of parameter names; unknown names raise ValueError."""
+    if isinstance(free, str):
+        free = [f for f in free.replace(" ", ",").split(",") if f]
+    out = []
+    for f in free:
+        key = _ALIASES.get(str(f).strip().lower())
+        if key is None:
+            raise ValueError(f"unknown parameter {f!r} to fit; choose from {', '.join(PARAMETERS)}")
+        if key not in out:
+            out.append(key)
+    if not out:
+        raise ValueError(f"no parameter to fit; choose from {', '.join(PARAMETERS)}")
+    return sorted(out, key=_ORDER.index)
+
+
+@dataclass
+class Parameter:
+    """One identified parameter (lmfit-style): value, standard error, bounds, vary flag, unit."""
+
+    name: str
+    field: str
+    unit: str
+    value: float
+    stderr: float | None
+    min: float
+    max: float
+    vary: bool
+    initial: float
+
+    def to_dict(self) -> dict:
+        return {"value": self.value, "stderr": self.stderr, "min": self.min, "max": self.max, "vary": self.vary,
+                "initial": self.initial, "unit": self.unit}
+
+
+@dataclass
+class Metrics:
+    """Paper metrics (eq 53-55) and plain RMSEs of a model against processed data."""
+
+    nrmse_cycles: float
+    nrmse_blocked_moment: float
+    nrmse_free_curvature: float
+    rmse_cycles: float
+    rmse_blocked_moment: float
+    rmse_free_curvature: float
+    per_pressure: list[dict]
+    no_equilibrium_kpa: list[float]
+
+    def to_dict(self) -> dict:
+        return {
+            "nrmse": {"cycles": self.nrmse_cycles, "blocked_moment": self.nrmse_blocked_moment,
+                      "free_curvature": self.nrmse_free_curvature},
+            "rmse": {"cycles_nmm": self.rmse_cycles, "blocked_moment_nmm": self.rmse_blocked_moment,
+                     "free_curvature_per_mm": self.rmse_free_curvature},
+            "per_pressure": self.per_pressure,
+            "no_equilibrium_kpa": self.no_equilibrium_kpa,
+        }
+
+
+@dataclass
+class _Data:
+    P: np.ndarray  # (n,) MPa
+    k: list[np.ndarray]  # magnitudes, 1/mm
+    M: list[np.ndarray]  # mean curves, N*mm
+    BM: np.ndarray  # blocked moments (data), N*mm
+    BM_se: np.ndarray
+    K: np.ndarray  # free curvatures (data), 1/mm
+    K_se: np.ndarray
+    w: np.ndarray  # per-point weights (concatenated)
+    kc: np.ndarray  # concatenated curvature magnitudes
+    Mc: np.ndarray  # concatenated data
+    Pc: np.ndarray  # concatenated pressures (MPa)
+    seg: np.ndarray  # curve index per point
+
+
+def developed_range(result, threshold: float = 0.8, negligible: float = 0.01) -> np.ndarray:
+    """Mask of the grid points where the hysteresis loop is developed.
+
+    Near each reversal a rounded loop closes: there both branches lie on the same side of the
+    hysteresis-free curve, and their average is biased by up to the loop's half-width.  Where the
+    half-width ``(loading - unloading) / 2`` is at least ``threshold`` times its median, the average
+    of the branches is a fair estimate of the quasi-static curve.  If the loop is negligible
+    (median half-width below ``negligible`` of the blocked moment) every point is kept.
+    """
+    hw = 0.5 * (np.asarray(result.mean_loading) - np.asarray(result.mean_unloading))
+    med = float(np.median(hw))
+    if not np.isfinite(med) or med <= negligible * float(result.blocked_moment[0]):
+        return np.ones(hw.size, dtype=bool)
+    keep = hw >= threshold * med
+    if keep.sum() < max(5, hw.size // 5):
+        return np.ones(hw.size, dtype=bool)
+    # one contiguous range: from the first to the last developed point
+    idx = np.flatnonzero(keep)
+    mask = np.zeros(hw.size, dtype=bool)
+    mask[idx[0]: idx[-1] + 1] = True
+    return mask
+
+
+def _data(processed, fit_range: str = "developed") -> _Data:
+    res = processed.results
+    if not res:
+        raise ValueError("no processed pressures to fit")
+    if fit_range not in ("developed", "all"):
+        raise ValueError(f"fit_range = {fit_range!r}; choose 'developed' or 'all'")
+    P = np.array([r.pressure_kpa for r in res]) * 1e-3
+    masks = [developed_range(r) if fit_range == "developed" else np.ones(r.curvature_grid.size, bool) for r in res]
+    k = [np.asarray(r.curvature_grid, float)[m] for r, m in zip(res, masks)]
+    M = [np.asarray(r.mean_curve, float)[m] for r, m in zip(res, masks)]
+    BM = np.array([r.blocked_moment[0] for r in res])
+    BMse = np.array([r.blocked_moment[1] for r in res])
+    K = np.array([r.free_curvature[0] for r in res])
+    Kse = np.array([r.free_curvature[1] for r in res])
+    if np.any(~np.isfinite(BM)) or np.any(BM <= 0) or np.any(~np.isfinite(K)) or np.any(K <= 0):
+        raise ValueError("processed data need a positive blocked moment and free curvature at every pressure")
+    wK = K / K.sum()
+    w = np.concatenate([np.full(kk.size, math.sqrt(wK[i]) / (BM[i] * math.sqrt(kk.size))) for i, kk in enumerate(k)])
+    seg = np.concatenate([np.full(kk.size, i) for i, kk in enumerate(k)])
+    return _Data(P, k, M, BM, BMse, K, Kse, w, np.concatenate(k), np.concatenate(M),
+                 np.concatenate([np.full(kk.size, P[i]) for i, kk in enumerate(k)]), seg)
+
+
+def _default_bounds(actuator: Actuator, P_min_kpa: float) -> dict[str, tuple[float, float]]:
+    a0 = actuator.alpha0_deg
+    lo, hi = 0.9 * a0, min(1.1 * a0, 89.9)
+    if actuator.bend_sign > 0:
+        lo = max(lo, NEUTRAL_ANGLE_DEG + 0.05)
+    elif actuator.bend_sign < 0:
+        hi = min(hi, NEUTRAL_ANGLE_DEG - 0.05)
+    return {
+        "alpha0": (lo, hi),
+        "C10": (-5000.0, 5000.0),
+        "C01": (-5000.0, 5000.0),
+        "P_start": (0.0, 0.98 * P_min_kpa),
+        "E_f": (0.1 * actuator.frame_modulus_mpa, 10.0 * actuator.frame_modulus_mpa),
+        "R0_start": (actuator.R0_mm, 1.5 * actuator.R0_mm),
+    }
+
+
+class _Problem:
+    """Residuals of the weighted problem for a given set of free parameters."""
+
+    def __init__(self, actuator: Actuator, data: _Data, model: str, free: list[str], bounds, order: int,
+                 eq19_factor: bool):
+        self.base = actuator
+        self.d = data
+        self.mod = get_model(model)
+        self.model = model
+        self.free = free
+        self.bounds = bounds
+        self.order = order
+        self.eq19 = eq19_factor
+        self.sign = actuator.bend_sign or 1
+        self.nonlin = [p for p in free if p in _NONLINEAR]
+        self.lin = [p for p in free if p not in _NONLINEAR]
+        # both C10 and C01 free: solve for S = C10 + C01 and C01 (S > 0)
+        self.sum_param = "C10" in self.lin and "C01" in self.lin
+
+    # -- linear parameters in internal coordinates ---------------------------------------------
+    def lin_names(self) -> list[str]:
+        return ["S" if (p == "C10" and self.sum_param) else p for p in self.lin]
+
+    def lin_bounds(self):
+        lo, hi = [], []
+        for p in self.lin_names():
+            if p == "S":
+                lo.append(1.0)
+                hi.append(self.bounds["C10"][1] + self.bounds["C01"][1])
+            elif p == "C10" and "C01" not in self.lin:  # C10 + C01_fixed >= 1
+                lo.append(max(self.bounds["C10"][0], 1.0 - self.base.C01_kpa))
+                hi.append(self.bounds["C10"][1])
+            elif p == "C01" and "C10" not in self.lin:
+                lo.append(max(self.bounds["C01"][0], 1.0 - self.base.C10_kpa))
+                hi.append(self.bounds["C01"][1])
+            else:
+                lo.append(self.bounds[p][0])
+                hi.append(self.bounds[p][1])
+        return np.array(lo), np.array(hi)
+
+    def actuator(self, values: dict[str, float]) -> Actuator:
+        ch = {PARAMETERS[p][0]: v for p, v in values.items()}
+        return self.base.replace(**ch)
+
+    def design(self, nl: dict[str, float], fixed: dict[str, float]):
+        """Fixed part ``c0`` and columns ``X`` (per internal linear unit) of the model magnitude."""
+        a = self.base.replace(**{PARAMETERS[p][0]: v for p, v in {**fixed, **nl}.items()})
+        s = self.sign
+        ks = s * self.d.kc
+        A, b10, b01 = self.mod.basis(a, ks, order=self.order, eq19_factor=self.eq19)
+        P = self.d.Pc
+        If = a.frame_inertia
+        cols = {
+            "C10": -s * b10 * 1e-3,  # per kPa
+            "C01": -s * b01 * 1e-3,
+            "P_start": -s * A * 1e-3,  # per kPa
+            "E_f": -If * self.d.kc,  # per MPa (magnitude: -E I |k|)
+        }
+        c0 = s * (P * A)
+        for p in ("C10", "C01", "P_start", "E_f"):
+            if p not in self.lin:
+                c0 = c0 + cols[p] * {"C10": a.C10_kpa, "C01": a.C01_kpa, "P_start": a.P_start_kpa,
+                                     "E_f": a.frame_modulus_mpa}[p]
+        X = []
+        for p in self.lin_names():
+            if p == "S":
+                X.append(cols["C10"])
+            elif p == "C01" and self.sum_param:
+                X.append(cols["C01"] - cols["C10"])
+            else:
+                X.append(cols[p])
+        X = np.column_stack(X) if X else np.zeros((c0.size, 0))
+        return c0, X
+
+    def to_user(self, nl: dict[str, float], lin_int: np.ndarray) -> dict[str, float]:
+        out = dict(nl)
+        names = self.lin_names()
+        vals = dict(zip(names, lin_int))
+        for p in self.lin:
+            if p == "C10" and self.sum_param:
+                out["C10"] = vals["S"] - vals["C01"]
+            else:
+                out[p] = vals[p]
+        return out
+
+    def project(self, nl: dict[str, float]):
+        """Best linear parameters for the nonlinear ones; returns (residuals, lin_int)."""
+        c0, X = self.design(nl, {})
+        w = self.d.w
+        y = w * (self.d.Mc - c0)
+        if X.shape[1] == 0:
+            return -y, np.zeros(0)
+        lo, hi = self.lin_bounds()
+        sol = lsq_linear(w[:, None] * X, y, bounds=(lo, hi), method="bvls", lsmr_tol=None)
+        return w * (c0 + X @ sol.x - self.d.Mc), sol.x
+
+    def residual_full(self, x_int: np.ndarray) -> np.ndarray:
+        nl = dict(zip(self.nonlin, x_int[: len(self.nonlin)]))
+        c0, X = self.design(nl, {})
+        return self.d.w * (c0 + X @ x_int[len(self.nonlin):] - self.d.Mc)
+
+
+def _lag1(resid: np.ndarray, seg: np.ndarray) -> float:
+    num = den = 0.0
+    for i in np.unique(seg):
+        r = resid[seg == i]
+        r = r - r.mean()
+        num += float(r[1:] @ r[:-1])
+        den += float(r @ r)
+    return num / den if den > 0 else 0.0
+
+
+@dataclass
+class FitResult:
+    """Result of :func:`fit`: a value you can print, save (JSON + TOML) and reuse."""
+
+    model: str
+    actuator: Actuator
+    parameters: dict[str, Parameter]
+    correlation: np.ndarray
+    correlation_names: list[str]
+    metrics: Metrics
+    converged: bool
+    message: str
+    nfev: int
+    time_s: float
+    flags: list[str] = field(default_factory=list)
+    autocorrelation: float = 0.0
+
+    def to_dict(self) -> dict:
+        m = self.metrics.to_dict()
+        return {
+            "model": self.model,
+            "parameters": {PARAMETERS[n][0]: p.to_dict() for n, p in self.parameters.items()},
+            "correlation": {"names": [PARAMETERS[n][0] for n in self.correlation_names],
+                            "matrix": self.correlation.tolist()},
+            "nrmse": m["nrmse"],
+            "rmse": m["rmse"],
+            "per_pressure": m["per_pressure"],
+            "no_equilibrium_kpa": m["no_equilibrium_kpa"],
+            "flags": self.flags,
+            "converged": self.converged,
+            "message": self.message,
+            "nfev": self.nfev,
+            "time_s": self.time_s,
+            "residual_autocorrelation": self.autocorrelation,
+            "actuator": self.actuator.to_dict(),
+        }
+
+    def to_json(self) -> str:
+        return json.dumps(_clean(self.to_dict()), indent=2)
+
+    def save(self, out_dir) -> dict[str, str]:
+        """Write ``fit.json`` and ``fitted_actuator.toml`` atomically into ``out_dir``."""
+        out = Path(out_dir)
+        out.mkdir(parents=True, exist_ok=True)
+        atomic_write_text(out / "fit.json", self.to_json())
+        self.actuator.to_toml(out / "fitted_actuator.toml")
+        return {"fit.json": str(out / "fit.json"), "fitted_actuator.toml": str(out / "fitted_actuator.toml")}
+
+    def __str__(self) -> str:
+        lines = [f"{self.model.replace('_', '-')} model fit ({'converged' if self.converged else 'NOT converged'}, "
+                 f"{self.nfev} evaluations, {self.time_s:.2f} s)"]
+        for n, p in self.parameters.items():
+            se = "fixed" if not p.vary else (f"± {p.stderr:.3g}" if p.stderr is not None else "± n/a")
+            lines.append(f"  {PARAMETERS[n][0]:>18} = {p.value:10.4g} {se:>12}  [{p.min:g}, {p.max:g}]")
+        m = self.metrics
+        lines.append(f"  NRMSE cycles {100 * m.nrmse_cycles:.2f} %, blocked moment {100 * m.nrmse_blocked_moment:.2f} %, "
+                     f"free curvature {_pct(m.nrmse_free_curvature)}")
+        lines += [f"  note: {f}" for f in self.flags]
+        return "\n".join(lines)
+
+
+def _pct(x):
+    return "n/a" if x is None or not np.isfinite(x) else f"{100 * x:.2f} %"
+
+
+def _clean(obj):
+    if isinstance(obj, dict):
+        return {k: _clean(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [_clean(v) for v in obj]
+    if isinstance(obj, float | np.floating):
+        return float(obj) if np.isfinite(obj) else None
+    if isinstance(obj, np.integer):
+        return int(obj)
+    return obj
+
+
+def score(processed, actuator: Actuator, model: str = "energy", *, order: int = 32, eq19_factor: bool = True) -> Metrics:
+    """Metrics of eq 53-55 (and plain RMSEs) of ``actuator`` against processed data, without fitting.
+
+    * eq 53: ``NRMSE_cycles = sqrt(sum_i (RMSE_i / M_max,i)^2 K_max,i / sum_i K_max,i)`` over the
+      mean curves, with ``M_max,i`` the test's blocked moment and ``K_max,i`` its free curvature;
+    * eq 54: ``NRMSE_BM = RMSE_BM / max_i BM_i``;
+    * eq 55: ``NRMSE_FBC = RMSE_FBC / max_i FBC_i``, over the pressures where the model has a
+      free-bending equilibrium (the others are listed in ``no_equilibrium_kpa``).
+    """
+    model = normalise_model(model)
+    d = _data(processed, "all")
+    mod = get_model(model)
+    s = actuator.bend_sign or 1
+    A, B = mod.coefficients(actuator, s * d.kc, order=order, eq19_factor=eq19_factor)
+    pa = np.maximum(d.Pc - actuator.P_start, 0.0)
+    Mm = s * (pa * A - B)
+    per = []
+    rm = []
+    for i in range(d.P.size):
+        sel = d.seg == i
+        rm.append(math.sqrt(float(np.mean((Mm[sel] - d.Mc[sel]) ** 2))))
+    rm = np.array(rm)
+    nrmse_c = math.sqrt(float(np.sum((rm / d.BM) ** 2 * d.K) / np.sum(d.K)))
+    bm_model = np.abs(np.maximum(d.P - actuator.P_start, 0.0) * mod.coefficients(actuator, np.zeros(1), order=order,
+                                                                                    eq19_factor=eq19_factor)[0])
+    rmse_bm = math.sqrt(float(np.mean((bm_model - d.BM) ** 2)))
+    fb = free_curvature(actuator, d.P, model, order=order, eq19_factor=eq19_factor)
+    kf_model = np.abs(fb.curvature)
+    ok = np.isfinite(kf_model)
+    rmse_fbc = math.sqrt(float(np.mean((kf_model[ok] - d.K[ok]) ** 2))) if ok.any() else math.nan
+    for i in range(d.P.size):
+        per.append({
+            "pressure_kpa": float(d.P[i] * 1e3), "rmse_cycle_nmm": float(rm[i]), "M_max_nmm": float(d.BM[i]),
+            "K_max_per_mm": float(d.K[i]), "blocked_moment_model_nmm": float(bm_model[i]),
+            "free_curvature_model_per_mm": float(kf_model[i]) if ok[i] else None,
+        })
+    sq = (Mm - d.Mc) ** 2
+    return Metrics(
+        nrmse_cycles=nrmse_c,
+        nrmse_blocked_moment=rmse_bm / float(d.BM.max()),
+        nrmse_free_curvature=rmse_fbc / float(d.K.max()) if ok.any() else math.nan,
+        rmse_cycles=math.sqrt(float(np.mean(sq))),
+        rmse_blocked_moment=rmse_bm,
+        rmse_free_curvature=rmse_fbc,
+        per_pressure=per,
+        no_equilibrium_kpa=[float(p * 1e3) for p in d.P[~ok]],
+    )
+
+
+def fit(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C10", "C01"), *,
+        bounds: dict[str, tuple[float, float]] | None = None, tension: TensionFit | None = None, order: int = 32,
+        eq19_factor: bool = True, grid_alpha: int = 41, grid_r0: int = 9, corr_flag: float = 0.95,
+        fit_range: str = "developed") -> FitResult:
+    """Identify ``free`` parameters of ``actuator`` for ``model`` from a processed test set.
+
+    Parameters
+    ----------
+    processed : :class:`bendpam.testdata.processing.ProcessedSet` (or ``load_processed(dir)``).
+    actuator : the nominal actuator (geometry, and the values of the parameters held fixed).
+    model : ``"energy"`` or ``"force_balance"``.
+    free : names among alpha0, C10, C01, P_start, E_f, R0_start (aliases such as ``alpha0_deg`` work).
+    bounds : overrides of the default bounds, ``{name: (lo, hi)}`` in the parameter's unit.
+    tension : a :class:`TensionFit`; its C10 and C01 replace the actuator's before fitting.
+    fit_range : ``"developed"`` (default) fits each mean curve where the hysteresis loop is
+        developed (see :func:`developed_range`): near the reversals a rounded loop biases the
+        average of the branches.  ``"all"`` fits every point, as the paper did.  The metrics are
+        always computed on every point (eq 53).
+
+    Returns
+    -------
+    FitResult
+    """
+    t0 = time.perf_counter()
+    model = normalise_model(model)
+    free = parse_free(free)
+    if tension is not None:
+        actuator = actuator.replace(C10_kpa=tension.C10_kpa, C01_kpa=tension.C01_kpa)
+    d = _data(processed, fit_range)
+    bnd = _default_bounds(actuator, float(d.P.min() * 1e3))
+    for k, v in (bounds or {}).items():
+        key = parse_free([k])[0]
+        lo, hi = float(v[0]), float(v[1])
+        if not lo < hi:
+            raise ValueError(f"bounds for {k}: lower {lo:g} must be below upper {hi:g}")
+        bnd[key] = (lo, hi)
+    if "P_start" not in free and actuator.P_start_kpa >= d.P.min() * 1e3:
+        raise ValueError(
+            f"P_start = {actuator.P_start_kpa:g} kPa is not below the lowest test pressure {d.P.min() * 1e3:g} kPa"
+        )
+    prob = _Problem(actuator, d, model, free, bnd, order, eq19_factor)
+    nfev = 0
+
+    # 1. global stage: grid over the nonlinear parameters, linear ones projected
+    grids = []
+    for p in prob.nonlin:
+        lo, hi = bnd[p]
+        grids.append(np.linspace(lo, hi, grid_alpha if p == "alpha0" else grid_r0))
+    best = (math.inf, {}, None)
+    if grids:
+        mesh = np.meshgrid(*grids, indexing="ij")
+        for idx in np.ndindex(mesh[0].shape):
+            nl = {p: float(m[idx]) for p, m in zip(prob.nonlin, mesh)}
+            r, lin = prob.project(nl)
+            nfev += 1
+            ssr = float(r @ r)
+            if ssr < best[0]:
+                best = (ssr, nl, lin)
+    else:
+        r, lin = prob.project({})
+        nfev += 1
+        best = (float(r @ r), {}, lin)
+
+    # 2. local stage on the projected problem
+    converged, message = True, "linear least squares (exact)"
+    nl_best = best[1]
+    if prob.nonlin:
+        x0 = np.array([nl_best[p] for p in prob.nonlin])
+        lo = np.array([bnd[p][0] for p in prob.nonlin])
+        hi = np.array([bnd[p][1] for p in prob.nonlin])
+
+        def fun(x):
+            return prob.project(dict(zip(prob.nonlin, x)))[0]
+
+        sol = least_squares(fun, x0, bounds=(lo, hi), method="trf", x_scale=np.maximum(hi - lo, 1e-9) * 0.05,
+                            diff_step=1e-6, xtol=1e-12, ftol=1e-12, gtol=1e-12)
+        nfev += sol.nfev * (1 + len(prob.nonlin))
+        converged = bool(sol.status > 0)
+        message = sol.message
+        nl_best = dict(zip(prob.nonlin, sol.x))
+    r, lin = prob.project(nl_best)
+    nfev += 1
+    x_int = np.concatenate([[nl_best[p] for p in prob.nonlin], lin])
+
+    # 3. uncertainty from the joint Jacobian (nonlinear columns by central differences)
+    m = r.size
+    J = np.empty((m, x_int.size))
+    nn = len(prob.nonlin)
+    for j in range(nn):
+        h = 1e-5 * max(abs(x_int[j]), 1.0)
+        e = np.zeros_like(x_int)
+        e[j] = h
+        J[:, j] = (prob.residual_full(x_int + e) - prob.residual_full(x_int - e)) / (2 * h)
+        nfev += 2
+    _, X = prob.design(nl_best, {})
+    J[:, nn:] = prob.d.w[:, None] * X
+    # sandwich covariance: the weights normalise each curve (eq 53), they are not inverse noise
+    # variances, so each curve gets its own residual variance (with its AR(1) inflation)
+    B = J.T @ J
+    meat = np.zeros_like(B)
+    share = 1.0 - x_int.size / max(m, 1)
+    rhos = []
+    for i in np.unique(d.seg):
+        sel = d.seg == i
+        ri = r[sel]
+        var_i = float(ri @ ri) / max(share * ri.size, 1.0)
+        rho_i = min(max(_lag1(ri, np.zeros(ri.size, int)), 0.0), 0.95)
+        rhos.append(rho_i)
+        meat += (J[sel].T @ J[sel]) * var_i * (1.0 + rho_i) / (1.0 - rho_i)
+    rho = float(np.mean(rhos)) if rhos else 0.0
+    # active bounds: parameters pinned at a bound get no standard error
+    names_int = prob.nonlin + prob.lin_names()
+    lo_all = np.concatenate([[bnd[p][0] for p in prob.nonlin], prob.lin_bounds()[0]])
+    hi_all = np.concatenate([[bnd[p][1] for p in prob.nonlin], prob.lin_bounds()[1]])
+    at_bound = (np.abs(x_int - lo_all) <= 1e-9 * np.maximum(1, np.abs(lo_all))) | (
+        np.abs(x_int - hi_all) <= 1e-9 * np.maximum(1, np.abs(hi_all)))
+    Binv = np.linalg.pinv(B, rcond=1e-13)
+    cov_int = Binv @ meat @ Binv
+    # map internal -> user parameters (S, C01) -> (C10, C01)
+    G = np.eye(x_int.size)
+    if prob.sum_param:
+        iS = names_int.index("S")
+        i1 = names_int.index("C01")
+        G[iS, i1] = -1.0  # C10 = S - C01
+    cov = G @ cov_int @ G.T
+    user_names = prob.nonlin + prob.lin
+    # user_names order: nonlinear first, then linear in the order of prob.lin (S slot -> C10)
+    values = prob.to_user(nl_best, lin)
+    sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = cov / np.outer(sd, sd)
+    flags = []
+    for i in range(len(user_names)):
+        for j in range(i + 1, len(user_names)):
+            if np.isfinite(corr[i, j]) and abs(corr[i, j]) > corr_flag:
+                flags.append(f"{user_names[i]} and {user_names[j]} are poorly identifiable together "
+                             f"(correlation {corr[i, j]:+.3f}): their combination is determined, not each one")
+    pinned = [names_int[i] for i in range(len(names_int)) if at_bound[i]]
+    for p in pinned:
+        flags.append(f"{'C10 + C01' if p == 'S' else p} is at a bound of its range; its standard error is not meaningful")
+    fitted = prob.actuator(values)
+    params = {}
+    for n in _ORDER:
+        field_, unit = PARAMETERS[n]
+        val = float(getattr(fitted, field_))
+        if n in user_names:
+            i = user_names.index(n)
+            se = float(sd[i]) if np.isfinite(sd[i]) else None
+            lo_b, hi_b = bnd[n]
+            params[n] = Parameter(n, field_, unit, val, se, lo_b, hi_b, True, float(getattr(actuator, field_)))
+        elif n in ("alpha0", "C10", "C01", "P_start"):
+            params[n] = Parameter(n, field_, unit, val, None, bnd[n][0], bnd[n][1], False, val)
+    metrics = score(processed, fitted, model, order=order, eq19_factor=eq19_factor)
+    if metrics.no_equilibrium_kpa:
+        flags.append("no free-bending equilibrium in the fitted model at " +
+                     ", ".join(f"{p:g}" for p in metrics.no_equilibrium_kpa) + " kPa (fold); "
+                     "those pressures are left out of the free-curvature metric")
+    return FitResult(
+        model=model, actuator=fitted, parameters=params, correlation=corr, correlation_names=user_names,
+        metrics=metrics, converged=converged, message=str(message), nfev=nfev, time_s=time.perf_counter() - t0,
+        flags=flags, autocorrelation=rho,
+    )
+
+
+# ------------------------------------------------------------------------------------------------
+# the bladder's uniaxial tension test
+# ------------------------------------------------------------------------------------------------
+@dataclass
+class TensionFit:
+    """Mooney-Rivlin constants from a uniaxial tension test (kPa), with standard errors."""
+
+    C10_kpa: float
+    C01_kpa: float
+    C10_se_kpa: float
+    C01_se_kpa: float
+    correlation: float
+    rmse_kpa: float
+    max_stretch: float
+    n_points: int
+    source: str = ""
+
+    def to_dict(self) -> dict:
+        return _clean(self.__dict__.copy())
+
+
+def fit_tension(stretch, nominal_stress_mpa, *, source: str = "") -> TensionFit:
+    """Fit C10, C01 to uniaxial data: ``P = 2 (l - l^-2)(C10 + C01 / l)`` is linear in both.
+
+    Parameters
+    ----------
+    stretch : array of stretches l = 1 + dL / L_gauge (> 1 for the loading part).
+    nominal_stress_mpa : array of nominal stresses F / A0 (MPa).
+    """
+    lam = np.asarray(stretch, dtype=float)
+    sig = np.asarray(nominal_stress_mpa, dtype=float)
+    sel = np.isfinite(lam) & np.isfinite(sig) & (lam > 1.0 + 1e-6)
+    if sel.sum() < 3:
+        raise ValueError(f"{source or 'tension data'}: fewer than 3 points in tension (stretch > 1)")
+    lam, sig = lam[sel], sig[sel]
+    g = 2.0 * (lam - lam**-2)
+    X = np.column_stack([g, g / lam])
+    coef, *_ = np.linalg.lstsq(X, sig, rcond=None)
+    r = sig - X @ coef
+    dof = max(sig.size - 2, 1)
+    cov = np.linalg.inv(X.T @ X) * float(r @ r) / dof
+    se = np.sqrt(np.diag(cov))
+    return TensionFit(
+        C10_kpa=float(coef[0] * 1e3), C01_kpa=float(coef[1] * 1e3), C10_se_kpa=float(se[0] * 1e3),
+        C01_se_kpa=float(se[1] * 1e3), correlation=float(cov[0, 1] / (se[0] * se[1])) if se.all() else math.nan,
+        rmse_kpa=float(math.sqrt(float(r @ r) / sig.size) * 1e3), max_stretch=float(lam.max()), n_points=int(sig.size),
+        source=source,
+    )
+
+
+def tension_from_test(raw, *, gauge_length_mm: float, area_mm2: float) -> TensionFit:
+    """Stretch and nominal stress from a raw tension export (:class:`~bendpam.testdata.RawTest`).
+
+    Uses the loading part up to the maximum extension; stretch ``1 + extension / gauge_length``,
+    nominal stress ``force / area``.
+    """
+    for name, v in (("gauge length", gauge_length_mm), ("area", area_mm2)):
+        if not (math.isfinite(v) and v > 0):
+            raise ValueError(f"tension specimen {name} = {v!r} must be > 0")
+    ext = raw.data["stroke_mm"].to_numpy()
+    f = raw.data["force_n"].to_numpy()
+    ext = ext - ext[0]
+    if np.median(f) < 0:
+        f = -f
+    if np.median(ext) < 0:
+        ext = -ext
+    i = int(np.argmax(ext))
+    return fit_tension(1.0 + ext[: i + 1] / gauge_length_mm, f[: i + 1] / area_mm2, source=str(raw.path))
