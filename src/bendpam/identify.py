@@ -606,6 +606,7 @@ def fit(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C
     for p in pinned:
         flags.append(f"{'C10 + C01' if p == 'S' else p} is at a bound of its range; its standard error is not meaningful")
     fitted = prob.actuator(values)
+    fitted = fitted.replace(name=f"{actuator.name or actuator.kind} [fitted, {model.replace('_', '-')} model]")
     params = {}
     for n in _ORDER:
         field_, unit = PARAMETERS[n]

@@ -28,6 +28,7 @@ __all__ = [
     "save_figure",
     "demo_figure",
     "figure4",
+    "figure7",
 ]
 
 
@@ -224,5 +225,61 @@ def figure4(processed, title: str = ""):
     ax.set_title("(c) free-bending curvature", fontsize=9)
     if title:
         fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
+def figure7(processed, fit_result, title: str = ""):
+    """A figure like the paper's Figure 7: a fitted model against processed data.
+
+    (a) the data's branches (thin) and mean curve (markers) with the model curve at each pressure;
+    (b) blocked moment against pressure, data (mean ± SE) and model; (c) free-bending curvature
+    against pressure, data (mean ± SE) and model (pressures without an equilibrium are marked).
+    Magnitudes, as in the paper.
+    """
+    act = fit_result.actuator
+    model = fit_result.model
+    s = act.bend_sign or 1
+    res = processed.results
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.5))
+    ax = axes[0]
+    colors = plt.cm.viridis(np.linspace(0.0, 0.9, len(res)))
+    for c, r in zip(colors, res):
+        k = r.curvature_grid
+        ax.plot(k, r.mean_loading, color=c, lw=0.6, alpha=0.5)
+        ax.plot(k, r.mean_unloading, color=c, lw=0.6, alpha=0.5)
+        ax.plot(k[::4], r.mean_curve[::4], "o", color=c, ms=3, label=f"{r.pressure_kpa:g} kPa")
+        kk = np.linspace(0.0, k[-1], 120)
+        ax.plot(kk, s * moment(act, r.pressure_kpa * 1e-3, s * kk, model), "-", color=c, lw=1.5)
+    ax.set_xlabel("curvature |k'| (1/mm)")
+    ax.set_ylabel("moment |M| (N·mm)")
+    ax.set_title(f"(a) data (markers: mean curve) and {model.replace('_', '-')} model (lines)", fontsize=9)
+    ax.legend(fontsize=7)
+    P = processed.pressures_kpa
+    bm = np.array([r.blocked_moment for r in res])
+    kf = np.array([r.free_curvature for r in res])
+    Pm = np.linspace(min(P.min(), act.P_start_kpa), P.max() * 1.05, 100)
+    ax = axes[1]
+    ax.errorbar(P, bm[:, 0], yerr=np.nan_to_num(bm[:, 1]), fmt="o", capsize=3, label="data")
+    ax.plot(Pm, np.abs(moment(act, Pm * 1e-3, 0.0, model)), "-", label="model")
+    ax.set_xlabel("pressure (kPa)")
+    ax.set_ylabel("blocked moment (N·mm)")
+    ax.set_title(f"(b) blocked moment, NRMSE {100 * fit_result.metrics.nrmse_blocked_moment:.2f} %", fontsize=9)
+    ax.legend(fontsize=7)
+    ax = axes[2]
+    ax.errorbar(P, kf[:, 0], yerr=np.nan_to_num(kf[:, 1]), fmt="s", capsize=3, color="C2", label="data")
+    fb = free_curvature(act, Pm * 1e-3, model)
+    ax.plot(Pm, np.abs(fb.curvature), "-", color="C3", label="model")
+    if np.any(~fb.ok):
+        ax.axvline(fb.max_pressure * 1e3, color="crimson", ls=":", lw=1,
+                   label=f"no equilibrium above {fb.max_pressure * 1e3:.4g} kPa")
+    nf = fit_result.metrics.nrmse_free_curvature
+    ax.set_title("(c) free-bending curvature, NRMSE " + ("n/a" if not np.isfinite(nf) else f"{100 * nf:.2f} %"),
+                 fontsize=9)
+    ax.set_xlabel("pressure (kPa)")
+    ax.set_ylabel("free-bending curvature |k'| (1/mm)")
+    ax.legend(fontsize=7)
+    fig.suptitle(title or f"{act.name or act.kind}: {model.replace('_', '-')} model fit, NRMSE of the cycles "
+                 f"{100 * fit_result.metrics.nrmse_cycles:.2f} %", fontsize=10)
     fig.tight_layout()
     return fig
