@@ -90,14 +90,22 @@ def gauss_nodes(order: int = DEFAULT_ORDER) -> tuple[np.ndarray, np.ndarray]:
     return phi, wbar
 
 
+def _col(x):
+    """A scalar as is; an array parameter gets a trailing axis to broadcast against the nodes."""
+    return x[..., None] if np.ndim(x) else x
+
+
 def _ibar(u, c, omc, wbar):
-    """Circle means Ibar(u) and dIbar/du; ``u`` has shape S, ``omc = 1 - cos(phi)`` shape (n,)."""
+    """Circle means Ibar(u) and dIbar/du; ``u`` has shape S, ``omc = 1 - cos(phi)`` shape (n,).
+
+    ``c = cos(alpha0)`` is a scalar or an array broadcasting against ``u`` (vectorised sweeps).
+    """
     lam1 = 1.0 + u[..., None] * omc
-    cl = c * lam1
+    cl = _col(c) * lam1
     g = 1.0 - cl * cl
     inv = 1.0 / np.sqrt(g)
     ib = inv @ wbar
-    dib = ((c * cl * omc) * (inv / g)) @ wbar
+    dib = ((_col(c) * cl * omc) * (inv / g)) @ wbar
     return ib, dib
 
 
@@ -121,18 +129,26 @@ def solve_u(q_target, alpha0: float, order: int = DEFAULT_ORDER, u_bounds: tuple
     u, ibar, dibar : ndarray
         The root, and the circle mean ``Ibar(u)`` and its derivative at the root.
     """
+    c, s = np.cos(alpha0), np.sin(alpha0)
     q = np.asarray(q_target, dtype=float)
-    c, s = math.cos(alpha0), math.sin(alpha0)
+    if np.ndim(alpha0):
+        q = np.broadcast_to(q, np.broadcast_shapes(q.shape, np.shape(alpha0)))
     phi, wbar = gauss_nodes(order)
     omc = 1.0 - np.cos(phi)
     if u_bounds is None:
         u_bounds = (-0.5, (1.0 / c - 1.0) / 2.0)
     lo = np.where(q >= 0.0, 0.0, u_bounds[0])
     hi = np.where(q >= 0.0, u_bounds[1], 0.0)
-    # start from a monotone interpolation of the inverse q -> u (tabulated once per alpha0)
-    qt, ut = _inverse_table(float(alpha0), int(order))
     eps = 1e-9 * (hi - lo)
-    u = np.where(q == 0.0, 0.0, np.clip(np.interp(q, qt, ut), lo + eps, hi - eps))
+    if np.ndim(alpha0) == 0:
+        # start from a monotone interpolation of the inverse q -> u (tabulated once per alpha0)
+        qt, ut = _inverse_table(float(alpha0), int(order))
+        u0 = np.interp(q, qt, ut)
+    else:
+        # per-point braid angles (sweeps): xi(u) ~ 1 - cot^2(a0) u near 0, so u ~ q / (1 + cot^2 q)
+        cot2 = (c / s) ** 2
+        u0 = q / (1.0 + cot2 * np.maximum(q, 0.0))
+    u = np.where(q == 0.0, 0.0, np.clip(u0, lo + eps, hi - eps))
     for _ in range(_NEWTON_MAXITER):
         ib, dib = _ibar(u, c, omc, wbar)
         f = s * u * ib - q
@@ -308,13 +324,13 @@ class Kinematics:
 def radius_terms(kprime, alpha0: float, R0: float, order: int = DEFAULT_ORDER):
     """Core of eq 5 for the models: ``u, R, dR/dk', Ibar`` at ``kprime`` (no limit checks)."""
     k = np.asarray(kprime, dtype=float)
-    s = math.sin(alpha0)
+    s = np.sin(alpha0)
     u, ib, dib = solve_u(k * R0, alpha0, order)
     # eta(0) = 1 and xi'(0) = -cot^2 alpha0 hold exactly; don't let quadrature rounding blur them
     at0 = u == 0.0
     xi = np.where(at0, 1.0, 1.0 / (s * ib))
     R = R0 * xi
-    dxi = np.where(at0, -1.0 / math.tan(alpha0) ** 2, -xi * dib / ib)
+    dxi = np.where(at0, -1.0 / np.tan(alpha0) ** 2, -xi * dib / ib)
     dR = R0 * dxi * R / (1.0 - R0 * dxi * k)
     return u, R, dR
 

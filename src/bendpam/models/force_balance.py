@@ -37,11 +37,10 @@ With the corrections of section 3.3, ``P`` is the active pressure ``max(P - P_st
 
 from __future__ import annotations
 
-import math
 
 import numpy as np
 
-from ..kinematics import DEFAULT_ORDER, gauss_nodes, radius_terms
+from ..kinematics import DEFAULT_ORDER, _col, gauss_nodes, radius_terms
 
 __all__ = ["basis", "coefficients", "terms", "stress_state"]
 
@@ -52,18 +51,18 @@ def _state(actuator, k, order):
     phi, wbar = gauss_nodes(order)
     omc = 1.0 - np.cos(phi)
     lam1 = 1.0 + u[..., None] * omc
-    c = math.cos(actuator.alpha0)
+    c = np.cos(actuator.alpha0)
     lbar = 1.0 + u
     eta = R / R0
     tbar = actuator.t0_start / (lbar * eta)
-    cl2 = (c * lam1) ** 2
+    cl2 = (_col(c) * lam1) ** 2
     J = 2.0 * np.pi * ((lam1 * lam1 * omc / (1.0 - cl2)) @ wbar)
     C1, C2 = actuator.C10, actuator.C01
     le2 = (lbar * eta) ** 2
     # elastic (pressure-free) parts of eq 43 and eq 44
     const1 = -2.0 * C1 / le2 + 2.0 * C2 * le2  # Phi-independent part of sigma_bl,1^el
     sig2e = 2.0 * C1 * (eta * eta - 1.0 / le2) - 2.0 * C2 * (1.0 / (eta * eta) - le2)
-    varpart = 2.0 * np.pi * (((2.0 * C1 * lam1 * lam1 - 2.0 * C2 / (lam1 * lam1)) * omc) @ wbar)
+    varpart = 2.0 * np.pi * (((2.0 * _col(C1) * lam1 * lam1 - 2.0 * _col(C2) / (lam1 * lam1)) * omc) @ wbar)
     m_bl = tbar * R * R * (varpart + 2.0 * np.pi * const1)
     return dict(u=u, R=R, lam1=lam1, c=c, lbar=lbar, eta=eta, tbar=tbar, J=J, sig2e=sig2e, const1=const1, m_bl=m_bl,
                 omc=omc, wbar=wbar)
