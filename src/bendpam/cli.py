@@ -302,25 +302,14 @@ def demo(
     typer.echo(f"\nwrote {out}  ({time.perf_counter() - t0:.1f} s)")
 
 
-RAW_SUFFIXES = {".csv", ".txt", ".tsv", ".dat", ".asc", ".tra"}
-
-
 def collect_raw_files(paths: list[Path]) -> list[Path]:
-    """Expand folders into their raw test files (known suffixes, sorted); check files exist."""
-    files: list[Path] = []
-    for p in paths:
-        if p.is_dir():
-            found = sorted(q for q in p.iterdir() if q.is_file() and q.suffix.lower() in RAW_SUFFIXES)
-            if not found:
-                raise UserError(f"{p}: no raw test files here (looked for {', '.join(sorted(RAW_SUFFIXES))})")
-            files.extend(found)
-        elif p.exists():
-            files.append(p)
-        else:
-            raise UserError(f"{p}: no such file or folder")
-    if not files:
-        raise UserError("give raw test files or a folder of them")
-    return files
+    """Expand folders into their raw test files (see :func:`bendpam.testdata.files.collect_raw_files`)."""
+    from .testdata.files import collect_raw_files as _collect
+
+    try:
+        return _collect(paths)
+    except ValueError as exc:
+        raise UserError(str(exc)) from None
 
 
 class Format(str, Enum):
@@ -547,6 +536,14 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     return 0
 
+
+def _register_extensions() -> None:
+    from .cli_report import register as register_report
+
+    register_report(app)
+
+
+_register_extensions()
 
 if __name__ == "__main__":  # pragma: no cover
     sys.exit(main())

@@ -1,0 +1,102 @@
+"""The ``bendpam report`` command: raw test files -> one self-contained HTML report.
+
+``register(app)`` adds the command to the ``bendpam`` Typer app (``bendpam.cli.app``).  Like the
+other commands it only parses and prints; the work is :func:`bendpam.report.build_report`.  The
+shared helpers come from :mod:`bendpam.cli`, imported when ``register`` runs (the option types) or
+when the command runs (the rest), so ``cli.py`` can call ``register(app)`` at its end without an
+import cycle.
+
+(No ``from __future__ import annotations`` here: the command is defined inside ``register`` and
+Typer reads its annotations as objects.)
+"""
+
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+__all__ = ["register"]
+
+
+def register(app: typer.Typer) -> None:
+    """Add the ``report`` command to ``app`` (does nothing if it has one already)."""
+    if any(getattr(c, "name", None) == "report" for c in app.registered_commands):
+        return
+    from .cli import ActuatorOpt, PresetOpt
+
+    @app.command("report")
+    def report(
+        inputs: Annotated[list[Path], typer.Argument(help="Raw test files, or a folder of them.", show_default=False)],
+        preset: PresetOpt = None,
+        actuator: ActuatorOpt = None,
+        out: Annotated[Optional[Path], typer.Option("--out", help="The HTML report to write (report.html).")] = None,
+        pressure_kpa: Annotated[
+            Optional[list[str]],
+            typer.Option("--pressure-kpa", help="Pressure of each file in kPa, comma-separated, in file order "
+                         "(default: each file's metadata or filename)."),
+        ] = None,
+        l0_mm: Annotated[
+            Optional[float],
+            typer.Option("--l0-mm", help="Active length L0 for k' = 2 beta / L0 (mm); default: the actuator's."),
+        ] = None,
+        fixture: Annotated[str, typer.Option("--fixture", help="Fixture geometry d,r,t in mm.")] = "35,2.5,4",
+        free: Annotated[
+            str, typer.Option("--free", help="Parameters to identify: alpha0,C10,C01,P_start,E_f,R0_start.")
+        ] = "alpha0,C10,C01",
+        model: Annotated[
+            Optional[list[str]],
+            typer.Option("--model", help="Model(s) to fit: energy, force-balance (repeat or comma-separate; "
+                         "default both)."),
+        ] = None,
+        progress: Annotated[
+            bool, typer.Option("--progress/--no-progress", help="Progress bar on stderr (drawn only on a terminal).")
+        ] = True,
+    ):
+        """Process raw cyclic tests, fit the models and write ONE self-contained HTML report."""
+        _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, model, progress)
+
+
+def _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, model, progress) -> None:
+    from .cli import Model, UserError, _num, collect_raw_files, load_actuator, parse_values
+    from .fixture import Fixture
+    from .report import build_report
+
+    if out is None:
+        raise UserError("give the report to write with --out report.html")
+    if out.suffix.lower() not in {".html", ".htm"}:
+        raise UserError(f"--out {str(out)!r}: the report is HTML; give a file name ending in .html")
+    models = []
+    for tok in model or ["energy", "force-balance"]:
+        for part in tok.replace(",", " ").split():
+            try:
+                m = Model(part.strip().lower().replace("_", "-"))
+            except ValueError:
+                raise UserError(f"--model {part!r} is not known; choose energy or force-balance") from None
+            if m not in models:
+                models.append(m)
+    if not models:
+        raise UserError("--model: give energy, force-balance or both")
+    # the nominal actuator: a preset takes the first model's Table 3 constants (start values only)
+    act = load_actuator(preset, actuator, models[0])
+    files = collect_raw_files(inputs)
+    pressures = parse_values(pressure_kpa, "--pressure-kpa") if pressure_kpa else None
+    if pressures is not None and len(pressures) != len(files):
+        raise UserError(
+            f"--pressure-kpa: got {len(pressures)} pressure(s) for {len(files)} file(s); give one per file, in order"
+        )
+    fx = Fixture.from_string(fixture, L0_mm=act.L0_mm if l0_mm is None else l0_mm)
+    res = build_report(files, act, out, models=[m.value for m in models], free=free, pressure_kpa=pressures,
+                       fixture=fx, progress=progress)
+
+    summ = res["summary"]
+    for row in res["table2"]:
+        typer.echo(f"{row['pressure_kpa']:>6} kPa  {row['cycles']} cycles  blocked {row['blocked_moment_nmm']} N·mm  "
+                   f"free k' {row['free_curvature_per_mm']} 1/mm  loss {row['energy_loss_percent']} %")
+    typer.echo(f"deadband: {_num(summ['deadband_kpa'], '.4g')} ± {_num(summ['deadband_se_kpa'], '.2g')} kPa")
+    for row in res["table3"]:
+        typer.echo(f"{row['model']}: alpha0 {row['alpha0']} deg, C10 {row['C10']} kPa, C01 {row['C01']} kPa; NRMSE "
+                   f"cycles {row['nrmse_cycles']} %, blocked moment {row['nrmse_blocked_moment']} %, free curvature "
+                   f"{row['nrmse_free_curvature']} %")
+    for note in res["notes"]:
+        typer.echo(f"bendpam: warning: {note}", err=True)
+    typer.echo(f"wrote {out} ({res['bytes'] / 1024:.0f} KiB, {len(res['figures'])} figures)")

@@ -1,0 +1,1004 @@
+r"""A bending-PAM finger under in-plane loads: equilibrium shape, tip pose, blocked force, stiffness.
+
+Model
+-----
+The actuator is an inextensible rod along its frame line, of length ``L0`` (the active length).
+With arc length ``s`` (mm), tangent angle ``phi(s)`` (rad, counterclockwise from +x) and position
+``(x(s), y(s))`` (mm)::
+
+    dx/ds = cos phi,   dy/ds = sin phi,   dphi/ds = c k'(s)
+
+where ``k'`` is the frame curvature of the paper (1/mm, > 0 toward the frame) and ``c = +-1`` is the
+*frame side* of the mounting (below).  At each ``s`` the section is in equilibrium::
+
+    M_load(P, k'(s)) = M_ext(s)
+
+``M_load`` is the actuator's output moment (:func:`bendpam.moment`) and ``M_ext`` is the moment of
+every load beyond ``s`` about the point ``(x(s), y(s))``, written in the actuator's sign convention:
+``M_ext = -c m(s)`` where ``m(s)`` is the counterclockwise moment of those loads.  A load that
+resists bending gives ``M_ext`` of the sign of the blocked moment and a smaller ``|k'|``.  The loads
+are a tip force in any in-plane direction, a tip moment, a point mass at the fingertip, a
+distributed self-weight (mass per length), and the contact forces of :mod:`bendpam.design.grasp`.
+A rigid fingertip of length ``fingertip_mm`` continues the rod along its end tangent; its end point,
+shifted ``fingertip_offset_mm`` toward the bending side, is where tip loads act and is reported as
+the tip.
+
+Mounting and signs
+------------------
+``bend = +1`` (``"ccw"``) makes the finger curl counterclockwise when inflated, ``-1`` (``"cw"``)
+clockwise.  A BE-PAM bends toward its frame and a BC-PAM away from it, so the frame side is
+``c = bend * actuator.bend_sign``: a BC-PAM finger is mounted with its frame on the other side and
+then bends the same geometric way as a BE-PAM finger with the same ``bend``.  Mirroring the base,
+``bend`` and all loads about a line mirrors the shape (tested).
+
+Numerics
+--------
+Collocation on ``n`` equally spaced nodes (default 81): the unknowns are the nodal curvatures;
+``phi`` is their trapezoidal integral and every segment is integrated exactly as a circular arc of
+linearly varying angle, so a constant-curvature (free) shape is exact.  The moment law is
+tabulated once per actuator and model (8000 curvatures, cubic Hermite interpolation, relative
+error below 1e-7) and inverted only on the **stable branch**: the interval of ``k'`` around the
+straight state on which ``dM/dk' < 0``.  It ends at a fold of the moment law (the BC-PAM's N-shaped
+law, and the BE-PAM's at large curvature) or at braid lock-up.  Every Newton step is kept inside
+that interval, so a curvature on the unstable (snapped) part of the law is never returned.
+
+The nonlinear equations are solved by a damped Newton method with an exact (complex-step)
+Jacobian, by continuation in the load fraction from the free shape (constant free curvature).
+When the loads ask for more moment than the stable branch can supply anywhere along the finger,
+the continuation stops at a load fraction below one: the result has ``equilibrium=False``, NaN
+shape arrays and a note (snap-through at the fold, or lock-up); the last equilibrium reached is in
+``.limit``.  Above the BC-PAM's fold pressure there is no free shape; the solver then looks for a
+loaded equilibrium on the stable branch directly and says so in the note.  Each equilibrium is also
+checked for structural stability (the weighted, symmetrised Jacobian must be negative definite:
+the second variation of the potential energy of dead loads).  The reported ``residual_nmm`` is
+``max |M(P, k'(s)) - M_ext(s)|`` along ``s`` with the exact model (not the table).
+
+Units: mm, N, N*mm, MPa (the functions take pressures in MPa, as the rest of the library), rad.
+Masses are given in grams, weights use g = 9.80665 m/s^2.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from functools import lru_cache
+
+import numpy as np
+
+from ..actuator import Actuator
+from ..kinematics import curvature_limits
+from ..models import get_model
+from ..predict import free_curvature, moment
+from ..presets import normalise_model
+
+__all__ = [
+    "G_N_PER_G",
+    "Finger",
+    "FingerLoads",
+    "FingerShape",
+    "StableBranch",
+    "BlockedTipForce",
+    "TipStiffness",
+    "stable_branch",
+    "solve_finger",
+    "finger_sweep",
+    "free_tip_trajectory",
+    "blocked_tip_force",
+    "tip_stiffness",
+    "linear_tip_compliance",
+]
+
+#: weight of one gram, N (standard gravity 9.80665 m/s^2)
+G_N_PER_G = 9.80665e-3
+
+_TABLE_POINTS = 8000
+_NEWTON_TOL = 1e-10  # on the residual divided by the moment scale
+_MAX_NEWTON = 40
+_MIN_STEP = 1.0 / 2048
+
+
+def _num(name: str, value, lo=None, hi=None, *, lo_open=False, unit="") -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} = {value!r} is not a number") from None
+    rng = f"{'(' if lo_open else '['}{'-inf' if lo is None else f'{lo:g}'}, {'inf' if hi is None else f'{hi:g}'}]"
+    u = f" {unit}" if unit else ""
+    if not math.isfinite(v) or (lo is not None and (v <= lo if lo_open else v < lo)) or (hi is not None and v > hi):
+        raise ValueError(f"{name} = {v:g}{u} is outside the allowed range {rng}{u}")
+    return v
+
+
+def _pair(name: str, value, unit: str) -> tuple[float, float]:
+    try:
+        a = np.asarray(value, dtype=float).ravel()
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} = {value!r} must be two numbers ({unit})") from None
+    if a.size != 2 or not np.all(np.isfinite(a)):
+        raise ValueError(f"{name} = {value!r} must be two finite numbers ({unit})")
+    return float(a[0]), float(a[1])
+
+
+def _pressure(pressure) -> float:
+    return _num("pressure", pressure, 0.0, unit="MPa")
+
+
+# ------------------------------------------------------------------------------------------------
+# the moment law on its stable branch
+# ------------------------------------------------------------------------------------------------
+class _Law:
+    """``A(k'), B(k')`` (``M = p_a A - B``) tabulated on a dense grid with their derivatives."""
+
+    def __init__(self, actuator: Actuator, model: str):
+        lim = curvature_limits(actuator)
+        span = lim.k_max - lim.k_min
+        n_neg = max(int(_TABLE_POINTS * (-lim.k_min) / span), 50)
+        n_pos = max(_TABLE_POINTS - n_neg, 50)
+        shrink = 1.0 - 1e-9
+        kg = np.concatenate([np.linspace(lim.k_min * shrink, 0.0, n_neg + 1)[:-1],
+                             np.linspace(0.0, lim.k_max * shrink, n_pos + 1)])
+        A, B = get_model(model).coefficients(actuator, kg)
+        self.k = kg
+        self.A, self.B = A, B
+        self.dA = np.gradient(A, kg, edge_order=2)
+        self.dB = np.gradient(B, kg, edge_order=2)
+        self.i0 = n_neg  # index of k' = 0
+        self.P_start = actuator.P_start
+        self.k_min, self.k_max = float(kg[0]), float(kg[-1])
+
+
+@lru_cache(maxsize=32)
+def _law_cached(actuator: Actuator, model: str) -> _Law:
+    return _Law(actuator, model)
+
+
+def _law(actuator: Actuator, model: str) -> _Law:
+    # the section law does not depend on the length or the label: share one table
+    return _law_cached(actuator.replace(L0_mm=100.0, name=""), normalise_model(model))
+
+
+def _hermite(kg, f, df, x):
+    """Cubic Hermite interpolant of ``f`` (with slopes ``df``) and its derivative at ``x``.
+
+    ``x`` may be complex (complex-step derivatives): the interval comes from its real part.
+    """
+    xr = np.real(x)
+    j = np.clip(np.searchsorted(kg, xr, side="right") - 1, 0, kg.size - 2)
+    k0 = kg[j]
+    h = kg[j + 1] - k0
+    t = (x - k0) / h
+    t2 = t * t
+    f0, f1, d0, d1 = f[j], f[j + 1], df[j] * h, df[j + 1] * h
+    val = (1 + 2 * t) * (1 - t) ** 2 * f0 + t * (1 - t) ** 2 * d0 + t2 * (3 - 2 * t) * f1 + t2 * (t - 1) * d1
+    der = ((6 * t2 - 6 * t) * f0 + (3 * t2 - 4 * t + 1) * d0 + (6 * t - 6 * t2) * f1 + (3 * t2 - 2 * t) * d1) / h
+    return val, der
+
+
+@dataclass(frozen=True)
+class StableBranch:
+    """The stable part of the moment law ``M(P, k')`` at one pressure.
+
+    Along the branch connected to the straight state (``k' = 0``) ``M`` decreases strictly with
+    ``k'``; it is the only part of the law on which a loaded finger can rest (a segment with
+    ``dM/dk' > 0`` is unstable and snaps through).
+
+    Attributes
+    ----------
+    pressure : MPa.
+    k_lo, k_hi : ends of the branch, 1/mm (``k_lo < 0 < k_hi``).
+    moment_max, moment_min : ``M`` at ``k_lo`` and ``k_hi`` (N*mm): the range of moments the
+        actuator can balance at this pressure.
+    end_lo, end_hi : ``"fold"`` or ``"lock-up"``: what ends the branch on each side.
+    free_curvature : the free curvature on the branch (1/mm), NaN if ``M = 0`` is outside the range.
+    """
+
+    pressure: float
+    k_lo: float
+    k_hi: float
+    moment_max: float
+    moment_min: float
+    end_lo: str
+    end_hi: str
+    free_curvature: float
+    _law: _Law = field(repr=False, compare=False)
+    _m: np.ndarray = field(repr=False, compare=False)
+    _dm: np.ndarray = field(repr=False, compare=False)
+
+    def moment(self, k):
+        """``M`` (N*mm) and ``dM/dk'`` (N*mm^2) from the table (cubic Hermite), broadcasting ``k``."""
+        return _hermite(self._law.k, self._m, self._dm, k)
+
+    def curvature(self, m):
+        """Invert ``M(P, k') = m`` on the branch (1/mm); NaN outside ``[moment_min, moment_max]``."""
+        m = np.asarray(m, dtype=float)
+        lo = np.searchsorted(self._law.k, self.k_lo)
+        hi = np.searchsorted(self._law.k, self.k_hi, side="right")
+        kk, mm = self._law.k[lo:hi], self._m[lo:hi]
+        k = np.interp(-m, -mm, kk)
+        for _ in range(3):  # Newton polish on the Hermite law
+            f, d = self.moment(k)
+            k = np.clip(k - (f - m) / d, self.k_lo, self.k_hi)
+        return np.where((m <= self.moment_max) & (m >= self.moment_min), k, np.nan)
+
+    def describe_end(self, side: int) -> str:
+        k, kind = (self.k_hi, self.end_hi) if side > 0 else (self.k_lo, self.end_lo)
+        m = self.moment_min if side > 0 else self.moment_max
+        what = "a fold of the moment law (N-shaped: beyond it the actuator snaps through)" if kind == "fold" \
+            else "braid lock-up"
+        return f"{what} at k' = {k:.5g} 1/mm, M = {m:.4g} N*mm"
+
+
+def stable_branch(actuator, pressure, model: str = "energy") -> StableBranch:
+    """The stable branch of the moment law at ``pressure`` (MPa): see :class:`StableBranch`."""
+    if not isinstance(actuator, Actuator):
+        raise TypeError(f"actuator must be a bendpam.Actuator, got {type(actuator).__name__}")
+    P = _pressure(pressure)
+    model = normalise_model(model)
+    law = _law(actuator, model)
+    pa = max(P - law.P_start, 0.0)
+    m = pa * law.A - law.B
+    dm = pa * law.dA - law.dB
+    i0 = law.i0
+    if dm[i0] >= 0.0:
+        raise ValueError(
+            f"pressure = {P * 1e3:g} kPa: the straight state is unstable (dM/dk' = {dm[i0]:.4g} N*mm^2 >= 0 at "
+            "k' = 0), so the actuator has no stable branch to rest on"
+        )
+    bad = np.flatnonzero(dm >= 0.0)
+    left, right = bad[bad < i0], bad[bad > i0]
+    kg = law.k
+
+    def fold(i):  # dm changes sign between i and i+1: linear zero of dm
+        return kg[i] + (kg[i + 1] - kg[i]) * dm[i] / (dm[i] - dm[i + 1])
+
+    if right.size:
+        k_hi, end_hi = float(fold(right[0] - 1)), "fold"
+    else:
+        k_hi, end_hi = float(kg[-1]), "lock-up"
+    if left.size:
+        k_lo, end_lo = float(fold(left[-1])), "fold"
+    else:
+        k_lo, end_lo = float(kg[0]), "lock-up"
+    m_lo = float(_hermite(kg, m, dm, k_lo)[0])
+    m_hi = float(_hermite(kg, m, dm, k_hi)[0])
+    br = StableBranch(P, k_lo, k_hi, m_lo, m_hi, end_lo, end_hi, math.nan, law, m, dm)
+    if m_hi < 0.0 < m_lo:
+        kf = float(br.curvature(0.0))
+        br = replace(br, free_curvature=kf)
+    elif m_hi == 0.0 or m_lo == 0.0:
+        br = replace(br, free_curvature=0.0)
+    return br
+
+
+# ------------------------------------------------------------------------------------------------
+# finger, loads, results
+# ------------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Finger:
+    """A bending-PAM finger and its mounting (validated, immutable).
+
+    Parameters
+    ----------
+    actuator : Actuator
+        The actuator; its ``L0_mm`` is the finger's active length.
+    model : {"energy", "force_balance"}
+    base_xy_mm : (float, float)
+        Position of the frame line's base, mm.
+    base_angle_deg : float
+        Direction of the finger at its base, degrees counterclockwise from +x (default 0:
+        horizontal, pointing along +x).
+    bend : {+1, -1} or {"ccw", "cw"}
+        Direction in which the finger curls when inflated (default counterclockwise).  The
+        frame side follows: ``frame_side = bend * actuator.bend_sign``.
+    fingertip_mm : float
+        Length of a rigid fingertip along the end tangent, mm, >= 0.
+    fingertip_offset_mm : float
+        Lateral offset of the fingertip point toward the bending side, mm.
+    nodes : int
+        Collocation nodes along the active length, in [11, 1001] (default 81).
+    """
+
+    actuator: Actuator
+    model: str = "energy"
+    base_xy_mm: tuple[float, float] = (0.0, 0.0)
+    base_angle_deg: float = 0.0
+    bend: int = 1
+    fingertip_mm: float = 0.0
+    fingertip_offset_mm: float = 0.0
+    nodes: int = 81
+
+    def __post_init__(self):
+        s = object.__setattr__
+        if not isinstance(self.actuator, Actuator):
+            raise TypeError(f"actuator must be a bendpam.Actuator, got {type(self.actuator).__name__}")
+        if self.actuator.bend_sign == 0:
+            raise ValueError(f"alpha0_deg = {self.actuator.alpha0_deg:g} deg is the neutral braid angle: "
+                             "the actuator does not bend, so it cannot be a finger")
+        s(self, "model", normalise_model(self.model))
+        s(self, "base_xy_mm", _pair("base_xy_mm", self.base_xy_mm, "mm"))
+        s(self, "base_angle_deg", _num("base_angle_deg", self.base_angle_deg, -720.0, 720.0, unit="deg"))
+        b = self.bend
+        if isinstance(b, str):
+            key = b.strip().lower()
+            if key not in ("ccw", "cw"):
+                raise ValueError(f"bend = {b!r} is not allowed; choose 'ccw' (+1) or 'cw' (-1)")
+            b = 1 if key == "ccw" else -1
+        if b not in (1, -1):
+            raise ValueError(f"bend = {b!r} is not allowed; choose +1 (ccw) or -1 (cw)")
+        s(self, "bend", int(b))
+        s(self, "fingertip_mm", _num("fingertip_mm", self.fingertip_mm, 0.0, 1e4, unit="mm"))
+        s(self, "fingertip_offset_mm", _num("fingertip_offset_mm", self.fingertip_offset_mm, -1e4, 1e4, unit="mm"))
+        n = self.nodes
+        if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not 11 <= int(n) <= 1001:
+            raise ValueError(f"nodes = {n!r} is outside the allowed range [11, 1001] (an integer)")
+        s(self, "nodes", int(n))
+
+    @property
+    def length(self) -> float:
+        """Active length L0, mm."""
+        return self.actuator.L0
+
+    @property
+    def frame_side(self) -> int:
+        """+1 if the frame lies on the counterclockwise side of the rod, -1 otherwise."""
+        return self.bend * self.actuator.bend_sign
+
+    @property
+    def base_angle(self) -> float:
+        return math.radians(self.base_angle_deg)
+
+    def mirrored(self, axis_angle_deg: float = 0.0) -> Finger:
+        """The mirror image about the line through the origin at ``axis_angle_deg``."""
+        a = math.radians(axis_angle_deg)
+        x, y = self.base_xy_mm
+        c2, s2 = math.cos(2 * a), math.sin(2 * a)
+        return replace(self, base_xy_mm=(c2 * x + s2 * y, s2 * x - c2 * y),
+                       base_angle_deg=2 * axis_angle_deg - self.base_angle_deg, bend=-self.bend)
+
+
+@dataclass(frozen=True)
+class FingerLoads:
+    """In-plane loads on a finger (dead loads: fixed directions).
+
+    Parameters
+    ----------
+    tip_force_n : (Fx, Fy)
+        Force on the fingertip point, N, in the plane's axes.
+    tip_moment_nmm : float
+        Moment on the tip, N*mm, counterclockwise positive.
+    tip_mass_g : float
+        Point mass at the fingertip point, g (its weight acts along ``gravity``).
+    mass_per_length_g_per_mm : float
+        Self-weight of the actuator, g/mm, uniform along the active length.
+    gravity : (gx, gy)
+        Direction of gravity in the plane (normalised here); default ``(0, -1)``.
+    """
+
+    tip_force_n: tuple[float, float] = (0.0, 0.0)
+    tip_moment_nmm: float = 0.0
+    tip_mass_g: float = 0.0
+    mass_per_length_g_per_mm: float = 0.0
+    gravity: tuple[float, float] = (0.0, -1.0)
+
+    def __post_init__(self):
+        s = object.__setattr__
+        s(self, "tip_force_n", _pair("tip_force_n", self.tip_force_n, "N"))
+        s(self, "tip_moment_nmm", _num("tip_moment_nmm", self.tip_moment_nmm, unit="N*mm"))
+        s(self, "tip_mass_g", _num("tip_mass_g", self.tip_mass_g, 0.0, unit="g"))
+        s(self, "mass_per_length_g_per_mm",
+          _num("mass_per_length_g_per_mm", self.mass_per_length_g_per_mm, 0.0, unit="g/mm"))
+        g = _pair("gravity", self.gravity, "direction")
+        ng = math.hypot(*g)
+        if ng == 0.0:
+            raise ValueError("gravity = (0, 0) has no direction; give a non-zero vector, e.g. (0, -1)")
+        s(self, "gravity", (g[0] / ng, g[1] / ng))
+
+    @property
+    def is_zero(self) -> bool:
+        return (self.tip_force_n == (0.0, 0.0) and self.tip_moment_nmm == 0.0 and self.tip_mass_g == 0.0
+                and self.mass_per_length_g_per_mm == 0.0)
+
+    def tip_resultant(self) -> tuple[float, float]:
+        """Total force at the fingertip point (force + weight of the tip mass), N."""
+        w = self.tip_mass_g * G_N_PER_G
+        return self.tip_force_n[0] + w * self.gravity[0], self.tip_force_n[1] + w * self.gravity[1]
+
+    def distributed(self) -> tuple[float, float]:
+        """Distributed load per length, N/mm."""
+        w = self.mass_per_length_g_per_mm * G_N_PER_G
+        return w * self.gravity[0], w * self.gravity[1]
+
+    def mirrored(self, axis_angle_deg: float = 0.0) -> FingerLoads:
+        a = math.radians(axis_angle_deg)
+        c2, s2 = math.cos(2 * a), math.sin(2 * a)
+
+        def m(v):
+            return (c2 * v[0] + s2 * v[1], s2 * v[0] - c2 * v[1])
+
+        return replace(self, tip_force_n=m(self.tip_force_n), tip_moment_nmm=-self.tip_moment_nmm,
+                       gravity=m(self.gravity))
+
+
+@dataclass(frozen=True)
+class FingerShape:
+    """Equilibrium shape of a finger (arrays over the ``nodes`` collocation points).
+
+    Attributes
+    ----------
+    pressure : MPa.
+    s : arc length, mm.
+    x, y : frame-line position, mm.
+    angle : tangent angle phi, rad (counterclockwise from +x).
+    curvature : frame curvature k', 1/mm (paper's sign: > 0 toward the frame).
+    moment_ext : M_ext(s), N*mm, in the actuator's sign convention (equal to M_load(P, k')).
+    tip_xy : fingertip point, mm.  tip_angle : tip orientation phi(L), rad.
+    equilibrium : a stable equilibrium was found for the full load.
+    stable : the structural stability check passed.
+    residual_nmm : max |M(P, k'(s)) - M_ext(s)| with the exact model, N*mm.
+    load_fraction : fraction of the load reached by the continuation (1 on success).
+    note : empty on a plain success, else what happened (snap-through, no free shape, ...).
+    limit : on failure, the last equilibrium reached (a FingerShape at ``load_fraction``), else None.
+    branch : the :class:`StableBranch` used.
+    """
+
+    finger: Finger
+    loads: FingerLoads
+    pressure: float
+    s: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    angle: np.ndarray
+    curvature: np.ndarray
+    moment_ext: np.ndarray
+    tip_xy: tuple[float, float]
+    tip_angle: float
+    equilibrium: bool
+    stable: bool
+    residual_nmm: float
+    load_fraction: float
+    note: str
+    limit: FingerShape | None = field(default=None, repr=False)
+    branch: StableBranch | None = field(default=None, repr=False)
+
+    @property
+    def tip_angle_deg(self) -> float:
+        return math.degrees(self.tip_angle)
+
+    @property
+    def bend_angle(self) -> float:
+        """Rotation of the tip from the base direction, rad, positive in the finger's bending direction."""
+        return self.finger.bend * (self.tip_angle - self.finger.base_angle)
+
+    @property
+    def bend_angle_deg(self) -> float:
+        return math.degrees(self.bend_angle)
+
+    def to_dataframe(self):
+        """The shape as a :class:`pandas.DataFrame` (units in the column names)."""
+        import pandas as pd
+
+        return pd.DataFrame({"s_mm": self.s, "x_mm": self.x, "y_mm": self.y, "angle_deg": np.degrees(self.angle),
+                             "curvature_per_mm": self.curvature, "moment_ext_nmm": self.moment_ext})
+
+
+# ------------------------------------------------------------------------------------------------
+# the discretised rod
+# ------------------------------------------------------------------------------------------------
+def _sinc(x):
+    """sin(x)/x, analytic (complex-step safe)."""
+    small = np.abs(x) < 1e-3
+    xs = np.where(small, 1.0, x)
+    x2 = x * x
+    return np.where(small, 1.0 - x2 / 6.0 + x2 * x2 / 120.0, np.sin(xs) / xs)
+
+
+def _cross(ax, ay, bx, by):
+    return ax * by - ay * bx
+
+
+class _Rod:
+    """Geometry and load moments of the discretised finger (batched over leading axes)."""
+
+    def __init__(self, finger: Finger, loads: FingerLoads):
+        self.f = finger
+        n = finger.nodes
+        L = finger.length
+        self.n, self.L = n, L
+        self.s = np.linspace(0.0, L, n)
+        self.h = L / (n - 1)
+        self.w = np.full(n, self.h)
+        self.w[[0, -1]] *= 0.5
+        self.c = finger.frame_side
+        self.x0, self.y0 = finger.base_xy_mm
+        self.phi0 = finger.base_angle
+        self.ell, self.off = finger.fingertip_mm, finger.fingertip_offset_mm
+        self.loads = loads
+        self.F = loads.tip_resultant()
+        self.q = loads.distributed()
+        self.Mt = loads.tip_moment_nmm
+        self.rem = L - self.s  # length beyond each node
+
+    def geometry(self, k):
+        h = self.h
+        kap = self.c * k
+        inc = 0.5 * h * (kap[..., 1:] + kap[..., :-1])
+        zero = np.zeros(k.shape[:-1] + (1,), dtype=k.dtype)
+        phi = self.phi0 + np.concatenate([zero, np.cumsum(inc, axis=-1)], axis=-1)
+        mid = 0.5 * (phi[..., 1:] + phi[..., :-1])
+        sc = h * _sinc(0.5 * inc)
+        x = self.x0 + np.concatenate([zero, np.cumsum(np.cos(mid) * sc, axis=-1)], axis=-1)
+        y = self.y0 + np.concatenate([zero, np.cumsum(np.sin(mid) * sc, axis=-1)], axis=-1)
+        pl = phi[..., -1]
+        b = self.f.bend
+        xt = x[..., -1] + self.ell * np.cos(pl) - b * self.off * np.sin(pl)
+        yt = y[..., -1] + self.ell * np.sin(pl) + b * self.off * np.cos(pl)
+        return phi, x, y, xt, yt
+
+    def point(self, phi, x, y, sc):
+        """Position and angle at arc length ``sc`` (batched scalar) on the arcs between nodes."""
+        h = self.h
+        jr = np.clip(np.floor(np.real(sc) / h).astype(int), 0, self.n - 2)
+        idx = jr[..., None]
+        p0 = np.take_along_axis(phi, idx, -1)[..., 0]
+        p1 = np.take_along_axis(phi, idx + 1, -1)[..., 0]
+        x0 = np.take_along_axis(x, idx, -1)[..., 0]
+        y0 = np.take_along_axis(y, idx, -1)[..., 0]
+        tau = sc - jr * h
+        dp = (p1 - p0) * tau / h
+        pm = p0 + 0.5 * dp
+        ln = tau * _sinc(0.5 * dp)
+        return x0 + ln * np.cos(pm), y0 + ln * np.sin(pm), p0 + dp
+
+    def load_moment(self, x, y, xt, yt, lam=1.0):
+        """Counterclockwise moment m(s_j) of the dead loads beyond each node, N*mm."""
+        Fx, Fy = self.F
+        m = lam * (self.Mt + _cross(xt[..., None] - x, yt[..., None] - y, Fx, Fy))
+        qx, qy = self.q
+        if qx or qy:
+            w = self.h
+            # X_j = int_{s_j}^L x du by the trapezoidal rule
+            cx = np.cumsum(0.5 * w * (x[..., 1:] + x[..., :-1])[..., ::-1], axis=-1)[..., ::-1]
+            cy = np.cumsum(0.5 * w * (y[..., 1:] + y[..., :-1])[..., ::-1], axis=-1)[..., ::-1]
+            zero = np.zeros(x.shape[:-1] + (1,), dtype=x.dtype)
+            X = np.concatenate([cx, zero], axis=-1)
+            Y = np.concatenate([cy, zero], axis=-1)
+            m = m + lam * _cross(X - self.rem * x, Y - self.rem * y, qx, qy)
+        return m
+
+
+def _complex_jacobian(fun, u):
+    """Exact Jacobian of a real-analytic vector function by the complex step (one batched call)."""
+    m = u.size
+    eps = 1e-30
+    U = u[None, :] + 1j * eps * np.eye(m)
+    return (np.imag(fun(U)) / eps).T
+
+
+def _newton(fun, u0, lo, hi, tol, maxit=_MAX_NEWTON):
+    """Damped Newton on ``fun(u) = 0`` keeping ``lo < u < hi``.  Returns ``(u, ok, |r|_inf)``."""
+    u = np.array(u0, dtype=float)
+    r = np.real(fun(u[None, :]))[0]
+    nr = float(np.max(np.abs(r)))
+    for _ in range(maxit):
+        if not np.isfinite(nr):
+            return u, False, nr
+        if nr < tol:
+            return u, True, nr
+        J = _complex_jacobian(fun, u)
+        try:
+            du = np.linalg.solve(J, -r)
+        except np.linalg.LinAlgError:
+            du = np.linalg.lstsq(J, -r, rcond=None)[0]
+        if not np.all(np.isfinite(du)):
+            return u, False, nr
+        # stay strictly inside the bounds (the stable branch): at most 90 % of the way to a bound
+        with np.errstate(divide="ignore", invalid="ignore"):
+            a_hi = np.where(du > 0, 0.9 * (hi - u) / du, np.inf)
+            a_lo = np.where(du < 0, 0.9 * (lo - u) / du, np.inf)
+        alpha = float(min(1.0, np.min(a_hi), np.min(a_lo)))
+        n2 = float(np.sum(r * r))
+        for _ in range(30):
+            un = u + alpha * du
+            rn = np.real(fun(un[None, :]))[0]
+            n2n = float(np.sum(rn * rn))
+            if np.isfinite(n2n) and n2n <= (1.0 - 1e-4 * alpha) * n2:
+                break
+            alpha *= 0.5
+        else:
+            return u, False, nr
+        if alpha < 1e-12:
+            return u, False, nr
+        u, r = un, rn
+        nr = float(np.max(np.abs(r)))
+    return u, nr < tol, nr
+
+
+def _moment_scale(branch: StableBranch, rod: _Rod) -> float:
+    load = abs(rod.Mt) + math.hypot(*rod.F) * (rod.L + rod.ell) + math.hypot(*rod.q) * rod.L ** 2
+    return max(abs(branch.moment_max) if np.isfinite(branch.moment_max) else 0.0,
+               abs(branch.moment_min), abs(float(branch.moment(0.0)[0])), load, 1.0)
+
+
+def _k_bounds(branch: StableBranch, n: int):
+    return np.full(n, branch.k_lo), np.full(n, branch.k_hi)
+
+
+def _dead_load_system(rod: _Rod, branch: StableBranch, scale: float):
+    c = rod.c
+
+    def fun(U, lam):
+        phi, x, y, xt, yt = rod.geometry(U)
+        m_act = -c * rod.load_moment(x, y, xt, yt, lam)
+        M, _ = branch.moment(U)
+        return (M - m_act) / scale
+
+    return fun
+
+
+def _stability(fun, k, w):
+    """Smallest eigenvalue of the symmetrised, weighted Hessian (relative to the largest)."""
+    J = _complex_jacobian(fun, k)
+    sw = np.sqrt(w)
+    H = -(sw[:, None] * J / sw[None, :])
+    H = 0.5 * (H + H.T)
+    ev = np.linalg.eigvalsh(H)
+    return float(ev[0] / max(abs(ev[-1]), 1e-300))
+
+
+def _shape(rod: _Rod, k, branch, P, loads, *, lam=1.0, equilibrium=True, stable=True, note="", exact=True):
+    f = rod.f
+    phi, x, y, xt, yt = rod.geometry(k)
+    m_act = -rod.c * rod.load_moment(x, y, xt, yt, lam)
+    res = float(np.max(np.abs(moment(f.actuator, P, k, f.model) - m_act))) if exact else math.nan
+    return FingerShape(f, loads, P, rod.s.copy(), x, y, phi, np.asarray(k, float), m_act, (float(xt), float(yt)),
+                       float(phi[-1]), equilibrium, stable, res, lam, note, None, branch)
+
+
+def _failed(rod: _Rod, branch, P, loads, note, limit=None, lam=0.0):
+    nan = np.full(rod.n, np.nan)
+    return FingerShape(rod.f, loads, P, rod.s.copy(), nan, nan.copy(), nan.copy(), nan.copy(), nan.copy(),
+                       (math.nan, math.nan), math.nan, False, False, math.nan, lam, note, limit, branch)
+
+
+def _near_end_note(branch: StableBranch, k, s):
+    """Which end of the stable branch the last equilibrium was approaching, as a note."""
+    span = branch.k_hi - branch.k_lo
+    d_hi = (branch.k_hi - k) / span
+    d_lo = (k - branch.k_lo) / span
+    j_hi, j_lo = int(np.argmin(d_hi)), int(np.argmin(d_lo))
+    if min(d_hi[j_hi], d_lo[j_lo]) > 0.05:
+        return None
+    if d_hi[j_hi] <= d_lo[j_lo]:
+        return f"at s = {s[j_hi]:.3g} mm the section reaches {branch.describe_end(+1)}"
+    return f"at s = {s[j_lo]:.3g} mm the section reaches {branch.describe_end(-1)}"
+
+
+def solve_finger(finger: Finger, pressure, loads: FingerLoads | None = None) -> FingerShape:
+    """Equilibrium shape of ``finger`` at ``pressure`` (MPa) under ``loads``.
+
+    Returns a :class:`FingerShape`.  With no load the shape is the free shape (constant free
+    curvature).  Otherwise the solution is continued in the load fraction from the free shape.  If
+    no stable equilibrium exists (the loads need more moment than the stable branch supplies, or
+    a structural limit point), ``equilibrium`` is False, the arrays are NaN, the note says why and
+    ``limit`` holds the last equilibrium reached.  Never a shape on the unstable branch.
+    """
+    if not isinstance(finger, Finger):
+        raise TypeError(f"finger must be a bendpam.design.Finger, got {type(finger).__name__}")
+    loads = FingerLoads() if loads is None else loads
+    if not isinstance(loads, FingerLoads):
+        raise TypeError(f"loads must be a FingerLoads, got {type(loads).__name__}")
+    P = _pressure(pressure)
+    rod = _Rod(finger, loads)
+    try:
+        br = stable_branch(finger.actuator, P, finger.model)
+    except ValueError as exc:
+        return _failed(rod, None, P, loads, str(exc))
+    scale = _moment_scale(br, rod)
+    fun = _dead_load_system(rod, br, scale)
+    lo, hi = _k_bounds(br, rod.n)
+    kf = br.free_curvature
+    free_ok = np.isfinite(kf)
+    if free_ok:  # agree with free_curvature (same root, without the table's interpolation error)
+        fb = free_curvature(finger.actuator, P, finger.model)
+        if fb.status != "no-equilibrium" and np.isfinite(fb.curvature):
+            kf = float(fb.curvature)
+    if loads.is_zero:
+        if not free_ok:
+            fb = free_curvature(finger.actuator, P, finger.model)
+            return _failed(rod, br, P, loads, f"no free-bending equilibrium: {fb.reason or br.describe_end(+1)}")
+        return _shape(rod, np.full(rod.n, kf), br, P, loads)
+
+    def finish(k, lam_note=""):
+        st = _stability(lambda U: fun(U, 1.0), k, rod.w)
+        if st < -1e-7:
+            sh = _shape(rod, k, br, P, loads, stable=False)
+            return _failed(rod, br, P, loads, "unstable equilibrium (a structural limit or bifurcation: the "
+                           "finger buckles under these loads)" + lam_note, limit=sh, lam=1.0)
+        return _shape(rod, k, br, P, loads, note=lam_note)
+
+    if free_ok:
+        k = np.full(rod.n, kf)
+        lam, step = 0.0, 1.0
+        while lam < 1.0:
+            step = min(step, 1.0 - lam)
+            kn, ok, _ = _newton(lambda U, t=lam + step: fun(U, t), k, lo, hi, _NEWTON_TOL)
+            if ok:
+                k, lam = kn, lam + step
+                step *= 2.0
+            else:
+                step *= 0.5
+                if step < _MIN_STEP:
+                    break
+        if lam >= 1.0:
+            return finish(k)
+        last = _shape(rod, k, br, P, loads, lam=lam, equilibrium=False)
+        where = _near_end_note(br, k, rod.s)
+        if where:
+            note = (f"no equilibrium: snap-through at load fraction {lam:.3g} ({where}); the loads need more "
+                    "moment than the stable branch supplies")
+        else:
+            note = (f"no equilibrium: the load path reaches a structural limit point at load fraction {lam:.3g} "
+                    "(the finger would snap to another configuration)")
+        return _failed(rod, br, P, loads, note, limit=last, lam=lam)
+    # no free shape (pressure above the fold): look for a loaded equilibrium on the stable branch
+    span = br.k_hi - br.k_lo
+    sgn = finger.actuator.bend_sign
+    k_end, k_other = (br.k_hi, br.k_lo) if sgn > 0 else (br.k_lo, br.k_hi)
+    guesses = [k_end - sgn * f * span for f in (0.02, 0.1, 0.3)] + [0.0, k_other + sgn * 0.1 * span]
+    for g in guesses:
+        k, ok, _ = _newton(lambda U: fun(U, 1.0), np.full(rod.n, g), lo, hi, _NEWTON_TOL, maxit=60)
+        if ok:
+            return finish(k, "; no free shape at this pressure (fold of the moment law): the equilibrium exists "
+                          "only under these loads")
+    fb = free_curvature(finger.actuator, P, finger.model)
+    return _failed(rod, br, P, loads, "no equilibrium: " + (fb.reason or "the loads cannot be balanced on the stable "
+                                                              "branch") + "; the finger snaps through")
+
+
+def finger_sweep(finger: Finger, pressures, loads: FingerLoads | None = None):
+    """Solve ``finger`` at each pressure (MPa).
+
+    Returns ``(table, shapes)``: a :class:`pandas.DataFrame` with ``pressure_kpa``, ``tip_x_mm``,
+    ``tip_y_mm``, ``tip_angle_deg``, ``bend_angle_deg``, ``base_moment_nmm``, ``residual_nmm``,
+    ``equilibrium`` and ``note``, and the list of :class:`FingerShape`.
+    """
+    import pandas as pd
+
+    P = np.atleast_1d(np.asarray(pressures, dtype=float)).ravel()
+    shapes = [solve_finger(finger, p, loads) for p in P]
+    return pd.DataFrame({
+        "pressure_kpa": P * 1e3,
+        "tip_x_mm": [sh.tip_xy[0] for sh in shapes],
+        "tip_y_mm": [sh.tip_xy[1] for sh in shapes],
+        "tip_angle_deg": [sh.tip_angle_deg for sh in shapes],
+        "bend_angle_deg": [sh.bend_angle_deg for sh in shapes],
+        "base_moment_nmm": [float(sh.moment_ext[0]) for sh in shapes],
+        "residual_nmm": [sh.residual_nmm for sh in shapes],
+        "equilibrium": [sh.equilibrium for sh in shapes],
+        "note": [sh.note for sh in shapes],
+    }), shapes
+
+
+def free_tip_trajectory(finger: Finger, pressures):
+    """Tip pose of the unloaded finger against pressure (MPa), vectorised.
+
+    The free shape is a circular arc of the free curvature (:func:`bendpam.free_curvature`) plus the
+    rigid fingertip.  Returns a :class:`pandas.DataFrame` with ``pressure_kpa``,
+    ``free_curvature_per_mm``, ``tip_x_mm``, ``tip_y_mm``, ``tip_angle_deg``, ``bend_angle_deg``,
+    ``status`` and ``note`` (NaN pose where there is no free equilibrium).
+    """
+    import pandas as pd
+
+    if not isinstance(finger, Finger):
+        raise TypeError(f"finger must be a bendpam.design.Finger, got {type(finger).__name__}")
+    P = np.atleast_1d(np.asarray(pressures, dtype=float)).ravel()
+    fb = free_curvature(finger.actuator, P, finger.model)
+    k = fb.curvature
+    kap = finger.frame_side * k
+    L = finger.length
+    th = kap * L
+    p0 = finger.base_angle
+    ln = L * _sinc(0.5 * th)
+    x0, y0 = finger.base_xy_mm
+    pl = p0 + th
+    b = finger.bend
+    xt = x0 + ln * np.cos(p0 + 0.5 * th) + finger.fingertip_mm * np.cos(pl) - b * finger.fingertip_offset_mm * np.sin(pl)
+    yt = y0 + ln * np.sin(p0 + 0.5 * th) + finger.fingertip_mm * np.sin(pl) + b * finger.fingertip_offset_mm * np.cos(pl)
+    return pd.DataFrame({
+        "pressure_kpa": P * 1e3,
+        "free_curvature_per_mm": k,
+        "tip_x_mm": xt,
+        "tip_y_mm": yt,
+        "tip_angle_deg": np.degrees(pl),
+        "bend_angle_deg": np.degrees(b * th),
+        "status": fb.status,
+        "note": fb.reason,
+    })
+
+
+# ------------------------------------------------------------------------------------------------
+# blocked tip force and tip stiffness
+# ------------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class BlockedTipForce:
+    """The force that holds the fingertip point at a target (the tip is pinned, free to rotate).
+
+    Attributes
+    ----------
+    force_n : (Fx, Fy) applied to the tip by the holder, N (the finger pushes with the opposite).
+    target_xy : the target point, mm.
+    shape : the held :class:`FingerShape` (its ``loads`` include the holding force).
+    equilibrium, note : as in :class:`FingerShape`.
+    """
+
+    force_n: tuple[float, float]
+    target_xy: tuple[float, float]
+    shape: FingerShape
+    equilibrium: bool
+    note: str
+
+    @property
+    def magnitude_n(self) -> float:
+        return math.hypot(*self.force_n)
+
+
+def _straight_tip(finger: Finger) -> tuple[float, float]:
+    p = finger.base_angle
+    x0, y0 = finger.base_xy_mm
+    L = finger.length + finger.fingertip_mm
+    o = finger.bend * finger.fingertip_offset_mm
+    return x0 + L * math.cos(p) - o * math.sin(p), y0 + L * math.sin(p) + o * math.cos(p)
+
+
+def blocked_tip_force(finger: Finger, pressure, target_xy_mm=None, loads: FingerLoads | None = None) -> BlockedTipForce:
+    """Force needed to hold the fingertip at ``target_xy_mm`` (default: its straight position).
+
+    Solved with the force components as extra unknowns and the tip position as two extra
+    equations, by continuation of the target from the free (or loaded) tip to ``target_xy_mm``.
+    ``loads`` (optional) act in addition to the holding force.
+    """
+    if not isinstance(finger, Finger):
+        raise TypeError(f"finger must be a bendpam.design.Finger, got {type(finger).__name__}")
+    loads = FingerLoads() if loads is None else loads
+    P = _pressure(pressure)
+    target = _straight_tip(finger) if target_xy_mm is None else _pair("target_xy_mm", target_xy_mm, "mm")
+    start = solve_finger(finger, P, loads)
+    rod = _Rod(finger, loads)
+    try:
+        br = stable_branch(finger.actuator, P, finger.model)
+    except ValueError as exc:
+        return BlockedTipForce((math.nan, math.nan), target, start, False, str(exc))
+    n = rod.n
+    c = rod.c
+    Lr = rod.L + rod.ell
+    scale = _moment_scale(br, rod)
+    fscale = max(scale / Lr, 1e-3)
+
+    def make(tx, ty):
+        def fun(U):
+            k = U[..., :n]
+            gx, gy = U[..., n] * fscale, U[..., n + 1] * fscale
+            phi, x, y, xt, yt = rod.geometry(k)
+            m = rod.load_moment(x, y, xt, yt) + _cross(xt[..., None] - x, yt[..., None] - y, gx[..., None], gy[..., None])
+            M, _ = br.moment(k)
+            r1 = (M + c * m) / scale
+            return np.concatenate([r1, ((xt - tx) / Lr)[..., None], ((yt - ty) / Lr)[..., None]], axis=-1)
+
+        return fun
+
+    lo = np.concatenate([np.full(n, br.k_lo), [-np.inf, -np.inf]])
+    hi = np.concatenate([np.full(n, br.k_hi), [np.inf, np.inf]])
+    if start.equilibrium:
+        u = np.concatenate([start.curvature, [0.0, 0.0]])
+        t0 = np.array(start.tip_xy)
+    else:
+        # no free shape: start from the straight finger (k' = 0) with the blocked-moment guess
+        kap_guess = 0.0
+        u = np.concatenate([np.full(n, kap_guess), [0.0, 0.0]])
+        phi, x, y, xt, yt = rod.geometry(u[None, :n])
+        t0 = np.array([float(xt[0]), float(yt[0])])
+    tgt = np.array(target)
+    lam, step = 0.0, 1.0
+    ok_any = True
+    while lam < 1.0:
+        step = min(step, 1.0 - lam)
+        tx, ty = t0 + (lam + step) * (tgt - t0)
+        un, ok, _ = _newton(make(tx, ty), u, lo, hi, _NEWTON_TOL)
+        if ok:
+            u, lam = un, lam + step
+            step *= 2.0
+        else:
+            step *= 0.5
+            if step < _MIN_STEP:
+                ok_any = False
+                break
+    if not ok_any:
+        note = (f"no equilibrium holds the tip at ({target[0]:.4g}, {target[1]:.4g}) mm: the continuation stops at "
+                f"{lam:.3g} of the way from the free tip")
+        sh = _failed(rod, br, P, loads, note, lam=lam)
+        return BlockedTipForce((math.nan, math.nan), target, sh, False, note)
+    F = (float(u[n] * fscale), float(u[n + 1] * fscale))
+    total = replace(loads, tip_force_n=(loads.tip_force_n[0] + F[0], loads.tip_force_n[1] + F[1]))
+    rod2 = _Rod(finger, total)
+    sh = _shape(rod2, u[:n], br, P, total)
+    return BlockedTipForce(F, target, sh, True, "")
+
+
+@dataclass(frozen=True)
+class TipStiffness:
+    """Tangent stiffness of the fingertip at an equilibrium.
+
+    ``matrix`` maps small changes of the tip load ``(dFx, dFy, dM)`` (N, N, N*mm) to the tip pose
+    ``(dx, dy, dphi)`` (mm, mm, rad) by ``compliance``; ``matrix = inv(compliance)``.  Both include the
+    geometric stiffness of the loads already acting; for dead loads they are symmetric.
+    """
+
+    matrix: np.ndarray
+    compliance: np.ndarray
+    shape: FingerShape
+
+
+def tip_stiffness(finger: Finger, pressure, loads: FingerLoads | None = None) -> TipStiffness:
+    """Tip stiffness matrix (3x3) at the equilibrium under ``loads``: from the exact Jacobian."""
+    loads = FingerLoads() if loads is None else loads
+    sh = solve_finger(finger, pressure, loads)
+    if not sh.equilibrium:
+        raise ValueError(f"no equilibrium at pressure = {float(pressure) * 1e3:g} kPa under these loads: {sh.note}")
+    rod = _Rod(finger, loads)
+    br = sh.branch
+    n = rod.n
+    c = rod.c
+    k = sh.curvature
+
+    def fun(U):  # unknowns k, then the load increment (dFx, dFy, dM)
+        kk = U[..., :n]
+        phi, x, y, xt, yt = rod.geometry(kk)
+        dF = U[..., n:]
+        m = rod.load_moment(x, y, xt, yt) + dF[..., 2:3] + _cross(xt[..., None] - x, yt[..., None] - y,
+                                                                  dF[..., 0:1], dF[..., 1:2])
+        M, _ = br.moment(kk)
+        return M + c * m
+
+    def pose(U):
+        phi, x, y, xt, yt = rod.geometry(U[..., :n])
+        return np.stack([xt, yt, phi[..., -1]], axis=-1)
+
+    u = np.concatenate([k, np.zeros(3)])
+    J = _complex_jacobian(fun, u)
+    Jk, JF = J[:, :n], J[:, n:]
+    dk = -np.linalg.solve(Jk, JF)
+    Q = _complex_jacobian(pose, u)
+    C = Q[:, :n] @ dk
+    return TipStiffness(np.linalg.inv(C), C, sh)
+
+
+def linear_tip_compliance(finger: Finger, pressure) -> np.ndarray:
+    """Linear beam-theory compliance (3x3) of the free finger: reference for the nonlinear solver.
+
+    With the free (constant) curvature and the tangent stiffness ``K = dM/dk'`` there (negative), a
+    small tip load changes the curvature by ``dk' = dM_ext / K`` and the tip pose by the integral of
+    the rotations, with no geometric stiffness (the finger is unloaded).  Integrated on 2001 points.
+    """
+    from ..predict import tangent_stiffness
+
+    P = _pressure(pressure)
+    fb = free_curvature(finger.actuator, P, finger.model)
+    if fb.status == "no-equilibrium":
+        raise ValueError(f"pressure = {P * 1e3:g} kPa has no free-bending equilibrium: {fb.reason}")
+    k = float(fb.curvature)
+    K = float(tangent_stiffness(finger.actuator, P, k, finger.model))
+    fine = replace(finger, nodes=1001)
+    rod = _Rod(fine, FingerLoads())
+    phi, x, y, xt, yt = rod.geometry(np.full((1, rod.n), k))
+    x, y, xt, yt = x[0], y[0], float(xt[0]), float(yt[0])
+    ax, ay = xt - x, yt - y  # lever from each section to the tip
+    # unit loads: Fx, Fy, M -> m(s) (counterclockwise moment) -> dkappa = c dk' = c (-c m)/K = -m/K
+    ms = [_cross(ax, ay, 1.0, 0.0), _cross(ax, ay, 0.0, 1.0), np.ones_like(ax)]
+    C = np.zeros((3, 3))
+    for j, m in enumerate(ms):
+        dkap = -m / K
+        w = rod.w
+        C[0, j] = np.sum(w * dkap * -ay)  # rotation about s moves the tip by dtheta * z x (tip - r)
+        C[1, j] = np.sum(w * dkap * ax)
+        C[2, j] = np.sum(w * dkap)
+    return C

@@ -1,0 +1,36 @@
+"""Finding raw test files: folders expand to their exports (known suffixes, sorted)."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+__all__ = ["RAW_SUFFIXES", "collect_raw_files"]
+
+#: File suffixes taken from a folder as raw testing-machine exports.
+RAW_SUFFIXES = frozenset({".csv", ".txt", ".tsv", ".dat", ".asc", ".tra"})
+
+
+def collect_raw_files(inputs) -> list[Path]:
+    """Expand folders into their raw test files (known suffixes, sorted); check files exist.
+
+    ``inputs`` is one path or a sequence of paths.  Raises ``ValueError`` (one line) for a missing
+    path, a folder without raw files, or no input at all.
+    """
+    if isinstance(inputs, str | os.PathLike):
+        inputs = [inputs]
+    files: list[Path] = []
+    for item in inputs or []:
+        p = Path(item)
+        if p.is_dir():
+            found = sorted(q for q in p.iterdir() if q.is_file() and q.suffix.lower() in RAW_SUFFIXES)
+            if not found:
+                raise ValueError(f"{p}: no raw test files here (looked for {', '.join(sorted(RAW_SUFFIXES))})")
+            files.extend(found)
+        elif p.exists():
+            files.append(p)
+        else:
+            raise ValueError(f"{p}: no such file or folder")
+    if not files:
+        raise ValueError("give raw test files or a folder of them")
+    return files
