@@ -9,7 +9,7 @@ from scipy.integrate import quad
 
 import bendpam
 from bendpam import Actuator, presets
-from bendpam.kinematics import LOCK_FRACTION, gauss_nodes
+from bendpam.braid import LOCK_FRACTION, gauss_nodes
 
 
 def eq5_quad(u, alpha0):

@@ -14,10 +14,9 @@ Quick start::
 
 from __future__ import annotations
 
-from . import kinematics as _kinematics_module  # noqa: F401
-from . import material, models, presets
+from . import braid, fast, material, models, presets
 from .actuator import NEUTRAL_ANGLE_DEG, Actuator
-from .kinematics import CurvatureLimits, Kinematics, curvature_limits
+from .braid import CurvatureLimits, Kinematics, curvature_limits
 from .material import MooneyRivlin
 from .predict import (
     BranchInfo,
@@ -34,6 +33,8 @@ from .predict import (
     tangent_stiffness,
 )
 
+from .sweeps import sweep  # noqa: E402  (the function; the module is bendpam.sweeps)
+
 __version__ = "0.1.0"
 
 __all__ = [
@@ -42,6 +43,8 @@ __all__ = [
     "MooneyRivlin",
     "Kinematics",
     "CurvatureLimits",
+    "braid",
+    "fast",
     "BranchInfo",
     "FreeBending",
     "active_pressure",
@@ -57,5 +60,6 @@ __all__ = [
     "moment_terms",
     "prediction_table",
     "presets",
+    "sweep",
     "tangent_stiffness",
 ]

@@ -20,7 +20,7 @@ import typer
 from . import presets as _presets
 from ._io import atomic_write_text
 from .actuator import Actuator
-from .kinematics import curvature_limits
+from .braid import curvature_limits
 
 # Typer >= 0.20 vendors click; find its exception base class without importing click directly.
 _ClickException = next(c for c in typer.BadParameter.__mro__ if c.__name__ == "ClickException")

@@ -31,7 +31,7 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 
 from .actuator import Actuator
-from .kinematics import curvature_limits
+from .braid import curvature_limits
 from .models import get_model
 from .predict import FreeBending, _pressure, branch_info
 from .presets import normalise_model

@@ -17,7 +17,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from ._io import atomic_path  # noqa: E402
-from .kinematics import curvature_limits  # noqa: E402
+from .braid import curvature_limits  # noqa: E402
 from .predict import active_pressure, free_curvature, internal_stresses, moment  # noqa: E402
 
 __all__ = [

@@ -25,8 +25,8 @@ import xarray as xr
 from scipy.optimize import minimize_scalar
 
 from .actuator import Actuator
-from .kinematics import DEFAULT_ORDER, curvature_limits
-from .kinematics import kinematics as _kinematics
+from .braid import DEFAULT_ORDER, curvature_limits
+from .braid import kinematics as _kinematics
 from .models import force_balance as _fb
 from .models import get_model
 from .presets import normalise_model
@@ -82,7 +82,7 @@ def active_pressure(actuator, pressure) -> np.ndarray:
 
 
 def kinematics(actuator, curvature, *, order: int = DEFAULT_ORDER):
-    """Braid kinematics at ``curvature`` (1/mm): see :class:`bendpam.kinematics.Kinematics` (eq 1-5)."""
+    """Braid kinematics at ``curvature`` (1/mm): see :class:`bendpam.braid.Kinematics` (eq 1-5)."""
     return _kinematics(_check_actuator(actuator), curvature, order)
 
 
@@ -95,7 +95,7 @@ def moment(actuator, pressure, curvature, model: str = "energy", *, order: int =
     pressure : array_like
         Gauge pressure P, MPa, >= 0.
     curvature : array_like
-        Frame curvature k', 1/mm, within the lock-up limits (:func:`bendpam.kinematics.curvature_limits`).
+        Frame curvature k', 1/mm, within the lock-up limits (:func:`bendpam.braid.curvature_limits`).
     model : {"energy", "force_balance"}
         ``"force-balance"`` is accepted too.
     order : int

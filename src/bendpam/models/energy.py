@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..kinematics import DEFAULT_ORDER, gauss_nodes, radius_terms
+from ..braid import DEFAULT_ORDER, gauss_nodes, radius_terms
 from ..material import MooneyRivlin
 
 __all__ = ["basis", "coefficients", "terms", "bladder_energy"]

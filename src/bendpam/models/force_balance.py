@@ -40,7 +40,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..kinematics import DEFAULT_ORDER, _col, gauss_nodes, radius_terms
+from ..braid import DEFAULT_ORDER, _col, gauss_nodes, radius_terms
 
 __all__ = ["basis", "coefficients", "terms", "stress_state"]
 

@@ -34,7 +34,7 @@ from scipy.optimize import brentq
 from .._io import atomic_write_text
 from ..fixture import PAPER_FIXTURE, Fixture
 from ..hysteresis import DahlLaw
-from ..kinematics import curvature_limits
+from ..braid import curvature_limits
 from ..predict import blocked_moment, free_curvature, moment
 from ..presets import normalise_model
 

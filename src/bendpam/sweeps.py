@@ -1,4 +1,4 @@
-"""Design sweeps: any actuator parameters crossed with pressures, in-process or on a Dask cluster.
+"""Design sweeps (the module behind :func:`bendpam.sweep`): any actuator parameters crossed with pressures, in-process or on a Dask cluster.
 
 ``bendpam.sweep(base, pressure_kpa=[...], alpha0_deg=[...], t0_mm=[...])`` evaluates every
 combination of the swept parameters (an "actuator case") at every pressure and returns an
@@ -47,7 +47,7 @@ import numpy as np
 import xarray as xr
 
 from .actuator import NEUTRAL_ANGLE_DEG, Actuator
-from .kinematics import DEFAULT_ORDER, LOCK_FRACTION, MIN_FAR_STRETCH, _ibar, gauss_nodes
+from .braid import DEFAULT_ORDER, LOCK_FRACTION, MIN_FAR_STRETCH, _ibar, gauss_nodes
 from .models import get_model
 from .presets import normalise_model
 
@@ -59,7 +59,7 @@ SWEEP_PARAMETERS = (
     "C10_kpa", "C01_kpa", "P_start_kpa", "R0_start_mm",
 )
 BRANCH_END = {"lock-up": 0, "fold": 1, "unbounded": 2, "neutral": 3}
-_BRANCH_SAMPLES = 1200
+_BRANCH_SAMPLES = 300
 _OUTPUTS = ("blocked_moment_nmm", "free_curvature_per_mm", "free_angle_deg", "lockup_margin", "frame_stress_mpa",
             "max_pressure_kpa", "branch_end")
 _UNITS = {
