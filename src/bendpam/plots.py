@@ -29,6 +29,7 @@ __all__ = [
     "demo_figure",
     "figure4",
     "figure7",
+    "sweep_figure",
 ]
 
 
@@ -281,5 +282,43 @@ def figure7(processed, fit_result, title: str = ""):
     ax.legend(fontsize=7)
     fig.suptitle(title or f"{act.name or act.kind}: {model.replace('_', '-')} model fit, NRMSE of the cycles "
                  f"{100 * fit_result.metrics.nrmse_cycles:.2f} %", fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
+def sweep_figure(ds, var: str = "free_angle_deg", x: str | None = None, y: str | None = None):
+    """Colour map of one sweep output against two of its dimensions.
+
+    Other dimensions are fixed at their middle value (named in the title).  ``x`` and ``y``
+    default to the first two dimensions of ``var``.
+    """
+    if var not in ds.data_vars:
+        raise ValueError(f"--plot-var {var!r} is not a sweep output; choose from {', '.join(ds.data_vars)}")
+    da_ = ds[var]
+    dims = list(da_.dims)
+    x = x or dims[0]
+    y = y or (dims[1] if len(dims) > 1 else None)
+    for d in (x, y):
+        if d is not None and d not in dims:
+            raise ValueError(f"{d!r} is not a dimension of {var}; choose from {', '.join(dims)}")
+    fixed = {d: da_[d].values[da_[d].size // 2] for d in dims if d not in (x, y)}
+    sel = da_.isel({d: da_[d].size // 2 for d in fixed}) if fixed else da_
+    fig, ax = plt.subplots(figsize=(6.5, 4.8))
+    if y is None:
+        ax.plot(sel[x].values, np.asarray(sel.values, dtype=float), "-o", ms=3)
+        ax.set_ylabel(f"{var} ({da_.attrs.get('units', '')})")
+    else:
+        z = np.asarray(sel.transpose(y, x).values, dtype=float)
+        m = ax.pcolormesh(sel[x].values, sel[y].values, np.ma.masked_invalid(z), shading="auto", cmap="viridis")
+        fig.colorbar(m, ax=ax, label=f"{var} ({da_.attrs.get('units', '')})")
+        if np.any(~np.isfinite(z)):
+            ax.contour(sel[x].values, sel[y].values, np.isfinite(z).astype(float), levels=[0.5], colors="crimson",
+                       linewidths=1.0)
+        ax.set_ylabel(y)
+    ax.set_xlabel(x)
+    title = da_.attrs.get("long_name", var)
+    if fixed:
+        title += "\n" + ", ".join(f"{d} = {v:g}" for d, v in fixed.items())
+    ax.set_title(title, fontsize=9)
     fig.tight_layout()
     return fig

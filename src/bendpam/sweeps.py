@@ -41,6 +41,7 @@ When only ``R0_mm`` is swept, ``R0_start_mm`` keeps the base actuator's ratio ``
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass
 
 import numpy as np
@@ -370,21 +371,21 @@ def _grid_values(params: dict) -> dict[str, np.ndarray]:
 
 
 def _block(base, model, names, grids, P, order, eq19, idx_block):
-    """Kernel for one block of flat case indices -> (cases, pressures, outputs) float array."""
+    """Kernel for one block of flat case indices (any shape B) -> array B + (pressures, outputs)."""
+    idx_block = np.asarray(idx_block)
     shape = tuple(g.size for g in grids)
-    flat = np.asarray(idx_block).ravel()
-    sub = np.unravel_index(flat, shape) if names else ()
-    values = {n: g[i] for n, g, i in zip(names, grids, sub)}
-    if not names:
-        values = {}
-    res = evaluate_cases(base, model, {k: np.asarray(v) for k, v in values.items()} or
-                         {"alpha0_deg": np.full(flat.size, base.alpha0_deg)}, P, order=order, eq19_factor=eq19)
-    m = P.size
-    out = np.empty((flat.size, m, len(_OUTPUTS)))
+    flat = idx_block.ravel()
+    if names:
+        sub = np.unravel_index(flat, shape)
+        values = {n: g[i] for n, g, i in zip(names, grids, sub)}
+    else:
+        values = {"alpha0_deg": np.full(flat.size, base.alpha0_deg)}
+    res = evaluate_cases(base, model, values, P, order=order, eq19_factor=eq19)
+    out = np.empty((flat.size, P.size, len(_OUTPUTS)))
     for i, name in enumerate(_OUTPUTS):
         v = res[name]
         out[:, :, i] = v if v.ndim == 2 else v[:, None]
-    return out
+    return out.reshape(idx_block.shape + (P.size, len(_OUTPUTS)))
 
 
 def sweep(base_actuator: Actuator, pressure_kpa, model: str = "energy", *, chunk_cases: int = 256,
@@ -421,8 +422,9 @@ def sweep(base_actuator: Actuator, pressure_kpa, model: str = "energy", *, chunk
     # validate before any work (the same checks as Actuator): every combination of the
     # parameters that constrain each other, each other parameter on its own
     _prevalidate(base_actuator, names, grids)
-    n_blocks = -(-n_cases // chunk_cases)
-    show = progress if progress is not None else n_blocks >= 20
+    chunks = _natural_chunks(shape, chunk_cases)
+    n_blocks = int(np.prod([len(c) for c in chunks])) if shape else 1
+    show = progress if progress is not None else (n_blocks >= 20 and sys.stderr.isatty())
     fn = _block_fn(base_actuator, model, names, grids, P, order, eq19_factor)
     try:
         import dask.array as da
@@ -431,16 +433,37 @@ def sweep(base_actuator: Actuator, pressure_kpa, model: str = "energy", *, chunk
     if da is None:
         if scheduler or workers or not compute:
             raise ValueError("distributed or lazy sweeps need Dask: pip install 'bendpam[distributed]'")
-        data = _loop_blocks(fn, n_cases, chunk_cases, show)
+        data = _loop_blocks(fn, shape, chunks, show)
     else:
-        idx = da.arange(n_cases, chunks=chunk_cases)
-        arr = idx.map_blocks(fn, dtype=float, new_axis=[1, 2], chunks=(idx.chunks[0], (P.size,), (len(_OUTPUTS),)),
-                             meta=np.empty((0, 0, 0)))
-        if compute:
-            data = _compute(arr, scheduler, workers, show)
-        else:
-            data = arr
+        idx = da.arange(n_cases, chunks=n_cases).reshape(shape or (1,)).rechunk(chunks or ((1,),))
+        nd = idx.ndim
+        arr = idx.map_blocks(fn, dtype=float, new_axis=[nd, nd + 1],
+                             chunks=idx.chunks + ((P.size,), (len(_OUTPUTS),)), meta=np.empty((0,) * (nd + 2)))
+        data = _compute(arr, scheduler, workers, show) if compute else arr
     return _dataset(data, names, grids, shape, P, base_actuator, model, order)
+
+
+def _natural_chunks(shape: tuple[int, ...], chunk_cases: int) -> tuple[tuple[int, ...], ...]:
+    """Block the case grid so that each block holds at most ``chunk_cases`` cases.
+
+    Trailing dimensions are kept whole while they fit; the first dimension that does not fit is
+    split, and the ones before it go one index at a time.
+    """
+    out = []
+    prod = 1
+    split = False
+    for size in reversed(shape):
+        if split:
+            out.append((1,) * size)
+            continue
+        if prod * size <= chunk_cases:
+            out.append((size,))
+            prod *= size
+        else:
+            step = max(chunk_cases // prod, 1)
+            out.append(tuple(min(step, size - i) for i in range(0, size, step)))
+            split = True
+    return tuple(reversed(out))
 
 
 _COUPLED = ({"t0_mm", "R0_mm", "R0_start_mm"}, {"C10_kpa", "C01_kpa"})
@@ -469,16 +492,23 @@ class _block_fn:
         return _block(*self.args, idx_block)
 
 
-def _loop_blocks(fn, n_cases, chunk, show):
-    out = []
-    starts = range(0, n_cases, chunk)
+def _loop_blocks(fn, shape, chunks, show):
+    """The same blocks as the Dask path, computed in a loop (no Dask installed)."""
+    flat = np.arange(int(np.prod(shape)) if shape else 1).reshape(shape or (1,))
+    bounds = [np.cumsum((0,) + c) for c in (chunks or ((1,),))]
+    blocks = list(np.ndindex(*[len(c) for c in (chunks or ((1,),))]))
     if show:
         from rich.progress import track
 
-        starts = track(list(starts), description="sweep", transient=True)
-    for s in starts:
-        out.append(fn(np.arange(s, min(s + chunk, n_cases))))
-    return np.concatenate(out, axis=0)
+        blocks = track(blocks, description="sweep", transient=True)
+    out = None
+    for b in blocks:
+        sl = tuple(slice(bd[i], bd[i + 1]) for bd, i in zip(bounds, b))
+        res = fn(flat[sl])
+        if out is None:
+            out = np.empty(flat.shape + res.shape[-2:])
+        out[sl] = res
+    return out
 
 
 def _compute(arr, scheduler, workers, show):
@@ -506,24 +536,24 @@ def _compute(arr, scheduler, workers, show):
     if show:
         from dask.diagnostics import ProgressBar
 
-        with ProgressBar():
+        with ProgressBar(out=sys.stderr):
             return dask.compute(arr, scheduler="threads")[0]
     return dask.compute(arr, scheduler="threads")[0]
 
 
 def _dataset(data, names, grids, shape, P, base, model, order) -> xr.Dataset:
     dims = names + ["pressure_kpa"]
-    full_shape = shape + (P.size,)
     vars_ = {}
     for i, name in enumerate(_OUTPUTS):
-        v = data[:, :, i]
         if name in ("max_pressure_kpa", "branch_end"):
-            v = v[:, 0].reshape(shape) if shape else v[0, 0]
+            v = data[..., 0, i]
             d = names
         else:
-            v = v.reshape(full_shape) if shape else v[0]
-            d = dims if shape else ["pressure_kpa"]
-        if name == "branch_end" and isinstance(v, np.ndarray):
+            v = data[..., i]
+            d = dims
+        if not shape:  # no swept parameter: drop the dummy case axis
+            v = v[0]
+        if name == "branch_end":
             v = v.astype(np.int8)
         unit, long_name = _UNITS[name]
         vars_[name] = xr.DataArray(v, dims=d, attrs={"units": unit, "long_name": long_name})

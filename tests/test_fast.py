@@ -1,0 +1,98 @@
+"""The fast table path against the exact path (issue 5), over a hypothesis-drawn domain."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from numpy.testing import assert_allclose
+
+import bendpam
+from bendpam import Actuator, presets
+from bendpam.fast import MomentTable, moment_table
+from bendpam.models import get_model
+
+TOL = 1e-6
+
+
+def check_against_exact(table, P, k, order=128):
+    """|M_fast - M_ref| <= TOL (|P_a A| + |B|) against a 256-node reference (order 128 on [0, pi])."""
+    a = table.actuator
+    A, B = get_model(table.model).coefficients(a, k, order=order, eq19_factor=table.eq19_factor)
+    pa = np.maximum(P - a.P_start, 0.0)
+    ref = pa * A - B
+    got = table.moment(P, k)
+    scale = np.abs(pa * A) + np.abs(B) + 1e-12
+    err = np.abs(got - ref) / scale
+    assert err.max() <= TOL, err.max()
+    return err.max()
+
+
+@pytest.mark.parametrize("name", ["be-pam", "bc-pam"])
+@pytest.mark.parametrize("model", ["energy", "force_balance"])
+def test_presets_full_range(name, model):
+    a = presets.get(name, model)
+    t = moment_table(a, model)
+    assert t.max_rel_error <= TOL
+    lim = bendpam.curvature_limits(a)
+    rng = np.random.default_rng(1)
+    k = np.concatenate([rng.uniform(lim.k_min, lim.k_max, 20000), [lim.k_min, 0.0, lim.k_max]])
+    P = rng.uniform(0.0, 0.5, k.size)
+    check_against_exact(t, P, k)
+    # agrees with the public exact path as well
+    assert_allclose(t.moment(0.15, k[:50]), bendpam.moment(a, 0.15, k[:50], model), rtol=1e-6, atol=1e-6)
+
+
+actuators = st.builds(
+    lambda a0, R0, tf, Rs, c10, c01, ps, E: Actuator(
+        alpha0_deg=a0, R0_mm=R0, t0_mm=tf * R0, L0_mm=145.0, frame_thickness_mm=0.5, frame_width_mm=5.0,
+        frame_modulus_mpa=E, C10_kpa=c10, C01_kpa=c01 + max(-c10, 0.0) + 20.0, P_start_kpa=ps,
+        R0_start_mm=R0 * Rs),
+    a0=st.one_of(st.floats(20.0, 52.0), st.floats(58.0, 85.0)),
+    R0=st.floats(3.0, 15.0),
+    tf=st.floats(0.1, 0.5),
+    Rs=st.floats(1.0, 1.25),
+    c10=st.floats(-400.0, 1500.0),
+    c01=st.floats(0.0, 800.0),
+    ps=st.floats(0.0, 80.0),
+    E=st.floats(500.0, 20000.0),
+)
+
+
+@settings(max_examples=25, deadline=None)
+@given(a=actuators, model=st.sampled_from(["energy", "force_balance"]), seed=st.integers(0, 2**31 - 1))
+def test_fast_equals_exact_over_the_domain(a, model, seed):
+    t = MomentTable(a, model)
+    assert t.max_rel_error <= TOL
+    lim = bendpam.curvature_limits(a)
+    rng = np.random.default_rng(seed)
+    k = rng.uniform(lim.k_min, lim.k_max, 400)
+    P = rng.uniform(0.0, 0.5, k.size)
+    check_against_exact(t, P, k)
+
+
+@settings(max_examples=15, deadline=None)
+@given(a=actuators, model=st.sampled_from(["energy", "force_balance"]))
+def test_fast_free_curvature_and_stiffness(a, model):
+    t = MomentTable(a, model)
+    P = np.linspace(0.0, 0.4, 41)
+    fast = t.free_curvature(P)
+    exact = bendpam.free_curvature(a, P, model)
+    assert np.array_equal(fast.status, exact.status)
+    ok = exact.status == "ok"
+    assert_allclose(fast.curvature[ok], exact.curvature[ok], rtol=1e-6, atol=1e-9)
+    assert np.all(np.isnan(fast.curvature[~ok & (exact.status == "no-equilibrium")]))
+    k = 0.5 * np.nan_to_num(exact.curvature[ok])
+    if k.size:
+        assert_allclose(t.tangent_stiffness(P[ok], k), bendpam.tangent_stiffness(a, P[ok], k, model),
+                        rtol=1e-4, atol=1e-3 * np.abs(bendpam.tangent_stiffness(a, P[ok], k, model)).max())
+
+
+def test_fast_validates_like_the_exact_path():
+    t = moment_table(presets.be_pam())
+    with pytest.raises(ValueError, match="below zero"):
+        t.moment(-0.1, 0.0)
+    with pytest.raises(ValueError, match="lock-up"):
+        t.moment(0.1, 1.0)
+    with pytest.raises(TypeError):
+        MomentTable("be-pam")
+    assert moment_table(presets.be_pam()) is t  # cached
