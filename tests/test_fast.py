@@ -15,13 +15,18 @@ TOL = 1e-6
 
 
 def check_against_exact(table, P, k, order=128):
-    """|M_fast - M_ref| <= TOL (|P_a A| + |B|) against a 256-node reference (order 128 on [0, pi])."""
+    """|M_fast - M_ref| <= TOL (|P_a A| + |B|) against a 256-node reference (order 128 on [0, pi]).
+
+    The scale is floored at 0.1 % of its median: the elastic term B crosses zero away from k' = 0
+    in the force-balance model, where no relative error is meaningful.
+    """
     a = table.actuator
     A, B = get_model(table.model).coefficients(a, k, order=order, eq19_factor=table.eq19_factor)
     pa = np.maximum(P - a.P_start, 0.0)
     ref = pa * A - B
     got = table.moment(P, k)
-    scale = np.abs(pa * A) + np.abs(B) + 1e-12
+    terms = np.abs(pa * A) + np.abs(B)
+    scale = np.maximum(terms, 1e-3 * np.median(terms))  # B and M cross zero: floor the scale
     err = np.abs(got - ref) / scale
     assert err.max() <= TOL, err.max()
     return err.max()

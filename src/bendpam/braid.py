@@ -144,13 +144,9 @@ def solve_u(q_target, alpha0: float, order: int = DEFAULT_ORDER, u_bounds: tuple
         # start from a monotone interpolation of the inverse q -> u (tabulated once per alpha0)
         qt, ut = _inverse_table(float(alpha0), int(order))
         u0 = np.interp(q, qt, ut)
-    elif q.ndim >= 2 and q.shape[-1] >= 64 and np.shape(alpha0)[-1:] == (1,):
-        # one braid angle per row and many targets per row (sweeps): a per-row inverse table
-        u0 = _row_start(q, c, s, omc, wbar)
     else:
-        # per-point braid angles: xi(u) ~ 1 - cot^2(a0) u near 0, so u ~ q / (1 + cot^2 q)
-        cot2 = (c / s) ** 2
-        u0 = q / (1.0 + cot2 * np.maximum(q, 0.0))
+        # per-point braid angles (sweeps): interpolate a table of q over (alpha0, normalised u)
+        u0 = _universal_start(q, np.broadcast_to(alpha0, q.shape), int(order))
     u = np.where(q == 0.0, 0.0, np.clip(u0, lo + eps, hi - eps))
     for _ in range(_NEWTON_MAXITER):
         ib, dib = _ibar(u, c, omc, wbar)
@@ -170,25 +166,48 @@ def solve_u(q_target, alpha0: float, order: int = DEFAULT_ORDER, u_bounds: tuple
     return u, ib, dib
 
 
-def _row_start(q, c, s, omc, wbar, n: int = 65):
-    """Starting values of u for targets ``q`` (..., m) with one braid angle per row (..., 1).
+_A_GRID = np.radians(np.linspace(0.5, 89.5, 179))
+_NU = np.concatenate([-(1.0 - (1.0 - np.linspace(0.0, 1.0, 65)[::-1]) ** 2)[:-1],
+                      (1.0 - (1.0 - np.linspace(0.0, 1.0, 65)) ** 2)]) * 0.9999
 
-    Tabulates q(u) on ``2n - 1`` points per row over (-1/2, u_lock) and interpolates the inverse
-    linearly; Newton then needs a few steps instead of a dozen.
-    """
+
+@lru_cache(maxsize=8)
+def _universal_table(order: int) -> np.ndarray:
+    """q(alpha0, nu) on a grid: nu in (-1, 0) means u = nu / 2, nu in [0, 1) means u = nu u_lock."""
+    phi, wbar = gauss_nodes(order)
+    c, s = np.cos(_A_GRID)[:, None], np.sin(_A_GRID)[:, None]
     u_lock = (1.0 / c - 1.0) / 2.0
-    t = np.linspace(0.0, 1.0, n)
-    neg = -0.5 * (1.0 - (1.0 - t[::-1]) ** 2)[:-1] * 0.9999
-    pos = (1.0 - (1.0 - t) ** 2) * 0.9999
-    ug = np.concatenate([np.broadcast_to(neg, u_lock.shape[:-1] + neg.shape), u_lock * pos], axis=-1)
-    ib, _ = _ibar(ug, c, omc, wbar)
-    qg = s * ug * ib
-    j = (qg[..., None, :] < q[..., :, None]).sum(-1)
-    j = np.clip(j, 1, ug.shape[-1] - 1)
-    q0, q1 = np.take_along_axis(qg, j - 1, -1), np.take_along_axis(qg, j, -1)
-    u0, u1 = np.take_along_axis(ug, j - 1, -1), np.take_along_axis(ug, j, -1)
-    w = np.clip((q - q0) / np.where(q1 > q0, q1 - q0, 1.0), 0.0, 1.0)
-    return u0 + w * (u1 - u0)
+    u = np.where(_NU < 0.0, 0.5 * _NU, _NU * u_lock)
+    ib, _ = _ibar(u, c, 1.0 - np.cos(phi), wbar)
+    q = s * u * ib
+    q.setflags(write=False)
+    return q
+
+
+def _universal_start(q, alpha0, order: int):
+    """Starting values of u for per-point braid angles: interpolate the (alpha0, nu) table.
+
+    The row is interpolated linearly in alpha0 (0.5 deg steps), then inverted linearly in nu; a
+    Newton iteration from there needs a few steps.
+    """
+    Q = _universal_table(order)
+    qf = np.asarray(q, dtype=float).ravel()
+    af = np.asarray(alpha0, dtype=float).ravel()
+    t = np.clip((af - _A_GRID[0]) / (_A_GRID[1] - _A_GRID[0]), 0.0, _A_GRID.size - 1.000001)
+    i = t.astype(np.intp)
+    w = (t - i)[:, None]
+    out = np.empty(qf.size)
+    for s0 in range(0, qf.size, 8192):  # bounded memory: 8192 x 129 rows at a time
+        sl = slice(s0, s0 + 8192)
+        row = (1.0 - w[sl]) * Q[i[sl]] + w[sl] * Q[i[sl] + 1]
+        j = np.clip((row < qf[sl, None]).sum(-1), 1, _NU.size - 1)
+        q0 = np.take_along_axis(row, (j - 1)[:, None], -1)[:, 0]
+        q1 = np.take_along_axis(row, j[:, None], -1)[:, 0]
+        f = np.clip((qf[sl] - q0) / np.where(q1 > q0, q1 - q0, 1.0), 0.0, 1.0)
+        out[sl] = _NU[j - 1] + f * (_NU[j] - _NU[j - 1])
+    nu = out
+    u_lock = (1.0 / np.cos(af) - 1.0) / 2.0
+    return np.where(nu < 0.0, 0.5 * nu, nu * u_lock).reshape(np.shape(q))
 
 
 @lru_cache(maxsize=64)

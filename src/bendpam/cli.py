@@ -607,9 +607,11 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _register_extensions() -> None:
+    from .cli_design import register as register_design
     from .cli_report import register as register_report
 
     register_report(app)
+    register_design(app)
 
 
 _register_extensions()

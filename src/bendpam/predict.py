@@ -112,8 +112,24 @@ def moment(actuator, pressure, curvature, model: str = "energy", *, order: int =
     mod = get_model(model)
     p = active_pressure(act, pressure)
     k = _curvature(act, curvature, order)
-    A, B = mod.coefficients(act, k, order=order, eq19_factor=eq19_factor)
+    A, B = _chunked_coefficients(mod, act, k, order, eq19_factor)
     return p * A - B
+
+
+_CHUNK = 1 << 15
+
+
+def _chunked_coefficients(mod, act, k, order, eq19_factor):
+    """``mod.coefficients`` in blocks of 32768 curvatures, so memory stays bounded for large inputs."""
+    if k.size <= _CHUNK:
+        return mod.coefficients(act, k, order=order, eq19_factor=eq19_factor)
+    flat = k.ravel()
+    A = np.empty(flat.size)
+    B = np.empty(flat.size)
+    for s in range(0, flat.size, _CHUNK):
+        A[s:s + _CHUNK], B[s:s + _CHUNK] = mod.coefficients(act, flat[s:s + _CHUNK], order=order,
+                                                            eq19_factor=eq19_factor)
+    return A.reshape(k.shape), B.reshape(k.shape)
 
 
 def moment_terms(actuator, pressure, curvature, model: str = "energy", *, order: int = DEFAULT_ORDER, eq19_factor: bool = True):
@@ -363,42 +379,60 @@ def free_curvature(actuator, pressure, model: str = "energy", *, order: int = DE
 
 
 def _solve_branch(act, mod, br: BranchInfo, pa, order, eq19_factor, xtol):
-    """Vectorised Illinois iteration for ``sgn (pa A(k) - B(k)) = 0`` inside table brackets."""
+    """Root of ``sgn (pa A(k) - B(k)) = 0`` inside the branch-table brackets (vectorised Illinois)."""
     sgn = br.direction
     kt, pt = br.k_table, br.p_table
     j = np.searchsorted(pt, pa, side="left")
     j = np.clip(j, 1, kt.size - 1)
-    a, b = kt[j - 1], kt[j]
-    # F = sgn (pa A - B) = sgn A (pa - p): F(a) >= 0 and F(b) <= 0 on the monotone branch
-    def F(x):
-        A, B = mod.coefficients(act, x, order=order, eq19_factor=eq19_factor)
-        return sgn * (pa * A - B)
 
-    fa = F(a)
-    fb = F(b)
-    # exact hits at table points
+    # F = sgn (pa A - B) = sgn A (pa - p): F >= 0 at the table point before the root, <= 0 after
+    def F(x, idx):
+        A, B = mod.coefficients(act, x, order=order, eq19_factor=eq19_factor)
+        return sgn * (pa[idx] * A - B)
+
+    return illinois(F, kt[j - 1], kt[j], xtol * abs(br.k_end if br.k_end else 1.0))
+
+
+def illinois(F, a, b, tol, maxiter: int = 100):
+    """Vectorised Illinois (modified regula falsi) root finder on brackets with ``F(a) >= 0 >= F(b)``.
+
+    ``F(x, idx)`` evaluates the function at points ``x`` for the flat indices ``idx`` of the
+    problem, so only unconverged points are evaluated.  A point stops when its bracket or its last
+    step is below ``tol`` (scalar or per point), or ``F`` hits zero.  Returns the roots (shape of
+    ``a``).
+    """
+    shape = np.shape(a)
+    a = np.array(a, dtype=float).ravel()
+    b = np.array(b, dtype=float).ravel()
+    tol = np.broadcast_to(np.asarray(tol, dtype=float), shape).ravel()
+    every = np.arange(a.size)
+    fa, fb = F(a, every), F(b, every)
     x = np.where(fa == 0.0, a, np.where(fb == 0.0, b, 0.5 * (a + b)))
-    tol = xtol * abs(br.k_end if br.k_end else 1.0)
-    side = np.zeros(pa.shape)
-    active = (fa != 0.0) & (fb != 0.0)
-    for _ in range(200):
-        if not np.any(active):
+    side = np.zeros(a.size)
+    act = np.flatnonzero((fa != 0.0) & (fb != 0.0))
+    for _ in range(maxiter):
+        if act.size == 0:
             break
-        x = np.where(active, (a * fb - b * fa) / (fb - fa), x)
-        x = np.where(active & ~((x > np.minimum(a, b)) & (x < np.maximum(a, b))), 0.5 * (a + b), x)
-        fx = F(x)
+        aa, bb, fa_, fb_ = a[act], b[act], fa[act], fb[act]
+        xs = (aa * fb_ - bb * fa_) / (fb_ - fa_)
+        inside = (xs > np.minimum(aa, bb)) & (xs < np.maximum(aa, bb))
+        xs = np.where(inside, xs, 0.5 * (aa + bb))
+        step = np.abs(xs - x[act])
+        x[act] = xs
+        fx = F(xs, act)
         pos = fx > 0.0
-        # replace the endpoint with the same sign; Illinois: halve the retained endpoint's value
-        a_new = np.where(active & pos, x, a)
-        b_new = np.where(active & ~pos, x, b)
-        fb = np.where(active & pos & (side == 1), fb * 0.5, fb)
-        fa = np.where(active & ~pos & (side == -1), fa * 0.5, fa)
-        fa = np.where(active & pos, fx, fa)
-        fb = np.where(active & ~pos, fx, fb)
-        side = np.where(active, np.where(pos, 1, -1), side)
-        a, b = a_new, b_new
-        active = active & (np.abs(b - a) > tol) & (fx != 0.0)
-    return x
+        sd = side[act]
+        # Illinois: halve the function value kept at the end that did not move twice in a row
+        fb_ = np.where(pos & (sd == 1), 0.5 * fb_, fb_)
+        fa_ = np.where(~pos & (sd == -1), 0.5 * fa_, fa_)
+        a[act] = np.where(pos, xs, aa)
+        fa[act] = np.where(pos, fx, fa_)
+        b[act] = np.where(pos, bb, xs)
+        fb[act] = np.where(pos, fb_, fx)
+        side[act] = np.where(pos, 1.0, -1.0)
+        done = (fx == 0.0) | (np.abs(b[act] - a[act]) <= tol[act]) | (step <= tol[act])
+        act = act[~done]
+    return x.reshape(shape)
 
 
 # ------------------------------------------------------------------------------------------------

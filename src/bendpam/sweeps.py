@@ -50,6 +50,7 @@ import xarray as xr
 from .actuator import NEUTRAL_ANGLE_DEG, Actuator
 from .braid import DEFAULT_ORDER, LOCK_FRACTION, MIN_FAR_STRETCH, _ibar, gauss_nodes
 from .models import get_model
+from .predict import illinois
 from .presets import normalise_model
 
 __all__ = ["sweep", "SWEEP_PARAMETERS", "evaluate_cases", "CaseArrays"]
@@ -267,7 +268,6 @@ def _roots(cs: CaseArrays, mod, br: dict, pa: np.ndarray, order: int, eq19: bool
     """Free curvature for active pressures ``pa`` (cases, pressures) on each case's branch."""
     sgn = br["sgn"][..., None]
     kt, pt = br["kt"], br["pt"]
-    m = pa.shape[-1]
     # bracket: first table index with p >= pa (the table is increasing up to its end, then inf)
     j = (pt[..., None, :] < pa[..., :, None]).sum(-1)
     j = np.clip(j, 1, kt.shape[-1] - 1)
@@ -280,36 +280,16 @@ def _roots(cs: CaseArrays, mod, br: dict, pa: np.ndarray, order: int, eq19: bool
     unb = (br["kind"] == BRANCH_END["unbounded"])[..., None] & (j > br["last"][..., None])
     b = np.where(unb, br["k_end"][..., None], b)
     a = np.where(unb | fold_end, np.take_along_axis(kt, np.broadcast_to(br["last"][..., None], j.shape), -1), a)
-    col = cs.col()
+    case = np.broadcast_to(np.arange(pa.shape[0])[:, None], pa.shape).ravel()
+    pa_flat, sgn_flat = pa.ravel(), np.broadcast_to(sgn, pa.shape).ravel()
 
-    def F(x):
-        A, B = mod.coefficients(col, x, order=order, eq19_factor=eq19)
-        return sgn * (pa * A - B)
+    def F(x, idx):
+        sub = CaseArrays(**{f: np.asarray(v)[case[idx]] for f, v in cs.__dict__.items()})
+        A, B = mod.coefficients(sub, x, order=order, eq19_factor=eq19)
+        return sgn_flat[idx] * (pa_flat[idx] * A - B)
 
-    fa, fb = F(a), F(b)
-    x = np.where(fa == 0.0, a, np.where(fb == 0.0, b, 0.5 * (a + b)))
-    tol = xtol * np.abs(br["k_end"])[..., None] + 1e-300
-    side = np.zeros(pa.shape)
-    active = (fa != 0.0) & (fb != 0.0)
-    for _ in range(200):
-        if not np.any(active):
-            break
-        xs = (a * fb - b * fa) / (fb - fa)
-        xs = np.where((xs > np.minimum(a, b)) & (xs < np.maximum(a, b)), xs, 0.5 * (a + b))
-        x = np.where(active, xs, x)
-        fx = F(x)
-        pos = fx > 0.0
-        a_new = np.where(active & pos, x, a)
-        b_new = np.where(active & ~pos, x, b)
-        fb = np.where(active & pos & (side == 1), fb * 0.5, fb)
-        fa = np.where(active & ~pos & (side == -1), fa * 0.5, fa)
-        fa = np.where(active & pos, fx, fa)
-        fb = np.where(active & ~pos, fx, fb)
-        side = np.where(active, np.where(pos, 1, -1), side)
-        a, b = a_new, b_new
-        active = active & (np.abs(b - a) > tol) & (fx != 0.0)
-    del m
-    return x
+    tol = xtol * np.abs(br["k_end"])[:, None] + np.zeros(pa.shape) + 1e-300
+    return illinois(F, a, b, tol)
 
 
 def evaluate_cases(base: Actuator, model: str, values: dict[str, np.ndarray], pressure_kpa, *,

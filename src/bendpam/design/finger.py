@@ -36,8 +36,8 @@ Numerics
 Collocation on ``n`` equally spaced nodes (default 81): the unknowns are the nodal curvatures;
 ``phi`` is their trapezoidal integral and every segment is integrated exactly as a circular arc of
 linearly varying angle, so a constant-curvature (free) shape is exact.  The moment law is
-tabulated once per actuator and model (8000 curvatures, cubic Hermite interpolation, relative
-error below 1e-7) and inverted only on the **stable branch**: the interval of ``k'`` around the
+tabulated once per actuator and model (8000 curvatures graded toward lock-up, cubic Hermite
+interpolation, relative error below 1e-6) and inverted only on the **stable branch**: the interval of ``k'`` around the
 straight state on which ``dM/dk' < 0``.  It ends at a fold of the moment law (the BC-PAM's N-shaped
 law, and the BE-PAM's at large curvature) or at braid lock-up.  Every Newton step is kept inside
 that interval, so a curvature on the unstable (snapped) part of the law is never returned.
@@ -65,10 +65,9 @@ from functools import lru_cache
 
 import numpy as np
 
-from ..actuator import Actuator
-from ..kinematics import curvature_limits
+# public names from the package top level (robust to the modules being reorganised)
+from .. import Actuator, curvature_limits, free_curvature, moment
 from ..models import get_model
-from ..predict import free_curvature, moment
 from ..presets import normalise_model
 
 __all__ = [
@@ -86,6 +85,7 @@ __all__ = [
     "blocked_tip_force",
     "tip_stiffness",
     "linear_tip_compliance",
+    "plot_finger_shapes",
 ]
 
 #: weight of one gram, N (standard gravity 9.80665 m/s^2)
@@ -135,8 +135,10 @@ class _Law:
         n_neg = max(int(_TABLE_POINTS * (-lim.k_min) / span), 50)
         n_pos = max(_TABLE_POINTS - n_neg, 50)
         shrink = 1.0 - 1e-9
-        kg = np.concatenate([np.linspace(lim.k_min * shrink, 0.0, n_neg + 1)[:-1],
-                             np.linspace(0.0, lim.k_max * shrink, n_pos + 1)])
+        # graded toward the lock-up ends, where the law steepens: k = k_end sin(pi t / 2)
+        g_neg = np.sin(0.5 * np.pi * np.linspace(0.0, 1.0, n_neg + 1))
+        g_pos = np.sin(0.5 * np.pi * np.linspace(0.0, 1.0, n_pos + 1))
+        kg = np.concatenate([(lim.k_min * shrink * g_neg)[::-1][:-1], lim.k_max * shrink * g_pos])
         A, B = get_model(model).coefficients(actuator, kg)
         self.k = kg
         self.A, self.B = A, B
@@ -614,9 +616,10 @@ def _newton(fun, u0, lo, hi, tol, maxit=_MAX_NEWTON):
 
 
 def _moment_scale(branch: StableBranch, rod: _Rod) -> float:
+    """Moment scale for the Newton tolerance: blocked moment, fold moments and load moments (not lock-up)."""
     load = abs(rod.Mt) + math.hypot(*rod.F) * (rod.L + rod.ell) + math.hypot(*rod.q) * rod.L ** 2
-    return max(abs(branch.moment_max) if np.isfinite(branch.moment_max) else 0.0,
-               abs(branch.moment_min), abs(float(branch.moment(0.0)[0])), load, 1.0)
+    folds = [abs(m) for m, e in ((branch.moment_max, branch.end_lo), (branch.moment_min, branch.end_hi)) if e == "fold"]
+    return max([abs(float(branch.moment(0.0)[0])), load, 1.0] + folds)
 
 
 def _k_bounds(branch: StableBranch, n: int):
@@ -671,6 +674,32 @@ def _near_end_note(branch: StableBranch, k, s):
     if d_hi[j_hi] <= d_lo[j_lo]:
         return f"at s = {s[j_hi]:.3g} mm the section reaches {branch.describe_end(+1)}"
     return f"at s = {s[j_lo]:.3g} mm the section reaches {branch.describe_end(-1)}"
+
+
+def _continue(system, u0):
+    """Continuation in a path parameter t in [0, 1]: ``system(t) -> (fun, lo, hi)``.
+
+    ``u0`` must be (close to) the solution at t = 0.  Adaptive steps (doubling on success, halving
+    on failure down to 1/2048).  Returns the last solution and the parameter reached (1.0 on
+    success; -1.0 if even the start does not converge).
+    """
+    fun, lo, hi = system(0.0)
+    u, ok, _ = _newton(fun, np.asarray(u0, dtype=float), lo, hi, _NEWTON_TOL)
+    if not ok:
+        return np.asarray(u0, dtype=float), -1.0
+    t, step = 0.0, 1.0
+    while t < 1.0:
+        step = min(step, 1.0 - t)
+        fun, lo, hi = system(t + step)
+        un, ok, _ = _newton(fun, u, lo, hi, _NEWTON_TOL)
+        if ok:
+            u, t = un, t + step
+            step *= 2.0
+        else:
+            step *= 0.5
+            if step < _MIN_STEP:
+                break
+    return u, t
 
 
 def solve_finger(finger: Finger, pressure, loads: FingerLoads | None = None) -> FingerShape:
@@ -750,9 +779,10 @@ def solve_finger(finger: Finger, pressure, loads: FingerLoads | None = None) -> 
         if ok:
             return finish(k, "; no free shape at this pressure (fold of the moment law): the equilibrium exists "
                           "only under these loads")
-    fb = free_curvature(finger.actuator, P, finger.model)
-    return _failed(rod, br, P, loads, "no equilibrium: " + (fb.reason or "the loads cannot be balanced on the stable "
-                                                              "branch") + "; the finger snaps through")
+    note = (f"no equilibrium: at {P * 1e3:.4g} kPa the stable branch supplies only M in [{br.moment_min:.4g}, "
+            f"{br.moment_max:.4g}] N*mm, not M = 0 (above the fold: {br.describe_end(sgn)}); where the load moment is "
+            "smaller (toward the tip) the finger snaps through")
+    return _failed(rod, br, P, loads, note)
 
 
 def finger_sweep(finger: Finger, pressures, loads: FingerLoads | None = None):
@@ -821,18 +851,23 @@ def free_tip_trajectory(finger: Finger, pressures):
 # ------------------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class BlockedTipForce:
-    """The force that holds the fingertip point at a target (the tip is pinned, free to rotate).
+    """The force that holds the fingertip point at a target.
 
     Attributes
     ----------
     force_n : (Fx, Fy) applied to the tip by the holder, N (the finger pushes with the opposite).
     target_xy : the target point, mm.
+    constraint : ``"roller"`` (only the tip's coordinate along ``direction`` is held, the force acts
+        along ``direction``) or ``"pin"`` (both coordinates held).
+    direction : unit vector of the roller (None for a pin).
     shape : the held :class:`FingerShape` (its ``loads`` include the holding force).
     equilibrium, note : as in :class:`FingerShape`.
     """
 
     force_n: tuple[float, float]
     target_xy: tuple[float, float]
+    constraint: str
+    direction: tuple[float, float] | None
     shape: FingerShape
     equilibrium: bool
     note: str
@@ -850,78 +885,119 @@ def _straight_tip(finger: Finger) -> tuple[float, float]:
     return x0 + L * math.cos(p) - o * math.sin(p), y0 + L * math.sin(p) + o * math.cos(p)
 
 
-def blocked_tip_force(finger: Finger, pressure, target_xy_mm=None, loads: FingerLoads | None = None) -> BlockedTipForce:
-    """Force needed to hold the fingertip at ``target_xy_mm`` (default: its straight position).
+def blocked_tip_force(finger: Finger, pressure, target_xy_mm=None, direction_deg=None,
+                      loads: FingerLoads | None = None) -> BlockedTipForce:
+    """Force needed to hold the fingertip at a target point.
 
-    Solved with the force components as extra unknowns and the tip position as two extra
-    equations, by continuation of the target from the free (or loaded) tip to ``target_xy_mm``.
-    ``loads`` (optional) act in addition to the holding force.
+    Parameters
+    ----------
+    finger : Finger
+    pressure : float, MPa.
+    target_xy_mm : (x, y), optional
+        Target point, mm.  Default: the straight (unpressurised) tip position, held by a roller
+        normal to the base direction, as a force sensor measures a blocked force (a pin there would
+        need an infinite force: an inextensible rod reaches distance L only when exactly straight).
+    direction_deg : float, optional
+        Hold only the tip coordinate along this direction (degrees counterclockwise from +x) with a
+        frictionless roller; the force acts along it.  Default with ``target_xy_mm``: a pin (both
+        coordinates held, any force direction).
+    loads : FingerLoads, optional
+        Further loads acting together with the holding force.
+
+    The force components are extra unknowns and the held coordinates extra equations; the target
+    is reached by continuation from the free (or loaded) tip.  If the holder cannot be reached on
+    the stable branch (a fold: snap-through), ``equilibrium`` is False with a note.
     """
     if not isinstance(finger, Finger):
         raise TypeError(f"finger must be a bendpam.design.Finger, got {type(finger).__name__}")
     loads = FingerLoads() if loads is None else loads
     P = _pressure(pressure)
-    target = _straight_tip(finger) if target_xy_mm is None else _pair("target_xy_mm", target_xy_mm, "mm")
+    if target_xy_mm is None:
+        target = _straight_tip(finger)
+        if direction_deg is None:
+            p = finger.base_angle
+            direction = (-finger.bend * math.sin(p), finger.bend * math.cos(p))
+        else:
+            d = math.radians(_num("direction_deg", direction_deg, unit="deg"))
+            direction = (math.cos(d), math.sin(d))
+    else:
+        target = _pair("target_xy_mm", target_xy_mm, "mm")
+        if direction_deg is None:
+            direction = None
+        else:
+            d = math.radians(_num("direction_deg", direction_deg, unit="deg"))
+            direction = (math.cos(d), math.sin(d))
+    constraint = "pin" if direction is None else "roller"
     start = solve_finger(finger, P, loads)
     rod = _Rod(finger, loads)
     try:
         br = stable_branch(finger.actuator, P, finger.model)
     except ValueError as exc:
-        return BlockedTipForce((math.nan, math.nan), target, start, False, str(exc))
+        return BlockedTipForce((math.nan, math.nan), target, constraint, direction, start, False, str(exc))
     n = rod.n
     c = rod.c
     Lr = rod.L + rod.ell
     scale = _moment_scale(br, rod)
     fscale = max(scale / Lr, 1e-3)
+    nf = 2 if direction is None else 1
 
-    def make(tx, ty):
+    def make(P_t, tx, ty):
+        b = stable_branch(finger.actuator, P_t, finger.model)
+
         def fun(U):
             k = U[..., :n]
-            gx, gy = U[..., n] * fscale, U[..., n + 1] * fscale
+            if direction is None:
+                gx, gy = U[..., n] * fscale, U[..., n + 1] * fscale
+            else:
+                gx, gy = U[..., n] * fscale * direction[0], U[..., n] * fscale * direction[1]
             phi, x, y, xt, yt = rod.geometry(k)
             m = rod.load_moment(x, y, xt, yt) + _cross(xt[..., None] - x, yt[..., None] - y, gx[..., None], gy[..., None])
-            M, _ = br.moment(k)
+            M, _ = b.moment(k)
             r1 = (M + c * m) / scale
-            return np.concatenate([r1, ((xt - tx) / Lr)[..., None], ((yt - ty) / Lr)[..., None]], axis=-1)
+            if direction is None:
+                extra = [((xt - tx) / Lr)[..., None], ((yt - ty) / Lr)[..., None]]
+            else:
+                extra = [(((xt - tx) * direction[0] + (yt - ty) * direction[1]) / Lr)[..., None]]
+            return np.concatenate([r1] + extra, axis=-1)
 
-        return fun
+        lo = np.concatenate([np.full(n, b.k_lo), np.full(nf, -np.inf)])
+        hi = np.concatenate([np.full(n, b.k_hi), np.full(nf, np.inf)])
+        return fun, lo, hi
 
-    lo = np.concatenate([np.full(n, br.k_lo), [-np.inf, -np.inf]])
-    hi = np.concatenate([np.full(n, br.k_hi), [np.inf, np.inf]])
-    if start.equilibrium:
-        u = np.concatenate([start.curvature, [0.0, 0.0]])
-        t0 = np.array(start.tip_xy)
-    else:
-        # no free shape: start from the straight finger (k' = 0) with the blocked-moment guess
-        kap_guess = 0.0
-        u = np.concatenate([np.full(n, kap_guess), [0.0, 0.0]])
-        phi, x, y, xt, yt = rod.geometry(u[None, :n])
-        t0 = np.array([float(xt[0]), float(yt[0])])
     tgt = np.array(target)
-    lam, step = 0.0, 1.0
-    ok_any = True
-    while lam < 1.0:
-        step = min(step, 1.0 - lam)
-        tx, ty = t0 + (lam + step) * (tgt - t0)
-        un, ok, _ = _newton(make(tx, ty), u, lo, hi, _NEWTON_TOL)
-        if ok:
-            u, lam = un, lam + step
-            step *= 2.0
-        else:
-            step *= 0.5
-            if step < _MIN_STEP:
-                ok_any = False
-                break
-    if not ok_any:
-        note = (f"no equilibrium holds the tip at ({target[0]:.4g}, {target[1]:.4g}) mm: the continuation stops at "
-                f"{lam:.3g} of the way from the free tip")
-        sh = _failed(rod, br, P, loads, note, lam=lam)
-        return BlockedTipForce((math.nan, math.nan), target, sh, False, note)
-    F = (float(u[n] * fscale), float(u[n + 1] * fscale))
+    straight = np.array(_straight_tip(finger))
+    P0 = min(P, finger.actuator.P_start)
+    paths = []
+    if target_xy_mm is not None and start.equilibrium:
+        # move the holder from the free tip to the target at the working pressure
+        t0 = np.array(start.tip_xy)
+        paths.append((np.concatenate([start.curvature, np.zeros(nf)]),
+                      lambda t, t0=t0: make(P, *(t0 + t * (tgt - t0)))))
+    # as a test rig does: hold the tip from the straight, unpressurised state while the pressure rises
+    # (first move the holder to the target at P0, then raise the pressure)
+    paths.append((np.zeros(n + nf),
+                  lambda t: make(P0, *(straight + min(2 * t, 1.0) * (tgt - straight))) if t <= 0.5
+                  else make(P0 + (2 * t - 1.0) * (P - P0), *tgt)))
+    t_best = 0.0
+    for u0, system in paths:
+        u, t_reached = _continue(system, u0)
+        t_best = max(t_best, t_reached)
+        if t_reached >= 1.0:
+            break
+    else:
+        what = "roller" if direction is not None else "pin"
+        why = "" if start.equilibrium else f" (no unloaded equilibrium: {start.note})"
+        note = (f"no equilibrium holds the tip with a {what} at ({target[0]:.4g}, {target[1]:.4g}) mm: the finger "
+                f"snaps through on the way (continuation stops at {t_best:.3g} of the path){why}")
+        sh = _failed(rod, br, P, loads, note, lam=t_best)
+        return BlockedTipForce((math.nan, math.nan), target, constraint, direction, sh, False, note)
+    if direction is None:
+        F = (float(u[n] * fscale), float(u[n + 1] * fscale))
+    else:
+        F = (float(u[n] * fscale * direction[0]), float(u[n] * fscale * direction[1]))
     total = replace(loads, tip_force_n=(loads.tip_force_n[0] + F[0], loads.tip_force_n[1] + F[1]))
-    rod2 = _Rod(finger, total)
-    sh = _shape(rod2, u[:n], br, P, total)
-    return BlockedTipForce(F, target, sh, True, "")
+    sh = _shape(_Rod(finger, total), u[:n], br, P, total)
+    return BlockedTipForce(F, target, constraint, direction, sh, True, "")
 
 
 @dataclass(frozen=True)
@@ -979,7 +1055,7 @@ def linear_tip_compliance(finger: Finger, pressure) -> np.ndarray:
     small tip load changes the curvature by ``dk' = dM_ext / K`` and the tip pose by the integral of
     the rotations, with no geometric stiffness (the finger is unloaded).  Integrated on 2001 points.
     """
-    from ..predict import tangent_stiffness
+    from .. import tangent_stiffness
 
     P = _pressure(pressure)
     fb = free_curvature(finger.actuator, P, finger.model)
@@ -1002,3 +1078,42 @@ def linear_tip_compliance(finger: Finger, pressure) -> np.ndarray:
         C[1, j] = np.sum(w * dkap * ax)
         C[2, j] = np.sum(w * dkap)
     return C
+
+
+# ------------------------------------------------------------------------------------------------
+# figure
+# ------------------------------------------------------------------------------------------------
+def plot_finger_shapes(shapes, ax=None, title: str | None = None):
+    """Draw finger shapes (frame line, fingertip, tip point) on ``ax``; returns the figure.
+
+    Shapes without equilibrium are drawn dashed from their last equilibrium (``limit``) if any.
+    """
+    from .. import plots  # noqa: F401  (selects the Agg backend unless the caller chose one)
+    import matplotlib.pyplot as plt
+
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(6.0, 5.0))
+    else:
+        fig = ax.figure
+    shapes = list(shapes)
+    colors = plt.cm.viridis(np.linspace(0.0, 0.9, max(len(shapes), 1)))
+    for sh, col in zip(shapes, colors):
+        draw, style = (sh, "-") if sh.equilibrium else (sh.limit, "--")
+        label = f"{sh.pressure * 1e3:g} kPa" + ("" if sh.equilibrium else " (no equilibrium)")
+        if draw is None:
+            ax.plot([], [], style, color=col, label=label)
+            continue
+        ax.plot(draw.x, draw.y, style, color=col, label=label)
+        ax.plot([draw.x[-1], draw.tip_xy[0]], [draw.y[-1], draw.tip_xy[1]], style, color=col, lw=3, alpha=0.6)
+        ax.plot(*draw.tip_xy, "o", color=col, ms=4)
+    if shapes:
+        x0, y0 = shapes[0].finger.base_xy_mm
+        ax.plot(x0, y0, "ks", ms=6)
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("x (mm)")
+    ax.set_ylabel("y (mm)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    if title:
+        ax.set_title(title)
+    return fig

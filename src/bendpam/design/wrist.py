@@ -1,0 +1,455 @@
+r"""A wrist of four bending PAMs around a column (the paper's Figure 9(d)): bend angle, holding load.
+
+Model and assumptions
+---------------------
+* Four identical actuators (default: the paper's BC-PAM) sit at ``positions_deg`` (0, 90, 180,
+  270 deg) around a column, at ``radius_mm`` from its axis.  Each is mounted so that inflating it
+  bends the wrist toward its own side: a BC-PAM has its frame toward the column (it bends away
+  from the frame), a BE-PAM its frame outward.
+* **Shared curvature.**  The wrist bends as one uniform arc of curvature ``kappa`` (1/mm) toward
+  the direction ``psi`` in the cross-section; the bending angle is ``theta = kappa L``.  Actuator
+  ``i`` at angle ``theta_i`` has the in-plane frame curvature ``k'_i = s kappa cos(psi - theta_i)``
+  (``s`` = ``bend_sign``: the sign of its free bending) and the out-of-plane curvature
+  ``kappa sin(psi - theta_i)``.
+* **Moments add.**  The wrist's bending moment (a vector along the bending direction) is::
+
+      m(kappa, psi) = sum_i [ s M(P_i, k'_i) e_i  -  EI_lat kappa sin(psi - theta_i) e_i_perp ]  -  EI_col kappa e_psi
+
+  with ``M`` the paper's moment law (:func:`bendpam.moment`; an inactive actuator gives its
+  passive moment at ``P = 0``), ``EI_lat`` the out-of-plane (lateral) bending stiffness of one
+  actuator and ``EI_col`` that of the column.  The default ``EI_lat`` is the frame strip bent about
+  its strong axis, ``E_f t w^3 / 12`` (35 400 N*mm^2 for the paper's frame); bendpam has no model
+  of the bladder's lateral stiffness, so this is a lower bound, and ``lateral_stiffness_nmm2=0``
+  gives the brief's simplest model (only in-plane moments).  The default column is a free joint
+  (``EI_col = 0``).
+* The radius does not enter the moment balance: the actuators are taken to slide axially at the
+  end plate, so that each keeps its inextensible frame length ``L``.  It fixes where the actuators
+  sit (reported with the geometry).
+* Each actuator must stay on the stable branch of its own moment law (``dM/dk' < 0``); the
+  combined equilibrium must be stable (the 2x2 stiffness negative definite).  Otherwise the
+  result says ``equilibrium=False`` (a snap-through: the BC-PAM's fold).  The passive actuators
+  stiffen the wrist, so the active BC-PAM stays far from its fold curvature and the wrist has an
+  equilibrium well above the single actuator's fold pressure (134 kPa with the energy constants).
+  The solution is continued in pressure (and load) from the straight wrist.
+* **Holding a load** (Figure 9(b), (d) i-ii): the forearm is horizontal, the hand sticks out along
+  the wrist, one actuator is on top.  A mass ``load_g`` (default 335 g: the paper's bottle) at
+  ``lever_mm`` beyond the end plate (default 100 mm: roughly palm to bottle axis; the paper does
+  not say) and an optional hand mass pull down.  With the uniform arc the load point rises by
+  ``z(kappa) = (1 - cos kappa L)/kappa + lever sin(kappa L)``, and virtual work gives the equilibrium
+  ``L m(kappa) = W dz/dkappa`` (at ``kappa = 0``: the load moment about the wrist's mid-length,
+  ``W (L/2 + lever)``).
+
+Units: mm, N, N*mm, MPa for pressures passed to functions (kPa in tables), grams, degrees in names
+ending ``_deg``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import Actuator, presets
+from ..presets import normalise_model
+from .finger import G_N_PER_G, StableBranch, _num, _pressure, stable_branch
+
+__all__ = [
+    "DEFAULT_RADIUS_MM",
+    "DEFAULT_LEVER_MM",
+    "BOTTLE_G",
+    "Wrist",
+    "WristState",
+    "WristHold",
+    "wrist_pressures",
+    "wrist_bend",
+    "wrist_moment",
+    "wrist_hold",
+    "wrist_sweep",
+    "plot_wrist",
+]
+
+#: default mounting radius of the actuators around the column, mm
+DEFAULT_RADIUS_MM = 20.0
+#: default lever of the held mass beyond the wrist's end plate, mm
+DEFAULT_LEVER_MM = 100.0
+#: the paper's bottle of water held horizontally (Figure 9(d) i-ii), g
+BOTTLE_G = 335.0
+
+
+@dataclass(frozen=True)
+class Wrist:
+    """Four actuators around a column (validated, immutable).
+
+    Parameters
+    ----------
+    actuator : Actuator
+        The actuators (default: the paper's BC-PAM with the model's constants).
+    model : {"energy", "force_balance"}
+    radius_mm : float
+        Mounting radius of the actuators around the column axis, mm (default 20: four tubes of
+        17 mm diameter around a thin column).  Geometry only (see the module docstring).
+    length_mm : float, optional
+        Active length of the wrist, mm (default: the actuator's ``L0_mm``, 145 mm for the presets).
+    lateral_stiffness_nmm2 : float, optional
+        Out-of-plane bending stiffness of one actuator, N*mm^2 (default: its frame about the strong
+        axis, ``E_f t w^3 / 12``).
+    column_stiffness_nmm2 : float
+        Bending stiffness of the column, N*mm^2 (default 0: a free joint).
+    positions_deg : tuple of 4 floats
+        Angular positions of the actuators (default 0, 90, 180, 270).
+    """
+
+    actuator: Actuator | None = None
+    model: str = "energy"
+    radius_mm: float = DEFAULT_RADIUS_MM
+    length_mm: float | None = None
+    lateral_stiffness_nmm2: float | None = None
+    column_stiffness_nmm2: float = 0.0
+    positions_deg: tuple = (0.0, 90.0, 180.0, 270.0)
+
+    def __post_init__(self):
+        s = object.__setattr__
+        s(self, "model", normalise_model(self.model))
+        if self.actuator is None:
+            s(self, "actuator", presets.bc_pam(self.model))
+        if not isinstance(self.actuator, Actuator):
+            raise TypeError(f"actuator must be a bendpam.Actuator, got {type(self.actuator).__name__}")
+        if self.actuator.bend_sign == 0:
+            raise ValueError("the actuator has the neutral braid angle (54.74 deg): it does not bend")
+        s(self, "radius_mm", _num("radius_mm", self.radius_mm, 0.0, 1e3, unit="mm"))
+        L = self.actuator.L0_mm if self.length_mm is None else self.length_mm
+        s(self, "length_mm", _num("length_mm", L, 0.0, 1e4, lo_open=True, unit="mm"))
+        if self.lateral_stiffness_nmm2 is None:
+            a = self.actuator
+            s(self, "lateral_stiffness_nmm2", a.frame_modulus_mpa * a.frame_thickness_mm * a.frame_width_mm ** 3 / 12.0)
+        else:
+            s(self, "lateral_stiffness_nmm2",
+              _num("lateral_stiffness_nmm2", self.lateral_stiffness_nmm2, 0.0, unit="N*mm^2"))
+        s(self, "column_stiffness_nmm2", _num("column_stiffness_nmm2", self.column_stiffness_nmm2, 0.0, unit="N*mm^2"))
+        pos = tuple(float(_num("positions_deg", p, -360.0, 360.0, unit="deg")) for p in self.positions_deg)
+        if len(pos) != 4:
+            raise ValueError(f"positions_deg = {self.positions_deg!r} must give 4 angles (deg)")
+        s(self, "positions_deg", pos)
+
+    @property
+    def directions(self) -> np.ndarray:
+        """Unit vectors e_i of the actuators' positions, shape (4, 2)."""
+        t = np.radians(self.positions_deg)
+        return np.stack([np.cos(t), np.sin(t)], axis=1)
+
+
+@dataclass(frozen=True)
+class WristState:
+    """Equilibrium of the wrist.
+
+    Attributes
+    ----------
+    pressures : the four pressures, MPa.
+    curvature : kappa, 1/mm (>= 0).
+    direction_deg : bending direction psi in the cross-section, deg (NaN when straight).
+    angle_deg : bending angle theta = kappa L, deg.
+    actuator_curvatures : the four in-plane frame curvatures k'_i, 1/mm.
+    load_moment_nmm : the external moment vector balanced (N*mm, 2 components).
+    equilibrium : a stable equilibrium was found on every actuator's stable branch.
+    note : why not, else empty.
+    """
+
+    pressures: tuple
+    curvature: float
+    direction_deg: float
+    angle_deg: float
+    actuator_curvatures: tuple
+    load_moment_nmm: tuple
+    equilibrium: bool
+    note: str
+
+
+def wrist_pressures(direction_deg: float, pressure, positions_deg=(0.0, 90.0, 180.0, 270.0)) -> tuple:
+    """The four pressures that bend the wrist toward ``direction_deg``: the actuator there, or the two
+    neighbours at the same pressure for a direction halfway between them (multiples of 45 deg)."""
+    P = _pressure(pressure)
+    d = float(_num("direction_deg", direction_deg, -720.0, 720.0, unit="deg")) % 360.0
+    pos = np.mod(np.asarray(positions_deg, dtype=float), 360.0)
+    diff = np.abs((pos - d + 180.0) % 360.0 - 180.0)
+    on = diff < 1e-9
+    if np.any(on):
+        return tuple(P if o else 0.0 for o in on)
+    two = np.argsort(diff)[:2]
+    if abs(diff[two[0]] - diff[two[1]]) > 1e-9:
+        raise ValueError(f"direction_deg = {direction_deg:g} is neither an actuator's direction nor halfway between "
+                         f"two (actuators at {', '.join(f'{p:g}' for p in positions_deg)} deg)")
+    return tuple(P if i in two else 0.0 for i in range(4))
+
+
+class _WristLaw:
+    def __init__(self, wrist: Wrist, pressures):
+        self.w = wrist
+        self.s = wrist.actuator.bend_sign
+        self.e = wrist.directions
+        self.ep = np.stack([-self.e[:, 1], self.e[:, 0]], axis=1)
+        self.P = tuple(float(p) for p in pressures)
+        self.br: list[StableBranch] = [stable_branch(wrist.actuator, p, wrist.model) for p in self.P]
+
+    def kprime(self, b):
+        return self.s * (self.e @ b)
+
+    def moment(self, b):
+        """Wrist moment vector m(b) (N*mm) and its Jacobian (N*mm^2) at curvature vector b (1/mm)."""
+        kp = self.kprime(b)
+        M = np.empty(4)
+        dM = np.empty(4)
+        for i, br in enumerate(self.br):
+            m, d = br.moment(kp[i])
+            M[i], dM[i] = float(m), float(d)
+        klat = self.ep @ b
+        EIl, EIc = self.w.lateral_stiffness_nmm2, self.w.column_stiffness_nmm2
+        m = self.s * (M @ self.e) - EIl * (klat @ self.ep) - EIc * b
+        J = (self.e.T * dM) @ self.e - EIl * (self.ep.T @ self.ep) - EIc * np.eye(2)  # s^2 = 1
+        return m, J
+
+    def inside(self, b) -> tuple[bool, str]:
+        kp = self.kprime(b)
+        for i, br in enumerate(self.br):
+            if not br.k_lo < kp[i] < br.k_hi:
+                side = +1 if kp[i] >= br.k_hi else -1
+                return False, (f"actuator {i} (at {self.w.positions_deg[i]:g} deg, {self.P[i] * 1e3:g} kPa) "
+                               f"leaves its stable branch: {br.describe_end(side)}")
+        return True, ""
+
+
+def _solve(wrist: Wrist, pressures, load_fn=None, b0=None):
+    """Newton with continuation in the pressures (and the load) from the straight, unpressurised wrist."""
+    P = np.array([_pressure(p) for p in pressures], dtype=float)
+    if P.shape != (4,):
+        raise ValueError(f"pressures = {pressures!r} must give 4 pressures (MPa), one per actuator")
+    b = np.zeros(2) if b0 is None else np.array(b0, dtype=float)
+    t, step = 0.0, 1.0
+    law = None
+    note = ""
+    scale = max(1.0, float(np.max(np.abs([stable_branch(wrist.actuator, p, wrist.model).moment(0.0)[0] for p in P]))))
+    while t < 1.0:
+        step = min(step, 1.0 - t)
+        tt = t + step
+        law_t = _WristLaw(wrist, tuple(tt * P))
+        bb, ok = b.copy(), False
+        for _ in range(50):
+            m, J = law_t.moment(bb)
+            if load_fn is not None:
+                ml, Jl = load_fn(bb, tt)
+                m, J = m + ml, J + Jl
+            if np.max(np.abs(m)) < 1e-10 * scale:
+                ok = True
+                break
+            try:
+                db = -np.linalg.solve(J, m)
+            except np.linalg.LinAlgError:
+                break
+            alpha = 1.0
+            for _ in range(30):
+                cand = bb + alpha * db
+                if law_t.inside(cand)[0]:
+                    m2, _ = law_t.moment(cand)
+                    if load_fn is not None:
+                        m2 = m2 + load_fn(cand, tt)[0]
+                    if np.linalg.norm(m2) < (1 - 1e-4 * alpha) * np.linalg.norm(m):
+                        break
+                alpha *= 0.5
+            else:
+                break
+            bb = cand
+        if ok:
+            m, J = law_t.moment(bb)
+            if load_fn is not None:
+                J = J + load_fn(bb, tt)[1]
+            ev = np.linalg.eigvals(0.5 * (J + J.T))
+            ok = bool(np.all(ev.real < 0))
+        if ok:
+            b, t, law = bb, tt, law_t
+            step *= 2.0
+        else:
+            step *= 0.5
+            if step < 1.0 / 2048:
+                inside, why = law_t.inside(bb)
+                note = (f"no equilibrium: the wrist snaps through at {t:.3g} of the load/pressure path"
+                        + (f" ({why})" if why else " (its combined moment law folds)"))
+                break
+    return b, t, law, note
+
+
+def _state(wrist: Wrist, P, b, t, law, note, load_moment=(0.0, 0.0)) -> WristState:
+    if t < 1.0:
+        nan = math.nan
+        return WristState(tuple(P), nan, nan, nan, (nan,) * 4, tuple(load_moment), False, note)
+    kap = float(np.hypot(*b))
+    psi = math.degrees(math.atan2(b[1], b[0])) % 360.0 if kap > 1e-15 else math.nan
+    if psi > 360.0 - 1e-6:
+        psi = 0.0
+    return WristState(tuple(float(p) for p in P), kap, psi, math.degrees(kap * wrist.length_mm),
+                      tuple(float(k) for k in law.kprime(b)), tuple(load_moment), True, note)
+
+
+def wrist_bend(wrist: Wrist, pressures=None, *, direction_deg=None, pressure=None) -> WristState:
+    """Free bending of the wrist.
+
+    Give the four ``pressures`` (MPa), or ``direction_deg`` and ``pressure`` (MPa) to inflate the
+    actuator(s) of that direction (:func:`wrist_pressures`).
+    """
+    if not isinstance(wrist, Wrist):
+        raise TypeError(f"wrist must be a bendpam.design.Wrist, got {type(wrist).__name__}")
+    if pressures is None:
+        if direction_deg is None or pressure is None:
+            raise ValueError("give the four pressures, or direction_deg and pressure")
+        pressures = wrist_pressures(direction_deg, pressure, wrist.positions_deg)
+    b, t, law, note = _solve(wrist, pressures)
+    return _state(wrist, pressures, b, t, law, note)
+
+
+def wrist_moment(wrist: Wrist, pressures, angle_deg, direction_deg):
+    """The moment the wrist exerts when held at ``angle_deg`` toward ``direction_deg`` (N*mm vector).
+
+    This is the load it holds there: an external moment ``-m`` keeps it at that angle.  Returns
+    ``(m, on_branch, note)``; ``on_branch`` is False (with a note) where an actuator is beyond its
+    stable branch at that curvature.
+    """
+    P = tuple(_pressure(p) for p in pressures)
+    law = _WristLaw(wrist, P)
+    kap = math.radians(_num("angle_deg", angle_deg, unit="deg")) / wrist.length_mm
+    d = math.radians(_num("direction_deg", direction_deg, unit="deg"))
+    b = kap * np.array([math.cos(d), math.sin(d)])
+    ok, why = law.inside(b)
+    m, _ = law.moment(b)
+    return m, ok, why
+
+
+@dataclass(frozen=True)
+class WristHold:
+    """The wrist holding a mass horizontally (forearm horizontal, one actuator on top).
+
+    Attributes
+    ----------
+    pressure : MPa, in the upper actuator.
+    load_g, lever_mm, hand_mass_g, hand_lever_mm : the load case.
+    angle_deg : equilibrium bending angle, deg: > 0 the hand is raised above horizontal, < 0 it droops.
+    holds_horizontal : ``angle_deg >= 0`` (the wrist keeps the hand at or above horizontal).
+    capacity_g : the largest mass at ``lever_mm`` it holds with the hand horizontal (with the hand mass).
+    pressure_needed_kpa : pressure of the upper actuator that holds the load exactly horizontal.
+    load_moment_nmm : the load's moment at kappa = 0, ``W (L/2 + lever)`` summed, N*mm.
+    equilibrium, note : as in :class:`WristState`.
+    """
+
+    pressure: float
+    load_g: float
+    lever_mm: float
+    hand_mass_g: float
+    hand_lever_mm: float
+    angle_deg: float
+    holds_horizontal: bool
+    capacity_g: float
+    pressure_needed_kpa: float
+    load_moment_nmm: float
+    equilibrium: bool
+    note: str
+
+
+def _dz(kap, L, lever):
+    """d z / d kappa for the load point of a uniform arc (z = (1 - cos kL)/k + lever sin kL), and its derivative."""
+    x = kap * L
+    if abs(x) < 1e-4:
+        d1 = L * L / 2.0 - L ** 4 * kap ** 2 / 8.0 + lever * L * math.cos(x)
+        d2 = -L ** 4 * kap / 4.0 - lever * L * L * math.sin(x)
+        return d1, d2
+    d1 = (x * math.sin(x) - (1.0 - math.cos(x))) / kap ** 2 + lever * L * math.cos(x)
+    d2 = (L * math.sin(x) + x * L * math.cos(x) - L * math.sin(x)) / kap ** 2 \
+        - 2.0 * (x * math.sin(x) - (1.0 - math.cos(x))) / kap ** 3 - lever * L * L * math.sin(x)
+    return d1, d2
+
+
+def wrist_hold(wrist: Wrist, pressure, *, load_g: float = BOTTLE_G, lever_mm: float = DEFAULT_LEVER_MM,
+               hand_mass_g: float = 0.0, hand_lever_mm: float = 50.0, up_deg: float = 90.0) -> WristHold:
+    """The wrist, forearm horizontal, holding ``load_g`` at ``lever_mm`` with the upper actuator at ``pressure``.
+
+    The actuator at ``up_deg`` (default 90) is on top and inflated; the others are at P = 0.
+    Gravity acts toward ``up_deg + 180``.  See the module docstring for the model.
+    """
+    if not isinstance(wrist, Wrist):
+        raise TypeError(f"wrist must be a bendpam.design.Wrist, got {type(wrist).__name__}")
+    P = _pressure(pressure)
+    mL = _num("load_g", load_g, 0.0, unit="g")
+    lev = _num("lever_mm", lever_mm, 0.0, unit="mm")
+    mh = _num("hand_mass_g", hand_mass_g, 0.0, unit="g")
+    levh = _num("hand_lever_mm", hand_lever_mm, 0.0, unit="mm")
+    pressures = wrist_pressures(up_deg, P, wrist.positions_deg)
+    if sum(p > 0 for p in pressures) != 1:
+        raise ValueError(f"up_deg = {up_deg:g} must be the direction of one actuator ({wrist.positions_deg} deg)")
+    L = wrist.length_mm
+    u = np.array([math.cos(math.radians(up_deg)), math.sin(math.radians(up_deg))])
+    W1, W2 = mL * G_N_PER_G, mh * G_N_PER_G
+
+    def load_fn(b, t):
+        # generalised load moment along u (virtual work): -(W dz/dkappa)/L, for the bending component along u
+        kap = float(b @ u)
+        d1a, d2a = _dz(kap, L, lev)
+        d1b, d2b = _dz(kap, L, levh)
+        ml = -t * (W1 * d1a + W2 * d1b) / L
+        dml = -t * (W1 * d2a + W2 * d2b) / L
+        return ml * u, dml * np.outer(u, u)
+
+    b, t, law, note = _solve(wrist, pressures, load_fn)
+    M0 = (W1 * (L / 2 + lev) + W2 * (L / 2 + levh))
+    # capacity and pressure needed: at kappa = 0 only the upper actuator's blocked moment acts
+    br = stable_branch(wrist.actuator, P, wrist.model)
+    s = wrist.actuator.bend_sign
+    m_block = s * float(br.moment(0.0)[0])  # the upper actuator's blocked moment magnitude
+    cap = max((m_block - W2 * (L / 2 + levh)) / (G_N_PER_G * (L / 2 + lev)), 0.0)
+    act = wrist.actuator
+    slope = abs(math.pi * act.R0_start ** 3 * (1.0 - 2.0 / math.tan(act.alpha0) ** 2))  # dM_blocked/dP (eq 49 closed form)
+    p_need = (act.P_start + M0 / slope) * 1e3
+    if t < 1.0:
+        return WristHold(P, mL, lev, mh, levh, math.nan, False, cap, p_need, M0, False, note)
+    ang = math.degrees(float(b @ u) * L)
+    return WristHold(P, mL, lev, mh, levh, ang, ang >= -1e-9, cap, p_need, M0, True, "")
+
+
+def wrist_sweep(wrist: Wrist, pressures, directions_deg=(0.0, 90.0, 180.0, 270.0)):
+    """Free bending against pressure (MPa) in each direction: a :class:`pandas.DataFrame`.
+
+    Columns ``direction_deg``, ``pressure_kpa``, ``angle_deg``, ``bend_direction_deg``,
+    ``curvature_per_mm``, ``equilibrium``, ``note``.
+    """
+    import pandas as pd
+
+    rows = []
+    for d in directions_deg:
+        for p in np.atleast_1d(np.asarray(pressures, dtype=float)).ravel():
+            st = wrist_bend(wrist, direction_deg=d, pressure=p)
+            rows.append({"direction_deg": float(d), "pressure_kpa": float(p) * 1e3, "angle_deg": st.angle_deg,
+                         "bend_direction_deg": st.direction_deg, "curvature_per_mm": st.curvature,
+                         "equilibrium": st.equilibrium, "note": st.note})
+    return pd.DataFrame(rows)
+
+
+def plot_wrist(table, holds=(), ax=None, title: str | None = None):
+    """Bending angle against pressure per direction (and the holding angles with the load, dashed)."""
+    from .. import plots  # noqa: F401  (Agg backend unless chosen)
+    import matplotlib.pyplot as plt
+
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    else:
+        fig = ax.figure
+    for d, grp in table.groupby("direction_deg"):
+        ax.plot(grp["pressure_kpa"], grp["angle_deg"], "o-", label=f"free, toward {d:g} deg")
+    holds = list(holds)
+    if holds:
+        ax.plot([h.pressure * 1e3 for h in holds], [h.angle_deg for h in holds], "s--", color="k",
+                label=f"holding {holds[0].load_g:g} g at {holds[0].lever_mm:g} mm")
+        ax.axhline(0.0, color="0.5", lw=0.8)
+    ax.axhline(30.0, color="tab:red", lw=0.8, ls=":", label="30 deg")
+    ax.set_xlabel("pressure (kPa)")
+    ax.set_ylabel("bending angle (deg)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    if title:
+        ax.set_title(title)
+    return fig
