@@ -144,8 +144,19 @@ def predict(
     model: ModelOpt = Model.energy,
     pressure_kpa: PressureOpt = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object instead of a table.")] = False,
+    cycle: Annotated[
+        bool, typer.Option("--cycle", help="Also predict the hysteresis loop of a free-bending cycle (needs loop "
+                           "parameters: the [hysteresis] table of --actuator, or the --loop-* options).")
+    ] = False,
+    loop_law: Annotated[Optional[str], typer.Option("--loop-law", help="Loop law: pi or dahl.")] = None,
+    loop_a0_nmm: Annotated[Optional[float], typer.Option("--loop-a0-nmm", help="Loop amplitude, constant part (N·mm).")]
+    = None,
+    loop_a1_nmm_per_kpa: Annotated[
+        Optional[float], typer.Option("--loop-a1-nmm-per-kpa", help="Loop amplitude per active pressure (N·mm/kPa).")
+    ] = None,
+    loop_angle_deg: Annotated[Optional[float], typer.Option("--loop-angle-deg", help="Loop angle (deg).")] = None,
 ):
-    """Blocked moment and free bending curvature/angle at each pressure."""
+    """Blocked moment and free bending curvature/angle at each pressure (and, with --cycle, the loop)."""
     from .predict import branch_info, prediction_table
 
     act = load_actuator(preset, actuator, model)
@@ -153,6 +164,12 @@ def predict(
     mname = model_name(model)
     df = prediction_table(act, P, mname)
     br = branch_info(act, mname)
+    loop = _loop_model(actuator, loop_law, loop_a0_nmm, loop_a1_nmm_per_kpa, loop_angle_deg) if cycle else None
+    cycles = None
+    if loop is not None:
+        from .hysteresis import predict_cycle
+
+        cycles = [predict_cycle(act, loop, p, mname) for p in P]
     if as_json:
         obj = {
             "model": mname,
@@ -168,15 +185,49 @@ def predict(
                     "free_curvature_per_mm": _jsonable(r.free_curvature_per_mm),
                     "free_angle_deg": _jsonable(r.free_angle_deg),
                     "note": r.note or None,
+                    **({"cycle": _cycle_json(cycles[i])} if cycles is not None else {}),
                 }
-                for r in df.itertuples()
+                for i, r in enumerate(df.itertuples())
             ],
+            **({"hysteresis": loop.to_dict()} if loop is not None else {}),
         }
         typer.echo(json.dumps(obj, indent=2))
         return
     typer.echo(format_prediction_table(df, f"{act.name or act.kind} — {mname.replace('_', '-')} model"))
     if math.isfinite(br.max_pressure):
         typer.echo(f"highest pressure with a free-bending equilibrium: {br.max_pressure * 1e3:.4g} kPa ({br.kind})")
+    if cycles is not None:
+        typer.echo(f"\nloop ({loop.law}, a0 = {loop.a0_nmm:g} N·mm, a1 = {loop.a1_nmm_per_mpa:g} N·mm/MPa, "
+                   f"angle {loop.theta_h_deg:g} deg): free-bending cycle blocked -> free -> blocked")
+        typer.echo(f"{'P (kPa)':>8}  {'k_free,unloading (1/mm)':>24}  {'energy-loss ratio':>18}  note")
+        for c in cycles:
+            typer.echo(f"{c.pressure_kpa:8.4g}  {_num(c.free_curvature_per_mm, '24.5f')}  "
+                       f"{_num(100 * c.energy_loss_ratio, '17.2f')}%  {c.note}")
+
+
+def _loop_model(actuator_file, law, a0, a1_per_kpa, angle):
+    """Loop parameters for --cycle: the actuator file's [hysteresis] table, overridden by --loop-* options."""
+    from .hysteresis import LoopModel
+
+    base = LoopModel.from_toml(actuator_file) if actuator_file is not None else None
+    given = {k: v for k, v in (("law", law), ("a0_nmm", a0), ("theta_h_deg", angle),
+                               ("a1_nmm_per_mpa", None if a1_per_kpa is None else a1_per_kpa * 1e3)) if v is not None}
+    if base is None and not {"a0_nmm", "a1_nmm_per_mpa"} & set(given):
+        raise UserError("--cycle needs loop parameters: an --actuator file with a [hysteresis] table "
+                        "(bendpam fit --hysteresis writes one) or --loop-a0-nmm / --loop-a1-nmm-per-kpa")
+    d = (base.to_dict() if base is not None else {}) | given
+    return LoopModel.from_dict(d, source="loop parameters")
+
+
+def _cycle_json(c) -> dict:
+    return {
+        "free_curvature_unloading_per_mm": _jsonable(c.free_curvature_per_mm),
+        "energy_loss_ratio": _jsonable(c.energy_loss_ratio),
+        "curvature_per_mm": [float(x) for x in c.curvature_per_mm[::10]],
+        "loading_nmm": [float(x) for x in c.loading_nmm[::10]],
+        "unloading_nmm": [float(x) for x in c.unloading_nmm[::10]],
+        "note": c.note or None,
+    }
 
 
 @app.command()
@@ -387,11 +438,17 @@ def simulate_test_cmd(
     noise_n: Annotated[float, typer.Option("--noise-n", help="Force noise, standard deviation (N).")] = 0.05,
     noise_stroke_mm: Annotated[float, typer.Option("--noise-stroke-mm", help="Stroke noise, standard deviation (mm).")] = 0.002,
     hysteresis: Annotated[
-        float, typer.Option("--hysteresis", help="Loop half-width as a fraction of the blocked moment (Dahl law).")
+        float, typer.Option("--hysteresis", help="Pressure part of the loop amplitude, as a fraction of the blocked moment.")
     ] = 0.06,
     hysteresis_angle_deg: Annotated[
-        float, typer.Option("--hysteresis-angle-deg", help="Dahl characteristic angle: roundness of reversals (deg).")
+        float, typer.Option("--hysteresis-angle-deg",
+                            help="Loop angle (deg): saturation angle (pi) or characteristic angle (dahl).")
     ] = 5.0,
+    hysteresis_law: Annotated[str, typer.Option("--hysteresis-law", help="Loop law: pi (Prandtl-Ishlinskii) or dahl.")]
+    = "pi",
+    hysteresis_offset_nmm: Annotated[
+        float, typer.Option("--hysteresis-offset-nmm", help="Constant part of the loop amplitude (N·mm).")
+    ] = 0.0,
     cycles: Annotated[int, typer.Option("--cycles", help="Cycles per pressure.")] = 3,
     speed_mm_min: Annotated[float, typer.Option("--speed-mm-min", help="Crosshead speed (mm/min).")] = 30.0,
     rate_hz: Annotated[float, typer.Option("--rate-hz", help="Sampling rate (Hz).")] = 20.0,
@@ -412,7 +469,8 @@ def simulate_test_cmd(
     P = pressures_kpa(pressure_kpa, more)
     st = SimulationSettings(cycles=cycles, speed_mm_min=speed_mm_min, rate_hz=rate_hz, noise_n=noise_n,
                             noise_stroke_mm=noise_stroke_mm, hysteresis=hysteresis,
-                            hysteresis_angle_deg=hysteresis_angle_deg, dwell_s=dwell_s,
+                            hysteresis_angle_deg=hysteresis_angle_deg, hysteresis_law=hysteresis_law,
+                            hysteresis_offset_nmm=hysteresis_offset_nmm, dwell_s=dwell_s,
                             stroke_offset_mm=stroke_offset_mm, seed=seed)
     fx = Fixture.from_string(fixture, L0_mm=act.L0_mm)
     truth = simulate_tests(act, P, out, model_name(model), dialect=fmt.value, fixture=fx, settings=st)
@@ -459,6 +517,11 @@ def fit(
     thickness_mm: ThickOpt = None,
     fit_range: Annotated[str, typer.Option("--fit-range", help="'developed' (loop developed) or 'all' points.")]
     = "developed",
+    hysteresis: Annotated[
+        bool, typer.Option("--hysteresis", help="Also identify a rate-independent loop from both branches.")
+    ] = False,
+    hysteresis_law: Annotated[str, typer.Option("--hysteresis-law", help="Loop law: pi (Prandtl-Ishlinskii) or dahl.")]
+    = "pi",
     out: Annotated[Optional[Path], typer.Option("--out", help="Output folder.")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print fit.json to stdout.")] = False,
 ):
@@ -472,7 +535,8 @@ def fit(
     act = load_actuator(preset, actuator, model)
     data = load_processed(processed_dir)
     tfit = _tension(tension, gauge_length_mm, area_mm2, width_mm, thickness_mm) if tension else None
-    res = _fit(data, act, model_name(model), free=free, tension=tfit, fit_range=fit_range)
+    res = _fit(data, act, model_name(model), free=free, tension=tfit, fit_range=fit_range,
+               hysteresis=hysteresis_law if hysteresis else None)
     res.save(out)
     if tfit is not None:
         obj = json.loads((out / "fit.json").read_text())

@@ -18,7 +18,9 @@ Laws for ``z`` (both rate-independent: they depend on the path, not on its speed
       thresholds ``r_j = (theta_h / 2)(j - 1/2) / n`` are uniformly spread, each weighted by its
       threshold, so after a reversal ``z`` runs from -1 to +1 along a rounded (nearly parabolic)
       curve and saturates after the angle ``theta_h``.  Loops between fixed end points close
-      exactly after the first cycle (the wiping-out property of play/stop operators).
+      exactly after the first cycle (the wiping-out property of play/stop operators); a loop
+      narrower than ``theta_h`` keeps the memory of how its end points were reached, and bendpam's
+      steady cycles start from the blocked state reached by a long loading (as in the test).
     * :class:`DahlLaw` (``"dahl"``): Dahl's first-order law, ``dz/dtheta = (s - z) / theta_c`` with
       ``s = sign(dtheta)``: exponential approach over the characteristic angle ``theta_c``; loops
       close only asymptotically (by a factor ``exp(-2 Theta / theta_c)`` per cycle).
@@ -42,7 +44,8 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-__all__ = ["DahlLaw", "PrandtlIshlinskii", "LoopModel", "make_law", "LAWS", "loss_ratio"]
+__all__ = ["DahlLaw", "PrandtlIshlinskii", "LoopModel", "make_law", "LAWS", "loss_ratio", "loop_branches",
+           "predict_cycle", "Cycle"]
 
 LAWS = ("pi", "dahl")
 
@@ -96,10 +99,11 @@ class DahlLaw:
     def steady_branches(self, delta, span):
         """Periodic cycle between two end points ``span`` (rad) apart.
 
-        Returns ``(z_up, z_down)`` at the distances ``delta`` (rad) from the end each branch starts
-        at: ``z_up`` on the branch moving away from the first end point (z -> +1), ``z_down`` on the
-        way back (z -> -1).  Steady state: ``z`` at the turning points is ``-+(1 - E)/(1 + E)``,
-        ``E = exp(-span / theta_c)``.
+        Returns ``(z_away, z_back)`` at distances ``delta`` (rad): ``z_away`` on the branch leaving
+        the first end point (the blocked state; z -> +1), ``z_back`` on the branch leaving the second
+        one (z -> -1), each ``delta`` from its own starting end point.  Dahl's law forgets its
+        history, so the steady cycle is symmetric: ``z`` at the turning points is
+        ``-+(1 - E)/(1 + E)``, ``E = exp(-span / theta_c)``.
         """
         E = np.exp(-np.asarray(span) / self.theta_c_rad)
         zb = -(1.0 - E) / (1.0 + E)
@@ -159,15 +163,25 @@ class PrandtlIshlinskii:
     def steady_branches(self, delta, span):
         """Periodic cycle between end points ``span`` (rad) apart (closed form).
 
-        Element ``j`` swings between ``-m_j`` and ``m_j`` with ``m_j = min(r_j, span / 2)``; on the
-        branch moving away from the first end point, at distance ``delta`` from it,
-        ``s_j = -m_j + min(delta, 2 m_j)``.  Returns ``(z_up, z_down = -z_up)``.
+        The cycle is anchored at the first end point (the blocked state), which the actuator
+        reached last by a long motion toward it: every element starts at ``s_j = -r_j``.  Element
+        ``j`` then travels ``m_j = min(span, 2 r_j)`` each way: elements wider than the loop never
+        saturate at ``+r_j`` (Prandtl-Ishlinskii operators keep that memory).  At distance ``delta``
+        from each branch's starting end point::
+
+            away from the blocked state:  s_j = -r_j + min(delta, m_j)
+            back toward it:               s_j = -r_j + m_j - min(delta, m_j)
+
+        Returns ``(z_away, z_back)`` with ``z = sum_j s_j / sum_j r_j``.
         """
         r = self.thresholds
-        dd = np.asarray(delta, dtype=float)[..., None]
-        m = np.minimum(r, 0.5 * np.asarray(span, dtype=float)[..., None])
-        up = (-m + np.minimum(dd, 2.0 * m)).sum(-1) / r.sum()
-        return up, -up
+        dd = np.minimum(np.asarray(delta, dtype=float)[..., None], np.asarray(span, dtype=float)[..., None])
+        m = np.minimum(2.0 * r, np.asarray(span, dtype=float)[..., None])
+        step = np.minimum(dd, m)
+        norm = r.sum()
+        away = (-r + step).sum(-1) / norm
+        back = (-r + m - step).sum(-1) / norm
+        return away, back
 
 
 def make_law(name: str, angle_deg: float):
@@ -219,6 +233,19 @@ class LoopModel:
         return asdict(self)
 
     @classmethod
+    def from_toml(cls, path) -> LoopModel | None:
+        """The ``[hysteresis]`` table of an actuator TOML file (as ``bendpam fit --hysteresis`` writes), or None."""
+        import tomllib
+        from pathlib import Path
+
+        try:
+            data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
+            raise ValueError(f"{path}: cannot read the hysteresis table ({exc})") from None
+        table = data.get("hysteresis")
+        return None if table is None else cls.from_dict(table, source=f"{path} [hysteresis]")
+
+    @classmethod
     def from_dict(cls, d: dict, *, source: str = "hysteresis") -> LoopModel:
         known = set(cls.__dataclass_fields__)
         unknown = [k for k in d if k not in known]
@@ -263,3 +290,73 @@ def loss_ratio(k_mag, upper, lower, L0_mm: float) -> tuple[float, float, float]:
     loss = float(np.trapezoid(np.asarray(upper) - np.asarray(lower), th))
     stored = float(np.trapezoid(0.5 * (np.asarray(upper) + np.asarray(lower)), th))
     return (loss / stored if stored > 0 else math.nan), loss, stored
+
+
+def loop_branches(actuator, loop: LoopModel, pressure_kpa: float, k_free: float, k, model: str = "energy", *,
+                  order: int = 32, eq19_factor: bool = True):
+    """Steady-cycle branches between the blocked state and ``k_free`` (magnitudes, 1/mm).
+
+    Returns ``(loading, unloading)``: the upper and the lower branch (N*mm, magnitudes) at the
+    curvature magnitudes ``k``.
+    """
+    from .models import get_model
+
+    s = actuator.bend_sign or 1
+    k = np.asarray(k, dtype=float)
+    P = pressure_kpa * 1e-3
+    A, B = get_model(model).coefficients(actuator, s * k, order=order, eq19_factor=eq19_factor)
+    Mqs = s * (max(P - actuator.P_start, 0.0) * A - B)
+    L0 = actuator.L0_mm
+    z_unl, _ = loop.z_law.steady_branches(k * L0, k_free * L0)
+    _, z_load = loop.z_law.steady_branches(np.maximum(k_free - k, 0.0) * L0, k_free * L0)
+    amp = loop.amplitude_nmm(actuator, P, s * k)
+    return Mqs - amp * z_load, Mqs - amp * z_unl
+
+
+@dataclass(frozen=True)
+class Cycle:
+    """A predicted steady loop between the blocked state and the free state reached on unloading."""
+
+    pressure_kpa: float
+    free_curvature_per_mm: float  # magnitude, where the unloading branch reaches M = 0 (NaN if never)
+    curvature_per_mm: np.ndarray  # magnitudes
+    loading_nmm: np.ndarray
+    unloading_nmm: np.ndarray
+    energy_loss_ratio: float
+    note: str = ""
+
+
+def predict_cycle(actuator, loop: LoopModel, pressure_kpa: float, model: str = "energy", *, n: int = 201,
+                  order: int = 32, eq19_factor: bool = True) -> Cycle:
+    """The loop a free-bending cycle traces at ``pressure_kpa``: blocked -> free -> blocked.
+
+    The free state is where the unloading (lower) branch reaches zero moment; friction lowers that
+    branch, so it is reached before the quasi-static free curvature.  The steady branches depend on
+    the loop's span, so the free state is found by a short fixed-point iteration.  Where the
+    unloading branch never reaches zero before the lock-up limit, the cycle is empty (NaN) with a note.
+    """
+    from .braid import curvature_limits
+
+    lim = curvature_limits(actuator)
+    sgn = actuator.bend_sign or 1
+    k_lim = abs(lim.k_max if sgn > 0 else lim.k_min) * 0.999
+    grid = np.linspace(0.0, k_lim, 2001)
+    span = k_lim
+    kf = math.nan
+    for _ in range(8):
+        _, low = loop_branches(actuator, loop, pressure_kpa, span, grid, model, order=order, eq19_factor=eq19_factor)
+        cross = np.flatnonzero(low <= 0.0)
+        if cross.size == 0 or cross[0] == 0:
+            break
+        j = cross[0]
+        new = float(grid[j - 1] + (grid[j] - grid[j - 1]) * low[j - 1] / (low[j - 1] - low[j]))
+        if math.isfinite(kf) and abs(new - kf) <= 1e-12 * max(abs(new), 1e-30):
+            kf = new
+            break
+        kf = span = new
+    if not math.isfinite(kf):
+        return Cycle(float(pressure_kpa), math.nan, np.zeros(0), np.zeros(0), np.zeros(0), math.nan,
+                     "the unloading branch does not reach zero moment before lock-up: no free-bending cycle")
+    k = np.linspace(0.0, kf, int(n))
+    up, low = loop_branches(actuator, loop, pressure_kpa, kf, k, model, order=order, eq19_factor=eq19_factor)
+    return Cycle(float(pressure_kpa), kf, k, up, low, loss_ratio(k, up, low, actuator.L0_mm)[0])

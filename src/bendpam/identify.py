@@ -65,8 +65,9 @@ from .models import get_model
 from .predict import free_curvature
 from .presets import normalise_model
 
-__all__ = ["PARAMETERS", "Parameter", "FitResult", "Metrics", "fit", "score", "fit_tension", "TensionFit",
-           "parse_free", "developed_range", "tension_from_test"]
+__all__ = ["PARAMETERS", "HYST_PARAMETERS", "Parameter", "FitResult", "Metrics", "fit", "score", "fit_tension",
+           "TensionFit", "parse_free", "developed_range", "tension_from_test", "predicted_loss_ratios",
+           "branch_nrmse"]
 
 #: Identifiable parameters: short name -> (Actuator field, unit).
 PARAMETERS = {
@@ -148,6 +149,13 @@ class Metrics:
         }
 
 
+HYST_PARAMETERS = {"theta_h": ("theta_h_deg", "deg"), "a0": ("a0_nmm", "N*mm"), "a1": ("a1_nmm_per_mpa", "N*mm/MPa")}
+
+
+def _label(name: str) -> str:
+    return (PARAMETERS.get(name) or HYST_PARAMETERS[name])[0]
+
+
 @dataclass
 class _Data:
     P: np.ndarray  # (n,) MPa
@@ -162,6 +170,9 @@ class _Data:
     Mc: np.ndarray  # concatenated data
     Pc: np.ndarray  # concatenated pressures (MPa)
     seg: np.ndarray  # curve index per point
+    branch: np.ndarray | None = None  # +1 loading (free -> blocked), -1 unloading (hysteresis fits)
+    delta: np.ndarray | None = None  # bending angle from the branch's starting end point (rad)
+    span: np.ndarray | None = None  # bending angle between the loop's end points (rad)
 
 
 def developed_range(result, threshold: float = 0.8, negligible: float = 0.01) -> np.ndarray:
@@ -185,6 +196,32 @@ def developed_range(result, threshold: float = 0.8, negligible: float = 0.01) ->
     mask = np.zeros(hw.size, dtype=bool)
     mask[idx[0]: idx[-1] + 1] = True
     return mask
+
+
+def _branch_data(processed, L0: float) -> _Data:
+    """Both mean branches of every pressure (for fits with a hysteresis loop)."""
+    res = processed.results
+    if not res:
+        raise ValueError("no processed pressures to fit")
+    d = _data(processed, "all")
+    k, M, w, Pc, seg, br, delta, span = [], [], [], [], [], [], [], []
+    wK = d.K / d.K.sum()
+    for i, r in enumerate(res):
+        g = np.asarray(r.curvature_grid, float)
+        n = g.size
+        Kf = d.K[i]
+        for sign, curve, dist in ((1, r.mean_loading, (Kf - g) * L0), (-1, r.mean_unloading, g * L0)):
+            k.append(g)
+            M.append(np.asarray(curve, float))
+            w.append(np.full(n, math.sqrt(wK[i]) / (d.BM[i] * math.sqrt(2 * n))))
+            Pc.append(np.full(n, d.P[i]))
+            seg.append(np.full(n, i))
+            br.append(np.full(n, sign))
+            delta.append(np.maximum(dist, 0.0))
+            span.append(np.full(n, Kf * L0))
+    cat = np.concatenate
+    return _Data(d.P, d.k, d.M, d.BM, d.BM_se, d.K, d.K_se, cat(w), cat(k), cat(M), cat(Pc), cat(seg), cat(br),
+                 cat(delta), cat(span))
 
 
 def _data(processed, fit_range: str = "developed") -> _Data:
@@ -231,7 +268,11 @@ class _Problem:
     """Residuals of the weighted problem for a given set of free parameters."""
 
     def __init__(self, actuator: Actuator, data: _Data, model: str, free: list[str], bounds, order: int,
-                 eq19_factor: bool):
+                 eq19_factor: bool, hysteresis: str | None = None):
+        self.hyst = hysteresis
+        if hysteresis:
+            free = list(free) + ["theta_h", "a0", "a1"]
+        self._qs_cache: dict = {}
         self.base = actuator
         self.d = data
         self.mod = get_model(model)
@@ -241,8 +282,8 @@ class _Problem:
         self.order = order
         self.eq19 = eq19_factor
         self.sign = actuator.bend_sign or 1
-        self.nonlin = [p for p in free if p in _NONLINEAR]
-        self.lin = [p for p in free if p not in _NONLINEAR]
+        self.nonlin = [p for p in free if p in _NONLINEAR or p == "theta_h"]
+        self.lin = [p for p in free if p not in _NONLINEAR and p != "theta_h"]
         # both C10 and C01 free: solve for S = C10 + C01 and C01 (S > 0)
         self.sum_param = "C10" in self.lin and "C01" in self.lin
 
@@ -268,12 +309,37 @@ class _Problem:
         return np.array(lo), np.array(hi)
 
     def actuator(self, values: dict[str, float]) -> Actuator:
-        ch = {PARAMETERS[p][0]: v for p, v in values.items()}
+        ch = {PARAMETERS[p][0]: v for p, v in values.items() if p in PARAMETERS}
         return self.base.replace(**ch)
 
-    def design(self, nl: dict[str, float], fixed: dict[str, float]):
+    def design(self, nl: dict[str, float]):
         """Fixed part ``c0`` and columns ``X`` (per internal linear unit) of the model magnitude."""
-        a = self.base.replace(**{PARAMETERS[p][0]: v for p, v in {**fixed, **nl}.items()})
+        key = tuple(sorted((p, v) for p, v in nl.items() if p in PARAMETERS))
+        if key not in self._qs_cache:
+            if len(self._qs_cache) > 64:
+                self._qs_cache.clear()
+            self._qs_cache[key] = self._design_qs(dict(key))
+        c0, cols = self._qs_cache[key]
+        if self.hyst:
+            from .hysteresis import make_law
+
+            z_away, z_back = make_law(self.hyst, nl["theta_h"]).steady_branches(self.d.delta, self.d.span)
+            z = np.where(self.d.branch < 0, z_away, z_back)  # unloading leaves the blocked state
+            pa = np.maximum(self.d.Pc - self.base.P_start, 0.0)
+            cols = {**cols, "a0": -z, "a1": -z * pa}
+        X = []
+        for p in self.lin_names():
+            if p == "S":
+                X.append(cols["C10"])
+            elif p == "C01" and self.sum_param:
+                X.append(cols["C01"] - cols["C10"])
+            else:
+                X.append(cols[p])
+        X = np.column_stack(X) if X else np.zeros((c0.size, 0))
+        return c0, X
+
+    def _design_qs(self, nl: dict[str, float]):
+        a = self.base.replace(**{PARAMETERS[p][0]: v for p, v in nl.items()})
         s = self.sign
         ks = s * self.d.kc
         A, b10, b01 = self.mod.basis(a, ks, order=self.order, eq19_factor=self.eq19)
@@ -290,16 +356,7 @@ class _Problem:
             if p not in self.lin:
                 c0 = c0 + cols[p] * {"C10": a.C10_kpa, "C01": a.C01_kpa, "P_start": a.P_start_kpa,
                                      "E_f": a.frame_modulus_mpa}[p]
-        X = []
-        for p in self.lin_names():
-            if p == "S":
-                X.append(cols["C10"])
-            elif p == "C01" and self.sum_param:
-                X.append(cols["C01"] - cols["C10"])
-            else:
-                X.append(cols[p])
-        X = np.column_stack(X) if X else np.zeros((c0.size, 0))
-        return c0, X
+        return c0, cols
 
     def to_user(self, nl: dict[str, float], lin_int: np.ndarray) -> dict[str, float]:
         out = dict(nl)
@@ -314,7 +371,7 @@ class _Problem:
 
     def project(self, nl: dict[str, float]):
         """Best linear parameters for the nonlinear ones; returns (residuals, lin_int)."""
-        c0, X = self.design(nl, {})
+        c0, X = self.design(nl)
         w = self.d.w
         y = w * (self.d.Mc - c0)
         if X.shape[1] == 0:
@@ -325,7 +382,7 @@ class _Problem:
 
     def residual_full(self, x_int: np.ndarray) -> np.ndarray:
         nl = dict(zip(self.nonlin, x_int[: len(self.nonlin)]))
-        c0, X = self.design(nl, {})
+        c0, X = self.design(nl)
         return self.d.w * (c0 + X @ x_int[len(self.nonlin):] - self.d.Mc)
 
 
@@ -355,13 +412,15 @@ class FitResult:
     time_s: float
     flags: list[str] = field(default_factory=list)
     autocorrelation: float = 0.0
+    hysteresis: dict | None = None
+    loop: object | None = None
 
     def to_dict(self) -> dict:
         m = self.metrics.to_dict()
         return {
             "model": self.model,
             "parameters": {PARAMETERS[n][0]: p.to_dict() for n, p in self.parameters.items()},
-            "correlation": {"names": [PARAMETERS[n][0] for n in self.correlation_names],
+            "correlation": {"names": [_label(n) for n in self.correlation_names],
                             "matrix": self.correlation.tolist()},
             "nrmse": m["nrmse"],
             "rmse": m["rmse"],
@@ -374,6 +433,7 @@ class FitResult:
             "time_s": self.time_s,
             "residual_autocorrelation": self.autocorrelation,
             "actuator": self.actuator.to_dict(),
+            **({"hysteresis": self.hysteresis} if self.hysteresis is not None else {}),
         }
 
     def to_json(self) -> str:
@@ -384,7 +444,12 @@ class FitResult:
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
         atomic_write_text(out / "fit.json", self.to_json())
-        self.actuator.to_toml(out / "fitted_actuator.toml")
+        text = self.actuator.to_toml()
+        if self.loop is not None:
+            import tomli_w
+
+            text += "\n" + tomli_w.dumps({"hysteresis": self.loop.to_dict()})
+        atomic_write_text(out / "fitted_actuator.toml", text)
         return {"fit.json": str(out / "fit.json"), "fitted_actuator.toml": str(out / "fitted_actuator.toml")}
 
     def __str__(self) -> str:
@@ -396,6 +461,14 @@ class FitResult:
         m = self.metrics
         lines.append(f"  NRMSE cycles {100 * m.nrmse_cycles:.2f} %, blocked moment {100 * m.nrmse_blocked_moment:.2f} %, "
                      f"free curvature {_pct(m.nrmse_free_curvature)}")
+        if self.hysteresis is not None:
+            hp = self.hysteresis["parameters"]
+            lines.append("  loop (" + self.hysteresis["law"] + "): " + ", ".join(
+                f"{k} = {v['value']:.4g}" + (f" ± {v['stderr']:.2g}" if v["stderr"] is not None else "")
+                for k, v in hp.items()) + f"; NRMSE of the branches {100 * self.hysteresis['nrmse_branches']:.2f} %")
+            lines.append("  energy-loss ratio measured/predicted: " + ", ".join(
+                f"{e['pressure_kpa']:g} kPa {100 * e['measured']:.1f}/{100 * e['predicted']:.1f} %"
+                for e in self.hysteresis["energy_loss_ratio"]))
         lines += [f"  note: {f}" for f in self.flags]
         return "\n".join(lines)
 
@@ -468,7 +541,7 @@ def score(processed, actuator: Actuator, model: str = "energy", *, order: int = 
 def fit(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C10", "C01"), *,
         bounds: dict[str, tuple[float, float]] | None = None, tension: TensionFit | None = None, order: int = 32,
         eq19_factor: bool = True, grid_alpha: int = 41, grid_r0: int = 9, corr_flag: float = 0.95,
-        fit_range: str = "developed") -> FitResult:
+        fit_range: str = "developed", hysteresis: str | None = None) -> FitResult:
     """Identify ``free`` parameters of ``actuator`` for ``model`` from a processed test set.
 
     Parameters
@@ -483,6 +556,14 @@ def fit(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C
         developed (see :func:`developed_range`): near the reversals a rounded loop biases the
         average of the branches.  ``"all"`` fits every point, as the paper did.  The metrics are
         always computed on every point (eq 53).
+    hysteresis : ``None`` (fit the mean curves), or a loop law (``"pi"`` or ``"dahl"``, see
+        :mod:`bendpam.hysteresis`): fit both branches of every pressure with
+        ``M = M_load - (a0 + a1 P_active) z`` on a steady cycle between the blocked state and each
+        test's free curvature.  ``a0`` and ``a1`` are linear parameters (projected like C10 and
+        C01), the law's angle ``theta_h`` is a nonlinear one (scanned and searched with alpha0).
+        The amplitude uses the starting ``P_start``.  The result gains ``hysteresis`` (parameters
+        with standard errors, the energy-loss ratio measured and predicted at each pressure, and the
+        NRMSE of the branches) and ``loop`` (a :class:`bendpam.hysteresis.LoopModel`).
 
     Returns
     -------
@@ -493,8 +574,17 @@ def fit(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C
     free = parse_free(free)
     if tension is not None:
         actuator = actuator.replace(C10_kpa=tension.C10_kpa, C01_kpa=tension.C01_kpa)
-    d = _data(processed, fit_range)
+    if hysteresis is not None:
+        from .hysteresis import LAWS
+
+        hysteresis = str(hysteresis).lower()
+        if hysteresis not in LAWS:
+            raise ValueError(f"hysteresis law {hysteresis!r} is not known; choose one of {', '.join(LAWS)}")
+        d = _branch_data(processed, actuator.L0_mm)
+    else:
+        d = _data(processed, fit_range)
     bnd = _default_bounds(actuator, float(d.P.min() * 1e3))
+    bnd.update({"theta_h": (0.2, 90.0), "a0": (0.0, 10.0 * float(d.BM.max())), "a1": (0.0, 1e5)})
     for k, v in (bounds or {}).items():
         key = parse_free([k])[0]
         lo, hi = float(v[0]), float(v[1])
@@ -505,14 +595,17 @@ def fit(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C
         raise ValueError(
             f"P_start = {actuator.P_start_kpa:g} kPa is not below the lowest test pressure {d.P.min() * 1e3:g} kPa"
         )
-    prob = _Problem(actuator, d, model, free, bnd, order, eq19_factor)
+    prob = _Problem(actuator, d, model, free, bnd, order, eq19_factor, hysteresis)
     nfev = 0
 
     # 1. global stage: grid over the nonlinear parameters, linear ones projected
     grids = []
     for p in prob.nonlin:
         lo, hi = bnd[p]
-        grids.append(np.linspace(lo, hi, grid_alpha if p == "alpha0" else grid_r0))
+        if p == "theta_h":  # the loop's angle spans decades: a geometric grid
+            grids.append(np.geomspace(0.5, 40.0, 14))
+        else:
+            grids.append(np.linspace(lo, hi, grid_alpha if p == "alpha0" else grid_r0))
     best = (math.inf, {}, None)
     if grids:
         mesh = np.meshgrid(*grids, indexing="ij")
@@ -559,7 +652,7 @@ def fit(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C
         e[j] = h
         J[:, j] = (prob.residual_full(x_int + e) - prob.residual_full(x_int - e)) / (2 * h)
         nfev += 2
-    _, X = prob.design(nl_best, {})
+    _, X = prob.design(nl_best)
     J[:, nn:] = prob.d.w[:, None] * X
     # sandwich covariance: the weights normalise each curve (eq 53), they are not inverse noise
     # variances, so each curve gets its own residual variance (with its AR(1) inflation)
@@ -600,7 +693,7 @@ def fit(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C
     for i in range(len(user_names)):
         for j in range(i + 1, len(user_names)):
             if np.isfinite(corr[i, j]) and abs(corr[i, j]) > corr_flag:
-                flags.append(f"{user_names[i]} and {user_names[j]} are poorly identifiable together "
+                flags.append(f"{_label(user_names[i])} and {_label(user_names[j])} are poorly identifiable together "
                              f"(correlation {corr[i, j]:+.3f}): their combination is determined, not each one")
     pinned = [names_int[i] for i in range(len(names_int)) if at_bound[i]]
     for p in pinned:
@@ -623,11 +716,60 @@ def fit(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C
         flags.append("no free-bending equilibrium in the fitted model at " +
                      ", ".join(f"{p:g}" for p in metrics.no_equilibrium_kpa) + " kPa (fold); "
                      "those pressures are left out of the free-curvature metric")
+    hyst_out, loop = None, None
+    if hysteresis is not None:
+        from .hysteresis import LoopModel
+
+        loop = LoopModel(law=hysteresis, a0_nmm=float(values["a0"]), a1_nmm_per_mpa=float(values["a1"]),
+                         theta_h_deg=float(values["theta_h"]))
+        hp = {}
+        for n in ("a0", "a1", "theta_h"):
+            i = user_names.index(n)
+            hp[HYST_PARAMETERS[n][0]] = {"value": float(values[n]),
+                                         "stderr": float(sd[i]) if np.isfinite(sd[i]) else None,
+                                         "min": bnd[n][0], "max": bnd[n][1], "unit": HYST_PARAMETERS[n][1]}
+        elr = predicted_loss_ratios(processed, fitted, loop, model, order=order, eq19_factor=eq19_factor)
+        hyst_out = {
+            "law": hysteresis, "amplitude": "linear", "parameters": hp,
+            "energy_loss_ratio": elr,
+            "nrmse_branches": branch_nrmse(processed, fitted, loop, model, order=order, eq19_factor=eq19_factor),
+        }
     return FitResult(
         model=model, actuator=fitted, parameters=params, correlation=corr, correlation_names=user_names,
         metrics=metrics, converged=converged, message=str(message), nfev=nfev, time_s=time.perf_counter() - t0,
-        flags=flags, autocorrelation=rho,
+        flags=flags, autocorrelation=rho, hysteresis=hyst_out, loop=loop,
     )
+
+
+def predicted_loss_ratios(processed, actuator: Actuator, loop, model: str = "energy", *, order: int = 32,
+                          eq19_factor: bool = True) -> list[dict]:
+    """Energy-loss ratio of each test, measured (processing) and predicted (loop model on the same range)."""
+    from .hysteresis import loop_branches, loss_ratio
+
+    out = []
+    for r in processed.results:
+        kf = float(r.free_curvature[0])
+        k = np.linspace(0.0, kf, 400)
+        up, low = loop_branches(actuator, loop, r.pressure_kpa, kf, k, model, order=order, eq19_factor=eq19_factor)
+        out.append({"pressure_kpa": float(r.pressure_kpa), "measured": float(r.energy_loss_ratio),
+                    "predicted": loss_ratio(k, up, low, actuator.L0_mm)[0]})
+    return out
+
+
+def branch_nrmse(processed, actuator: Actuator, loop, model: str = "energy", *, order: int = 32,
+                 eq19_factor: bool = True) -> float:
+    """eq-53-style NRMSE of both branches (loading and unloading) against the loop model."""
+    from .hysteresis import loop_branches
+
+    num = den = 0.0
+    for r in processed.results:
+        kf = float(r.free_curvature[0])
+        up, low = loop_branches(actuator, loop, r.pressure_kpa, kf, r.curvature_grid, model, order=order,
+                                eq19_factor=eq19_factor)
+        rm = math.sqrt(float(np.mean(np.concatenate([(up - r.mean_loading) ** 2, (low - r.mean_unloading) ** 2]))))
+        num += (rm / float(r.blocked_moment[0])) ** 2 * kf
+        den += kf
+    return math.sqrt(num / den)
 
 
 # ------------------------------------------------------------------------------------------------

@@ -251,10 +251,21 @@ def figure7(processed, fit_result, title: str = ""):
         ax.plot(k, r.mean_unloading, color=c, lw=0.6, alpha=0.5)
         ax.plot(k[::4], r.mean_curve[::4], "o", color=c, ms=3, label=f"{r.pressure_kpa:g} kPa")
         kk = np.linspace(0.0, k[-1], 120)
-        ax.plot(kk, s * moment(act, r.pressure_kpa * 1e-3, s * kk, model), "-", color=c, lw=1.5)
+        if getattr(fit_result, "loop", None) is not None:
+            from .hysteresis import loop_branches
+
+            kf = float(r.free_curvature[0])
+            kk = np.linspace(0.0, kf, 160)
+            up, low = loop_branches(act, fit_result.loop, r.pressure_kpa, kf, kk, model)
+            ax.plot(kk, up, "-", color=c, lw=1.3)
+            ax.plot(kk, low, "-", color=c, lw=1.3)
+        else:
+            ax.plot(kk, s * moment(act, r.pressure_kpa * 1e-3, s * kk, model), "-", color=c, lw=1.5)
     ax.set_xlabel("curvature |k'| (1/mm)")
     ax.set_ylabel("moment |M| (N·mm)")
-    ax.set_title(f"(a) data (markers: mean curve) and {model.replace('_', '-')} model (lines)", fontsize=9)
+    loop_txt = " with its loop" if getattr(fit_result, "loop", None) is not None else ""
+    ax.set_title(f"(a) data (thin: branches, markers: mean) and {model.replace('_', '-')} model{loop_txt}",
+                 fontsize=9)
     ax.legend(fontsize=7)
     P = processed.pressures_kpa
     bm = np.array([r.blocked_moment for r in res])
