@@ -204,3 +204,21 @@ def test_figure7_draws_the_loop(tmp_path):
     # per pressure: two data branches, the mean markers and two model branches
     assert n_lines == 5 * 3
     write_processed(ps, tmp_path / "p", figure=False)
+
+
+def test_finger_loading_and_unloading_shapes_differ():
+    from bendpam.design import Finger, FingerLoads, solve_finger
+
+    a = presets.be_pam()
+    loop = LoopModel(a0_nmm=3.0, a1_nmm_per_mpa=120.0, theta_h_deg=10.0)
+    loads = FingerLoads(tip_force_n=(0.0, -0.3))
+    plain = solve_finger(Finger(a), 0.15, loads)
+    opening = solve_finger(Finger(a, loop=loop, motion="unloading"), 0.15, loads)
+    closing = solve_finger(Finger(a, loop=loop, motion="loading"), 0.15, loads)
+    assert plain.equilibrium and opening.equilibrium and closing.equilibrium
+    # friction holds the finger back while it opens and while it is pushed back: the loading shape
+    # bends further than the quasi-static one, the unloading shape less
+    assert opening.tip_angle_deg < plain.tip_angle_deg < closing.tip_angle_deg
+    # with zero amplitude the loop changes nothing
+    zero = solve_finger(Finger(a, loop=LoopModel(), motion="loading"), 0.15, loads)
+    assert zero.tip_angle_deg == pytest.approx(plain.tip_angle_deg, abs=1e-9)

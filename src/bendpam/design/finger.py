@@ -230,15 +230,19 @@ class StableBranch:
         return f"{what} at k' = {k:.5g} 1/mm, M = {m:.4g} N*mm"
 
 
-def stable_branch(actuator, pressure, model: str = "energy") -> StableBranch:
-    """The stable branch of the moment law at ``pressure`` (MPa): see :class:`StableBranch`."""
+def stable_branch(actuator, pressure, model: str = "energy", friction_nmm: float = 0.0) -> StableBranch:
+    """The stable branch of the moment law at ``pressure`` (MPa): see :class:`StableBranch`.
+
+    ``friction_nmm`` shifts the law by a saturated hysteretic moment, ``M = M_load - friction``
+    (signed, bendpam's convention): see :meth:`Finger.friction_nmm`.
+    """
     if not isinstance(actuator, Actuator):
         raise TypeError(f"actuator must be a bendpam.Actuator, got {type(actuator).__name__}")
     P = _pressure(pressure)
     model = normalise_model(model)
     law = _law(actuator, model)
     pa = max(P - law.P_start, 0.0)
-    m = pa * law.A - law.B
+    m = pa * law.A - law.B - float(friction_nmm)
     dm = pa * law.dA - law.dB
     i0 = law.i0
     if dm[i0] >= 0.0:
@@ -298,6 +302,13 @@ class Finger:
         Lateral offset of the fingertip point toward the bending side, mm.
     nodes : int
         Collocation nodes along the active length, in [11, 1001] (default 81).
+    loop : bendpam.hysteresis.LoopModel, optional
+        A fitted hysteresis loop (``bendpam fit --hysteresis``).  With it the moment law is shifted
+        by the saturated friction moment ``A(P)`` against the motion: ``motion="unloading"`` (the
+        finger opening toward its free shape, the lower branch) or ``"loading"`` (being pushed
+        back, the upper branch), so loading and unloading shapes differ.  Saturation assumes the
+        finger moved more than the loop's angle since the last reversal.
+    motion : {"unloading", "loading"}
     """
 
     actuator: Actuator
@@ -308,6 +319,8 @@ class Finger:
     fingertip_mm: float = 0.0
     fingertip_offset_mm: float = 0.0
     nodes: int = 81
+    loop: object = None
+    motion: str = "unloading"
 
     def __post_init__(self):
         s = object.__setattr__
@@ -334,6 +347,21 @@ class Finger:
         if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not 11 <= int(n) <= 1001:
             raise ValueError(f"nodes = {n!r} is outside the allowed range [11, 1001] (an integer)")
         s(self, "nodes", int(n))
+        if self.motion not in ("unloading", "loading"):
+            raise ValueError(f"motion = {self.motion!r}; choose 'unloading' or 'loading'")
+        if self.loop is not None and not hasattr(self.loop, "amplitude_nmm"):
+            raise TypeError("loop must be a bendpam.hysteresis.LoopModel")
+
+    def friction_nmm(self, pressure) -> float:
+        """Signed saturated friction moment ``A(P) z`` (N*mm) for the finger's motion; 0 without a loop.
+
+        ``z = bend_sign`` while the actuator opens toward its free shape (unloading) and
+        ``-bend_sign`` while it is pushed back (loading); the law becomes ``M_load - A z``.
+        """
+        if self.loop is None:
+            return 0.0
+        z = self.actuator.bend_sign * (1.0 if self.motion == "unloading" else -1.0)
+        return float(self.loop.amplitude_nmm(self.actuator, float(pressure), 0.0)) * z
 
     @property
     def length(self) -> float:
@@ -719,7 +747,7 @@ def solve_finger(finger: Finger, pressure, loads: FingerLoads | None = None) -> 
     P = _pressure(pressure)
     rod = _Rod(finger, loads)
     try:
-        br = stable_branch(finger.actuator, P, finger.model)
+        br = stable_branch(finger.actuator, P, finger.model, finger.friction_nmm(P))
     except ValueError as exc:
         return _failed(rod, None, P, loads, str(exc))
     scale = _moment_scale(br, rod)
@@ -931,7 +959,7 @@ def blocked_tip_force(finger: Finger, pressure, target_xy_mm=None, direction_deg
     start = solve_finger(finger, P, loads)
     rod = _Rod(finger, loads)
     try:
-        br = stable_branch(finger.actuator, P, finger.model)
+        br = stable_branch(finger.actuator, P, finger.model, finger.friction_nmm(P))
     except ValueError as exc:
         return BlockedTipForce((math.nan, math.nan), target, constraint, direction, start, False, str(exc))
     n = rod.n
@@ -942,7 +970,7 @@ def blocked_tip_force(finger: Finger, pressure, target_xy_mm=None, direction_deg
     nf = 2 if direction is None else 1
 
     def make(P_t, tx, ty):
-        b = stable_branch(finger.actuator, P_t, finger.model)
+        b = stable_branch(finger.actuator, P_t, finger.model, finger.friction_nmm(P_t))
 
         def fun(U):
             k = U[..., :n]
