@@ -23,7 +23,7 @@ Method (variable projection)
     1. Global stage: a grid scan over the nonlinear parameters (41 alpha0 values across their
        bounds, 9 R0_start values), so the answer does not depend on a lucky start.
     2. Local stage: ``scipy.optimize.least_squares`` (trust-region reflective, bounds) on the
-       projected problem from the best grid point, then one joint polish over all free parameters.
+       projected problem from the best grid point; the linear parameters stay exact at every step.
     3. Uncertainty: a sandwich covariance ``(J^T J)^-1 (sum_i s_i^2 f_i J_i^T J_i) (J^T J)^-1``
        from the Jacobian at the optimum.  The eq-53 weights normalise the curves but are not
        inverse noise variances, so each pressure's curve ``i`` gets its own residual variance
@@ -39,9 +39,11 @@ Bounds: alpha0 within +-10 % of its nominal value (as in the paper) and on the a
 54.74 deg; C10, C01 in [-5000, 5000] kPa with C10 + C01 >= 1 kPa; P_start in [0, 0.98 min(P_i)];
 E_f in [0.1, 10] x nominal; R0_start in [R0, 1.5 R0].  Any bound can be overridden.
 
-Starting values: the linear parameters need none (they are solved exactly).  Parameters held fixed
-keep the actuator's values, or the tension-test values of C10 and C01 when ``tension`` is given
-(``bendpam fit-material``); the paper's own start was C10 = 114 kPa, C01 = 300 kPa.
+Starting values: the linear parameters need none (they are solved exactly for every trial of the
+nonlinear ones), and the grid scan makes alpha0's start irrelevant.  Parameters held fixed keep the
+actuator's values, or the tension-test values of C10 and C01 when ``tension`` is given
+(``bendpam fit-material``).  Each parameter's ``initial`` records the conventional start: the
+tension-test values, or else the paper's C10 = 114 kPa and C01 = 300 kPa (section 3.4).
 
 The fold of the BC-PAM does not affect the fit (it compares moments at measured curvatures, no
 root finding); it only makes the free-curvature metric skip pressures without an equilibrium,
@@ -87,6 +89,8 @@ _ALIASES = {
     "r0_start": "R0_start", "r0start": "R0_start", "r0_start_mm": "R0_start",
 }
 _NONLINEAR = ("alpha0", "R0_start")
+#: The paper's starting values of the identification (section 3.4, from its tension test), kPa.
+PAPER_START = {"C10": 114.0, "C01": 300.0}
 _ORDER = ("alpha0", "C10", "C01", "P_start", "E_f", "R0_start")
 
 
@@ -708,7 +712,9 @@ def fit(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C
             i = user_names.index(n)
             se = float(sd[i]) if np.isfinite(sd[i]) else None
             lo_b, hi_b = bnd[n]
-            params[n] = Parameter(n, field_, unit, val, se, lo_b, hi_b, True, float(getattr(actuator, field_)))
+            start = PAPER_START.get(n, float(getattr(actuator, field_))) if tension is None else \
+                {"C10": tension.C10_kpa, "C01": tension.C01_kpa}.get(n, float(getattr(actuator, field_)))
+            params[n] = Parameter(n, field_, unit, val, se, lo_b, hi_b, True, start)
         elif n in ("alpha0", "C10", "C01", "P_start"):
             params[n] = Parameter(n, field_, unit, val, None, bnd[n][0], bnd[n][1], False, val)
     metrics = score(processed, fitted, model, order=order, eq19_factor=eq19_factor)
