@@ -25,8 +25,9 @@ from __future__ import annotations
 
 import argparse
 import math
+import sys
 import time
-import tracemalloc
+from pathlib import Path
 
 import numpy as np
 from scipy.integrate import quad
@@ -37,20 +38,8 @@ from bendpam import presets
 from bendpam.fast import MomentTable
 from bendpam.models import get_model
 
-
-def measure(fn, repeat=3):
-    """Best wall time of ``repeat`` runs and the peak traced memory of one more (MiB)."""
-    best = math.inf
-    out = None
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fn()
-        best = min(best, time.perf_counter() - t0)
-    tracemalloc.start()
-    fn()
-    _, peak = tracemalloc.get_traced_memory()
-    tracemalloc.stop()
-    return out, best, peak / 2**20
+sys.path.insert(0, str(Path(__file__).parent))
+from _timing import measure  # noqa: E402
 
 
 # ---------------------------------------------------------------------------------------------

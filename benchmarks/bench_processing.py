@@ -8,9 +8,8 @@ peak memory of each stage (tracemalloc).  Run:  python benchmarks/bench_processi
 from __future__ import annotations
 
 import argparse
+import sys
 import tempfile
-import time
-import tracemalloc
 from pathlib import Path
 
 from bendpam import presets
@@ -18,18 +17,8 @@ from bendpam.testdata import read_test, write_test
 from bendpam.testdata.processing import process_series
 from bendpam.testdata.simulate import SimulationSettings, simulate_test
 
-
-def timed(fn, repeat=3):
-    best = float("inf")
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fn()
-        best = min(best, time.perf_counter() - t0)
-    tracemalloc.start()
-    fn()
-    _, peak = tracemalloc.get_traced_memory()
-    tracemalloc.stop()
-    return out, best, peak / 2**20
+sys.path.insert(0, str(Path(__file__).parent))
+from _timing import measure  # noqa: E402
 
 
 def main() -> None:
@@ -42,16 +31,16 @@ def main() -> None:
     data, _ = simulate_test(a, 200, settings=SimulationSettings(cycles=10, rate_hz=rate, seed=0))
     n = len(data)
     print(f"raw samples: {n:,} (10 cycles at {rate:.0f} Hz)")
-    _, t_proc, mem = timed(lambda: process_series(data.time_s.to_numpy(), data.stroke_mm.to_numpy(),
+    _, t_proc, mem = measure(lambda: process_series(data.time_s.to_numpy(), data.stroke_mm.to_numpy(),
                                                   data.force_n.to_numpy(), 200.0, keep_series=False))
     print(f"process_series: {t_proc:.3f} s  -> {n / t_proc:,.0f} samples/s   peak {mem:.0f} MiB   (target >= 1,000,000)")
     with tempfile.TemporaryDirectory() as d:
         for dialect in ("csv", "testxpert"):
             p = Path(d) / f"t_200kPa.{dialect}.txt"
             write_test(p, data, dialect, pressure_kpa=200)
-            rt, t_read, mem = timed(lambda: read_test(p))
+            rt, t_read, mem = measure(lambda: read_test(p))
             print(f"read_test[{dialect}]: {t_read:.3f} s  -> {n / t_read:,.0f} samples/s   peak {mem:.0f} MiB")
-            _, t_all, _ = timed(lambda: process_series(rt.data.time_s.to_numpy(), rt.data.stroke_mm.to_numpy(),
+            _, t_all, _ = measure(lambda: process_series(rt.data.time_s.to_numpy(), rt.data.stroke_mm.to_numpy(),
                                                        rt.data.force_n.to_numpy(), 200.0, keep_series=False), 1)
             print(f"read + process [{dialect}]: {t_read + t_all:.3f} s -> {n / (t_read + t_all):,.0f} samples/s")
 

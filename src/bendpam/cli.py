@@ -18,7 +18,7 @@ import numpy as np
 import typer
 
 from . import presets as _presets
-from ._io import atomic_write_text
+from ._io import atomic_write_text, json_safe
 from .actuator import Actuator
 from .braid import curvature_limits
 
@@ -117,12 +117,6 @@ def format_prediction_table(df, title: str) -> str:
     return "\n".join(lines)
 
 
-def _jsonable(x):
-    if isinstance(x, float | np.floating):
-        return float(x) if np.isfinite(x) else None
-    return x
-
-
 # ---- commands -------------------------------------------------------------------------------------
 PresetOpt = Annotated[Optional[Preset], typer.Option("--preset", help="Built-in actuator from the paper.")]
 ActuatorOpt = Annotated[
@@ -174,16 +168,16 @@ def predict(
         obj = {
             "model": mname,
             "actuator": act.to_dict() | act.derived(),
-            "max_equilibrium_pressure_kpa": _jsonable(br.max_pressure * 1e3),
+            "max_equilibrium_pressure_kpa": json_safe(br.max_pressure * 1e3),
             "branch_end": br.kind,
             "units": {"pressure_kpa": "kPa", "blocked_moment_nmm": "N*mm", "free_curvature_per_mm": "1/mm",
                       "free_angle_deg": "deg"},
             "results": [
                 {
-                    "pressure_kpa": _jsonable(r.pressure_kpa),
-                    "blocked_moment_nmm": _jsonable(r.blocked_moment_nmm),
-                    "free_curvature_per_mm": _jsonable(r.free_curvature_per_mm),
-                    "free_angle_deg": _jsonable(r.free_angle_deg),
+                    "pressure_kpa": json_safe(r.pressure_kpa),
+                    "blocked_moment_nmm": json_safe(r.blocked_moment_nmm),
+                    "free_curvature_per_mm": json_safe(r.free_curvature_per_mm),
+                    "free_angle_deg": json_safe(r.free_angle_deg),
                     "note": r.note or None,
                     **({"cycle": _cycle_json(cycles[i])} if cycles is not None else {}),
                 }
@@ -221,8 +215,8 @@ def _loop_model(actuator_file, law, a0, a1_per_kpa, angle):
 
 def _cycle_json(c) -> dict:
     return {
-        "free_curvature_unloading_per_mm": _jsonable(c.free_curvature_per_mm),
-        "energy_loss_ratio": _jsonable(c.energy_loss_ratio),
+        "free_curvature_unloading_per_mm": json_safe(c.free_curvature_per_mm),
+        "energy_loss_ratio": json_safe(c.energy_loss_ratio),
         "curvature_per_mm": [float(x) for x in c.curvature_per_mm[::10]],
         "loading_nmm": [float(x) for x in c.loading_nmm[::10]],
         "unloading_nmm": [float(x) for x in c.unloading_nmm[::10]],

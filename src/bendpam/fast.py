@@ -33,7 +33,7 @@ from scipy.interpolate import CubicSpline
 from .actuator import Actuator
 from .braid import curvature_limits
 from .models import get_model
-from .predict import FreeBending, _pressure, branch_info
+from .predict import FreeBending, _pressure, assemble_free_bending, branch_info
 from .presets import normalise_model
 
 __all__ = ["MomentTable", "moment_table"]
@@ -160,45 +160,30 @@ class MomentTable:
         """
         act = self.actuator
         P = _pressure(pressure)
-        pa = np.maximum(P - act.P_start, 0.0).ravel()
         br = branch_info(act, self.model, eq19_factor=self.eq19_factor)
-        k = np.zeros(pa.shape)
-        status = np.full(pa.shape, "ok", dtype=object)
-        reason = np.full(pa.shape, "", dtype=object)
-        below = P.ravel() < act.P_start
-        status[below] = "deadband"
-        reason[below] = f"below the threshold pressure P_start = {act.P_start_kpa:g} kPa: no active moment"
-        if br.direction != 0:
-            above = pa > br.p_end_active
-            k[above] = np.nan
-            status[above] = "no-equilibrium"
-            reason[above] = br.reason
-            solve = (pa > 0) & ~above
-            if np.any(solve):
-                q = pa[solve]
-                kt, pt = br.k_table, br.p_table
-                finite = np.isfinite(pt)
-                x = np.interp(q, pt[finite], kt[finite])
-                j = np.clip(np.searchsorted(pt, q), 1, kt.size - 1)
-                a, b = kt[j - 1], kt[j]
-                lo, hi = np.minimum(a, b), np.maximum(a, b)
-                d = br.direction
-                for _ in range(newton_steps):
-                    A, G = self._split(x)
-                    f = q * A - x * G
-                    # F = d f > 0 before the root along the branch, < 0 after it: shrink the bracket
-                    ahead = d * f > 0
-                    if d > 0:
-                        lo, hi = np.where(ahead, x, lo), np.where(~ahead, x, hi)
-                    else:
-                        hi, lo = np.where(ahead, x, hi), np.where(~ahead, x, lo)
-                    dA, dG = np.moveaxis(self._dspl(x), -1, 0)
-                    xn = x - f / (q * dA - (G + x * dG))
-                    x = np.where((xn >= lo) & (xn <= hi), xn, 0.5 * (lo + hi))
-                k[solve] = x
-        k = k.reshape(P.shape)
-        return FreeBending(pressure=P, curvature=k, angle=k * act.L0, status=status.reshape(P.shape).astype(str),
-                           reason=reason.reshape(P.shape).astype(str), max_pressure=br.max_pressure, branch=br)
+        kt, pt = br.k_table, br.p_table
+        finite = np.isfinite(pt)
+        d = br.direction
+
+        def solve(q):
+            x = np.interp(q, pt[finite], kt[finite])
+            j = np.clip(np.searchsorted(pt, q), 1, kt.size - 1)
+            lo, hi = np.minimum(kt[j - 1], kt[j]), np.maximum(kt[j - 1], kt[j])
+            for _ in range(newton_steps):
+                A, G = self._split(x)
+                f = q * A - x * G
+                # d f > 0 before the root along the branch, < 0 after it: shrink the bracket
+                ahead = d * f > 0
+                if d > 0:
+                    lo, hi = np.where(ahead, x, lo), np.where(~ahead, x, hi)
+                else:
+                    hi, lo = np.where(ahead, x, hi), np.where(~ahead, x, lo)
+                dA, dG = np.moveaxis(self._dspl(x), -1, 0)
+                xn = x - f / (q * dA - (G + x * dG))
+                x = np.where((xn >= lo) & (xn <= hi), xn, 0.5 * (lo + hi))
+            return x
+
+        return assemble_free_bending(act, P, br, solve)
 
 
 @lru_cache(maxsize=64)

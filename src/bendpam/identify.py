@@ -61,7 +61,7 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import least_squares, lsq_linear
 
-from ._io import atomic_write_text
+from ._io import atomic_write_text, json_safe
 from .actuator import NEUTRAL_ANGLE_DEG, Actuator
 from .models import get_model
 from .predict import free_curvature
@@ -441,7 +441,7 @@ class FitResult:
         }
 
     def to_json(self) -> str:
-        return json.dumps(_clean(self.to_dict()), indent=2)
+        return json.dumps(json_safe(self.to_dict()), indent=2)
 
     def save(self, out_dir) -> dict[str, str]:
         """Write ``fit.json`` and ``fitted_actuator.toml`` atomically into ``out_dir``."""
@@ -479,18 +479,6 @@ class FitResult:
 
 def _pct(x):
     return "n/a" if x is None or not np.isfinite(x) else f"{100 * x:.2f} %"
-
-
-def _clean(obj):
-    if isinstance(obj, dict):
-        return {k: _clean(v) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return [_clean(v) for v in obj]
-    if isinstance(obj, float | np.floating):
-        return float(obj) if np.isfinite(obj) else None
-    if isinstance(obj, np.integer):
-        return int(obj)
-    return obj
 
 
 def score(processed, actuator: Actuator, model: str = "energy", *, order: int = 32, eq19_factor: bool = True) -> Metrics:
@@ -796,7 +784,7 @@ class TensionFit:
     source: str = ""
 
     def to_dict(self) -> dict:
-        return _clean(self.__dict__.copy())
+        return json_safe(self.__dict__.copy())
 
 
 def fit_tension(stretch, nominal_stress_mpa, *, source: str = "") -> TensionFit:

@@ -347,35 +347,37 @@ def free_curvature(actuator, pressure, model: str = "energy", *, order: int = DE
     act = _check_actuator(actuator)
     mod = get_model(model)
     P = _pressure(pressure)
-    pa = np.maximum(P - act.P_start, 0.0)
     br = branch_info(act, model, order=order, eq19_factor=eq19_factor)
-    shape = P.shape
-    pa_f = pa.ravel()
-    k = np.zeros(pa_f.shape)
-    status = np.full(pa_f.shape, "ok", dtype=object)
-    reason = np.full(pa_f.shape, "", dtype=object)
-    status[P.ravel() < act.P_start] = "deadband"
-    reason[P.ravel() < act.P_start] = f"below the threshold pressure P_start = {act.P_start_kpa:g} kPa: no active moment"
+    return assemble_free_bending(act, P, br,
+                                 lambda pa: _solve_branch(act, mod, br, pa, order, eq19_factor, xtol))
+
+
+def assemble_free_bending(act, P, br: BranchInfo, solve) -> FreeBending:
+    """Statuses, reasons and roots of free bending at pressures ``P`` (MPa) on the branch ``br``.
+
+    ``solve(pa)`` returns the roots for the active pressures ``pa`` that have an equilibrium on the
+    branch (``0 < pa <= br.p_end_active``); the exact path and the fast path share this logic.
+    """
+    pa = np.maximum(P - act.P_start, 0.0).ravel()
+    k = np.zeros(pa.shape)
+    status = np.full(pa.shape, "ok", dtype=object)
+    reason = np.full(pa.shape, "", dtype=object)
+    below = P.ravel() < act.P_start
+    status[below] = "deadband"
+    reason[below] = f"below the threshold pressure P_start = {act.P_start_kpa:g} kPa: no active moment"
     if br.direction == 0:
-        reason[pa_f > 0] = br.reason
+        reason[pa > 0] = br.reason
     else:
-        above = pa_f > br.p_end_active
+        above = pa > br.p_end_active
         k[above] = np.nan
         status[above] = "no-equilibrium"
         reason[above] = br.reason
-        solve = (pa_f > 0) & ~above
-        if np.any(solve):
-            k[solve] = _solve_branch(act, mod, br, pa_f[solve], order, eq19_factor, xtol)
-    k = k.reshape(shape)
-    return FreeBending(
-        pressure=P,
-        curvature=k,
-        angle=k * act.L0,
-        status=status.reshape(shape).astype(str),
-        reason=reason.reshape(shape).astype(str),
-        max_pressure=br.max_pressure,
-        branch=br,
-    )
+        want = (pa > 0) & ~above
+        if np.any(want):
+            k[want] = solve(pa[want])
+    k = k.reshape(P.shape)
+    return FreeBending(pressure=P, curvature=k, angle=k * act.L0, status=status.reshape(P.shape).astype(str),
+                       reason=reason.reshape(P.shape).astype(str), max_pressure=br.max_pressure, branch=br)
 
 
 def _solve_branch(act, mod, br: BranchInfo, pa, order, eq19_factor, xtol):

@@ -574,18 +574,6 @@ def process_tests(tests, *, fixture: Fixture = PAPER_FIXTURE, options: Processin
 # ------------------------------------------------------------------------------------------------
 # outputs
 # ------------------------------------------------------------------------------------------------
-def _json_clean(obj):
-    if isinstance(obj, dict):
-        return {k: _json_clean(v) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return [_json_clean(v) for v in obj]
-    if isinstance(obj, float | np.floating):
-        return float(obj) if np.isfinite(obj) else None
-    if isinstance(obj, np.integer):
-        return int(obj)
-    return obj
-
-
 def write_processed(processed: ProcessedSet, out_dir, *, figure: bool = True) -> dict[str, str]:
     """Write ``curves.nc`` (xarray/NetCDF), ``curves.csv``, ``summary.json`` and ``figure4.png``.
 
@@ -594,7 +582,7 @@ def write_processed(processed: ProcessedSet, out_dir, *, figure: bool = True) ->
     import json
     from pathlib import Path
 
-    from .._io import atomic_path, atomic_write_text
+    from .._io import atomic_path, atomic_write_text, json_safe
 
     out = Path(out_dir)
     if out.exists() and not out.is_dir():
@@ -607,7 +595,7 @@ def write_processed(processed: ProcessedSet, out_dir, *, figure: bool = True) ->
     written["curves.nc"] = str(out / "curves.nc")
     atomic_write_text(out / "curves.csv", processed.to_frame().to_csv(index=False, float_format="%.10g"))
     written["curves.csv"] = str(out / "curves.csv")
-    atomic_write_text(out / "summary.json", json.dumps(_json_clean(processed.summary()), indent=2))
+    atomic_write_text(out / "summary.json", json.dumps(json_safe(processed.summary()), indent=2))
     written["summary.json"] = str(out / "summary.json")
     if figure:
         from ..plots import figure4, save_figure
