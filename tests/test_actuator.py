@@ -131,3 +131,14 @@ def test_unknown_preset_and_model():
         presets.get("xx-pam")
     with pytest.raises(ValueError, match="model"):
         presets.be_pam("fem")
+
+
+def test_outputs_have_ordinary_permissions(tmp_path):
+    import os
+    import stat
+
+    p = tmp_path / "a.toml"
+    presets.be_pam().to_toml(p)
+    umask = os.umask(0)
+    os.umask(umask)
+    assert stat.S_IMODE(p.stat().st_mode) == 0o666 & ~umask
