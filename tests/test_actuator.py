@@ -71,7 +71,9 @@ def test_bad_values_name_parameter_value_and_range(kw, words):
 
 def test_immutable_and_replace():
     a = base()
-    with pytest.raises(Exception):
+    import dataclasses
+
+    with pytest.raises(dataclasses.FrozenInstanceError):
         a.alpha0_deg = 70.0
     b = a.replace(alpha0_deg=70.0)
     assert b.alpha0_deg == 70.0 and a.alpha0_deg == 68.0

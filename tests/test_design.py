@@ -11,7 +11,6 @@ from hypothesis import strategies as st
 import bendpam
 import bendpam.cli as cli
 from bendpam import presets
-from bendpam.cli_design import register
 from bendpam.design import (
     Finger,
     FingerLoads,

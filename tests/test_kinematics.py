@@ -8,7 +8,7 @@ from numpy.testing import assert_allclose
 from scipy.integrate import quad
 
 import bendpam
-from bendpam import Actuator, presets
+from bendpam import Actuator
 from bendpam.braid import LOCK_FRACTION, gauss_nodes
 
 

@@ -10,7 +10,7 @@ from numpy.testing import assert_allclose
 
 import bendpam
 from bendpam import Actuator, presets
-from bendpam.models import energy, force_balance, get_model
+from bendpam.models import energy, get_model
 
 
 def closed_form(a, P):

@@ -46,7 +46,6 @@ import datetime as _dt
 import html
 import io
 import math
-import os
 import struct
 from collections.abc import Iterable, Iterator, Sequence
 from pathlib import Path

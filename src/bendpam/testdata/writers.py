@@ -127,7 +127,7 @@ def write_test(
     if fkey not in _FORCE_SPELLING:
         raise ValueError(f"unknown force unit {force_unit!r}; expected N, kN, mN or lbf")
     funit = _FORCE_SPELLING[fkey]
-    if hasattr(data, "data") and isinstance(getattr(data, "data"), pd.DataFrame):
+    if hasattr(data, "data") and isinstance(data.data, pd.DataFrame):
         data = data.data  # a RawTest
     missing = [c for c in COLUMNS if c not in data.columns]
     if missing:
