@@ -11,7 +11,7 @@ Run: ``python benchmarks/bench_fit_sweep.py``.
 
 from __future__ import annotations
 
-import math
+import sys
 import tempfile
 import time
 import tracemalloc
@@ -26,6 +26,9 @@ from bendpam.fixture import PAPER_FIXTURE
 from bendpam.identify import fit, score
 from bendpam.testdata.processing import ProcessedSet, ProcessingOptions, process_series
 from bendpam.testdata.simulate import SimulationSettings, simulate_test
+
+sys.path.insert(0, str(Path(__file__).parent))
+from _timing import measure  # noqa: E402
 
 
 def processed_set(truth, pressures, model):
@@ -45,14 +48,8 @@ def main() -> None:
             base = presets.get(name, model)
             truth = base.replace(alpha0_deg=base.alpha0_deg + 0.8, C10_kpa=base.C10_kpa * 1.05)
             ps = processed_set(truth, P, model)
-            best = best_all = math.inf
-            for _ in range(3):
-                t0 = time.perf_counter()
-                r = fit(ps, base, model)
-                best = min(best, time.perf_counter() - t0)
-                t0 = time.perf_counter()
-                r_all = fit(ps, base, model, fit_range="all")
-                best_all = min(best_all, time.perf_counter() - t0)
+            r, best, mem = measure(lambda: fit(ps, base, model))
+            r_all, best_all, _ = measure(lambda: fit(ps, base, model, fit_range="all"))
             # baseline: Nelder-Mead on the same eq-53 objective from the paper's start values
             t0 = time.perf_counter()
             nev = [0]
@@ -68,7 +65,7 @@ def main() -> None:
             res = minimize(obj, [base.alpha0_deg, 114.0, 300.0], method="Nelder-Mead",
                            options={"maxfev": 400, "xatol": 1e-4, "fatol": 1e-9})
             t_nm = time.perf_counter() - t0
-            print(f"  {name} {model:13}: bendpam fit {best:.3f} s (NRMSE {100 * r.metrics.nrmse_cycles:.2f} %, "
+            print(f"  {name} {model:13}: bendpam fit {best:.3f} s, peak {mem:.0f} MiB (NRMSE {100 * r.metrics.nrmse_cycles:.2f} %, "
                   f"alpha0 {r.parameters['alpha0'].value:.3f} vs true {truth.alpha0_deg:.3f}); fit_range='all' "
                   f"{best_all:.3f} s (NRMSE {100 * r_all.metrics.nrmse_cycles:.2f} %, alpha0 "
                   f"{r_all.parameters['alpha0'].value:.3f});  Nelder-Mead baseline {t_nm:.2f} s, {nev[0]} "
