@@ -8,7 +8,7 @@ from numpy.testing import assert_allclose
 from scipy.integrate import quad
 
 import bendpam
-from bendpam import Actuator
+from strategies import actuators as actuator_strategy
 from bendpam.braid import LOCK_FRACTION, gauss_nodes
 
 
@@ -121,17 +121,8 @@ def test_nonfinite_curvature_rejected(be):
         bendpam.kinematics(be, [0.0, np.nan])
 
 
-actuators = st.builds(
-    lambda a0, R0, tf, Rs, c10, c01: Actuator(
-        alpha0_deg=a0, R0_mm=R0, t0_mm=tf * R0, L0_mm=145.0, frame_thickness_mm=0.5, frame_width_mm=5.0,
-        frame_modulus_mpa=6796.0, C10_kpa=c10, C01_kpa=c01 + abs(c10) + 10.0, P_start_kpa=30.0, R0_start_mm=R0 * Rs),
-    a0=st.one_of(st.floats(15.0, 53.0), st.floats(57.0, 85.0)),
-    R0=st.floats(3.0, 20.0),
-    tf=st.floats(0.05, 0.6),
-    Rs=st.floats(1.0, 1.3),
-    c10=st.floats(-500.0, 2000.0),
-    c01=st.floats(0.0, 1000.0),
-)
+actuators = actuator_strategy(a0=((15.0, 53.0), (57.0, 85.0)), R0=(3.0, 20.0), tf=(0.05, 0.6), Rs=(1.0, 1.3),
+                              c10=(-500.0, 2000.0), c01=(0.0, 1000.0), ps=(30.0, 30.0))
 
 
 @settings(max_examples=60, deadline=None)

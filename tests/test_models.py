@@ -9,7 +9,8 @@ from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
 import bendpam
-from bendpam import Actuator, presets
+from strategies import actuators as actuator_strategy
+from bendpam import presets
 from bendpam.models import energy, get_model
 
 
@@ -192,19 +193,7 @@ def test_bad_inputs(be):
         bendpam.moment(be, 0.1, 0.0, order=2)
 
 
-actuators = st.builds(
-    lambda a0, R0, tf, Rs, c10, c01, ps: Actuator(
-        alpha0_deg=a0, R0_mm=R0, t0_mm=tf * R0, L0_mm=145.0, frame_thickness_mm=0.5, frame_width_mm=5.0,
-        frame_modulus_mpa=6796.0, C10_kpa=c10, C01_kpa=c01 + max(-c10, 0.0) + 20.0, P_start_kpa=ps,
-        R0_start_mm=R0 * Rs),
-    a0=st.one_of(st.floats(20.0, 52.0), st.floats(58.0, 85.0)),
-    R0=st.floats(3.0, 15.0),
-    tf=st.floats(0.1, 0.5),
-    Rs=st.floats(1.0, 1.25),
-    c10=st.floats(-400.0, 1500.0),
-    c01=st.floats(0.0, 800.0),
-    ps=st.floats(0.0, 80.0),
-)
+actuators = actuator_strategy()
 
 
 @settings(max_examples=60, deadline=None)

@@ -9,7 +9,8 @@ from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
 import bendpam
-from bendpam import Actuator, presets
+from strategies import actuators as actuator_strategy
+from bendpam import presets
 
 
 def test_free_curvature_is_a_root_and_stable(preset_model):
@@ -116,17 +117,8 @@ def test_free_curvature_bad_pressure(be):
         bendpam.free_curvature(be, [0.1, -0.2])
 
 
-actuators = st.builds(
-    lambda a0, R0, tf, c10, c01, E: Actuator(
-        alpha0_deg=a0, R0_mm=R0, t0_mm=tf * R0, L0_mm=145.0, frame_thickness_mm=0.5, frame_width_mm=5.0,
-        frame_modulus_mpa=E, C10_kpa=c10, C01_kpa=c01 + max(-c10, 0.0) + 20.0, P_start_kpa=20.0),
-    a0=st.one_of(st.floats(25.0, 50.0), st.floats(60.0, 80.0)),
-    R0=st.floats(4.0, 12.0),
-    tf=st.floats(0.1, 0.4),
-    c10=st.floats(-300.0, 1500.0),
-    c01=st.floats(0.0, 600.0),
-    E=st.floats(500.0, 20000.0),
-)
+actuators = actuator_strategy(a0=((25.0, 50.0), (60.0, 80.0)), R0=(4.0, 12.0), tf=(0.1, 0.4), Rs=(1.0, 1.0),
+                              c10=(-300.0, 1500.0), c01=(0.0, 600.0), ps=(20.0, 20.0), E=(500.0, 20000.0))
 
 
 @settings(max_examples=40, deadline=None)
