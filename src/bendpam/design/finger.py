@@ -774,18 +774,9 @@ def solve_finger(finger: Finger, pressure, loads: FingerLoads | None = None) -> 
         return _shape(rod, k, br, P, loads, note=lam_note)
 
     if free_ok:
-        k = np.full(rod.n, kf)
-        lam, step = 0.0, 1.0
-        while lam < 1.0:
-            step = min(step, 1.0 - lam)
-            kn, ok, _ = _newton(lambda U, t=lam + step: fun(U, t), k, lo, hi, _NEWTON_TOL)
-            if ok:
-                k, lam = kn, lam + step
-                step *= 2.0
-            else:
-                step *= 0.5
-                if step < _MIN_STEP:
-                    break
+        # continuation in the load fraction from the free shape (exact at fraction 0)
+        k, lam = _continue(lambda t: ((lambda U: fun(U, t)), lo, hi), np.full(rod.n, kf))
+        lam = max(lam, 0.0)
         if lam >= 1.0:
             return finish(k)
         last = _shape(rod, k, br, P, loads, lam=lam, equilibrium=False)
