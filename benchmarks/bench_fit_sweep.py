@@ -24,8 +24,8 @@ import bendpam
 from bendpam import presets
 from bendpam.fixture import PAPER_FIXTURE
 from bendpam.identify import fit, score
-from bendpam.testdata.processing import ProcessedSet, ProcessingOptions, process_series
-from bendpam.testdata.simulate import SimulationSettings, simulate_test
+from bendpam.lab.processing import ProcessedSet, ProcessingOptions, process_series
+from bendpam.lab.simulate import SimulationSettings, simulate_test
 
 sys.path.insert(0, str(Path(__file__).parent))
 from _timing import measure  # noqa: E402

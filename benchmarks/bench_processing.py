@@ -13,9 +13,9 @@ import tempfile
 from pathlib import Path
 
 from bendpam import presets
-from bendpam.testdata import read_test, write_test
-from bendpam.testdata.processing import process_series
-from bendpam.testdata.simulate import SimulationSettings, simulate_test
+from bendpam.lab import read_test, write_test
+from bendpam.lab.processing import process_series
+from bendpam.lab.simulate import SimulationSettings, simulate_test
 
 sys.path.insert(0, str(Path(__file__).parent))
 from _timing import measure  # noqa: E402

@@ -13,8 +13,8 @@ from bendpam.cli import main
 from bendpam.fixture import PAPER_FIXTURE
 from bendpam.hysteresis import DahlLaw, LoopModel, PrandtlIshlinskii, loop_branches, predict_cycle
 from bendpam.identify import fit
-from bendpam.testdata.processing import ProcessedSet, ProcessingOptions, process_series, write_processed
-from bendpam.testdata.simulate import SimulationSettings, simulate_test
+from bendpam.lab.processing import ProcessedSet, ProcessingOptions, process_series, write_processed
+from bendpam.lab.simulate import SimulationSettings, simulate_test
 
 
 def triangle(theta_max, n=300, cycles=3):

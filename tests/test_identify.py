@@ -13,15 +13,15 @@ from bendpam.cli import main
 from bendpam.fixture import PAPER_FIXTURE
 from bendpam.identify import fit, fit_tension, parse_free, score, tension_from_test
 from bendpam.material import MooneyRivlin
-from bendpam.testdata import read_test, write_test
-from bendpam.testdata.processing import (
+from bendpam.lab import read_test, write_test
+from bendpam.lab.processing import (
     PressureResult,
     ProcessedSet,
     ProcessingOptions,
     process_series,
     write_processed,
 )
-from bendpam.testdata.simulate import SimulationSettings, simulate_test
+from bendpam.lab.simulate import SimulationSettings, simulate_test
 
 CASES = {"be-pam": [100, 125, 150, 175, 200], "bc-pam": [40, 60, 80, 100, 120]}
 # known parameters different from the presets (kept away from the BC-PAM fold)

@@ -11,8 +11,8 @@ import bendpam
 from bendpam import presets
 from bendpam.cli import main
 from bendpam.fixture import PAPER_FIXTURE
-from bendpam.testdata import read_test
-from bendpam.testdata.processing import (
+from bendpam.lab import read_test
+from bendpam.lab.processing import (
     ProcessingError,
     ProcessingOptions,
     deadband_fit,
@@ -22,7 +22,7 @@ from bendpam.testdata.processing import (
     process_tests,
     write_processed,
 )
-from bendpam.testdata.simulate import SimulationSettings, simulate_test, simulate_tests
+from bendpam.lab.simulate import SimulationSettings, simulate_test, simulate_tests
 
 FORMATS = ["csv", "testxpert", "bluehill", "mts"]
 CASES = {"be-pam": [100, 125, 150, 175, 200], "bc-pam": [40, 60, 80, 100, 120]}
@@ -249,7 +249,7 @@ def test_cli_errors(capsys, tmp_path, monkeypatch, args, words):
     (tmp_path / "raw").mkdir()
     a = presets.be_pam()
     data, _ = simulate_test(a, 150, settings=SimulationSettings(seed=0))
-    from bendpam.testdata import write_test
+    from bendpam.lab import write_test
 
     write_test(tmp_path / "raw" / "t.csv", data, "csv", pressure_kpa=150)
     write_test(tmp_path / "raw" / "u.csv", data, "csv", pressure_kpa=160)

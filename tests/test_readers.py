@@ -1,4 +1,4 @@
-"""Tests of bendpam.testdata readers and writers (raw four-point-bending exports)."""
+"""Tests of bendpam.lab readers and writers (raw four-point-bending exports)."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
-from bendpam.testdata import (
+from bendpam.lab import (
     COLUMNS,
     DIALECTS,
     RawTest,

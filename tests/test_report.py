@@ -20,9 +20,9 @@ import bendpam.cli
 from bendpam import presets
 from bendpam.identify import fit
 from bendpam.report import build_report, fmt_num, fmt_pct, fmt_pm, fmt_se, table2_rows, table3_rows
-from bendpam.testdata import read_test
-from bendpam.testdata.processing import process_tests
-from bendpam.testdata.simulate import SimulationSettings, simulate_tests
+from bendpam.lab import read_test
+from bendpam.lab.processing import process_tests
+from bendpam.lab.simulate import SimulationSettings, simulate_tests
 
 CHROMIUM = Path("/usr/bin/chromium")
 CHROMIUM_ARGS = ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",

@@ -348,8 +348,8 @@ def demo(
 
 
 def collect_raw_files(paths: list[Path]) -> list[Path]:
-    """Expand folders into their raw test files (see :func:`bendpam.testdata.files.collect_raw_files`)."""
-    from .testdata.files import collect_raw_files as _collect
+    """Expand folders into their raw test files (see :func:`bendpam.lab.files.collect_raw_files`)."""
+    from .lab.files import collect_raw_files as _collect
 
     try:
         return _collect(paths)
@@ -384,8 +384,8 @@ def process(
 ):
     """Process raw four-point-bending cyclic tests into moment-curvature curves and Table 2 values."""
     from .fixture import Fixture
-    from .testdata import read_test
-    from .testdata.processing import ProcessingOptions, process_tests, write_processed
+    from .lab import read_test
+    from .lab.processing import ProcessingOptions, process_tests, write_processed
 
     if out is None:
         raise UserError("give an output folder with --out OUTDIR")
@@ -453,7 +453,7 @@ def simulate_test_cmd(
 ):
     """Write the raw files a testing machine would record for a model actuator (a virtual test)."""
     from .fixture import Fixture
-    from .testdata.simulate import SimulationSettings, simulate_tests
+    from .lab.simulate import SimulationSettings, simulate_tests
 
     if out is None:
         raise UserError("give an output folder with --out DIR")
@@ -478,7 +478,7 @@ def simulate_test_cmd(
 
 def _tension(path: Path, gauge_length_mm, area_mm2, width_mm, thickness_mm):
     from .identify import tension_from_test
-    from .testdata import read_test
+    from .lab import read_test
 
     if gauge_length_mm is None:
         raise UserError("the tension test needs the specimen's --gauge-length-mm")
@@ -522,7 +522,7 @@ def fit(
     """Identify model parameters (alpha0, C10, C01, ...) from processed cyclic tests (section 3.4)."""
     from .identify import fit as _fit
     from .plots import figure7, save_figure
-    from .testdata.processing import load_processed
+    from .lab.processing import load_processed
 
     if out is None:
         raise UserError("give an output folder with --out OUTDIR")

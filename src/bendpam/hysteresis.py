@@ -284,7 +284,7 @@ def loss_ratio(k_mag, upper, lower, L0_mm: float) -> tuple[float, float, float]:
     """Energy-loss ratio of a loop given on a common curvature grid (magnitudes).
 
     Loss = loop area in M-theta, stored = area under the mean of the branches (Table 2's
-    definition, as in :mod:`bendpam.testdata.processing`).  Returns ``(ratio, loss, stored)``.
+    definition, as in :mod:`bendpam.lab.processing`).  Returns ``(ratio, loss, stored)``.
     """
     th = np.asarray(k_mag, dtype=float) * L0_mm
     loss = float(np.trapezoid(np.asarray(upper) - np.asarray(lower), th))

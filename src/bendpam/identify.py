@@ -538,7 +538,7 @@ def fit(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C
 
     Parameters
     ----------
-    processed : :class:`bendpam.testdata.processing.ProcessedSet` (or ``load_processed(dir)``).
+    processed : :class:`bendpam.lab.processing.ProcessedSet` (or ``load_processed(dir)``).
     actuator : the nominal actuator (geometry, and the values of the parameters held fixed).
     model : ``"energy"`` or ``"force_balance"``.
     free : names among alpha0, C10, C01, P_start, E_f, R0_start (aliases such as ``alpha0_deg`` work).
@@ -817,7 +817,7 @@ def fit_tension(stretch, nominal_stress_mpa, *, source: str = "") -> TensionFit:
 
 
 def tension_from_test(raw, *, gauge_length_mm: float, area_mm2: float) -> TensionFit:
-    """Stretch and nominal stress from a raw tension export (:class:`~bendpam.testdata.RawTest`).
+    """Stretch and nominal stress from a raw tension export (:class:`~bendpam.lab.RawTest`).
 
     Uses the loading part up to the maximum extension; stretch ``1 + extension / gauge_length``,
     nominal stress ``force / area``.

@@ -179,13 +179,13 @@ def save_figure(fig, path, dpi: int = 130) -> None:
 
 
 def figure4(processed, title: str = ""):
-    """A figure like the paper's Figure 4 for a :class:`~bendpam.testdata.processing.ProcessedSet`.
+    """A figure like the paper's Figure 4 for a :class:`~bendpam.lab.processing.ProcessedSet`.
 
     (a) the filtered loops at each pressure (moment against curvature, every cycle), with the
     hysteresis-free mean curve dashed; (b) blocked moment against pressure with standard-error bars
     and the deadband fit line; (c) free-bending curvature against pressure with standard-error bars.
     """
-    from .testdata.processing import deadband_fit
+    from .lab.processing import deadband_fit
 
     res = processed.results
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.5))

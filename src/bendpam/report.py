@@ -1,7 +1,7 @@
 """A one-command, self-contained HTML report: raw cyclic tests -> processing -> fits -> figures.
 
 :func:`build_report` reads raw four-point-bending exports (files, or folders of them), processes
-them (:func:`bendpam.testdata.processing.process_tests`), fits each model
+them (:func:`bendpam.lab.processing.process_tests`), fits each model
 (:func:`bendpam.identify.fit`), draws the figures and writes ONE HTML page atomically.  The page
 needs nothing else: the figures are embedded as base64 PNG (``data:`` URIs), the style sheet is
 inline, there is no JavaScript and no reference to any other file or address.  A
@@ -31,8 +31,8 @@ Progress: with ``progress=True`` a ``rich`` progress bar is drawn on stderr whil
 built, only when stderr is a terminal (so logs, pipes and tests stay clean); ``progress=False``
 never draws it.
 
-Errors are the library's one-line errors: :class:`~bendpam.testdata.ReadError` for an unreadable
-file, :class:`~bendpam.testdata.processing.ProcessingError` for a test that cannot be processed
+Errors are the library's one-line errors: :class:`~bendpam.lab.ReadError` for an unreadable
+file, :class:`~bendpam.lab.processing.ProcessingError` for a test that cannot be processed
 (e.g. a file without a pressure) and :class:`ValueError` for bad arguments or a failed fit.  A
 figure that cannot be drawn (for instance the internal stresses at a curvature beyond lock-up)
 does not stop the report: the page shows a note in its place, and the note is returned too.
@@ -56,7 +56,7 @@ from ._io import atomic_write_text
 from .actuator import Actuator
 from .fixture import PAPER_FIXTURE, Fixture
 from .presets import normalise_model
-from .testdata.files import RAW_SUFFIXES, collect_raw_files
+from .lab.files import RAW_SUFFIXES, collect_raw_files
 
 __all__ = [
     "RAW_SUFFIXES",
@@ -112,7 +112,7 @@ def _fixture(fixture, actuator: Actuator) -> Fixture:
 
 
 def _options(processing_options):
-    from .testdata.processing import ProcessingOptions
+    from .lab.processing import ProcessingOptions
 
     if processing_options is None:
         return ProcessingOptions()
@@ -375,7 +375,7 @@ def build_report(
         one pressure per file in order (kPa).
     fixture : a :class:`~bendpam.fixture.Fixture`, a string ``"d,r,t"`` (mm, L0 from the
         actuator) or None (the paper's fixture with the actuator's L0).
-    processing_options : a :class:`~bendpam.testdata.processing.ProcessingOptions`, a dict of its
+    processing_options : a :class:`~bendpam.lab.processing.ProcessingOptions`, a dict of its
         fields, or None for the defaults.
     progress : draw a rich progress bar on stderr while working, when stderr is a terminal.
 
@@ -392,8 +392,8 @@ def build_report(
 
     from .identify import fit as _fit
     from .identify import parse_free
-    from .testdata import read_test
-    from .testdata.processing import process_tests
+    from .lab import read_test
+    from .lab.processing import process_tests
 
     # ---- validate everything cheap before the work starts ------------------------------------
     if not isinstance(actuator, Actuator):

@@ -36,6 +36,8 @@ model sign convention (multiply by ``actuator.bend_sign`` to compare).
 
 from __future__ import annotations
 
+from ..errors import ProcessingError
+
 import math
 import warnings
 from dataclasses import dataclass, field
@@ -63,8 +65,6 @@ __all__ = [
 BRANCHES = ("loading", "unloading")
 
 
-class ProcessingError(ValueError):
-    """A test that cannot be processed; the message is one line naming the file."""
 
 
 @dataclass(frozen=True)
@@ -543,7 +543,7 @@ class ProcessedSet:
 
 def process_tests(tests, *, fixture: Fixture = PAPER_FIXTURE, options: ProcessingOptions | None = None,
                   keep_series: bool = True) -> ProcessedSet:
-    """Process several raw tests (``RawTest`` objects from :func:`bendpam.testdata.read_test`).
+    """Process several raw tests (``RawTest`` objects from :func:`bendpam.lab.read_test`).
 
     Every test needs a pressure (from the reader: option, metadata or filename).  Two tests at one
     pressure are an error.

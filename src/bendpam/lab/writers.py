@@ -1,6 +1,6 @@
 """Writers of raw four-point-bending exports in the dialects :func:`read_test` reads.
 
-:func:`write_test` is the inverse of :func:`bendpam.testdata.read_test`: reading back what it
+:func:`write_test` is the inverse of :func:`bendpam.lab.read_test`: reading back what it
 wrote gives the same numbers to the printed precision (9 significant digits) and the same
 metadata (plus a pressure line when ``pressure_kpa`` is given).  It is meant for fixtures,
 converted data sets and tests of the processing code; the files look like real exports::
@@ -98,7 +98,7 @@ def write_test(
         Output file; its folder must exist.
     data : pandas.DataFrame
         Columns ``time_s`` (s), ``stroke_mm`` (mm) and ``force_n`` (N), finite numbers; other
-        columns are ignored.  A :class:`~bendpam.testdata.RawTest` is accepted too.
+        columns are ignored.  A :class:`~bendpam.lab.RawTest` is accepted too.
     dialect : {"csv", "testxpert", "bluehill", "mts"}
         Export format to imitate.
     metadata : dict of str to str, optional

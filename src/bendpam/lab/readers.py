@@ -29,6 +29,8 @@ only when that fails is the text re-scanned line by line to find the offending l
 
 from __future__ import annotations
 
+from ..errors import FileFormatError
+
 import csv
 import io
 import math
@@ -147,7 +149,7 @@ def _show(value: str, limit: int = 40) -> str:
     return repr(value)
 
 
-class ReadError(ValueError):
+class ReadError(FileFormatError):
     """A raw test file that cannot be read.
 
     ``str(err)`` is one line ``FILE:LINE: what was wrong, what was expected`` (``LINE`` is
