@@ -1,29 +1,36 @@
 """bendpam: models, tests and design tools for bending pneumatic artificial muscles.
 
-Units inside the library: mm, N, MPa (N/mm^2), N*mm, 1/mm and radians.  Interfaces that users
-type (the CLI, TOML files, Actuator fields) carry the unit in the name (``pressure_kpa``,
-``alpha0_deg``).
+Units at every public edge: pressure in kPa, lengths in mm, force in N, moments in N*mm,
+curvature in 1/mm, angles in degrees; the name of an argument, field, column or key says its unit
+(``pressure_kpa``, ``alpha0_deg``).  MPa and radians live only inside the numerics.
 
 Quick start::
 
     import bendpam
     a = bendpam.presets.be_pam()
-    bendpam.blocked_moment(a, 0.2)                # N*mm at 200 kPa
-    bendpam.free_curvature(a, [0.1, 0.2]).angle_deg
+    bendpam.blocked_moment(a, 200.0)               # N*mm at 200 kPa
+    bendpam.free_curvature(a, [100.0, 200.0]).angle_deg
+    law = bendpam.MomentLaw.of(a, "energy")         # the moment law as one object
+
+Heavy modules (SciPy's optimisers, xarray, pandas, matplotlib, Dask) are imported only by the
+functions that need them, so ``import bendpam`` and the command line start quickly.
 """
 
 from __future__ import annotations
 
-from . import braid, fast, material, models, presets
-from .actuator import NEUTRAL_ANGLE_DEG, Actuator
+from typing import Any
+
+from . import braid, errors, material, models, presets
+from .actuator import NEUTRAL_ANGLE_DEG, Actuator, ModelParams
 from .braid import CurvatureLimits, Kinematics, curvature_limits
+from .checks import UnitWarning
+from .errors import BendpamError, FileFormatError, FitError, InputError, NoEquilibrium, ProcessingError
+from .law import FreeBending, FreeBranch, MomentLaw, MomentTable, StableBranch
 from .material import MooneyRivlin
 from .predict import (
-    BranchInfo,
-    FreeBending,
-    active_pressure,
+    active_pressure_kpa,
     blocked_moment,
-    branch_info,
+    free_branch,
     free_curvature,
     internal_stresses,
     kinematics,
@@ -33,24 +40,34 @@ from .predict import (
     tangent_stiffness,
 )
 
-from .sweeps import sweep  # noqa: E402  (the function; the module is bendpam.sweeps)
-
-__version__ = "0.1.0"
+__version__ = "0.2.0"
 
 __all__ = [
     "Actuator",
-    "NEUTRAL_ANGLE_DEG",
-    "MooneyRivlin",
-    "Kinematics",
+    "BendpamError",
     "CurvatureLimits",
-    "braid",
-    "fast",
-    "BranchInfo",
+    "FileFormatError",
+    "FitError",
     "FreeBending",
-    "active_pressure",
+    "FreeBranch",
+    "InputError",
+    "Kinematics",
+    "ModelParams",
+    "MomentLaw",
+    "MomentTable",
+    "MooneyRivlin",
+    "NEUTRAL_ANGLE_DEG",
+    "NoEquilibrium",
+    "ProcessingError",
+    "StableBranch",
+    "UnitWarning",
+    "active_pressure_kpa",
     "blocked_moment",
-    "branch_info",
+    "braid",
     "curvature_limits",
+    "errors",
+    "fit",
+    "free_branch",
     "free_curvature",
     "internal_stresses",
     "kinematics",
@@ -60,6 +77,39 @@ __all__ = [
     "moment_terms",
     "prediction_table",
     "presets",
+    "process_tests",
+    "read_test",
+    "simulate_test",
     "sweep",
     "tangent_stiffness",
 ]
+
+# Functions whose modules import heavy dependencies are loaded on first use.
+_LAZY = {
+    "sweep": ("sweeps", "sweep"),
+    "fit": ("identify", "fit"),
+    "read_test": ("lab.readers", "read_test"),
+    "process_tests": ("lab.processing", "process_tests"),
+    "simulate_test": ("lab.simulate", "simulate_test"),
+    "fast": ("fast", None),
+    "sweeps": ("sweeps", None),
+    "identify": ("identify", None),
+    "hysteresis": ("hysteresis", None),
+    "design": ("design", None),
+    "lab": ("lab", None),
+    "plots": ("plots", None),
+    "report": ("report", None),
+    "fixture": ("fixture", None),
+}
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY:
+        import importlib
+
+        mod_name, attr = _LAZY[name]
+        mod = importlib.import_module(f".{mod_name}", __name__)
+        value = mod if attr is None else getattr(mod, attr)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'bendpam' has no attribute {name!r}")

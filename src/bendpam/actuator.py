@@ -13,6 +13,7 @@ stress-free at ``P_start`` with outer radius ``R0_start`` and thickness ``t0_sta
 from __future__ import annotations
 
 import dataclasses
+import difflib
 import math
 import os
 import tomllib
@@ -20,34 +21,115 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import tomli_w
 
 from ._io import atomic_write_text
+from .checks import number
+from .errors import FileFormatError, InputError
 from .material import MooneyRivlin
 
-__all__ = ["Actuator", "NEUTRAL_ANGLE_DEG"]
+__all__ = ["Actuator", "ModelParams", "NEUTRAL_ANGLE_DEG", "bladder_area_mm2", "frame_inertia_mm4", "t0_start_mm"]
 
 #: The braid angle at which a McKibben sleeve has maximum volume, arctan(sqrt 2) = 54.7356 deg.
 NEUTRAL_ANGLE_DEG = math.degrees(math.atan(math.sqrt(2.0)))
 
 
 def _check(name: str, value: Any, lo: float | None, hi: float | None, *, lo_open=True, hi_open=True, unit=""):
-    """Validate a scalar against an interval and return it as float; raise a clear ValueError."""
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} = {value!r} is not a number") from None
-    lo_s = "(" if lo_open else "["
-    hi_s = ")" if hi_open else "]"
-    rng = f"{lo_s}{'-inf' if lo is None else f'{lo:g}'}, {'inf' if hi is None else f'{hi:g}'}{hi_s}"
-    u = f" {unit}" if unit else ""
-    if not math.isfinite(v):
-        raise ValueError(f"{name} = {value!r}{u} is not finite; allowed range {rng}{u}")
-    bad_lo = lo is not None and (v <= lo if lo_open else v < lo)
-    bad_hi = hi is not None and (v >= hi if hi_open else v > hi)
-    if bad_lo or bad_hi:
-        raise ValueError(f"{name} = {v:g}{u} is outside the allowed range {rng}{u}")
-    return v
+    return number(name, value, lo, hi, lo_open=lo_open, hi_open=hi_open, unit=unit)
+
+
+def t0_start_mm(R0_mm, t0_mm, R0_start_mm):
+    """Bladder wall thickness at P_start (mm), eq 52: constant wall area (eq 51); scalars or arrays."""
+    return R0_start_mm - np.sqrt(R0_start_mm * R0_start_mm - 2.0 * R0_mm * t0_mm + t0_mm * t0_mm)
+
+
+def bladder_area_mm2(R0_mm, t0_mm):
+    """Bladder wall cross-section area (mm^2), invariant under the prestrain (eq 51)."""
+    return np.pi * (2.0 * R0_mm * t0_mm - t0_mm * t0_mm)
+
+
+def frame_inertia_mm4(width_mm, thickness_mm):
+    """Second moment of area of the frame strip, ``I_f = w h^3 / 12`` (mm^4), eq 16 and 27."""
+    return width_mm * thickness_mm**3 / 12.0
+
+
+def _suggest(key: str, known) -> str:
+    """``'alpha_deg' (did you mean 'alpha0_deg'?); known: ...`` for an unknown key."""
+    near = difflib.get_close_matches(str(key), list(known), n=1, cutoff=0.5)
+    hint = f" (did you mean {near[0]!r}?)" if near else ""
+    return f"{key!r}{hint}; known: {', '.join(known)}"
+
+
+@dataclass(frozen=True)
+class ModelParams:
+    """An actuator (or an array of actuator cases) in the models' internal units: mm, MPa, rad.
+
+    This is the numerics' view of an :class:`Actuator`; users never build one by hand.  Every
+    field is a float for one actuator, or an array of one shape for a block of cases (sweeps,
+    design searches), so the kinematics and both models evaluate many actuators at once.  The
+    derived values of eq 51-52 are computed here and nowhere else (:meth:`build`).
+
+    Attributes
+    ----------
+    alpha0 : initial braid angle, rad.
+    R0_start, t0_start : bladder outer radius and wall thickness at P_start, mm (eq 51-52).
+    bladder_area : bladder wall cross-section area, mm^2 (eq 51).
+    frame_stiffness : E_f I_f, N*mm^2 (eq 16, 27).
+    frame_modulus : E_f, MPa.  frame_thickness : h_f, mm.
+    C10, C01 : Mooney-Rivlin constants, MPa.
+    P_start : threshold pressure, MPa (eq 50).
+    L0 : active length, mm.  braid_thickness : t_br, mm.
+    """
+
+    alpha0: Any
+    R0_start: Any
+    t0_start: Any
+    bladder_area: Any
+    frame_stiffness: Any
+    frame_modulus: Any
+    frame_thickness: Any
+    C10: Any
+    C01: Any
+    P_start: Any
+    L0: Any
+    braid_thickness: Any
+
+    @classmethod
+    def build(cls, *, alpha0_deg, R0_mm, t0_mm, L0_mm, frame_thickness_mm, frame_width_mm, frame_modulus_mpa,
+              C10_kpa, C01_kpa, P_start_kpa, R0_start_mm, braid_thickness_mm=0.3) -> ModelParams:
+        """From user units (the :class:`Actuator` field names); scalars or arrays that broadcast."""
+        return cls(
+            alpha0=np.radians(alpha0_deg), R0_start=R0_start_mm * 1.0,
+            t0_start=t0_start_mm(R0_mm, t0_mm, R0_start_mm), bladder_area=bladder_area_mm2(R0_mm, t0_mm),
+            frame_stiffness=frame_modulus_mpa * frame_inertia_mm4(frame_width_mm, frame_thickness_mm),
+            frame_modulus=frame_modulus_mpa * 1.0, frame_thickness=frame_thickness_mm * 1.0,
+            C10=C10_kpa * 1e-3, C01=C01_kpa * 1e-3, P_start=P_start_kpa * 1e-3, L0=L0_mm * 1.0,
+            braid_thickness=braid_thickness_mm * 1.0,
+        )
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        """Broadcast shape of the fields: ``()`` for one actuator."""
+        return np.broadcast_shapes(*(np.shape(v) for v in self.__dict__.values()))
+
+    def broadcast(self) -> ModelParams:
+        """Every field as a float array of :attr:`shape` (one entry per case)."""
+        shp = self.shape
+        return ModelParams(**{k: np.array(np.broadcast_to(v, shp), dtype=float) for k, v in self.__dict__.items()})
+
+    def take(self, index) -> ModelParams:
+        """The cases at ``index`` (array fields only; scalars stay)."""
+        return ModelParams(**{k: (np.asarray(v)[index] if np.ndim(v) else v) for k, v in self.__dict__.items()})
+
+    def col(self) -> ModelParams:
+        """The same cases with a trailing axis, to broadcast against per-case samples."""
+        return ModelParams(**{k: (np.asarray(v)[..., None] if np.ndim(v) else v) for k, v in self.__dict__.items()})
+
+    @property
+    def bend_sign(self):
+        """+1 (BE-PAM, bends toward the frame), -1 (BC-PAM) or 0 (neutral braid angle), per case."""
+        return np.sign(np.round(np.degrees(self.alpha0) - NEUTRAL_ANGLE_DEG, 9)).astype(int)
 
 
 @dataclass(frozen=True)
@@ -101,6 +183,7 @@ class Actuator:
 
     # derived, filled in __post_init__
     _material: MooneyRivlin = field(init=False, repr=False, compare=False, hash=False)
+    _params: ModelParams = field(init=False, repr=False, compare=False, hash=False)
 
     def __post_init__(self) -> None:
         s = object.__setattr__
@@ -114,7 +197,7 @@ class Actuator:
         s(self, "C10_kpa", _check("C10_kpa", self.C10_kpa, None, None, unit="kPa"))
         s(self, "C01_kpa", _check("C01_kpa", self.C01_kpa, None, None, unit="kPa"))
         if self.C10_kpa + self.C01_kpa <= 0.0:
-            raise ValueError(
+            raise InputError(
                 f"C10_kpa + C01_kpa = {self.C10_kpa + self.C01_kpa:g} kPa must be > 0 "
                 "(the bladder's initial shear modulus 2(C10 + C01) must be positive); "
                 f"got C10_kpa = {self.C10_kpa:g}, C01_kpa = {self.C01_kpa:g}"
@@ -130,75 +213,40 @@ class Actuator:
             )
         s(self, "braid_thickness_mm", _check("braid_thickness_mm", self.braid_thickness_mm, 0.0, None, unit="mm"))
         if not isinstance(self.name, str):
-            raise ValueError(f"name = {self.name!r} must be a string")
-        s(self, "_material", MooneyRivlin(self.C10, self.C01))
+            raise InputError(f"name = {self.name!r} must be a string")
+        s(self, "_material", MooneyRivlin(self.C10_kpa * 1e-3, self.C01_kpa * 1e-3))
+        s(self, "_params", ModelParams.build(**{f: getattr(self, f) for f in self.field_names() if f != "name"}))
 
-    # ---- internal units -------------------------------------------------------------------------
+    # ---- derived values (units in the names) ---------------------------------------------------
     @property
-    def alpha0(self) -> float:
-        """Initial braid angle, rad."""
-        return math.radians(self.alpha0_deg)
-
-    @property
-    def R0(self) -> float:
-        """Unpressurised bladder outer radius, mm."""
-        return self.R0_mm
-
-    @property
-    def t0(self) -> float:
-        """Unpressurised bladder wall thickness, mm."""
-        return self.t0_mm
-
-    @property
-    def L0(self) -> float:
-        """Active (frame) length, mm."""
-        return self.L0_mm
-
-    @property
-    def C10(self) -> float:
-        """Mooney-Rivlin C10, MPa."""
-        return self.C10_kpa * 1e-3
-
-    @property
-    def C01(self) -> float:
-        """Mooney-Rivlin C01, MPa."""
-        return self.C01_kpa * 1e-3
-
-    @property
-    def P_start(self) -> float:
-        """Threshold pressure P_start, MPa (eq 50)."""
-        return self.P_start_kpa * 1e-3
+    def params(self) -> ModelParams:
+        """The numerics' view: the same actuator in mm, MPa and rad (see :class:`ModelParams`)."""
+        return self._params
 
     @property
     def material(self) -> MooneyRivlin:
-        """The bladder's :class:`~bendpam.material.MooneyRivlin` law (constants in MPa)."""
+        """The bladder's :class:`~bendpam.material.MooneyRivlin` law (constants in MPa, numerics only)."""
         return self._material
 
     @property
-    def R0_start(self) -> float:
-        """Bladder outer radius at P_start, mm (Table 1)."""
-        return float(self.R0_start_mm)
-
-    @property
-    def t0_start(self) -> float:
+    def t0_start_mm(self) -> float:
         """Bladder wall thickness at P_start, mm: eq 52, constant wall area (eq 51)."""
-        R0s = self.R0_start
-        return R0s - math.sqrt(R0s * R0s - 2.0 * self.R0 * self.t0 + self.t0 * self.t0)
+        return float(self._params.t0_start)
 
     @property
-    def bladder_area(self) -> float:
+    def bladder_area_mm2(self) -> float:
         """Bladder wall cross-section area, mm^2 (invariant, eq 51)."""
-        return math.pi * (2.0 * self.R0 * self.t0 - self.t0 * self.t0)
+        return float(self._params.bladder_area)
 
     @property
-    def frame_inertia(self) -> float:
+    def frame_inertia_mm4(self) -> float:
         """Second moment of area of the frame strip, I_f = w h^3 / 12, mm^4."""
-        return self.frame_width_mm * self.frame_thickness_mm**3 / 12.0
+        return float(frame_inertia_mm4(self.frame_width_mm, self.frame_thickness_mm))
 
     @property
-    def frame_stiffness(self) -> float:
+    def frame_stiffness_nmm2(self) -> float:
         """Bending stiffness of the frame E_f I_f, N*mm^2 (eq 16, 27)."""
-        return self.frame_modulus_mpa * self.frame_inertia
+        return float(self._params.frame_stiffness)
 
     @property
     def kind(self) -> str:
@@ -215,11 +263,9 @@ class Actuator:
     # ---- convenience ----------------------------------------------------------------------------
     def replace(self, **changes: Any) -> Actuator:
         """Return a copy with some fields changed (validated again)."""
-        unknown = set(changes) - set(self.field_names())
+        unknown = [k for k in changes if k not in self.field_names()]
         if unknown:
-            raise ValueError(
-                f"unknown actuator parameter(s) {sorted(unknown)}; known: {', '.join(self.field_names())}"
-            )
+            raise InputError(f"unknown actuator parameter {_suggest(unknown[0], self.field_names())}")
         return dataclasses.replace(self, **changes)
 
     @classmethod
@@ -234,30 +280,34 @@ class Actuator:
     def derived(self) -> dict[str, float]:
         """Derived quantities, units in the names."""
         return {
-            "t0_start_mm": self.t0_start,
-            "bladder_area_mm2": self.bladder_area,
-            "frame_inertia_mm4": self.frame_inertia,
-            "frame_stiffness_nmm2": self.frame_stiffness,
+            "t0_start_mm": self.t0_start_mm,
+            "bladder_area_mm2": self.bladder_area_mm2,
+            "frame_inertia_mm4": self.frame_inertia_mm4,
+            "frame_stiffness_nmm2": self.frame_stiffness_nmm2,
             "shear_modulus_kpa": 2.0 * (self.C10_kpa + self.C01_kpa),
         }
 
     @classmethod
     def from_dict(cls, data: dict[str, Any], *, source: str = "actuator") -> Actuator:
-        """Build from a dict of init fields; unknown or missing keys raise a clear ValueError."""
+        """Build from a dict of init fields; unknown or missing keys raise a one-line InputError.
+
+        Values are type-checked: a bool or a string is not a number.  An unknown key is reported
+        with the nearest known one.
+        """
         if not isinstance(data, dict):
-            raise ValueError(f"{source}: expected a table of actuator parameters, got {type(data).__name__}")
+            raise InputError(f"{source}: expected a table of actuator parameters, got {type(data).__name__}")
         names = cls.field_names()
         unknown = [k for k in data if k not in names]
         if unknown:
-            raise ValueError(f"{source}: unknown actuator parameter(s) {unknown}; known: {', '.join(names)}")
+            raise InputError(f"{source}: unknown actuator parameter {_suggest(unknown[0], names)}")
         required = [f.name for f in dataclasses.fields(cls) if f.init and f.default is dataclasses.MISSING]
         missing = [k for k in required if k not in data]
         if missing:
-            raise ValueError(f"{source}: missing actuator parameter(s) {missing}")
+            raise InputError(f"{source}: missing actuator parameter(s) {', '.join(missing)}")
         try:
             return cls(**data)
-        except ValueError as exc:
-            raise ValueError(f"{source}: {exc}") from None
+        except InputError as exc:
+            raise InputError(f"{source}: {exc}") from None
 
     def to_toml(self, path: str | os.PathLike | None = None) -> str:
         """Serialise to TOML (an ``[actuator]`` table); write atomically to ``path`` if given."""
@@ -274,15 +324,15 @@ class Actuator:
         try:
             raw = p.read_bytes()
         except FileNotFoundError:
-            raise ValueError(f"{p}: actuator file not found") from None
+            raise FileFormatError(f"{p}: actuator file not found") from None
         except OSError as exc:
-            raise ValueError(f"{p}: cannot read actuator file ({exc.strerror})") from None
+            raise FileFormatError(f"{p}: cannot read actuator file ({exc.strerror})") from None
         try:
             data = tomllib.loads(raw.decode("utf-8"))
         except UnicodeDecodeError as exc:
-            raise ValueError(f"{p}: not UTF-8 text (byte {exc.start})") from None
+            raise FileFormatError(f"{p}: not UTF-8 text (byte {exc.start})") from None
         except tomllib.TOMLDecodeError as exc:
-            raise ValueError(f"{p}: invalid TOML: {exc}") from None
+            raise FileFormatError(f"{p}: invalid TOML: {exc}") from None
         table = data.get("actuator", data)
         return cls.from_dict(table, source=str(p))
 
@@ -293,6 +343,6 @@ class Actuator:
             f"{label}: alpha0={self.alpha0_deg:g} deg, R0={self.R0_mm:g} mm, t0={self.t0_mm:g} mm, "
             f"L0={self.L0_mm:g} mm, frame {self.frame_thickness_mm:g}x{self.frame_width_mm:g} mm "
             f"E={self.frame_modulus_mpa:g} MPa, C10={self.C10_kpa:g} kPa, C01={self.C01_kpa:g} kPa, "
-            f"P_start={self.P_start_kpa:g} kPa, R0_start={self.R0_start:g} mm (t0_start={self.t0_start:.4g} mm)"
+            f"P_start={self.P_start_kpa:g} kPa, R0_start={self.R0_start_mm:g} mm (t0_start={self.t0_start_mm:.4g} mm)"
         )
 

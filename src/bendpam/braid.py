@@ -47,9 +47,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import Any
 
 import numpy as np
-from scipy.optimize import brentq
+
+from .errors import InputError
 
 __all__ = [
     "DEFAULT_ORDER",
@@ -58,6 +60,7 @@ __all__ = [
     "gauss_nodes",
     "kinematics",
     "curvature_limits",
+    "limits",
     "solve_u",
     "LOCK_FRACTION",
     "MIN_FAR_STRETCH",
@@ -81,7 +84,7 @@ def gauss_nodes(order: int = DEFAULT_ORDER) -> tuple[np.ndarray, np.ndarray]:
     """
     order = int(order)
     if order < 4 or order > 1024:
-        raise ValueError(f"quadrature order = {order} is outside the allowed range [4, 1024]")
+        raise InputError(f"quadrature order = {order} is outside the allowed range [4, 1024]")
     x, w = np.polynomial.legendre.leggauss(order)
     phi = (x + 1.0) * (np.pi / 2.0)
     wbar = w / 2.0  # (pi/2 * w) / pi
@@ -90,7 +93,7 @@ def gauss_nodes(order: int = DEFAULT_ORDER) -> tuple[np.ndarray, np.ndarray]:
     return phi, wbar
 
 
-def _col(x):
+def case_column(x):
     """A scalar as is; an array parameter gets a trailing axis to broadcast against the nodes."""
     return x[..., None] if np.ndim(x) else x
 
@@ -101,11 +104,11 @@ def _ibar(u, c, omc, wbar):
     ``c = cos(alpha0)`` is a scalar or an array broadcasting against ``u`` (vectorised sweeps).
     """
     lam1 = 1.0 + u[..., None] * omc
-    cl = _col(c) * lam1
+    cl = case_column(c) * lam1
     g = 1.0 - cl * cl
     inv = 1.0 / np.sqrt(g)
     ib = inv @ wbar
-    dib = ((_col(c) * cl * omc) * (inv / g)) @ wbar
+    dib = ((case_column(c) * cl * omc) * (inv / g)) @ wbar
     return ib, dib
 
 
@@ -227,89 +230,128 @@ def _inverse_table(alpha0: float, order: int) -> tuple[np.ndarray, np.ndarray]:
 
 @dataclass(frozen=True)
 class CurvatureLimits:
-    """Admissible range of the frame curvature k' for one actuator (1/mm), with the reasons."""
+    """Admissible range of the frame curvature k' (1/mm), with the reasons.
 
-    k_min: float
-    k_max: float
+    For one actuator the fields are floats; for a block of cases (:class:`~bendpam.ModelParams`
+    with array fields) ``k_min``, ``k_max``, ``u_min`` and ``u_max`` are arrays and the reasons
+    describe the first case.
+    """
+
+    k_min: Any
+    k_max: Any
     reason_min: str
     reason_max: str
-    u_min: float
-    u_max: float
+    u_min: Any
+    u_max: Any
 
-    def check(self, curvature, *, name: str = "curvature") -> None:
-        """Raise ``ValueError`` if any curvature is outside ``[k_min, k_max]`` or not finite."""
+    def check(self, curvature, *, name: str = "curvature_per_mm") -> None:
+        """Raise :class:`~bendpam.errors.InputError` if a curvature is outside ``[k_min, k_max]`` or not finite."""
         k = np.asarray(curvature, dtype=float)
         if k.size == 0:
             return
         if not np.all(np.isfinite(k)):
             bad = np.flatnonzero(~np.isfinite(k.ravel()))[0]
-            raise ValueError(f"{name} has a non-finite value {k.ravel()[bad]!r} at index {int(bad)}")
+            raise InputError(f"{name} has a non-finite value {k.ravel()[bad]!r} at index {int(bad)}")
         kmin, kmax = float(k.min()), float(k.max())
-        if kmax > self.k_max:
-            raise ValueError(
-                f"{name} k' = {kmax:.6g} 1/mm is beyond the braid lock-up limit k'_max = {self.k_max:.6g} 1/mm "
-                f"({self.reason_max}); allowed range [{self.k_min:.6g}, {self.k_max:.6g}] 1/mm"
+        lo, hi = float(np.min(self.k_min)), float(np.max(self.k_max))
+        if np.any(k > self.k_max):
+            raise InputError(
+                f"{name} k' = {kmax:.6g} 1/mm is beyond the braid lock-up limit k'_max = {hi:.6g} 1/mm "
+                f"({self.reason_max}); allowed range [{lo:.6g}, {hi:.6g}] 1/mm"
             )
-        if kmin < self.k_min:
-            raise ValueError(
-                f"{name} k' = {kmin:.6g} 1/mm is beyond the braid lock-up limit k'_min = {self.k_min:.6g} 1/mm "
-                f"({self.reason_min}); allowed range [{self.k_min:.6g}, {self.k_max:.6g}] 1/mm"
+        if np.any(k < self.k_min):
+            raise InputError(
+                f"{name} k' = {kmin:.6g} 1/mm is beyond the braid lock-up limit k'_min = {lo:.6g} 1/mm "
+                f"({self.reason_min}); allowed range [{lo:.6g}, {hi:.6g}] 1/mm"
             )
 
 
-@lru_cache(maxsize=256)
-def _limits(alpha0: float, R0: float, t0: float, order: int) -> CurvatureLimits:
-    c, s = math.cos(alpha0), math.sin(alpha0)
-    u_lock = (1.0 / c - 1.0) / 2.0
+def _bisect(f, a, b, iters: int = 64):
+    """Vectorised bisection for the sign change of ``f`` between ``a`` (f > 0) and ``b`` (f <= 0)."""
+    for _ in range(iters):
+        m = 0.5 * (a + b)
+        pos = f(m) > 0
+        a, b = np.where(pos, m, a), np.where(pos, b, m)
+    return 0.5 * (a + b)
+
+
+def limits(params, order: int = DEFAULT_ORDER) -> CurvatureLimits:
+    """Lock-up limits of one actuator or of a block of cases (:class:`~bendpam.ModelParams`).
+
+    On each side the limit is the first of: the lumen closing (``R = t_bar``, found on a
+    201-point scan of ``u`` and refined by bisection) or the braid limit (99 % of ``u_lock`` for
+    k' > 0; far-side stretch 1 % for k' < 0).  Vectorised over cases; no Python loop over them.
+    """
     phi, wbar = gauss_nodes(order)
     omc = 1.0 - np.cos(phi)
+    scalar = np.ndim(params.alpha0) == 0 and np.ndim(params.R0_start) == 0 and np.ndim(params.t0_start) == 0
+    shape = np.broadcast_shapes(np.shape(params.alpha0), np.shape(params.R0_start), np.shape(params.t0_start))
+    a0 = np.broadcast_to(np.asarray(params.alpha0, dtype=float), shape).ravel()
+    R0 = np.broadcast_to(np.asarray(params.R0_start, dtype=float), shape).ravel()
+    t0 = np.broadcast_to(np.asarray(params.t0_start, dtype=float), shape).ravel()
+    c, s = np.cos(a0), np.sin(a0)
+    u_lock = (1.0 / c - 1.0) / 2.0
 
-    def xi(u):
-        ib, _ = _ibar(np.atleast_1d(float(u)), c, omc, wbar)
-        return 1.0 / (s * ib[0])
+    def xi(u, cc, ss):
+        ib, _ = _ibar(u, cc, omc, wbar)
+        return 1.0 / (ss * ib)
 
-    def lumen(u):  # R - t_bar, scaled: R0 xi^2 (1+u) - t0  (t_bar = t0 / ((1+u) xi))
-        x = xi(u)
-        return R0 * x * x * (1.0 + u) - t0
+    def lumen(u):  # R - t_bar, scaled: R0 xi^2 (1 + u) - t0  (t_bar = t0 / ((1 + u) xi))
+        x = xi(u, c[:, None], s[:, None])
+        return R0[:, None] * x * x * (1.0 + u) - t0[:, None]
 
-    def first_root(a, b):
-        """First sign change of lumen() going from a toward b (a has lumen > 0)."""
-        grid = np.linspace(a, b, 201)
-        vals = np.array([lumen(g) for g in grid])
-        neg = np.flatnonzero(vals <= 0.0)
-        if neg.size == 0:
-            return None
-        j = neg[0]
-        return brentq(lumen, grid[j - 1], grid[j], xtol=1e-15, rtol=1e-14)
+    ends = []
+    closes = []
+    for end in (LOCK_FRACTION * u_lock, np.full(a0.shape, -0.5 * (1.0 - MIN_FAR_STRETCH))):
+        grid = end[:, None] * np.linspace(0.0, 1.0, 201)
+        neg = lumen(grid) <= 0.0
+        has = neg.any(axis=-1)
+        j = np.where(has, np.argmax(neg, axis=-1), 1)
+        a = np.take_along_axis(grid, (j - 1)[:, None], -1)[:, 0]
+        b = np.take_along_axis(grid, j[:, None], -1)[:, 0]
+        root = _bisect(lambda u: lumen(u[:, None])[:, 0], a, b) if has.any() else a
+        ends.append(np.where(has, root, end))
+        closes.append(has)
+    u_hi, u_lo = ends
+    k_max = u_hi / (R0 * xi(u_hi[:, None], c[:, None], s[:, None])[:, 0])
+    k_min = u_lo / (R0 * xi(u_lo[:, None], c[:, None], s[:, None])[:, 0])
+    if closes[0][0]:
+        reason_max = f"bladder lumen closes (R = t_bar) at u = k'R = {u_hi[0]:.4g}, before braid lock-up u_lock = {u_lock[0]:.4g}"
+    else:
+        reason_max = (f"braid lock-up: far-side fibres within {100 * (1 - LOCK_FRACTION):g}% of straight "
+                      f"(u = k'R = {u_hi[0]:.4g} of u_lock = {u_lock[0]:.4g})")
+    if closes[1][0]:
+        reason_min = f"bladder lumen closes (R = t_bar) at u = k'R = {u_lo[0]:.4g}"
+    else:
+        reason_min = (f"braid lock-up: far-side axial stretch lambda1(pi) = 1 + 2k'R falls to {MIN_FAR_STRETCH:g} "
+                      "(fibres fully circumferential)")
+    if scalar:
+        return CurvatureLimits(float(k_min[0]), float(k_max[0]), reason_min, reason_max, float(u_lo[0]), float(u_hi[0]))
+    return CurvatureLimits(k_min.reshape(shape), k_max.reshape(shape), reason_min, reason_max,
+                           u_lo.reshape(shape), u_hi.reshape(shape))
 
-    # positive side
-    u_hi = LOCK_FRACTION * u_lock
-    reason_max = (
-        f"braid lock-up: far-side fibres within {100 * (1 - LOCK_FRACTION):g}% of straight "
-        f"(u = k'R = {u_hi:.4g} of u_lock = {u_lock:.4g})"
-    )
-    r = first_root(0.0, u_hi)
-    if r is not None:
-        u_hi = r
-        reason_max = f"bladder lumen closes (R = t_bar) at u = k'R = {r:.4g}, before braid lock-up u_lock = {u_lock:.4g}"
-    # negative side
-    u_lo = -0.5 * (1.0 - MIN_FAR_STRETCH)
-    reason_min = (
-        f"braid lock-up: far-side axial stretch lambda1(pi) = 1 + 2k'R falls to {MIN_FAR_STRETCH:g} "
-        "(fibres fully circumferential)"
-    )
-    r = first_root(0.0, u_lo)
-    if r is not None:
-        u_lo = r
-        reason_min = f"bladder lumen closes (R = t_bar) at u = k'R = {r:.4g}"
-    k_max = u_hi / (R0 * xi(u_hi))
-    k_min = u_lo / (R0 * xi(u_lo))
-    return CurvatureLimits(k_min=k_min, k_max=k_max, reason_min=reason_min, reason_max=reason_max, u_min=u_lo, u_max=u_hi)
+
+@lru_cache(maxsize=512)
+def _scalar_limits(alpha0: float, R0: float, t0: float, order: int) -> CurvatureLimits:
+    return limits(_Section(alpha0, R0, t0), order)
+
+
+@dataclass(frozen=True)
+class _Section:
+    alpha0: float
+    R0_start: float
+    t0_start: float
 
 
 def curvature_limits(actuator, order: int = DEFAULT_ORDER) -> CurvatureLimits:
-    """The braid lock-up limits ``[k'_min, k'_max]`` of ``actuator`` (1/mm), cached per geometry."""
-    return _limits(actuator.alpha0, actuator.R0_start, actuator.t0_start, int(order))
+    """The braid lock-up limits ``[k'_min, k'_max]`` of ``actuator`` (1/mm), cached per geometry.
+
+    ``actuator`` is an :class:`~bendpam.Actuator` or a :class:`~bendpam.ModelParams`.
+    """
+    p = getattr(actuator, "params", actuator)
+    if np.ndim(p.alpha0) == 0 and np.ndim(p.R0_start) == 0 and np.ndim(p.t0_start) == 0:
+        return _scalar_limits(float(p.alpha0), float(p.R0_start), float(p.t0_start), int(order))
+    return limits(p, order)
 
 
 @dataclass(frozen=True)
@@ -378,16 +420,22 @@ def radius_terms(kprime, alpha0: float, R0: float, order: int = DEFAULT_ORDER):
     return u, R, dR
 
 
-def kinematics(actuator, curvature, order: int = DEFAULT_ORDER) -> Kinematics:
-    """Kinematics (eq 1-5) of ``actuator`` at frame curvature(s) ``curvature`` (1/mm).
+def kinematics(actuator, curvature_per_mm, order: int = DEFAULT_ORDER) -> Kinematics:
+    """Kinematics (eq 1-5) of ``actuator`` at frame curvature(s) ``curvature_per_mm`` (1/mm).
 
-    Raises ``ValueError`` if a curvature lies beyond the braid lock-up limits
-    (see :func:`curvature_limits`).
+    Raises :class:`~bendpam.errors.InputError` if a curvature lies beyond the braid lock-up
+    limits (see :func:`curvature_limits`).
+
+    >>> import bendpam
+    >>> kin = bendpam.kinematics(bendpam.presets.be_pam(), [0.0, 0.01])
+    >>> round(float(kin.radius[0]), 6), bool(kin.radius[1] < kin.radius[0])
+    (10.1, True)
     """
-    k = np.asarray(curvature, dtype=float)
+    k = np.asarray(curvature_per_mm, dtype=float)
     curvature_limits(actuator, order).check(k)
-    a0 = actuator.alpha0
-    R0 = actuator.R0_start
+    p = actuator.params
+    a0 = float(p.alpha0)
+    R0 = float(p.R0_start)
     u, R, dR = radius_terms(k, a0, R0, order)
     phi, wbar = gauss_nodes(order)
     lam1 = 1.0 + u[..., None] * (1.0 - np.cos(phi))
@@ -402,10 +450,10 @@ def kinematics(actuator, curvature, order: int = DEFAULT_ORDER) -> Kinematics:
         dradius=dR,
         eta=eta,
         axis_curvature=k / (1.0 + u),
-        angle=k * actuator.L0,
-        axis_length=actuator.L0 * lbar,
+        angle=k * float(p.L0),
+        axis_length=float(p.L0) * lbar,
         mean_axial_stretch=lbar,
-        mean_thickness=actuator.t0_start / (lbar * eta),
+        mean_thickness=float(p.t0_start) / (lbar * eta),
         phi=phi,
         weights=wbar,
         lambda1=lam1,

@@ -27,6 +27,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from .errors import InputError
 
 __all__ = ["Fixture", "PAPER_FIXTURE"]
 
@@ -54,11 +55,11 @@ class Fixture:
             try:
                 fv = float(v)
             except (TypeError, ValueError):
-                raise ValueError(f"fixture {name} = {v!r} is not a number") from None
+                raise InputError(f"fixture {name} = {v!r} is not a number") from None
             lo = 0.0
             if not math.isfinite(fv) or fv < lo or (fv == 0.0 and name in ("d_mm", "L0_mm")):
                 rng = "(0, inf)" if name in ("d_mm", "L0_mm") else "[0, inf)"
-                raise ValueError(f"fixture {name} = {v!r} mm is outside the allowed range {rng} mm")
+                raise InputError(f"fixture {name} = {v!r} mm is outside the allowed range {rng} mm")
             object.__setattr__(self, name, fv)
 
     @property
@@ -71,11 +72,11 @@ class Fixture:
         """Parse ``"d,r,t"`` (mm), as given to ``--fixture``."""
         parts = [p for p in str(text).replace(";", ",").split(",") if p.strip()]
         if len(parts) != 3:
-            raise ValueError(f"--fixture {text!r}: expected three numbers d,r,t in mm, e.g. 35,2.5,4")
+            raise InputError(f"--fixture {text!r}: expected three numbers d,r,t in mm, e.g. 35,2.5,4")
         try:
             d, r, t = (float(p) for p in parts)
         except ValueError:
-            raise ValueError(f"--fixture {text!r}: expected three numbers d,r,t in mm, e.g. 35,2.5,4") from None
+            raise InputError(f"--fixture {text!r}: expected three numbers d,r,t in mm, e.g. 35,2.5,4") from None
         return cls(d, r, t, L0_mm)
 
     # ---- eq 6 ---------------------------------------------------------------------------------
@@ -100,7 +101,7 @@ class Fixture:
         b = np.asarray(beta, dtype=float)
         ab = np.abs(b)
         if np.any(ab >= np.pi / 2):
-            raise ValueError("beta must lie in (-pi/2, pi/2)")
+            raise InputError("beta must lie in (-pi/2, pi/2)")
         return np.sign(b) * (self.d_mm * np.tan(ab) + (1.0 / np.cos(ab) - 1.0) * self.c)
 
     # ---- eq 8 ---------------------------------------------------------------------------------

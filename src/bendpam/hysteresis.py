@@ -33,7 +33,7 @@ Amplitude (:class:`LoopModel`)
       bladder and braid of the force-balance model (eq 45): friction in proportion to the normal
       pressure where the sleeve slides on the bladder.
 
-Units: ``a0_nmm`` in N*mm, ``a1_nmm_per_mpa`` in N*mm/MPa, ``theta_h_deg`` (saturation angle of
+Units: ``a0_nmm`` in N*mm, ``a1_nmm_per_kpa`` in N*mm/MPa, ``theta_h_deg`` (saturation angle of
 the Prandtl-Ishlinskii law, or Dahl's ``theta_c``) in degrees.
 """
 
@@ -43,6 +43,7 @@ import math
 from dataclasses import asdict, dataclass
 
 import numpy as np
+from .errors import InputError
 
 __all__ = ["DahlLaw", "PrandtlIshlinskii", "LoopModel", "make_law", "LAWS", "loss_ratio", "loop_branches",
            "predict_cycle", "Cycle"]
@@ -70,7 +71,7 @@ class DahlLaw:
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.theta_c_rad) and self.theta_c_rad > 0):
-            raise ValueError(f"theta_c_rad = {self.theta_c_rad!r} must be > 0 rad")
+            raise InputError(f"theta_c_rad = {self.theta_c_rad!r} must be > 0 rad")
 
     name = "dahl"
 
@@ -121,9 +122,9 @@ class PrandtlIshlinskii:
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.theta_h_rad) and self.theta_h_rad > 0):
-            raise ValueError(f"theta_h_rad = {self.theta_h_rad!r} must be > 0 rad")
+            raise InputError(f"theta_h_rad = {self.theta_h_rad!r} must be > 0 rad")
         if not 1 <= int(self.n) <= 4096:
-            raise ValueError(f"n = {self.n!r} stop operators is outside the allowed range [1, 4096]")
+            raise InputError(f"n = {self.n!r} stop operators is outside the allowed range [1, 4096]")
 
     name = "pi"
 
@@ -191,7 +192,7 @@ def make_law(name: str, angle_deg: float):
         return PrandtlIshlinskii(math.radians(float(angle_deg)))
     if key == "dahl":
         return DahlLaw(math.radians(float(angle_deg)))
-    raise ValueError(f"hysteresis law {name!r} is not known; choose 'pi' (Prandtl-Ishlinskii) or 'dahl'")
+    raise InputError(f"hysteresis law {name!r} is not known; choose 'pi' (Prandtl-Ishlinskii) or 'dahl'")
 
 
 @dataclass(frozen=True)
@@ -202,7 +203,7 @@ class LoopModel:
     ----------
     law : ``"pi"`` (Prandtl-Ishlinskii / Iwan, default) or ``"dahl"``.
     a0_nmm : constant part of the amplitude (N*mm), >= 0.
-    a1_nmm_per_mpa : pressure part (N*mm/MPa), >= 0.
+    a1_nmm_per_kpa : pressure part (N*mm per kPa of active pressure), >= 0.
     theta_h_deg : saturation angle (PI) or characteristic angle (Dahl), degrees, > 0.
     amplitude : ``"linear"`` (``A = a0 + a1 P_active``) or ``"interfacial"``
         (``A = a0 + a1 P_e``, force-balance interfacial pressure, eq 45).
@@ -210,20 +211,20 @@ class LoopModel:
 
     law: str = "pi"
     a0_nmm: float = 0.0
-    a1_nmm_per_mpa: float = 0.0
+    a1_nmm_per_kpa: float = 0.0
     theta_h_deg: float = 10.0
     amplitude: str = "linear"
 
     def __post_init__(self) -> None:
         make_law(self.law, self.theta_h_deg if math.isfinite(self.theta_h_deg) and self.theta_h_deg > 0 else 1.0)
-        for name in ("a0_nmm", "a1_nmm_per_mpa"):
+        for name in ("a0_nmm", "a1_nmm_per_kpa"):
             v = getattr(self, name)
             if not (math.isfinite(v) and v >= 0):
-                raise ValueError(f"{name} = {v!r} must be >= 0")
+                raise InputError(f"{name} = {v!r} must be >= 0")
         if not (math.isfinite(self.theta_h_deg) and 0 < self.theta_h_deg <= 360):
-            raise ValueError(f"theta_h_deg = {self.theta_h_deg!r} is outside the allowed range (0, 360] deg")
+            raise InputError(f"theta_h_deg = {self.theta_h_deg!r} is outside the allowed range (0, 360] deg")
         if self.amplitude not in ("linear", "interfacial"):
-            raise ValueError(f"amplitude = {self.amplitude!r}; choose 'linear' or 'interfacial'")
+            raise InputError(f"amplitude = {self.amplitude!r}; choose 'linear' or 'interfacial'")
 
     @property
     def z_law(self):
@@ -241,7 +242,7 @@ class LoopModel:
         try:
             data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
         except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
-            raise ValueError(f"{path}: cannot read the hysteresis table ({exc})") from None
+            raise InputError(f"{path}: cannot read the hysteresis table ({exc})") from None
         table = data.get("hysteresis")
         return None if table is None else cls.from_dict(table, source=f"{path} [hysteresis]")
 
@@ -250,34 +251,35 @@ class LoopModel:
         known = set(cls.__dataclass_fields__)
         unknown = [k for k in d if k not in known]
         if unknown:
-            raise ValueError(f"{source}: unknown hysteresis parameter(s) {unknown}; known: {', '.join(sorted(known))}")
+            raise InputError(f"{source}: unknown hysteresis parameter(s) {unknown}; known: {', '.join(sorted(known))}")
         try:
             return cls(**d)
         except (TypeError, ValueError) as exc:
-            raise ValueError(f"{source}: {exc}") from None
+            raise InputError(f"{source}: {exc}") from None
 
-    def amplitude_nmm(self, actuator, pressure, curvature=0.0):
-        """``A(P, k')`` in N*mm (pressure in MPa, curvature in 1/mm), broadcasting."""
-        from .predict import active_pressure
+    def amplitude_nmm(self, actuator, pressure_kpa, curvature_per_mm=0.0):
+        """``A(P, k')`` in N*mm (pressure in kPa, curvature in 1/mm), broadcasting."""
+        from .checks import pressure_kpa as check_pressure
 
-        pa = active_pressure(actuator, pressure)
+        pa = np.maximum(check_pressure(pressure_kpa) - actuator.P_start_kpa, 0.0)
         if self.amplitude == "linear":
-            return self.a0_nmm + self.a1_nmm_per_mpa * np.broadcast_to(pa, np.broadcast_shapes(np.shape(pa),
-                                                                                             np.shape(curvature)))
+            return self.a0_nmm + self.a1_nmm_per_kpa * np.broadcast_to(
+                pa, np.broadcast_shapes(np.shape(pa), np.shape(curvature_per_mm)))
         from .models import force_balance
 
-        k = np.asarray(curvature, dtype=float)
-        pa_b, k_b = np.broadcast_arrays(pa, k)
-        st = force_balance.stress_state(actuator, pa_b, k_b, np.zeros(1))
-        return self.a0_nmm + self.a1_nmm_per_mpa * np.maximum(st["P_e"], 0.0)
+        k = np.asarray(curvature_per_mm, dtype=float)
+        pa_b, k_b = np.broadcast_arrays(pa * 1e-3, k)
+        st = force_balance.stress_state(actuator.params, pa_b, k_b, np.zeros(1))
+        return self.a0_nmm + self.a1_nmm_per_kpa * np.maximum(st["P_e"] * 1e3, 0.0)
 
-    def moment_path(self, actuator, pressure, curvature_path, model: str = "energy", z0: float = 0.0):
-        """``M`` (N*mm) along a sampled curvature path (1/mm) at pressure ``P`` (MPa), from state ``z0``."""
-        from .predict import moment
+    def moment_path(self, actuator, pressure_kpa, curvature_path_per_mm, model: str = "energy", z0: float = 0.0):
+        """``M`` (N*mm) along a sampled curvature path (1/mm) at ``pressure_kpa``, from state ``z0``."""
+        from .law import MomentLaw
 
-        k = np.asarray(curvature_path, dtype=float)
-        z = self.z_law.z_path(k * actuator.L0, z0)
-        return moment(actuator, pressure, k, model) - self.amplitude_nmm(actuator, pressure, k) * z
+        k = np.asarray(curvature_path_per_mm, dtype=float)
+        z = self.z_law.z_path(k * actuator.L0_mm, z0)
+        law = MomentLaw.of(actuator, model)
+        return law.moment(pressure_kpa, k) - self.amplitude_nmm(actuator, pressure_kpa, k) * z
 
 
 def loss_ratio(k_mag, upper, lower, L0_mm: float) -> tuple[float, float, float]:
@@ -299,13 +301,13 @@ def loop_branches(actuator, loop: LoopModel, pressure_kpa: float, k_free: float,
     Returns ``(loading, unloading)``: the upper and the lower branch (N*mm, magnitudes) at the
     curvature magnitudes ``k``.
     """
-    from .models import get_model
+    from .law import MomentLaw
 
     s = actuator.bend_sign or 1
     k = np.asarray(k, dtype=float)
-    P = pressure_kpa * 1e-3
-    A, B = get_model(model).coefficients(actuator, s * k, order=order, eq19_factor=eq19_factor)
-    Mqs = s * (max(P - actuator.P_start, 0.0) * A - B)
+    P = float(pressure_kpa)
+    A, B = MomentLaw.of(actuator, model, order=order, eq19_factor=eq19_factor).coefficients(s * k)
+    Mqs = s * (max(P - actuator.P_start_kpa, 0.0) * A - B)
     L0 = actuator.L0_mm
     z_unl, _ = loop.z_law.steady_branches(k * L0, k_free * L0)
     _, z_load = loop.z_law.steady_branches(np.maximum(k_free - k, 0.0) * L0, k_free * L0)

@@ -63,9 +63,9 @@ from scipy.optimize import least_squares, lsq_linear
 
 from ._io import atomic_write_text, json_safe
 from .actuator import NEUTRAL_ANGLE_DEG, Actuator
-from .models import get_model
-from .predict import free_curvature
-from .presets import normalise_model
+from .law import MomentLaw
+from .models import normalise_model
+from .errors import InputError
 
 __all__ = ["PARAMETERS", "HYST_PARAMETERS", "Parameter", "FitResult", "Metrics", "fit", "score", "fit_tension",
            "TensionFit", "parse_free", "developed_range", "tension_from_test", "predicted_loss_ratios",
@@ -102,11 +102,11 @@ def parse_free(free) -> list[str]:
     for f in free:
         key = _ALIASES.get(str(f).strip().lower())
         if key is None:
-            raise ValueError(f"unknown parameter {f!r} to fit; choose from {', '.join(PARAMETERS)}")
+            raise InputError(f"unknown parameter {f!r} to fit; choose from {', '.join(PARAMETERS)}")
         if key not in out:
             out.append(key)
     if not out:
-        raise ValueError(f"no parameter to fit; choose from {', '.join(PARAMETERS)}")
+        raise InputError(f"no parameter to fit; choose from {', '.join(PARAMETERS)}")
     return sorted(out, key=_ORDER.index)
 
 
@@ -153,7 +153,7 @@ class Metrics:
         }
 
 
-HYST_PARAMETERS = {"theta_h": ("theta_h_deg", "deg"), "a0": ("a0_nmm", "N*mm"), "a1": ("a1_nmm_per_mpa", "N*mm/MPa")}
+HYST_PARAMETERS = {"theta_h": ("theta_h_deg", "deg"), "a0": ("a0_nmm", "N*mm"), "a1": ("a1_nmm_per_kpa", "N*mm/kPa")}
 
 
 def _label(name: str) -> str:
@@ -162,7 +162,7 @@ def _label(name: str) -> str:
 
 @dataclass
 class _Data:
-    P: np.ndarray  # (n,) MPa
+    P: np.ndarray  # (n,) kPa
     k: list[np.ndarray]  # magnitudes, 1/mm
     M: list[np.ndarray]  # mean curves, N*mm
     BM: np.ndarray  # blocked moments (data), N*mm
@@ -172,7 +172,7 @@ class _Data:
     w: np.ndarray  # per-point weights (concatenated)
     kc: np.ndarray  # concatenated curvature magnitudes
     Mc: np.ndarray  # concatenated data
-    Pc: np.ndarray  # concatenated pressures (MPa)
+    Pc: np.ndarray  # concatenated pressures (kPa)
     seg: np.ndarray  # curve index per point
     branch: np.ndarray | None = None  # +1 loading (free -> blocked), -1 unloading (hysteresis fits)
     delta: np.ndarray | None = None  # bending angle from the branch's starting end point (rad)
@@ -206,7 +206,7 @@ def _branch_data(processed, L0: float) -> _Data:
     """Both mean branches of every pressure (for fits with a hysteresis loop)."""
     res = processed.results
     if not res:
-        raise ValueError("no processed pressures to fit")
+        raise InputError("no processed pressures to fit")
     d = _data(processed, "all")
     k, M, w, Pc, seg, br, delta, span = [], [], [], [], [], [], [], []
     wK = d.K / d.K.sum()
@@ -231,10 +231,10 @@ def _branch_data(processed, L0: float) -> _Data:
 def _data(processed, fit_range: str = "developed") -> _Data:
     res = processed.results
     if not res:
-        raise ValueError("no processed pressures to fit")
+        raise InputError("no processed pressures to fit")
     if fit_range not in ("developed", "all"):
-        raise ValueError(f"fit_range = {fit_range!r}; choose 'developed' or 'all'")
-    P = np.array([r.pressure_kpa for r in res]) * 1e-3
+        raise InputError(f"fit_range = {fit_range!r}; choose 'developed' or 'all'")
+    P = np.array([r.pressure_kpa for r in res], dtype=float)
     masks = [developed_range(r) if fit_range == "developed" else np.ones(r.curvature_grid.size, bool) for r in res]
     k = [np.asarray(r.curvature_grid, float)[m] for r, m in zip(res, masks)]
     M = [np.asarray(r.mean_curve, float)[m] for r, m in zip(res, masks)]
@@ -243,7 +243,7 @@ def _data(processed, fit_range: str = "developed") -> _Data:
     K = np.array([r.free_curvature[0] for r in res])
     Kse = np.array([r.free_curvature[1] for r in res])
     if np.any(~np.isfinite(BM)) or np.any(BM <= 0) or np.any(~np.isfinite(K)) or np.any(K <= 0):
-        raise ValueError("processed data need a positive blocked moment and free curvature at every pressure")
+        raise InputError("processed data need a positive blocked moment and free curvature at every pressure")
     wK = K / K.sum()
     w = np.concatenate([np.full(kk.size, math.sqrt(wK[i]) / (BM[i] * math.sqrt(kk.size))) for i, kk in enumerate(k)])
     seg = np.concatenate([np.full(kk.size, i) for i, kk in enumerate(k)])
@@ -279,7 +279,6 @@ class _Problem:
         self._qs_cache: dict = {}
         self.base = actuator
         self.d = data
-        self.mod = get_model(model)
         self.model = model
         self.free = free
         self.bounds = bounds
@@ -329,7 +328,7 @@ class _Problem:
 
             z_away, z_back = make_law(self.hyst, nl["theta_h"]).steady_branches(self.d.delta, self.d.span)
             z = np.where(self.d.branch < 0, z_away, z_back)  # unloading leaves the blocked state
-            pa = np.maximum(self.d.Pc - self.base.P_start, 0.0)
+            pa = np.maximum(self.d.Pc - self.base.P_start_kpa, 0.0)
             cols = {**cols, "a0": -z, "a1": -z * pa}
         X = []
         for p in self.lin_names():
@@ -346,13 +345,13 @@ class _Problem:
         a = self.base.replace(**{PARAMETERS[p][0]: v for p, v in nl.items()})
         s = self.sign
         ks = s * self.d.kc
-        A, b10, b01 = self.mod.basis(a, ks, order=self.order, eq19_factor=self.eq19)
+        A, b10, b01 = MomentLaw(a, self.model, eq19_factor=self.eq19, order=self.order).basis(ks)
         P = self.d.Pc
-        If = a.frame_inertia
+        If = a.frame_inertia_mm4
         cols = {
-            "C10": -s * b10 * 1e-3,  # per kPa
-            "C01": -s * b01 * 1e-3,
-            "P_start": -s * A * 1e-3,  # per kPa
+            "C10": -s * b10,  # per kPa
+            "C01": -s * b01,
+            "P_start": -s * A,  # per kPa
             "E_f": -If * self.d.kc,  # per MPa (magnitude: -E I |k|)
         }
         c0 = s * (P * A)
@@ -492,10 +491,10 @@ def score(processed, actuator: Actuator, model: str = "energy", *, order: int = 
     """
     model = normalise_model(model)
     d = _data(processed, "all")
-    mod = get_model(model)
+    law = MomentLaw(actuator, model, order=order, eq19_factor=eq19_factor)
     s = actuator.bend_sign or 1
-    A, B = mod.coefficients(actuator, s * d.kc, order=order, eq19_factor=eq19_factor)
-    pa = np.maximum(d.Pc - actuator.P_start, 0.0)
+    A, B = law.coefficients(s * d.kc)
+    pa = np.maximum(d.Pc - actuator.P_start_kpa, 0.0)
     Mm = s * (pa * A - B)
     per = []
     rm = []
@@ -504,16 +503,14 @@ def score(processed, actuator: Actuator, model: str = "energy", *, order: int = 
         rm.append(math.sqrt(float(np.mean((Mm[sel] - d.Mc[sel]) ** 2))))
     rm = np.array(rm)
     nrmse_c = math.sqrt(float(np.sum((rm / d.BM) ** 2 * d.K) / np.sum(d.K)))
-    bm_model = np.abs(np.maximum(d.P - actuator.P_start, 0.0) * mod.coefficients(actuator, np.zeros(1), order=order,
-                                                                                    eq19_factor=eq19_factor)[0])
+    bm_model = np.abs(law.blocked_moment(d.P))
     rmse_bm = math.sqrt(float(np.mean((bm_model - d.BM) ** 2)))
-    fb = free_curvature(actuator, d.P, model, order=order, eq19_factor=eq19_factor)
-    kf_model = np.abs(fb.curvature)
+    kf_model = np.abs(law.free_curvature_array(d.P))
     ok = np.isfinite(kf_model)
     rmse_fbc = math.sqrt(float(np.mean((kf_model[ok] - d.K[ok]) ** 2))) if ok.any() else math.nan
     for i in range(d.P.size):
         per.append({
-            "pressure_kpa": float(d.P[i] * 1e3), "rmse_cycle_nmm": float(rm[i]), "M_max_nmm": float(d.BM[i]),
+            "pressure_kpa": float(d.P[i]), "rmse_cycle_nmm": float(rm[i]), "M_max_nmm": float(d.BM[i]),
             "K_max_per_mm": float(d.K[i]), "blocked_moment_model_nmm": float(bm_model[i]),
             "free_curvature_model_per_mm": float(kf_model[i]) if ok[i] else None,
         })
@@ -526,7 +523,7 @@ def score(processed, actuator: Actuator, model: str = "energy", *, order: int = 
         rmse_blocked_moment=rmse_bm,
         rmse_free_curvature=rmse_fbc,
         per_pressure=per,
-        no_equilibrium_kpa=[float(p * 1e3) for p in d.P[~ok]],
+        no_equilibrium_kpa=[float(p) for p in d.P[~ok]],
     )
 
 
@@ -571,21 +568,21 @@ def fit(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C
 
         hysteresis = str(hysteresis).lower()
         if hysteresis not in LAWS:
-            raise ValueError(f"hysteresis law {hysteresis!r} is not known; choose one of {', '.join(LAWS)}")
+            raise InputError(f"hysteresis law {hysteresis!r} is not known; choose one of {', '.join(LAWS)}")
         d = _branch_data(processed, actuator.L0_mm)
     else:
         d = _data(processed, fit_range)
-    bnd = _default_bounds(actuator, float(d.P.min() * 1e3))
-    bnd.update({"theta_h": (0.2, 90.0), "a0": (0.0, 10.0 * float(d.BM.max())), "a1": (0.0, 1e5)})
+    bnd = _default_bounds(actuator, float(d.P.min()))
+    bnd.update({"theta_h": (0.2, 90.0), "a0": (0.0, 10.0 * float(d.BM.max())), "a1": (0.0, 100.0)})
     for k, v in (bounds or {}).items():
         key = parse_free([k])[0]
         lo, hi = float(v[0]), float(v[1])
         if not lo < hi:
-            raise ValueError(f"bounds for {k}: lower {lo:g} must be below upper {hi:g}")
+            raise InputError(f"bounds for {k}: lower {lo:g} must be below upper {hi:g}")
         bnd[key] = (lo, hi)
-    if "P_start" not in free and actuator.P_start_kpa >= d.P.min() * 1e3:
-        raise ValueError(
-            f"P_start = {actuator.P_start_kpa:g} kPa is not below the lowest test pressure {d.P.min() * 1e3:g} kPa"
+    if "P_start" not in free and actuator.P_start_kpa >= d.P.min():
+        raise InputError(
+            f"P_start = {actuator.P_start_kpa:g} kPa is not below the lowest test pressure {d.P.min():g} kPa"
         )
     prob = _Problem(actuator, d, model, free, bnd, order, eq19_factor, hysteresis)
     nfev = 0
@@ -714,7 +711,7 @@ def fit(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C
     if hysteresis is not None:
         from .hysteresis import LoopModel
 
-        loop = LoopModel(law=hysteresis, a0_nmm=float(values["a0"]), a1_nmm_per_mpa=float(values["a1"]),
+        loop = LoopModel(law=hysteresis, a0_nmm=float(values["a0"]), a1_nmm_per_kpa=float(values["a1"]),
                          theta_h_deg=float(values["theta_h"]))
         hp = {}
         for n in ("a0", "a1", "theta_h"):
@@ -799,7 +796,7 @@ def fit_tension(stretch, nominal_stress_mpa, *, source: str = "") -> TensionFit:
     sig = np.asarray(nominal_stress_mpa, dtype=float)
     sel = np.isfinite(lam) & np.isfinite(sig) & (lam > 1.0 + 1e-6)
     if sel.sum() < 3:
-        raise ValueError(f"{source or 'tension data'}: fewer than 3 points in tension (stretch > 1)")
+        raise InputError(f"{source or 'tension data'}: fewer than 3 points in tension (stretch > 1)")
     lam, sig = lam[sel], sig[sel]
     g = 2.0 * (lam - lam**-2)
     X = np.column_stack([g, g / lam])
@@ -824,7 +821,7 @@ def tension_from_test(raw, *, gauge_length_mm: float, area_mm2: float) -> Tensio
     """
     for name, v in (("gauge length", gauge_length_mm), ("area", area_mm2)):
         if not (math.isfinite(v) and v > 0):
-            raise ValueError(f"tension specimen {name} = {v!r} must be > 0")
+            raise InputError(f"tension specimen {name} = {v!r} must be > 0")
     ext = raw.data["stroke_mm"].to_numpy()
     f = raw.data["force_n"].to_numpy()
     ext = ext - ext[0]

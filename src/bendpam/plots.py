@@ -18,7 +18,8 @@ import numpy as np  # noqa: E402
 
 from ._io import atomic_path  # noqa: E402
 from .braid import curvature_limits  # noqa: E402
-from .predict import active_pressure, free_curvature, internal_stresses, moment  # noqa: E402
+from .errors import InputError  # noqa: E402
+from .predict import active_pressure_kpa, free_curvature, internal_stresses, moment  # noqa: E402
 
 __all__ = [
     "curve_range",
@@ -33,7 +34,7 @@ __all__ = [
 ]
 
 
-def curve_range(actuator, pressures_mpa, model: str = "energy", k_max: float | None = None, n: int = 200) -> np.ndarray:
+def curve_range(actuator, pressures_kpa, model: str = "energy", k_max: float | None = None, n: int = 200) -> np.ndarray:
     """Curvature grid (1/mm) from 0 toward the bending direction, to ``k_max`` (magnitude).
 
     The default end is 15 % past the largest free-bending curvature at the given pressures (or past
@@ -43,50 +44,50 @@ def curve_range(actuator, pressures_mpa, model: str = "energy", k_max: float | N
     sgn = actuator.bend_sign or 1
     k_lim = lim.k_max if sgn > 0 else lim.k_min
     if k_max is None:
-        fb = free_curvature(actuator, pressures_mpa, model)
-        ks = np.abs(fb.curvature[np.isfinite(fb.curvature)])
+        fb = free_curvature(actuator, pressures_kpa, model)
+        ks = np.abs(fb.curvature_per_mm[np.isfinite(fb.curvature_per_mm)])
         end = ks.max() if ks.size else 0.0
         if np.any(~fb.ok):
-            end = max(end, abs(fb.branch.k_end))
+            end = max(end, abs(fb.branch.k_end_per_mm))
         if end <= 0.0:
             end = 0.1 * abs(k_lim)
         end = min(1.15 * end, abs(k_lim))
     else:
         end = float(k_max)
         if not np.isfinite(end) or end <= 0.0:
-            raise ValueError(f"k_max = {k_max!r} 1/mm must be a positive number (magnitude along the bending direction)")
+            raise InputError(f"k_max = {k_max!r} 1/mm must be a positive number (magnitude along the bending direction)")
         if end > abs(k_lim):
-            raise ValueError(
+            raise InputError(
                 f"k_max = {end:g} 1/mm is beyond the braid lock-up limit |k'| = {abs(k_lim):.6g} 1/mm for this actuator"
             )
     return sgn * np.linspace(0.0, end, int(n))
 
 
-def moment_curves(actuator, pressures_mpa, model: str = "energy", k_max: float | None = None, n: int = 200):
+def moment_curves(actuator, pressures_kpa, model: str = "energy", k_max: float | None = None, n: int = 200):
     """Moment-curvature curves: returns ``(k, M)`` with ``M`` of shape (n_pressures, n), N*mm."""
-    P = np.atleast_1d(np.asarray(pressures_mpa, dtype=float))
+    P = np.atleast_1d(np.asarray(pressures_kpa, dtype=float))
     k = curve_range(actuator, P, model, k_max, n)
     return k, moment(actuator, P[:, None], k[None, :], model)
 
 
-def plot_moment_curvature(ax, actuator, pressures_mpa, model: str = "energy", k_max: float | None = None, n: int = 200,
+def plot_moment_curvature(ax, actuator, pressures_kpa, model: str = "energy", k_max: float | None = None, n: int = 200,
                           title: str | None = None):
     """Draw M(P, k') curves and the free-bending points on ``ax``.  Returns ``ax``."""
-    P = np.atleast_1d(np.asarray(pressures_mpa, dtype=float))
+    P = np.atleast_1d(np.asarray(pressures_kpa, dtype=float))
     k, M = moment_curves(actuator, P, model, k_max, n)
     fb = free_curvature(actuator, P, model)
     colors = plt.cm.viridis(np.linspace(0.0, 0.9, P.size))
     for i, p in enumerate(P):
-        ax.plot(k, M[i], color=colors[i], label=f"{p * 1e3:g} kPa")
-        if fb.status[i] == "ok" and np.isfinite(fb.curvature[i]):
-            ax.plot([fb.curvature[i]], [0.0], "o", color=colors[i], ms=4)
+        ax.plot(k, M[i], color=colors[i], label=f"{p:g} kPa")
+        if fb.status[i] == "ok" and np.isfinite(fb.curvature_per_mm[i]):
+            ax.plot([fb.curvature_per_mm[i]], [0.0], "o", color=colors[i], ms=4)
     ax.axhline(0.0, color="0.6", lw=0.8)
     ax.set_xlabel("frame curvature k' (1/mm)")
     ax.set_ylabel("moment M (N·mm)")
     ax.set_title(title or f"{actuator.name or actuator.kind}\n{model.replace('_', '-')} model", fontsize=9)
     ax.legend(fontsize=7, ncol=2)
     if np.any(~fb.ok):
-        ax.text(0.02, 0.02, f"no equilibrium above {fb.max_pressure * 1e3:.4g} kPa (fold)", transform=ax.transAxes,
+        ax.text(0.02, 0.02, f"no equilibrium above {fb.max_pressure_kpa:.4g} kPa (fold)", transform=ax.transAxes,
                 fontsize=7, color="crimson")
     return ax
 
@@ -114,7 +115,7 @@ def _section_panel(ax, phi, R, values, label, unit, color):
     ax.set_title(f"{label}\n(radial band: value / max, circle = 0)", fontsize=8)
 
 
-def plot_internal_stresses(actuator, pressure_mpa: float, curvature: float, *, fig=None):
+def plot_internal_stresses(actuator, pressure_kpa: float, curvature: float, *, fig=None):
     """Force-balance internal state (eq 37-48) around the cross-section at one (P, k').
 
     Left two panels: the section (frame at the bottom, Phi = 0) with the bladder axial stress
@@ -122,22 +123,22 @@ def plot_internal_stresses(actuator, pressure_mpa: float, curvature: float, *, f
     same fields unrolled over Phi, with the uniform hoop stress sigma_bl,2, radial stress
     sigma_bl,3 = -P and interfacial pressure P_e as horizontal lines.
     """
-    ds = internal_stresses(actuator, float(pressure_mpa), float(curvature), n_phi=361)
+    ds = internal_stresses(actuator, float(pressure_kpa), float(curvature), n_phi=361)
     fig = fig or plt.figure(figsize=(13, 4.4))
     ax_a = fig.add_subplot(1, 3, 1)
     ax_b = fig.add_subplot(1, 3, 2)
     ax1 = fig.add_subplot(1, 3, 3)
     phi = np.radians(ds["phi_deg"].values)
     R = float(ds["R"])
-    s1 = ds["sigma_bl1"].values * 1e3
+    s1 = ds["sigma_bl1"].values
     n1 = ds["N_br1"].values
     _section_panel(ax_a, phi, R, s1, "bladder axial stress σ_bl,1 (kPa)", "kPa", "C0")
     _section_panel(ax_b, phi, R, n1, "braid axial line tension N_br,1 (N/mm)", "N/mm", "C1")
     deg = ds["phi_deg"].values
     ax1.plot(deg, s1, color="C0", label="σ_bl,1 bladder axial (kPa)")
-    ax1.axhline(float(ds["sigma_bl2"]) * 1e3, color="C2", ls="--", label="σ_bl,2 bladder hoop (kPa)")
-    ax1.axhline(float(ds["P_e"]) * 1e3, color="C3", ls=":", label="P_e interfacial (kPa)")
-    ax1.axhline(float(ds["sigma_bl3"]) * 1e3, color="C4", ls="-.", label="σ_bl,3 = -P (kPa)")
+    ax1.axhline(float(ds["sigma_bl2"]), color="C2", ls="--", label="σ_bl,2 bladder hoop (kPa)")
+    ax1.axhline(float(ds["P_e"]), color="C3", ls=":", label="P_e interfacial (kPa)")
+    ax1.axhline(float(ds["sigma_bl3"]), color="C4", ls="-.", label="σ_bl,3 = -P (kPa)")
     ax2 = ax1.twinx()
     ax2.plot(deg, n1, color="C1", label="N_br,1 braid axial tension (N/mm)")
     ax2.set_ylabel("braid line tension (N/mm)")
@@ -147,10 +148,10 @@ def plot_internal_stresses(actuator, pressure_mpa: float, curvature: float, *, f
     h1, l1 = ax1.get_legend_handles_labels()
     h2, l2 = ax2.get_legend_handles_labels()
     ax1.legend(h1 + h2, l1 + l2, fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.15), ncol=2)
-    pa = float(active_pressure(actuator, pressure_mpa))
+    pa = float(active_pressure_kpa(actuator, pressure_kpa))
     fig.suptitle(
-        f"{actuator.name or actuator.kind}: force-balance internal state at P = {pressure_mpa * 1e3:g} kPa "
-        f"(active {pa * 1e3:g} kPa), k' = {curvature:g} 1/mm, R = {R:.3g} mm, t̄ = {float(ds['t_bar']):.3g} mm",
+        f"{actuator.name or actuator.kind}: force-balance internal state at P = {pressure_kpa:g} kPa "
+        f"(active {pa:g} kPa), k' = {curvature:g} 1/mm, R = {R:.3g} mm, t̄ = {float(ds['t_bar']):.3g} mm",
         fontsize=10,
     )
     fig.tight_layout()
@@ -158,7 +159,7 @@ def plot_internal_stresses(actuator, pressure_mpa: float, curvature: float, *, f
 
 
 def demo_figure(items):
-    """A grid of moment-curvature plots; ``items`` is a list of ``(actuator, pressures_mpa, model)``."""
+    """A grid of moment-curvature plots; ``items`` is a list of ``(actuator, pressures_kpa, model)``."""
     n = len(items)
     ncol = 2
     nrow = (n + 1) // 2
@@ -260,7 +261,7 @@ def figure7(processed, fit_result, title: str = ""):
             ax.plot(kk, up, "-", color=c, lw=1.3)
             ax.plot(kk, low, "-", color=c, lw=1.3)
         else:
-            ax.plot(kk, s * moment(act, r.pressure_kpa * 1e-3, s * kk, model), "-", color=c, lw=1.5)
+            ax.plot(kk, s * moment(act, r.pressure_kpa, s * kk, model), "-", color=c, lw=1.5)
     ax.set_xlabel("curvature |k'| (1/mm)")
     ax.set_ylabel("moment |M| (N·mm)")
     loop_txt = " with its loop" if getattr(fit_result, "loop", None) is not None else ""
@@ -273,18 +274,18 @@ def figure7(processed, fit_result, title: str = ""):
     Pm = np.linspace(min(P.min(), act.P_start_kpa), P.max() * 1.05, 100)
     ax = axes[1]
     ax.errorbar(P, bm[:, 0], yerr=np.nan_to_num(bm[:, 1]), fmt="o", capsize=3, label="data")
-    ax.plot(Pm, np.abs(moment(act, Pm * 1e-3, 0.0, model)), "-", label="model")
+    ax.plot(Pm, np.abs(moment(act, Pm, 0.0, model)), "-", label="model")
     ax.set_xlabel("pressure (kPa)")
     ax.set_ylabel("blocked moment (N·mm)")
     ax.set_title(f"(b) blocked moment, NRMSE {100 * fit_result.metrics.nrmse_blocked_moment:.2f} %", fontsize=9)
     ax.legend(fontsize=7)
     ax = axes[2]
     ax.errorbar(P, kf[:, 0], yerr=np.nan_to_num(kf[:, 1]), fmt="s", capsize=3, color="C2", label="data")
-    fb = free_curvature(act, Pm * 1e-3, model)
-    ax.plot(Pm, np.abs(fb.curvature), "-", color="C3", label="model")
+    fb = free_curvature(act, Pm, model)
+    ax.plot(Pm, np.abs(fb.curvature_per_mm), "-", color="C3", label="model")
     if np.any(~fb.ok):
-        ax.axvline(fb.max_pressure * 1e3, color="crimson", ls=":", lw=1,
-                   label=f"no equilibrium above {fb.max_pressure * 1e3:.4g} kPa")
+        ax.axvline(fb.max_pressure_kpa, color="crimson", ls=":", lw=1,
+                   label=f"no equilibrium above {fb.max_pressure_kpa:.4g} kPa")
     nf = fit_result.metrics.nrmse_free_curvature
     ax.set_title("(c) free-bending curvature, NRMSE " + ("n/a" if not np.isfinite(nf) else f"{100 * nf:.2f} %"),
                  fontsize=9)
@@ -304,14 +305,14 @@ def sweep_figure(ds, var: str = "free_angle_deg", x: str | None = None, y: str |
     default to the first two dimensions of ``var``.
     """
     if var not in ds.data_vars:
-        raise ValueError(f"--plot-var {var!r} is not a sweep output; choose from {', '.join(ds.data_vars)}")
+        raise InputError(f"variable {var!r} is not a sweep output; choose from {', '.join(ds.data_vars)}")
     da_ = ds[var]
     dims = list(da_.dims)
     x = x or dims[0]
     y = y or (dims[1] if len(dims) > 1 else None)
     for d in (x, y):
         if d is not None and d not in dims:
-            raise ValueError(f"{d!r} is not a dimension of {var}; choose from {', '.join(dims)}")
+            raise InputError(f"{d!r} is not a dimension of {var}; choose from {', '.join(dims)}")
     fixed = {d: da_[d].values[da_[d].size // 2] for d in dims if d not in (x, y)}
     sel = da_.isel({d: da_[d].size // 2 for d in fixed}) if fixed else da_
     fig, ax = plt.subplots(figsize=(6.5, 4.8))

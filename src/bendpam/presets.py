@@ -9,6 +9,8 @@ kPa, NOTES.md item 6).  P_start is 68 kPa for the BE-PAM and 32 kPa for the BC-P
 from __future__ import annotations
 
 from .actuator import Actuator
+from .errors import InputError
+from .models import normalise_model
 
 __all__ = ["be_pam", "bc_pam", "get", "PRESETS", "normalise_model"]
 
@@ -32,15 +34,6 @@ _TABLE3 = {
 }
 
 _START = {"be-pam": dict(P_start_kpa=68.0, R0_start_mm=10.1), "bc-pam": dict(P_start_kpa=32.0, R0_start_mm=8.6)}
-
-
-def normalise_model(model: str) -> str:
-    """Map ``"energy"``, ``"force_balance"``, ``"force-balance"``, ``"fb"`` to a canonical name."""
-    key = str(model).strip().lower().replace("-", "_")
-    aliases = {"energy": "energy", "virtual_work": "energy", "force_balance": "force_balance", "fb": "force_balance"}
-    if key not in aliases:
-        raise ValueError(f"model = {model!r} is not known; choose 'energy' or 'force-balance'")
-    return aliases[key]
 
 
 def _make(which: str, model: str) -> Actuator:
@@ -74,5 +67,5 @@ def get(name: str, model: str = "energy") -> Actuator:
     """Look a preset up by name (``"be-pam"`` or ``"bc-pam"``, case and ``_``/``-`` insensitive)."""
     key = str(name).strip().lower().replace("_", "-")
     if key not in PRESETS:
-        raise ValueError(f"unknown preset {name!r}; choose one of: {', '.join(PRESETS)}")
+        raise InputError(f"unknown preset {name!r}; choose one of: {', '.join(PRESETS)}")
     return PRESETS[key](model)

@@ -57,6 +57,7 @@ from .actuator import Actuator
 from .fixture import PAPER_FIXTURE, Fixture
 from .presets import normalise_model
 from .lab.files import RAW_SUFFIXES, collect_raw_files
+from .errors import InputError
 
 __all__ = [
     "RAW_SUFFIXES",
@@ -90,12 +91,12 @@ def _pressures(pressure_kpa, n_files: int) -> list[float | None]:
         try:
             fv = float(v)
         except (TypeError, ValueError):
-            raise ValueError(f"pressure {v!r} is not a number in kPa") from None
+            raise InputError(f"pressure {v!r} is not a number in kPa") from None
         if not math.isfinite(fv) or fv < 0:
-            raise ValueError(f"pressure {v!r} kPa must be a finite gauge pressure >= 0 kPa")
+            raise InputError(f"pressure {v!r} kPa must be a finite gauge pressure >= 0 kPa")
         out.append(fv)
     if len(out) != n_files:
-        raise ValueError(
+        raise InputError(
             f"--pressure-kpa: got {len(out)} pressure(s) for {n_files} file(s); give one per file, in order"
         )
     return out
@@ -108,7 +109,7 @@ def _fixture(fixture, actuator: Actuator) -> Fixture:
         return fixture
     if isinstance(fixture, str):
         return Fixture.from_string(fixture, L0_mm=actuator.L0_mm)
-    raise ValueError(f"fixture = {fixture!r}: give a bendpam.fixture.Fixture or a string 'd,r,t' in mm")
+    raise InputError(f"fixture = {fixture!r}: give a bendpam.fixture.Fixture or a string 'd,r,t' in mm")
 
 
 def _options(processing_options):
@@ -122,8 +123,8 @@ def _options(processing_options):
         try:
             return ProcessingOptions(**processing_options)
         except TypeError as exc:
-            raise ValueError(f"processing_options: {exc}") from None
-    raise ValueError(f"processing_options = {processing_options!r}: give a ProcessingOptions or a dict")
+            raise InputError(f"processing_options: {exc}") from None
+    raise InputError(f"processing_options = {processing_options!r}: give a ProcessingOptions or a dict")
 
 
 # ------------------------------------------------------------------------------------------------
@@ -400,10 +401,10 @@ def build_report(
         raise TypeError(f"actuator must be a bendpam.Actuator, got {type(actuator).__name__}")
     out = Path(out_html)
     if out.is_dir():
-        raise ValueError(f"--out {str(out)!r} is a folder; give the HTML file to write, e.g. report.html")
+        raise InputError(f"--out {str(out)!r} is a folder; give the HTML file to write, e.g. report.html")
     parent = out.parent if str(out.parent) else Path(".")
     if not parent.is_dir():
-        raise ValueError(f"--out {str(out)!r}: the folder {str(parent)!r} does not exist")
+        raise InputError(f"--out {str(out)!r}: the folder {str(parent)!r} does not exist")
     if isinstance(models, str):
         models = [m for m in models.replace(" ", ",").split(",") if m]
     model_names: list[str] = []
@@ -412,7 +413,7 @@ def build_report(
         if n not in model_names:
             model_names.append(n)
     if not model_names:
-        raise ValueError("give at least one model to fit: energy, force-balance")
+        raise InputError("give at least one model to fit: energy, force-balance")
     free_names = parse_free(free)
     files = collect_raw_files(inputs)
     pressures = _pressures(pressure_kpa, len(files))

@@ -40,27 +40,24 @@ When only ``R0_mm`` is swept, ``R0_start_mm`` keeps the base actuator's ratio ``
 
 from __future__ import annotations
 
-import math
 import sys
-from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
-import xarray as xr
 
-from .actuator import NEUTRAL_ANGLE_DEG, Actuator
-from .braid import DEFAULT_ORDER, LOCK_FRACTION, MIN_FAR_STRETCH, _ibar, gauss_nodes
-from .models import get_model
-from .predict import illinois
-from .presets import normalise_model
+from .actuator import Actuator, ModelParams
+from .braid import DEFAULT_ORDER
+from .errors import InputError
+from .law import BRANCH_END, MomentLaw
+from .models import normalise_model
 
-__all__ = ["sweep", "SWEEP_PARAMETERS", "evaluate_cases", "CaseArrays"]
+__all__ = ["sweep", "SWEEP_PARAMETERS", "evaluate_cases", "build_cases"]
 
 #: Parameters that can be swept (Actuator field names; units in the names).
 SWEEP_PARAMETERS = (
     "alpha0_deg", "R0_mm", "t0_mm", "L0_mm", "frame_thickness_mm", "frame_width_mm", "frame_modulus_mpa",
     "C10_kpa", "C01_kpa", "P_start_kpa", "R0_start_mm",
 )
-BRANCH_END = {"lock-up": 0, "fold": 1, "unbounded": 2, "neutral": 3}
 _BRANCH_SAMPLES = 300
 _OUTPUTS = ("blocked_moment_nmm", "free_curvature_per_mm", "free_angle_deg", "lockup_margin", "frame_stress_mpa",
             "max_pressure_kpa", "branch_end")
@@ -75,221 +72,47 @@ _UNITS = {
 }
 
 
-@dataclass
-class CaseArrays:
-    """Actuator parameters as arrays (one entry per case), duck-typed like :class:`Actuator`.
+def build_cases(base: Actuator, values: dict[str, np.ndarray]) -> ModelParams:
+    """Actuator cases from the base actuator with ``values`` (Actuator field names -> arrays of one shape).
 
-    The model functions only read these attributes, in internal units (mm, MPa, rad).
+    Every value is validated as :class:`~bendpam.Actuator` would (one line naming the parameter
+    and the allowed range).  When ``R0_mm`` is swept without ``R0_start_mm``, ``R0_start_mm``
+    keeps the base ratio ``R0_start / R0``; eq 51-52 are applied by :meth:`ModelParams.build`.
     """
-
-    alpha0: np.ndarray
-    R0_start: np.ndarray
-    t0_start: np.ndarray
-    bladder_area: np.ndarray
-    frame_stiffness: np.ndarray
-    frame_modulus: np.ndarray
-    frame_thickness: np.ndarray
-    C10: np.ndarray
-    C01: np.ndarray
-    P_start: np.ndarray
-    L0: np.ndarray
-
-    @classmethod
-    def build(cls, base: Actuator, values: dict[str, np.ndarray]) -> CaseArrays:
-        """Cases from the base actuator with ``values`` (Actuator field names -> arrays of one shape)."""
-        n = np.broadcast_shapes(*(np.shape(v) for v in values.values())) if values else ()
-        get = {f: np.broadcast_to(np.asarray(values.get(f, getattr(base, f)), dtype=float), n)
-               for f in SWEEP_PARAMETERS if f != "R0_start_mm"}
-        if "R0_start_mm" in values:
-            R0s = np.broadcast_to(np.asarray(values["R0_start_mm"], dtype=float), n)
-        else:
-            R0s = get["R0_mm"] * (base.R0_start / base.R0_mm)
-        _validate(get, R0s)
-        R0, t0 = get["R0_mm"], get["t0_mm"]
-        area = np.pi * (2.0 * R0 * t0 - t0 * t0)
-        t0s = R0s - np.sqrt(R0s * R0s - 2.0 * R0 * t0 + t0 * t0)
-        inertia = get["frame_width_mm"] * get["frame_thickness_mm"] ** 3 / 12.0
-        return cls(
-            alpha0=np.radians(get["alpha0_deg"]), R0_start=np.array(R0s, dtype=float), t0_start=t0s,
-            bladder_area=area, frame_stiffness=get["frame_modulus_mpa"] * inertia,
-            frame_modulus=np.array(get["frame_modulus_mpa"]), frame_thickness=np.array(get["frame_thickness_mm"]),
-            C10=get["C10_kpa"] * 1e-3, C01=get["C01_kpa"] * 1e-3, P_start=get["P_start_kpa"] * 1e-3,
-            L0=np.array(get["L0_mm"]),
-        )
-
-    def col(self) -> CaseArrays:
-        """The same cases with a trailing axis, to broadcast against per-case samples."""
-        return CaseArrays(**{k: np.asarray(v)[..., None] for k, v in self.__dict__.items()})
-
-    @property
-    def bend_sign(self) -> np.ndarray:
-        deg = np.degrees(self.alpha0)
-        return np.where(np.abs(deg - NEUTRAL_ANGLE_DEG) < 1e-9, 0, np.where(deg > NEUTRAL_ANGLE_DEG, 1, -1))
+    n = np.broadcast_shapes(*(np.shape(v) for v in values.values())) if values else ()
+    get = {f: np.broadcast_to(np.asarray(values.get(f, getattr(base, f)), dtype=float), n)
+           for f in SWEEP_PARAMETERS if f != "R0_start_mm"}
+    if "R0_start_mm" in values:
+        R0s = np.broadcast_to(np.asarray(values["R0_start_mm"], dtype=float), n)
+    else:
+        R0s = get["R0_mm"] * (base.R0_start_mm / base.R0_mm)
+    _validate(get, R0s)
+    return ModelParams.build(R0_start_mm=np.array(R0s, dtype=float), braid_thickness_mm=base.braid_thickness_mm,
+                             **{k: np.array(v, dtype=float) for k, v in get.items()})
 
 
-def _validate(get: dict, R0s) -> None:
-    """Vectorised versions of the Actuator checks; the first bad case is named."""
-    def bad(mask, msg):
+def _validate(get: dict[str, np.ndarray], R0s: np.ndarray) -> None:
+    """The Actuator's range checks, vectorised: the first bad value is reported with its parameter."""
+    def bad(name, mask, rng, unit):
         if np.any(mask):
-            i = np.unravel_index(int(np.flatnonzero(np.ravel(mask))[0]), np.shape(mask))
-            vals = ", ".join(f"{k}={np.asarray(v)[i] if np.ndim(v) else v:g}" for k, v in get.items())
-            raise ValueError(f"sweep case {tuple(int(x) for x in i)}: {msg} ({vals})")
+            v = np.asarray(get[name] if name in get else R0s)[mask].ravel()[0]
+            raise InputError(f"{name} = {v:g} {unit} is outside the allowed range {rng} {unit}")
 
-    for k, v in get.items():
-        bad(~np.isfinite(v), f"{k} is not finite")
-    bad((get["alpha0_deg"] <= 0) | (get["alpha0_deg"] >= 90), "alpha0_deg outside (0, 90) deg")
-    for k in ("R0_mm", "L0_mm", "frame_thickness_mm", "frame_width_mm", "frame_modulus_mpa"):
-        bad(get[k] <= 0, f"{k} must be > 0")
-    bad((get["t0_mm"] <= 0) | (get["t0_mm"] >= get["R0_mm"]), "t0_mm must lie in (0, R0_mm)")
-    bad(get["C10_kpa"] + get["C01_kpa"] <= 0, "C10_kpa + C01_kpa must be > 0")
-    bad(get["P_start_kpa"] < 0, "P_start_kpa must be >= 0")
-    bad(R0s < get["R0_mm"], "R0_start_mm must be >= R0_mm")
-
-
-# ------------------------------------------------------------------------------------------------
-# vectorised kernel
-# ------------------------------------------------------------------------------------------------
-def _xi(u, c, s, omc, wbar):
-    ib, _ = _ibar(u, c, omc, wbar)
-    return 1.0 / (s * ib)
-
-
-def _bisect(f, a, b, iters=60):
-    """Vectorised bisection for a sign change of ``f`` between ``a`` (f > 0) and ``b`` (f <= 0)."""
-    for _ in range(iters):
-        m = 0.5 * (a + b)
-        pos = f(m) > 0
-        a, b = np.where(pos, m, a), np.where(pos, b, m)
-    return 0.5 * (a + b)
-
-
-def _limits(cs: CaseArrays, order: int):
-    """Vectorised :func:`bendpam.curvature_limits`: (k_min, k_max) per case."""
-    phi, wbar = gauss_nodes(order)
-    omc = 1.0 - np.cos(phi)
-    a0 = cs.alpha0
-    c, s = np.cos(a0), np.sin(a0)
-    u_lock = (1.0 / c - 1.0) / 2.0
-    R0, t0 = cs.R0_start, cs.t0_start
-
-    def lumen(u, cc=c[..., None], ss=s[..., None], R=R0[..., None], t=t0[..., None]):
-        x = _xi(u, cc, ss, omc, wbar)
-        return R * x * x * (1.0 + u) - t
-
-    out = []
-    for end in (LOCK_FRACTION * u_lock, np.full(a0.shape, -0.5 * (1.0 - MIN_FAR_STRETCH))):
-        grid = end[..., None] * np.linspace(0.0, 1.0, 201)
-        vals = lumen(grid)
-        neg = vals <= 0.0
-        has = neg.any(axis=-1)
-        j = np.where(has, np.argmax(neg, axis=-1), 1)
-        a = np.take_along_axis(grid, (j - 1)[..., None], -1)[..., 0]
-        b = np.take_along_axis(grid, j[..., None], -1)[..., 0]
-        root = _bisect(lambda u: lumen(u[..., None])[..., 0], a, b) if has.any() else a
-        u_end = np.where(has, root, end)
-        out.append(u_end / (R0 * _xi(u_end[..., None], c[..., None], s[..., None], omc, wbar)[..., 0]))
-    return out[1], out[0]
-
-
-def _branch(cs: CaseArrays, mod, order: int, eq19: bool):
-    """Vectorised :func:`bendpam.branch_info`: sampled branch tables and their ends, per case."""
-    sgn = cs.bend_sign
-    k_min, k_max = _limits(cs, order)
-    k_lim = np.where(sgn > 0, k_max, k_min)
-    frac = np.linspace(0.0, 1.0, _BRANCH_SAMPLES + 1)[1:] ** 1.5
-    kg = k_lim[..., None] * frac
-    col = cs.col()
-    A, B = mod.coefficients(col, kg, order=order, eq19_factor=eq19)
-    sA = sgn[..., None] * A
-    with np.errstate(divide="ignore", invalid="ignore"):
-        p = np.where(sA > 0.0, B / A, np.nan)
-    n = kg.shape[-1]
-    bad_a = ~(sA > 0.0)
-    n_ok = np.where(bad_a.any(-1), np.argmax(bad_a, -1), n)
-    pk = np.concatenate([np.zeros(kg.shape[:-1] + (1,)), p], axis=-1)
-    kk = np.concatenate([np.zeros(kg.shape[:-1] + (1,)), kg], axis=-1)
-    idx = np.arange(n + 1)
-    valid = idx[None, :] <= n_ok[..., None]  # the first n_ok samples (+ the origin)
-    pk_valid = np.where(valid, pk, np.nan)
-    dec = (np.diff(pk_valid, axis=-1) <= 0.0) & valid[..., 1:]
-    has_dec = dec.any(-1)
-    j = np.where(has_dec, np.argmax(dec, -1), 0)
-    # fold refinement: golden-section maximisation of p on [kk[j-1], kk[j+1]]
-    jl = np.clip(j - 1, 0, n)
-    jr = np.clip(j + 1, 0, n)
-    lo = np.take_along_axis(kk, jl[..., None], -1)[..., 0]
-    hi = np.take_along_axis(kk, jr[..., None], -1)[..., 0]
-    a_, b_ = np.minimum(lo, hi), np.maximum(lo, hi)
-
-    def p_of(x):
-        Ax, Bx = mod.coefficients(cs, x, order=order, eq19_factor=eq19)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            return Bx / Ax
-
-    g = (math.sqrt(5.0) - 1.0) / 2.0
-    x1, x2 = b_ - g * (b_ - a_), a_ + g * (b_ - a_)
-    f1, f2 = p_of(x1), p_of(x2)
-    for _ in range(60):
-        left = f1 > f2  # the maximum lies in [a, x2]
-        b_ = np.where(left, x2, b_)
-        a_ = np.where(left, a_, x1)
-        new = np.where(left, b_ - g * (b_ - a_), a_ + g * (b_ - a_))
-        fnew = p_of(new)
-        x1, f1, x2, f2 = (np.where(left, new, x2), np.where(left, fnew, f2),
-                          np.where(left, x1, new), np.where(left, f1, fnew))
-    xm = 0.5 * (a_ + b_)
-    pj = np.take_along_axis(pk, j[..., None], -1)[..., 0]
-    pm = p_of(xm)
-    use_ref = np.isfinite(pm) & (pm > pj)
-    k_fold = np.where(use_ref, xm, np.take_along_axis(kk, j[..., None], -1)[..., 0])
-    p_fold = np.where(use_ref, pm, pj)
-    # assemble per case: end kind, end curvature, end active pressure
-    kind = np.where(has_dec, BRANCH_END["fold"], np.where(n_ok < n, BRANCH_END["unbounded"], BRANCH_END["lock-up"]))
-    kind = np.where(sgn == 0, BRANCH_END["neutral"], kind)
-    unstable = has_dec & (j == 0)
-    p_end = np.where(kind == BRANCH_END["fold"], np.where(unstable, 0.0, p_fold),
-                     np.where(kind == BRANCH_END["unbounded"], np.inf,
-                              np.take_along_axis(pk, np.minimum(n_ok, n)[..., None], -1)[..., 0]))
-    p_end = np.where(kind == BRANCH_END["neutral"], np.inf, p_end)
-    # monotone table for bracketing: samples up to the branch end, then +inf
-    last = np.where(kind == BRANCH_END["fold"], j, np.minimum(n_ok, n))
-    in_tab = idx[None, :] <= last[..., None]
-    kt = kk.copy()
-    pt = np.where(in_tab, pk, np.inf)
-    # the unbounded case brackets up to the first sample where A lost its sign
-    nxt = np.clip(last + 1, 0, n)
-    k_after = np.take_along_axis(kk, nxt[..., None], -1)[..., 0]
-    k_end = np.where(kind == BRANCH_END["fold"], k_fold, np.where(kind == BRANCH_END["unbounded"], k_after, k_lim))
-    return dict(sgn=sgn, k_lim=k_lim, kind=kind, p_end=p_end, k_end=k_end, last=last, kt=kt, pt=pt,
-                k_fold=k_fold, p_fold=p_fold, use_ref=use_ref)
-
-
-def _roots(cs: CaseArrays, mod, br: dict, pa: np.ndarray, order: int, eq19: bool, xtol: float = 1e-13):
-    """Free curvature for active pressures ``pa`` (cases, pressures) on each case's branch."""
-    sgn = br["sgn"][..., None]
-    kt, pt = br["kt"], br["pt"]
-    # bracket: first table index with p >= pa (the table is increasing up to its end, then inf)
-    j = (pt[..., None, :] < pa[..., :, None]).sum(-1)
-    j = np.clip(j, 1, kt.shape[-1] - 1)
-    a = np.take_along_axis(kt, j - 1, -1)
-    b = np.take_along_axis(kt, j, -1)
-    # a fold end lies between table samples: use it as the bracket end where it applies
-    fold_end = (br["kind"] == BRANCH_END["fold"])[..., None] & br["use_ref"][..., None] & (j > br["last"][..., None])
-    b = np.where(fold_end, br["k_fold"][..., None], b)
-    # the unbounded case: beyond the last finite sample, bracket up to where A changed sign
-    unb = (br["kind"] == BRANCH_END["unbounded"])[..., None] & (j > br["last"][..., None])
-    b = np.where(unb, br["k_end"][..., None], b)
-    a = np.where(unb | fold_end, np.take_along_axis(kt, np.broadcast_to(br["last"][..., None], j.shape), -1), a)
-    case = np.broadcast_to(np.arange(pa.shape[0])[:, None], pa.shape).ravel()
-    pa_flat, sgn_flat = pa.ravel(), np.broadcast_to(sgn, pa.shape).ravel()
-
-    def F(x, idx):
-        sub = CaseArrays(**{f: np.asarray(v)[case[idx]] for f, v in cs.__dict__.items()})
-        A, B = mod.coefficients(sub, x, order=order, eq19_factor=eq19)
-        return sgn_flat[idx] * (pa_flat[idx] * A - B)
-
-    tol = xtol * np.abs(br["k_end"])[:, None] + np.zeros(pa.shape) + 1e-300
-    return illinois(F, a, b, tol)
+    bad("alpha0_deg", (get["alpha0_deg"] <= 0) | (get["alpha0_deg"] >= 90), "(0, 90)", "deg")
+    for name in ("R0_mm", "L0_mm", "frame_thickness_mm", "frame_width_mm"):
+        bad(name, get[name] <= 0, "(0, inf)", "mm")
+    bad("frame_modulus_mpa", get["frame_modulus_mpa"] <= 0, "(0, inf)", "MPa")
+    bad("t0_mm", (get["t0_mm"] <= 0) | (get["t0_mm"] >= get["R0_mm"]), "(0, R0_mm)", "mm")
+    bad("P_start_kpa", get["P_start_kpa"] < 0, "[0, inf)", "kPa")
+    if np.any(R0s < get["R0_mm"]):
+        v = np.asarray(R0s)[R0s < get["R0_mm"]].ravel()[0]
+        raise InputError(f"R0_start_mm = {v:g} mm is outside the allowed range [R0_mm, inf) mm")
+    mu = get["C10_kpa"] + get["C01_kpa"]
+    if np.any(mu <= 0):
+        i = np.flatnonzero(np.broadcast_to(mu, np.shape(mu)).ravel() <= 0)[0]
+        c10 = np.broadcast_to(get["C10_kpa"], np.shape(mu)).ravel()[i]
+        c01 = np.broadcast_to(get["C01_kpa"], np.shape(mu)).ravel()[i]
+        raise InputError(f"C10_kpa + C01_kpa = {c10 + c01:g} kPa must be > 0 (C10_kpa = {c10:g}, C01_kpa = {c01:g})")
 
 
 def evaluate_cases(base: Actuator, model: str, values: dict[str, np.ndarray], pressure_kpa, *,
@@ -298,38 +121,24 @@ def evaluate_cases(base: Actuator, model: str, values: dict[str, np.ndarray], pr
 
     Returns arrays of shape (cases, pressures) and (cases,) keyed by the names in the module doc.
     """
-    mod = get_model(normalise_model(model))
-    cs = CaseArrays.build(base, values)
-    P = np.asarray(pressure_kpa, dtype=float) * 1e-3
-    pa = np.maximum(P[None, :] - cs.P_start[:, None], 0.0)
-    A0, _ = mod.coefficients(cs, np.zeros(cs.alpha0.shape), order=order, eq19_factor=eq19_factor)
-    blocked = pa * A0[:, None]
-    br = _branch(cs, mod, order, eq19_factor)
-    k = np.zeros(pa.shape)
-    above = pa > br["p_end"][:, None]
-    solve = (pa > 0.0) & ~above & (br["sgn"][:, None] != 0)
-    if np.any(solve):
-        rows = np.flatnonzero(solve.any(axis=1))
-        sub = CaseArrays(**{f: np.asarray(v)[rows] for f, v in cs.__dict__.items()})
-        br_sub = {key: (v[rows] if np.ndim(v) else v) for key, v in br.items()}
-        pa_sub = np.where(solve[rows], pa[rows], np.nan)
-        # solve with a harmless pressure where no root is wanted, then discard
-        safe = np.where(solve[rows], pa[rows], np.take_along_axis(br_sub["pt"], np.ones((rows.size, 1), int), -1))
-        x = _roots(sub, mod, br_sub, safe, order, eq19_factor)
-        k[rows] = np.where(solve[rows], x, 0.0)
-        del pa_sub
-    k = np.where(above, np.nan, k)
-    k_lim = np.abs(br["k_lim"])[:, None]
+    cs = build_cases(base, values)
+    law = MomentLaw(cs, model, eq19_factor=eq19_factor, order=order)
+    P = np.asarray(pressure_kpa, dtype=float)
+    pa = np.maximum(P[None, :] - np.asarray(law.P_start_kpa)[:, None], 0.0)
+    A0, _ = law.coefficients(np.zeros(cs.shape))
+    tab = law.branches(_BRANCH_SAMPLES)
+    k = law.free_curvature_array(P, table=tab)
+    k_lim = np.abs(tab.k_lim)[:, None]
     with np.errstate(invalid="ignore"):
         margin = 1.0 - np.abs(k) / k_lim
     return {
-        "blocked_moment_nmm": blocked,
+        "blocked_moment_nmm": pa * A0[:, None],
         "free_curvature_per_mm": k,
         "free_angle_deg": np.degrees(k * cs.L0[:, None]),
         "lockup_margin": margin,
         "frame_stress_mpa": cs.frame_modulus[:, None] * cs.frame_thickness[:, None] * 0.5 * np.abs(k),
-        "max_pressure_kpa": (cs.P_start + br["p_end"]) * 1e3,
-        "branch_end": br["kind"].astype(float),
+        "max_pressure_kpa": law.P_start_kpa + tab.p_end,
+        "branch_end": tab.kind.astype(float),
     }
 
 
@@ -340,12 +149,12 @@ def _grid_values(params: dict) -> dict[str, np.ndarray]:
     out = {}
     for name, vals in params.items():
         if name not in SWEEP_PARAMETERS:
-            raise ValueError(f"cannot sweep {name!r}; choose from {', '.join(SWEEP_PARAMETERS)}")
+            raise InputError(f"cannot sweep {name!r}; choose from {', '.join(SWEEP_PARAMETERS)}")
         arr = np.atleast_1d(np.asarray(vals, dtype=float))
         if arr.ndim != 1 or arr.size == 0:
-            raise ValueError(f"sweep values of {name} must be a non-empty 1-D list")
+            raise InputError(f"sweep values of {name} must be a non-empty 1-D list")
         if not np.all(np.isfinite(arr)):
-            raise ValueError(f"sweep values of {name} must be finite")
+            raise InputError(f"sweep values of {name} must be finite")
         out[name] = arr
     return out
 
@@ -370,7 +179,7 @@ def _block(base, model, names, grids, P, order, eq19, idx_block):
 
 def sweep(base_actuator: Actuator, pressure_kpa, model: str = "energy", *, chunk_cases: int = 256,
           scheduler: str | None = None, workers: int | None = None, compute: bool = True, progress: bool | None = None,
-          order: int = DEFAULT_ORDER, eq19_factor: bool = True, **params) -> xr.Dataset:
+          order: int = DEFAULT_ORDER, eq19_factor: bool = True, **params) -> Any:
     """Sweep actuator parameters crossed with pressures.  See the module docstring.
 
     Parameters
@@ -390,7 +199,7 @@ def sweep(base_actuator: Actuator, pressure_kpa, model: str = "energy", *, chunk
     model = normalise_model(model)
     P = np.atleast_1d(np.asarray(pressure_kpa, dtype=float))
     if P.ndim != 1 or P.size == 0 or not np.all(np.isfinite(P)) or np.any(P < 0):
-        raise ValueError("pressure_kpa must be a non-empty 1-D list of pressures >= 0 kPa")
+        raise InputError("pressure_kpa must be a non-empty 1-D list of pressures >= 0 kPa")
     grids_d = _grid_values(params)
     names = list(grids_d)
     grids = [grids_d[n] for n in names]
@@ -398,7 +207,7 @@ def sweep(base_actuator: Actuator, pressure_kpa, model: str = "energy", *, chunk
     n_cases = int(np.prod(shape)) if shape else 1
     chunk_cases = int(chunk_cases)
     if chunk_cases < 1:
-        raise ValueError(f"chunk_cases = {chunk_cases} must be >= 1")
+        raise InputError(f"chunk_cases = {chunk_cases} must be >= 1")
     # validate before any work (the same checks as Actuator): every combination of the
     # parameters that constrain each other, each other parameter on its own
     _prevalidate(base_actuator, names, grids)
@@ -412,7 +221,7 @@ def sweep(base_actuator: Actuator, pressure_kpa, model: str = "energy", *, chunk
         da = None
     if da is None:
         if scheduler or workers or not compute:
-            raise ValueError("distributed or lazy sweeps need Dask: pip install 'bendpam[distributed]'")
+            raise InputError("distributed or lazy sweeps need Dask: pip install 'bendpam[distributed]'")
         data = _loop_blocks(fn, shape, chunks, show)
     else:
         idx = da.arange(n_cases, chunks=n_cases).reshape(shape or (1,)).rechunk(chunks or ((1,),))
@@ -455,11 +264,11 @@ def _prevalidate(base, names, grids) -> None:
         sel = [i for i, n in enumerate(names) if n in group]
         if sel:
             mesh = np.meshgrid(*(grids[i] for i in sel), indexing="ij", sparse=True)
-            CaseArrays.build(base, {names[i]: m for i, m in zip(sel, mesh)})
+            build_cases(base, {names[i]: m for i, m in zip(sel, mesh)})
             done.update(sel)
     for i, n in enumerate(names):
         if i not in done:
-            CaseArrays.build(base, {n: grids[i]})
+            build_cases(base, {n: grids[i]})
 
 
 class _block_fn:
@@ -521,7 +330,9 @@ def _compute(arr, scheduler, workers, show):
     return dask.compute(arr, scheduler="threads")[0]
 
 
-def _dataset(data, names, grids, shape, P, base, model, order) -> xr.Dataset:
+def _dataset(data, names, grids, shape, P, base, model, order) -> Any:
+    import xarray as xr
+
     dims = names + ["pressure_kpa"]
     vars_ = {}
     for i, name in enumerate(_OUTPUTS):

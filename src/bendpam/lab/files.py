@@ -1,6 +1,7 @@
 """Finding raw test files: folders expand to their exports (known suffixes, sorted)."""
 
 from __future__ import annotations
+from ..errors import InputError
 
 import os
 from pathlib import Path
@@ -25,12 +26,12 @@ def collect_raw_files(inputs) -> list[Path]:
         if p.is_dir():
             found = sorted(q for q in p.iterdir() if q.is_file() and q.suffix.lower() in RAW_SUFFIXES)
             if not found:
-                raise ValueError(f"{p}: no raw test files here (looked for {', '.join(sorted(RAW_SUFFIXES))})")
+                raise InputError(f"{p}: no raw test files here (looked for {', '.join(sorted(RAW_SUFFIXES))})")
             files.extend(found)
         elif p.exists():
             files.append(p)
         else:
-            raise ValueError(f"{p}: no such file or folder")
+            raise InputError(f"{p}: no such file or folder")
     if not files:
-        raise ValueError("give raw test files or a folder of them")
+        raise InputError("give raw test files or a folder of them")
     return files

@@ -48,6 +48,7 @@ import xarray as xr
 from scipy import signal
 
 from ..fixture import PAPER_FIXTURE, Fixture
+from ..errors import InputError
 
 __all__ = [
     "ProcessingOptions",
@@ -88,15 +89,15 @@ class ProcessingOptions:
 
     def __post_init__(self) -> None:
         if self.cutoff_hz is not None and (not math.isfinite(self.cutoff_hz) or self.cutoff_hz < 0):
-            raise ValueError(f"cutoff_hz = {self.cutoff_hz!r} must be >= 0 Hz (0 switches the filter off)")
+            raise InputError(f"cutoff_hz = {self.cutoff_hz!r} must be >= 0 Hz (0 switches the filter off)")
         if not 1 <= int(self.filter_order) <= 10:
-            raise ValueError(f"filter_order = {self.filter_order!r} is outside the allowed range [1, 10]")
+            raise InputError(f"filter_order = {self.filter_order!r} is outside the allowed range [1, 10]")
         if not 0.0 < self.reversal_fraction < 0.5:
-            raise ValueError(f"reversal_fraction = {self.reversal_fraction!r} is outside the allowed range (0, 0.5)")
+            raise InputError(f"reversal_fraction = {self.reversal_fraction!r} is outside the allowed range (0, 0.5)")
         if not 5 <= int(self.grid_points) <= 100000:
-            raise ValueError(f"grid_points = {self.grid_points!r} is outside the allowed range [5, 100000]")
+            raise InputError(f"grid_points = {self.grid_points!r} is outside the allowed range [5, 100000]")
         if not math.isfinite(self.tare_n):
-            raise ValueError(f"tare_n = {self.tare_n!r} N is not finite")
+            raise InputError(f"tare_n = {self.tare_n!r} N is not finite")
 
 
 @dataclass

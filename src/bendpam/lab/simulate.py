@@ -37,7 +37,9 @@ from ..fixture import PAPER_FIXTURE, Fixture
 from ..hysteresis import LAWS, make_law
 from ..braid import curvature_limits
 from ..predict import blocked_moment, free_curvature, moment
-from ..presets import normalise_model
+from ..checks import number
+from ..errors import InputError, NoEquilibrium
+from ..models import normalise_model
 
 __all__ = ["SimulationSettings", "simulate_test", "simulate_tests", "DIALECT_SUFFIX"]
 
@@ -83,11 +85,11 @@ class SimulationSettings:
             try:
                 fv = float(v)
             except (TypeError, ValueError):
-                raise ValueError(f"{name} = {v!r} is not a number") from None
+                raise InputError(f"{name} = {v!r} is not a number") from None
             if not (math.isfinite(fv) and lo <= fv <= hi):
-                raise ValueError(f"{name} = {v!r} is outside the allowed range [{lo:g}, {hi:g}]")
+                raise InputError(f"{name} = {v!r} is outside the allowed range [{lo:g}, {hi:g}]")
         if self.hysteresis_law not in LAWS:
-            raise ValueError(f"hysteresis_law = {self.hysteresis_law!r}; choose one of {', '.join(LAWS)}")
+            raise InputError(f"hysteresis_law = {self.hysteresis_law!r}; choose one of {', '.join(LAWS)}")
 
 
 def _signed(actuator):
@@ -104,14 +106,12 @@ def simulate_test(actuator, pressure_kpa: float, model: str = "energy", *, fixtu
     st = settings or SimulationSettings()
     model = normalise_model(model)
     rng = rng if rng is not None else np.random.default_rng(st.seed)
-    P = float(pressure_kpa) * 1e-3
-    if not math.isfinite(P) or P < 0:
-        raise ValueError(f"pressure_kpa = {pressure_kpa!r} must be >= 0 kPa")
+    P = float(number("pressure_kpa", pressure_kpa, 0.0, unit="kPa"))
     sgn = _signed(actuator)
     L0 = fixture.L0_mm
     Mb = abs(float(blocked_moment(actuator, P, model)))
     if Mb <= 0.0:
-        raise ValueError(
+        raise InputError(
             f"pressure {pressure_kpa:g} kPa is at or below P_start = {actuator.P_start_kpa:g} kPa: "
             "the actuator produces no moment to test"
         )
@@ -137,7 +137,7 @@ def simulate_test(actuator, pressure_kpa: float, model: str = "energy", *, fixtu
     if fvals[0] <= 0.0 or cross.size == 0:
         fb = free_curvature(actuator, P, model)
         why = fb.reason.item() if fb.status.item() == "no-equilibrium" else "the unloading force never falls that low"
-        raise ValueError(
+        raise NoEquilibrium(
             f"at {pressure_kpa:g} kPa there is no free state: the force does not fall to "
             f"{st.detection_load_n:g} N before the lock-up limit or the fixture's {MAX_BETA_DEG:g} deg plate "
             f"pitch ({why})"
@@ -177,10 +177,10 @@ def simulate_test(actuator, pressure_kpa: float, model: str = "energy", *, fixtu
         "energy_loss_ratio": truth_cycles["energy_loss_ratio"],
         "hysteresis_amplitude_nmm": A,
         "loop": {"law": st.hysteresis_law, "a0_nmm": st.hysteresis_offset_nmm,
-                 "a1_nmm_per_mpa": st.hysteresis * Mb / max(P - actuator.P_start, 1e-300),
+                 "a1_nmm_per_kpa": st.hysteresis * Mb / max(P - actuator.P_start_kpa, 1e-300),
                  "theta_h_deg": st.hysteresis_angle_deg, "amplitude": "linear"},
         "model_blocked_moment_nmm": Mb,
-        "model_free_curvature_per_mm": abs(float(fb.curvature)) if fb.status.item() == "ok" else None,
+        "model_free_curvature_per_mm": abs(float(fb.curvature_per_mm)) if fb.status.item() == "ok" else None,
         "samples": int(t.size),
         "duration_s": float(T),
     }
@@ -230,7 +230,7 @@ def simulate_tests(actuator, pressures_kpa, out_dir, model: str = "energy", *, d
     st = settings or SimulationSettings()
     model = normalise_model(model)
     if dialect not in DIALECT_SUFFIX:
-        raise ValueError(f"format {dialect!r} is not known; choose one of: {', '.join(DIALECT_SUFFIX)}")
+        raise InputError(f"format {dialect!r} is not known; choose one of: {', '.join(DIALECT_SUFFIX)}")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     rng = np.random.default_rng(st.seed)

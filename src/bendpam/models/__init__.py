@@ -9,12 +9,21 @@ Both expose ``coefficients(actuator, curvature, order=..., **options) -> (A, B)`
 
 from __future__ import annotations
 
-from ..presets import normalise_model
+from ..errors import InputError
 from . import energy, force_balance
 
-__all__ = ["energy", "force_balance", "get_model", "MODEL_NAMES"]
+__all__ = ["energy", "force_balance", "get_model", "normalise_model", "MODEL_NAMES"]
 
 MODEL_NAMES = ("energy", "force_balance")
+
+
+def normalise_model(model: str) -> str:
+    """Map ``"energy"``, ``"force_balance"``, ``"force-balance"``, ``"fb"`` to a canonical name."""
+    key = str(model).strip().lower().replace("-", "_")
+    aliases = {"energy": "energy", "virtual_work": "energy", "force_balance": "force_balance", "fb": "force_balance"}
+    if key not in aliases:
+        raise InputError(f"model = {model!r} is not known; choose 'energy' or 'force-balance'")
+    return aliases[key]
 
 
 def get_model(model: str):

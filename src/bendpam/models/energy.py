@@ -38,9 +38,9 @@ from ..material import MooneyRivlin
 __all__ = ["basis", "coefficients", "terms", "bladder_energy"]
 
 
-def _state(actuator, k, order):
-    R0 = actuator.R0_start
-    u, R, dR = radius_terms(k, actuator.alpha0, R0, order)
+def _state(params, k, order):
+    R0 = params.R0_start
+    u, R, dR = radius_terms(k, params.alpha0, R0, order)
     phi, wbar = gauss_nodes(order)
     omc = 1.0 - np.cos(phi)
     lam1 = 1.0 + u[..., None] * omc
@@ -55,12 +55,12 @@ _UNIT10 = MooneyRivlin(1.0, 0.0)
 _UNIT01 = MooneyRivlin(0.0, 1.0)
 
 
-def _bladder_basis(actuator, k, u, R, dR, omc, wbar, lam1, eq19_factor):
+def _bladder_basis(params, k, u, R, dR, omc, wbar, lam1, eq19_factor):
     """Bladder moment per unit C10 and per unit C01 (N*mm/MPa): M_bl = C10 b10 + C01 b01 (eq 19)."""
-    eta = (R / actuator.R0_start)[..., None]
+    eta = (R / params.R0_start)[..., None]
     dl1 = (R + k * dR)[..., None] * omc  # d lambda1 / dk'
-    dl2 = (dR / actuator.R0_start)[..., None]  # d lambda2 / dk'
-    fac = actuator.bladder_area * ((1.0 + u) if eq19_factor else 1.0)
+    dl2 = (dR / params.R0_start)[..., None]  # d lambda2 / dk'
+    fac = params.bladder_area * ((1.0 + u) if eq19_factor else 1.0)
     out = []
     for mat in (_UNIT10, _UNIT01):
         dW = mat.dW_dl1(lam1, eta) * dl1 + mat.dW_dl2(lam1, eta) * dl2
@@ -68,53 +68,53 @@ def _bladder_basis(actuator, k, u, R, dR, omc, wbar, lam1, eq19_factor):
     return out
 
 
-def basis(actuator, curvature, *, order: int = DEFAULT_ORDER, eq19_factor: bool = True):
+def basis(params, curvature, *, order: int = DEFAULT_ORDER, eq19_factor: bool = True):
     """Linear decomposition ``M = P_active A - E_f I_f k' - C10 b10 - C01 b01`` (C in MPa).
 
     Returns ``(A, b10, b01)``; they depend only on the kinematics (alpha0, R0_start, t0_start), so
     identification can solve for C10, C01, E_f and P_start by linear least squares.
     """
     k = np.asarray(curvature, dtype=float)
-    u, R, dR, omc, wbar, lam1 = _state(actuator, k, order)
-    b10, b01 = _bladder_basis(actuator, k, u, R, dR, omc, wbar, lam1, eq19_factor)
+    u, R, dR, omc, wbar, lam1 = _state(params, k, order)
+    b10, b01 = _bladder_basis(params, k, u, R, dR, omc, wbar, lam1, eq19_factor)
     return _air_coefficient(k, R, dR), b10, b01
 
 
-def coefficients(actuator, curvature, *, order: int = DEFAULT_ORDER, eq19_factor: bool = True):
+def coefficients(params, curvature, *, order: int = DEFAULT_ORDER, eq19_factor: bool = True):
     """``(A, B)`` with ``M = P_active A - B`` (N*mm/MPa and N*mm), shape of ``curvature``.
 
     No range checks: callers validate the curvature against the lock-up limits.
     """
     k = np.asarray(curvature, dtype=float)
-    A, b10, b01 = basis(actuator, k, order=order, eq19_factor=eq19_factor)
-    return A, actuator.C10 * b10 + actuator.C01 * b01 + actuator.frame_stiffness * k
+    A, b10, b01 = basis(params, k, order=order, eq19_factor=eq19_factor)
+    return A, params.C10 * b10 + params.C01 * b01 + params.frame_stiffness * k
 
 
-def terms(actuator, p_active, curvature, *, order: int = DEFAULT_ORDER, eq19_factor: bool = True):
+def terms(params, p_active, curvature, *, order: int = DEFAULT_ORDER, eq19_factor: bool = True):
     """The parts of eq 21 in N*mm: ``M_load``, ``M_air`` (eq 13), ``M_bl`` (eq 19), ``M_f`` (eq 16).
 
     ``p_active`` is ``max(P - P_start, 0)`` in MPa and broadcasts against ``curvature``.
     """
     k = np.asarray(curvature, dtype=float)
-    u, R, dR, omc, wbar, lam1 = _state(actuator, k, order)
+    u, R, dR, omc, wbar, lam1 = _state(params, k, order)
     m_air = np.asarray(p_active, dtype=float) * _air_coefficient(k, R, dR)
-    b10, b01 = _bladder_basis(actuator, k, u, R, dR, omc, wbar, lam1, eq19_factor)
-    m_bl = actuator.C10 * b10 + actuator.C01 * b01
-    m_f = actuator.frame_stiffness * k
+    b10, b01 = _bladder_basis(params, k, u, R, dR, omc, wbar, lam1, eq19_factor)
+    m_bl = params.C10 * b10 + params.C01 * b01
+    m_f = params.frame_stiffness * k
     m_bl, m_f = np.broadcast_arrays(m_bl, m_f)
     m_air, m_bl, m_f = np.broadcast_arrays(m_air, m_bl, m_f)
     return {"M_load": m_air - m_bl - m_f, "M_air": m_air, "M_bl": m_bl, "M_f": m_f}
 
 
-def bladder_energy(actuator, curvature, *, order: int = DEFAULT_ORDER):
+def bladder_energy(params, curvature, *, order: int = DEFAULT_ORDER):
     """Stored bladder energy per unit reference length ``U_bl(k')`` (N*mm/mm = N), eq 18.
 
     ``dU_bl/dk'`` is the bladder moment of eq 19 without its ``(1 + k'R)`` factor; the tests check
     :func:`terms` against a finite difference of this function.
     """
     k = np.asarray(curvature, dtype=float)
-    u, R, dR, omc, wbar, lam1 = _state(actuator, k, order)
-    eta = (R / actuator.R0_start)[..., None]
-    return actuator.bladder_area * (actuator.material.energy(lam1, eta) @ wbar)
+    u, R, dR, omc, wbar, lam1 = _state(params, k, order)
+    eta = (R / params.R0_start)[..., None]
+    return params.bladder_area * (MooneyRivlin(params.C10, params.C01).energy(lam1, eta) @ wbar)
 
 

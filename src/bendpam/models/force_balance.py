@@ -40,42 +40,42 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..braid import DEFAULT_ORDER, _col, gauss_nodes, radius_terms
+from ..braid import DEFAULT_ORDER, case_column, gauss_nodes, radius_terms
 
 __all__ = ["basis", "coefficients", "terms", "stress_state"]
 
 
-def _state(actuator, k, order):
-    R0 = actuator.R0_start
-    u, R, dR = radius_terms(k, actuator.alpha0, R0, order)
+def _state(params, k, order):
+    R0 = params.R0_start
+    u, R, dR = radius_terms(k, params.alpha0, R0, order)
     phi, wbar = gauss_nodes(order)
     omc = 1.0 - np.cos(phi)
     lam1 = 1.0 + u[..., None] * omc
-    c = np.cos(actuator.alpha0)
+    c = np.cos(params.alpha0)
     lbar = 1.0 + u
     eta = R / R0
-    tbar = actuator.t0_start / (lbar * eta)
-    cl2 = (_col(c) * lam1) ** 2
+    tbar = params.t0_start / (lbar * eta)
+    cl2 = (case_column(c) * lam1) ** 2
     J = 2.0 * np.pi * ((lam1 * lam1 * omc / (1.0 - cl2)) @ wbar)
-    C1, C2 = actuator.C10, actuator.C01
+    C1, C2 = params.C10, params.C01
     le2 = (lbar * eta) ** 2
     # elastic (pressure-free) parts of eq 43 and eq 44
     const1 = -2.0 * C1 / le2 + 2.0 * C2 * le2  # Phi-independent part of sigma_bl,1^el
     sig2e = 2.0 * C1 * (eta * eta - 1.0 / le2) - 2.0 * C2 * (1.0 / (eta * eta) - le2)
-    varpart = 2.0 * np.pi * (((2.0 * _col(C1) * lam1 * lam1 - 2.0 * _col(C2) / (lam1 * lam1)) * omc) @ wbar)
+    varpart = 2.0 * np.pi * (((2.0 * case_column(C1) * lam1 * lam1 - 2.0 * case_column(C2) / (lam1 * lam1)) * omc) @ wbar)
     m_bl = tbar * R * R * (varpart + 2.0 * np.pi * const1)
     return dict(u=u, R=R, lam1=lam1, c=c, lbar=lbar, eta=eta, tbar=tbar, J=J, sig2e=sig2e, const1=const1, m_bl=m_bl,
                 omc=omc, wbar=wbar)
 
 
-def basis(actuator, curvature, *, order: int = DEFAULT_ORDER, **_ignored):
+def basis(params, curvature, *, order: int = DEFAULT_ORDER):
     """Linear decomposition ``M = P_active A - E_f I_f k' - C10 b10 - C01 b01`` (C in MPa).
 
     ``B = M_bl - sigma_bl,2^el t_bar R^2 c^2 J`` is linear in C10 and C01; ``b10`` and ``b01`` are
     its coefficients.  Returns ``(A, b10, b01)``.
     """
     k = np.asarray(curvature, dtype=float)
-    st = _state(actuator, k, order)
+    st = _state(params, k, order)
     R, c, J, tb, lam1, omc, wbar = st["R"], st["c"], st["J"], st["tbar"], st["lam1"], st["omc"], st["wbar"]
     le2 = (st["lbar"] * st["eta"]) ** 2
     e2 = st["eta"] ** 2
@@ -86,28 +86,28 @@ def basis(actuator, curvature, *, order: int = DEFAULT_ORDER, **_ignored):
     return R**3 * (np.pi - c * c * J), b10, b01
 
 
-def coefficients(actuator, curvature, *, order: int = DEFAULT_ORDER, **_ignored):
+def coefficients(params, curvature, *, order: int = DEFAULT_ORDER):
     """``(A, B)`` with ``M = P_active A - B`` (N*mm/MPa and N*mm), shape of ``curvature``."""
     k = np.asarray(curvature, dtype=float)
-    A, b10, b01 = basis(actuator, k, order=order)
-    return A, actuator.C10 * b10 + actuator.C01 * b01 + actuator.frame_stiffness * k
+    A, b10, b01 = basis(params, k, order=order)
+    return A, params.C10 * b10 + params.C01 * b01 + params.frame_stiffness * k
 
 
-def terms(actuator, p_active, curvature, *, order: int = DEFAULT_ORDER, **_ignored):
+def terms(params, p_active, curvature, *, order: int = DEFAULT_ORDER):
     """The parts of eq 49 in N*mm: ``M_load``, ``M_p``, ``M_frame``, ``M_bl``, ``M_br``."""
     k = np.asarray(curvature, dtype=float)
     p = np.asarray(p_active, dtype=float)
-    st = _state(actuator, k, order)
+    st = _state(params, k, order)
     R, c, J = st["R"], st["c"], st["J"]
     m_p = p * np.pi * R**3
-    m_frame = actuator.frame_stiffness * k
+    m_frame = params.frame_stiffness * k
     m_bl = st["m_bl"]
     m_br = (p * R - st["sig2e"] * st["tbar"]) * R * R * c * c * J
     m_p, m_frame, m_bl, m_br = np.broadcast_arrays(m_p, m_frame, m_bl, m_br)
     return {"M_load": m_p - m_frame - m_bl - m_br, "M_p": m_p, "M_frame": m_frame, "M_bl": m_bl, "M_br": m_br}
 
 
-def stress_state(actuator, p_active, curvature, phi, *, order: int = DEFAULT_ORDER):
+def stress_state(params, p_active, curvature, phi, *, order: int = DEFAULT_ORDER):
     """Internal stresses of the force-balance model at angles ``phi`` (rad) around the section.
 
     ``p_active`` and ``curvature`` are scalars or arrays broadcasting to a shape S; ``phi`` is
@@ -127,10 +127,10 @@ def stress_state(actuator, p_active, curvature, phi, *, order: int = DEFAULT_ORD
     k = np.asarray(curvature, dtype=float)
     p = np.asarray(p_active, dtype=float)
     k, p = np.broadcast_arrays(k, p)
-    st = _state(actuator, k, order)
+    st = _state(params, k, order)
     phi = np.asarray(phi, dtype=float)
     lam1 = 1.0 + st["u"][..., None] * (1.0 - np.cos(phi))
-    C1, C2 = actuator.C10, actuator.C01
+    C1, C2 = params.C10, params.C01
     c = st["c"]
     sig1 = 2.0 * C1 * lam1**2 - 2.0 * C2 / lam1**2 + st["const1"][..., None] - p[..., None]
     sig2 = st["sig2e"] - p
@@ -140,7 +140,7 @@ def stress_state(actuator, p_active, curvature, phi, *, order: int = DEFAULT_ORD
     cot2 = cl2 / (1.0 - cl2)
     n2 = Pe * R
     n1 = cot2 * n2[..., None]
-    tb = actuator.braid_thickness_mm
+    tb = params.braid_thickness
     return {
         "sigma_bl1": sig1,
         "sigma_bl2": sig2,

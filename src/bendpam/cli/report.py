@@ -1,10 +1,7 @@
 """The ``bendpam report`` command: raw test files -> one self-contained HTML report.
 
-``register(app)`` adds the command to the ``bendpam`` Typer app (``bendpam.cli.app``).  Like the
-other commands it only parses and prints; the work is :func:`bendpam.report.build_report`.  The
-shared helpers come from :mod:`bendpam.cli`, imported when ``register`` runs (the option types) or
-when the command runs (the rest), so ``cli.py`` can call ``register(app)`` at its end without an
-import cycle.
+``register(app)`` adds the command to the ``bendpam`` Typer app.  Like the other commands it only
+parses and prints; the work is :func:`bendpam.report.build_report`.
 
 (No ``from __future__ import annotations`` here: the command is defined inside ``register`` and
 Typer reads its annotations as objects.)
@@ -22,7 +19,7 @@ def register(app: typer.Typer) -> None:
     """Add the ``report`` command to ``app`` (does nothing if it has one already)."""
     if any(getattr(c, "name", None) == "report" for c in app.registered_commands):
         return
-    from .cli import ActuatorOpt, PresetOpt
+    from .options import ActuatorOpt, PresetOpt
 
     @app.command("report")
     def report(
@@ -57,9 +54,10 @@ def register(app: typer.Typer) -> None:
 
 
 def _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, model, progress) -> None:
-    from .cli import Model, UserError, _num, collect_raw_files, load_actuator, parse_values
-    from .fixture import Fixture
-    from .report import build_report
+    from ..fixture import Fixture
+    from ..report import build_report
+    from .options import Model, UserError, collect_raw_files, load_actuator, parse_values
+    from .options import fmt_num as _num
 
     if out is None:
         raise UserError("give the report to write with --out report.html")

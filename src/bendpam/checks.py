@@ -1,0 +1,90 @@
+"""Validation at the boundary: numbers, ranges and pressures, with one-line messages.
+
+Every public function validates its arguments with these helpers before any numerics, so a bad
+value gives one :class:`~bendpam.errors.InputError` naming the argument, the value and the
+allowed range, never a NaN or a traceback from deep inside.
+
+Pressures are in kPa at every public edge.  :func:`pressure_kpa` warns (:class:`UnitWarning`)
+when every nonzero value is below 5 kPa: a bending PAM does nothing there, and the likely mistake
+is a pressure in MPa passed where kPa is expected.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+import warnings
+from typing import Any
+
+import numpy as np
+
+from .errors import InputError
+
+__all__ = ["UnitWarning", "number", "pressure_kpa", "MPA_SUSPECT_KPA"]
+
+#: Below this (kPa), a set of pressures is suspected to be in MPa.
+MPA_SUSPECT_KPA = 5.0
+
+
+class UnitWarning(UserWarning):
+    """A value whose size suggests a unit mistake (e.g. MPa passed as kPa)."""
+
+
+def _range_text(lo, hi, lo_open, hi_open) -> str:
+    lo_s = "(" if lo_open else "["
+    hi_s = ")" if hi_open else "]"
+    return f"{lo_s}{'-inf' if lo is None else f'{lo:g}'}, {'inf' if hi is None else f'{hi:g}'}{hi_s}"
+
+
+def number(name: str, value: Any, lo: float | None = None, hi: float | None = None, *, lo_open: bool = False,
+           hi_open: bool = False, unit: str = "") -> float:
+    """``value`` as a float inside the interval, or a one-line :class:`InputError`.
+
+    A bool or a string is not a number (a TOML ``alpha0_deg = true`` or ``"70"`` is refused).
+
+    >>> number("width_mm", 5, 0.0, lo_open=True, unit="mm")
+    5.0
+    """
+    if isinstance(value, bool | str | bytes) or not isinstance(value, numbers.Real | np.floating | np.integer):
+        raise InputError(f"{name} = {value!r} is not a number ({unit or 'a real number'} expected)")
+    v = float(value)
+    u = f" {unit}" if unit else ""
+    rng = _range_text(lo, hi, lo_open, hi_open)
+    if not math.isfinite(v):
+        raise InputError(f"{name} = {value!r}{u} is not finite; allowed range {rng}{u}")
+    bad_lo = lo is not None and (v <= lo if lo_open else v < lo)
+    bad_hi = hi is not None and (v >= hi if hi_open else v > hi)
+    if bad_lo or bad_hi:
+        raise InputError(f"{name} = {v:g}{u} is outside the allowed range {rng}{u}")
+    return v
+
+
+def pressure_kpa(value: Any, name: str = "pressure_kpa", *, warn: bool = True) -> np.ndarray:
+    """Gauge pressures in kPa as a float array: finite and >= 0, else a one-line :class:`InputError`.
+
+    Warns with :class:`UnitWarning` when every nonzero value is below 5 kPa (MPa passed as kPa?).
+
+    >>> pressure_kpa([100, 150]).tolist()
+    [100.0, 150.0]
+    """
+    if isinstance(value, bool | str | bytes):
+        raise InputError(f"{name} = {value!r} is not a number (kPa expected)")
+    try:
+        p = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} = {value!r} is not numeric (kPa expected)") from None
+    if p.size and not np.all(np.isfinite(p)):
+        i = int(np.flatnonzero(~np.isfinite(p.ravel()))[0])
+        raise InputError(f"{name} has a non-finite value {p.ravel()[i]!r} at index {i}; allowed range [0, inf) kPa")
+    if p.size and np.any(p < 0.0):
+        i = int(np.flatnonzero(p.ravel() < 0.0)[0])
+        raise InputError(f"{name} = {p.ravel()[i]:g} kPa at index {i} is below zero; allowed range [0, inf) kPa (gauge)")
+    if warn and p.size:
+        nz = p[p > 0.0]
+        if nz.size and float(nz.max()) < MPA_SUSPECT_KPA:
+            warnings.warn(
+                f"{name}: every nonzero pressure is below {MPA_SUSPECT_KPA:g} kPa (largest {float(nz.max()):g}); "
+                "pressures are in kPa: was a value in MPa passed (0.2 MPa = 200 kPa)?",
+                UnitWarning, stacklevel=3,
+            )
+    return p

@@ -1,0 +1,21 @@
+"""The ``bendpam`` command line: one module per group of commands, parsing and printing only.
+
+* :mod:`.app`: the Typer app and :func:`main` (errors, interrupts, exit codes);
+* :mod:`.options`: shared options and value parsing;
+* :mod:`.predict`: ``predict``, ``curve``, ``stresses``, ``actuator``, ``demo``;
+* :mod:`.lab`: ``process``, ``simulate-test``, ``inspect``;
+* :mod:`.identify`: ``fit``, ``fit-material``;
+* :mod:`.sweep`: ``sweep``;
+* :mod:`.design`: ``finger``, ``grasp``, ``wrist``;
+* :mod:`.report`: ``report``.
+"""
+
+from __future__ import annotations
+
+from . import design, identify, lab, predict, report, sweep  # noqa: F401  (registers the commands)
+from .app import app, main
+
+report.register(app)
+design.register(app)
+
+__all__ = ["app", "main"]

@@ -1,0 +1,111 @@
+"""The ``bendpam`` Typer application and its entry point :func:`main`.
+
+``main`` turns the library's :class:`~bendpam.errors.BendpamError` into one line
+``bendpam: error: ...`` on stderr and exit status 2; SIGINT and SIGTERM into
+``bendpam: interrupted; no outputs were changed`` and 130/143.  Any other exception is a bug: one
+line saying so and where to report it, exit status 1 (``--debug`` prints the traceback).
+"""
+
+from __future__ import annotations
+
+import sys
+import traceback
+from typing import Annotated, Optional
+
+import typer
+
+__all__ = ["app", "main", "ISSUES_URL"]
+
+ISSUES_URL = "the bendpam issue tracker (include the command line and bendpam --version)"
+
+app = typer.Typer(
+    add_completion=False,
+    no_args_is_help=True,
+    pretty_exceptions_enable=False,
+    rich_markup_mode=None,
+    help="bendpam: models, tests and design tools for bending pneumatic artificial muscles. "
+         "Units: pressure kPa, lengths mm, force N, moments N·mm, curvature 1/mm, angles deg.",
+)
+
+
+def _version(value: bool) -> None:
+    if value:
+        from importlib.metadata import PackageNotFoundError, version
+
+        try:
+            v = version("bendpam")
+        except PackageNotFoundError:  # pragma: no cover - running from a source tree
+            from .. import __version__ as v
+        typer.echo(f"bendpam {v}")
+        raise typer.Exit(0)
+
+
+@app.callback()
+def _root(
+    version: Annotated[Optional[bool], typer.Option("--version", callback=_version, is_eager=True,
+                                                    help="Print the version and exit.")] = None,
+    debug: Annotated[bool, typer.Option("--debug", help="Print the traceback of an internal error.")] = False,
+) -> None:
+    """bendpam: models, tests and design tools for bending pneumatic artificial muscles."""
+
+
+# Typer >= 0.20 vendors click; find its exception base class without importing click directly.
+_ClickException = next(c for c in typer.BadParameter.__mro__ if c.__name__ == "ClickException")
+
+
+def _one_line(exc: BaseException) -> str:
+    text = str(exc).strip()
+    return text.splitlines()[0] if text else type(exc).__name__
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point: run the app; user errors are one line and exit code 2, bugs exit code 1."""
+    from ..errors import BendpamError
+
+    args = list(sys.argv[1:] if argv is None else argv)
+    if not args:
+        args = ["--help"]
+    debug = "--debug" in args
+    try:
+        from ..outputs import interrupts
+    except ImportError:  # pragma: no cover
+        interrupts = None
+    try:
+        if interrupts is not None:
+            with interrupts():
+                app(args=args, prog_name="bendpam", standalone_mode=False)
+        else:  # pragma: no cover
+            app(args=args, prog_name="bendpam", standalone_mode=False)
+    except typer.Exit as exc:
+        return exc.exit_code
+    except (typer.Abort, KeyboardInterrupt):
+        typer.echo("bendpam: interrupted; no outputs were changed", err=True)
+        return 130
+    except _ClickException as exc:
+        typer.echo(f"bendpam: error: {exc.format_message()}", err=True)
+        return 2
+    except BendpamError as exc:
+        typer.echo(f"bendpam: error: {_one_line(exc)}", err=True)
+        return 2
+    except (FileNotFoundError, PermissionError, IsADirectoryError, NotADirectoryError, FileExistsError) as exc:
+        where = f": {exc.filename}" if exc.filename else ""
+        typer.echo(f"bendpam: error: {exc.strerror or _one_line(exc)}{where}", err=True)
+        return 2
+    except OSError as exc:
+        where = f": {exc.filename}" if exc.filename else ""
+        typer.echo(f"bendpam: error: {exc.strerror or _one_line(exc)}{where}", err=True)
+        return 2
+    except BaseException as exc:  # noqa: BLE001 - the last line of defence
+        code = getattr(exc, "exit_code", None)
+        if type(exc).__name__ == "Interrupted" and isinstance(code, int):
+            typer.echo("bendpam: interrupted; no outputs were changed", err=True)
+            return code
+        if isinstance(exc, SystemExit):
+            raise
+        if debug:
+            traceback.print_exc()
+        typer.echo(f"bendpam: internal error ({type(exc).__name__}: {_one_line(exc)}); this is a bug in bendpam, "
+                   f"please report it to {ISSUES_URL}" + ("" if debug else "; --debug shows the traceback"),
+                   err=True)
+        return 1
+    return 0

@@ -1,0 +1,144 @@
+"""``bendpam process`` and ``bendpam simulate-test``: raw cyclic tests in and out."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+from .app import app
+from .options import (
+    ActuatorOpt,
+    Format,
+    Model,
+    ModelOpt,
+    MorePressures,
+    PresetOpt,
+    PressureOpt,
+    UserError,
+    collect_raw_files,
+    fmt_num,
+    load_actuator,
+    model_name,
+    parse_values,
+    pressures_kpa,
+)
+
+FixtureOpt = Annotated[str, typer.Option("--fixture", help="Fixture geometry d,r,t in mm.")]
+
+
+@app.command()
+def process(
+    inputs: Annotated[list[Path], typer.Argument(help="Raw test files, or a folder of them.", show_default=False)],
+    out: Annotated[Optional[Path], typer.Option("--out", help="Output folder.")] = None,
+    pressure_kpa: PressureOpt = None,
+    l0_mm: Annotated[float, typer.Option("--l0-mm", help="Active length L0 for k' = 2 beta / L0 (mm).")] = 145.0,
+    fixture: FixtureOpt = "35,2.5,4",
+    cutoff_hz: Annotated[
+        Optional[float], typer.Option("--cutoff-hz", help="Low-pass cutoff (Hz); default 1 Hz (max 40% of Nyquist); 0 = off.")
+    ] = None,
+    tare_n: Annotated[float, typer.Option("--tare-n", help="Force tare for self-weight (N).")] = 0.0,
+    reversal_fraction: Annotated[
+        float, typer.Option("--reversal-fraction", help="Stroke-reversal threshold, fraction of the stroke range.")
+    ] = 0.05,
+    grid_points: Annotated[int, typer.Option("--grid-points", min=5, max=100000,
+                                             help="Points of the common curvature grid.")] = 101,
+    figure: Annotated[bool, typer.Option("--figure/--no-figure", help="Write figure4.png.")] = True,
+    as_json: Annotated[bool, typer.Option("--json", help="Print summary.json to stdout.")] = False,
+):
+    """Process raw four-point-bending cyclic tests into moment-curvature curves and Table 2 values."""
+    from ..fixture import Fixture
+    from ..lab import read_test
+    from ..lab.processing import ProcessingOptions, process_tests, write_processed
+
+    if out is None:
+        raise UserError("give an output folder with --out OUTDIR")
+    files = collect_raw_files(inputs)
+    pressures = parse_values(pressure_kpa, "--pressure-kpa") if pressure_kpa else []
+    if pressures and len(pressures) not in (1, len(files)) or (len(pressures) == 1 and len(files) > 1):
+        raise UserError(
+            f"--pressure-kpa: got {len(pressures)} pressure(s) for {len(files)} file(s); give one per file, in order"
+        )
+    for v in pressures:
+        if v < 0:
+            raise UserError(f"--pressure-kpa: {v:g} kPa is below zero")
+    fx = Fixture.from_string(fixture, L0_mm=l0_mm)
+    opts = ProcessingOptions(cutoff_hz=cutoff_hz, reversal_fraction=reversal_fraction, grid_points=grid_points,
+                             tare_n=tare_n)
+    tests = [read_test(f, pressure_kpa=pressures[i] if pressures else None) for i, f in enumerate(files)]
+    processed = process_tests(tests, fixture=fx, options=opts)
+    write_processed(processed, out, figure=figure)
+    if as_json:
+        typer.echo((out / "summary.json").read_text())
+        return
+    summ = processed.summary()
+    typer.echo(f"{'P (kPa)':>8} {'cycles':>6} {'M_blocked (N·mm)':>18} {'k_free (1/mm)':>20} {'loss ratio':>10}")
+    for r in summ["pressures"]:
+        typer.echo(
+            f"{r['pressure_kpa']:8.4g} {r['cycles']:6d} {r['blocked_moment_nmm']:9.2f} ± "
+            f"{fmt_num(r['blocked_moment_se_nmm'], '6.2f')} {r['free_curvature_per_mm']:10.5f} ± "
+            f"{fmt_num(r['free_curvature_se_per_mm'], '7.1e')} {100 * r['energy_loss_ratio']:9.2f}%"
+        )
+        for note in r["notes"]:
+            typer.echo(f"         note: {note}")
+    typer.echo(f"deadband: {fmt_num(summ['deadband_kpa'], '.4g')} ± {fmt_num(summ['deadband_se_kpa'], '.2g')} kPa")
+    typer.echo(f"wrote {out}/ (curves.nc, curves.csv, summary.json{', figure4.png' if figure else ''})")
+
+
+@app.command("simulate-test")
+def simulate_test_cmd(
+    more: MorePressures = None,
+    preset: PresetOpt = None,
+    actuator: ActuatorOpt = None,
+    model: ModelOpt = Model.energy,
+    pressure_kpa: PressureOpt = None,
+    out: Annotated[Optional[Path], typer.Option("--out", help="Output folder for the raw files and truth.json.")] = None,
+    fmt: Annotated[Format, typer.Option("--format", help="Export dialect to write.")] = Format.csv,
+    noise_n: Annotated[float, typer.Option("--noise-n", help="Force noise, standard deviation (N).")] = 0.05,
+    noise_stroke_mm: Annotated[float, typer.Option("--noise-stroke-mm", help="Stroke noise, standard deviation (mm).")]
+    = 0.002,
+    hysteresis: Annotated[
+        float, typer.Option("--hysteresis", help="Pressure part of the loop amplitude, as a fraction of the blocked moment.")
+    ] = 0.06,
+    hysteresis_angle_deg: Annotated[
+        float, typer.Option("--hysteresis-angle-deg",
+                            help="Loop angle (deg): saturation angle (pi) or characteristic angle (dahl).")
+    ] = 5.0,
+    hysteresis_law: Annotated[str, typer.Option("--hysteresis-law", help="Loop law: pi (Prandtl-Ishlinskii) or dahl.")]
+    = "pi",
+    hysteresis_offset_nmm: Annotated[
+        float, typer.Option("--hysteresis-offset-nmm", help="Constant part of the loop amplitude (N·mm).")
+    ] = 0.0,
+    cycles: Annotated[int, typer.Option("--cycles", min=1, max=1000, help="Cycles per pressure.")] = 3,
+    speed_mm_min: Annotated[float, typer.Option("--speed-mm-min", help="Crosshead speed (mm/min).")] = 30.0,
+    rate_hz: Annotated[float, typer.Option("--rate-hz", help="Sampling rate (Hz).")] = 20.0,
+    dwell_s: Annotated[float, typer.Option("--dwell-s", help="Dwell at each end of a stroke (s).")] = 0.0,
+    stroke_offset_mm: Annotated[float, typer.Option("--stroke-offset-mm", help="Machine stroke at the blocked state (mm).")]
+    = 0.0,
+    fixture: FixtureOpt = "35,2.5,4",
+    seed: Annotated[Optional[int], typer.Option("--seed", help="Random seed.")] = None,
+):
+    """Write the raw files a testing machine would record for a model actuator (a virtual test)."""
+    from ..fixture import Fixture
+    from ..lab.simulate import SimulationSettings, simulate_tests
+
+    if out is None:
+        raise UserError("give an output folder with --out DIR")
+    if out.exists() and not out.is_dir():
+        raise UserError(f"--out {str(out)!r} exists and is not a folder")
+    act = load_actuator(preset, actuator, model)
+    P = pressures_kpa(pressure_kpa, more)
+    st = SimulationSettings(cycles=cycles, speed_mm_min=speed_mm_min, rate_hz=rate_hz, noise_n=noise_n,
+                            noise_stroke_mm=noise_stroke_mm, hysteresis=hysteresis,
+                            hysteresis_angle_deg=hysteresis_angle_deg, hysteresis_law=hysteresis_law,
+                            hysteresis_offset_nmm=hysteresis_offset_nmm, dwell_s=dwell_s,
+                            stroke_offset_mm=stroke_offset_mm, seed=seed)
+    fx = Fixture.from_string(fixture, L0_mm=act.L0_mm)
+    truth = simulate_tests(act, P, out, model_name(model), dialect=fmt.value, fixture=fx, settings=st)
+    for t in truth["pressures"]:
+        typer.echo(
+            f"{t['file']}: {t['samples']} samples, blocked {t['blocked_moment_nmm']:.2f} N·mm, "
+            f"free k' {t['free_curvature_per_mm']:.5f} 1/mm, loss ratio {100 * t['energy_loss_ratio']:.1f}%"
+        )
+    typer.echo(f"wrote {out}/ ({len(truth['files'])} files and truth.json)")

@@ -1,0 +1,171 @@
+"""Shared options and parsing for the ``bendpam`` commands (parsing only; no numerics here).
+
+Multi-valued numbers (``--pressure-kpa``, ``--param``) take separate tokens, comma lists or ranges
+``start:stop:count`` (count values from start to stop inclusive: ``100:200:5`` is 100, 125, 150,
+175, 200).
+"""
+
+from __future__ import annotations
+
+import math
+from enum import Enum
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated, Optional
+
+import typer
+
+from ..errors import InputError
+
+if TYPE_CHECKING:
+    from ..actuator import Actuator
+
+__all__ = [
+    "UserError", "Model", "Preset", "Format", "PresetOpt", "ActuatorOpt", "ModelOpt", "PressureOpt", "MorePressures",
+    "parse_values", "pressures_kpa", "load_actuator", "model_name", "fmt_num", "format_prediction_table",
+    "collect_raw_files", "echo",
+]
+
+#: The largest number of values one option may expand to (a range like 100:200:30000000 is refused).
+MAX_VALUES = 1_000_000
+
+
+class UserError(InputError):
+    """A command line that cannot be acted on (a missing option, inconsistent options)."""
+
+
+class Model(str, Enum):
+    energy = "energy"
+    force_balance = "force-balance"
+
+
+class Preset(str, Enum):
+    be_pam = "be-pam"
+    bc_pam = "bc-pam"
+
+
+class Format(str, Enum):
+    csv = "csv"
+    testxpert = "testxpert"
+    bluehill = "bluehill"
+    mts = "mts"
+
+
+RANGE_HELP = "values '100 150 200', '100,150' or a range start:stop:count ('100:200:5' = 100, 125, ..., 200)"
+PresetOpt = Annotated[Optional[Preset], typer.Option("--preset", help="Built-in actuator from the paper.")]
+ActuatorOpt = Annotated[
+    Optional[Path], typer.Option("--actuator", help="Actuator TOML file (see `bendpam actuator --preset be-pam`).")
+]
+ModelOpt = Annotated[Model, typer.Option("--model", help="Moment model.")]
+PressureOpt = Annotated[
+    Optional[list[str]],
+    typer.Option("--pressure-kpa", metavar="KPA...", help=f"Gauge pressure(s) in kPa: {RANGE_HELP}."),
+]
+MorePressures = Annotated[Optional[list[str]], typer.Argument(hidden=True, metavar="")]
+
+
+def echo(text: str = "", err: bool = False) -> None:
+    typer.echo(text, err=err)
+
+
+def parse_values(tokens: list[str] | None, name: str, *, max_values: int = MAX_VALUES) -> list[float]:
+    """Parse numbers given as separate tokens, comma lists or ranges ``start:stop:count``."""
+    out: list[float] = []
+    for tok in tokens or []:
+        for part in str(tok).replace(",", " ").split():
+            if ":" in part:
+                bits = part.split(":")
+                if len(bits) != 3:
+                    raise UserError(f"{name}: range {part!r} must be start:stop:count")
+                try:
+                    a, b, n = float(bits[0]), float(bits[1]), int(bits[2])
+                except ValueError:
+                    raise UserError(f"{name}: range {part!r} must be start:stop:count with numbers") from None
+                if not (math.isfinite(a) and math.isfinite(b)):
+                    raise UserError(f"{name}: range {part!r} must have finite ends")
+                if n < 1:
+                    raise UserError(f"{name}: range {part!r} needs a count >= 1")
+                if len(out) + n > max_values:
+                    raise UserError(f"{name}: range {part!r} gives {n} values; at most {max_values} are allowed")
+                out.extend(a + (b - a) * i / (n - 1) if n > 1 else a for i in range(n))
+            else:
+                try:
+                    v = float(part)
+                except ValueError:
+                    raise UserError(f"{name}: {part!r} is not a number") from None
+                if not math.isfinite(v):
+                    raise UserError(f"{name}: {part!r} is not finite")
+                out.append(v)
+    if len(out) > max_values:
+        raise UserError(f"{name}: {len(out)} values; at most {max_values} are allowed")
+    return out
+
+
+def pressures_kpa(first: list[str] | None, more: list[str] | None = None) -> list[float]:
+    if more and not first:
+        raise UserError(f"unexpected argument(s) {' '.join(more)!r}; pressures go after --pressure-kpa")
+    values = parse_values((first or []) + (more or []), "--pressure-kpa")
+    if not values:
+        raise UserError("give at least one pressure with --pressure-kpa (kPa), e.g. --pressure-kpa 100 150 200")
+    for v in values:
+        if v < 0:
+            raise UserError(f"--pressure-kpa: {v:g} kPa is below zero; pressures are gauge pressures >= 0 kPa")
+    nz = [v for v in values if v > 0]
+    if nz and max(nz) < 5.0:
+        raise UserError(f"--pressure-kpa: every pressure is below 5 kPa (largest {max(nz):g}); pressures are in kPa "
+                        "(0.2 MPa = 200 kPa)")
+    return values
+
+
+def model_name(model: Model) -> str:
+    from ..models import normalise_model
+
+    return normalise_model(model.value)
+
+
+def load_actuator(preset: Preset | None, actuator: Path | None, model: Model) -> Actuator:
+    if preset is not None and actuator is not None:
+        raise UserError("give either --preset or --actuator, not both")
+    if preset is None and actuator is None:
+        raise UserError("give an actuator: --preset be-pam|bc-pam or --actuator FILE.toml")
+    from .. import presets
+    from ..actuator import Actuator
+
+    if preset is not None:
+        return presets.get(preset.value, model_name(model))
+    return Actuator.from_toml(actuator)
+
+
+def fmt_num(x, fmt: str) -> str:
+    """``format(x, fmt)``, or a dash of the same width for None/NaN/inf."""
+    width = fmt.split(".")[0]
+    try:
+        ok = x is not None and math.isfinite(float(x))
+    except (TypeError, ValueError):
+        ok = False
+    return format(float(x), fmt) if ok else "—".rjust(int(width) if width else 1)
+
+
+def format_prediction_table(df, title: str) -> str:
+    lines = [title, f"{'P (kPa)':>8}  {'M_blocked (N·mm)':>16}  {'k_free (1/mm)':>13}  {'θ_free (deg)':>12}  note"]
+    for r in df.itertuples():
+        lines.append(
+            f"{r.pressure_kpa:8.4g}  {fmt_num(r.blocked_moment_nmm, '16.2f')}  "
+            f"{fmt_num(r.free_curvature_per_mm, '13.5f')}  {fmt_num(r.free_angle_deg, '12.2f')}  {r.note}"
+        )
+    return "\n".join(lines)
+
+
+def collect_raw_files(paths: list[Path]) -> list[Path]:
+    """Expand folders into their raw test files (see :func:`bendpam.lab.files.collect_raw_files`)."""
+    from ..lab.files import collect_raw_files as collect
+
+    return collect(paths)
+
+
+def positive(name: str, value: float | None, unit: str) -> float | None:
+    """A numeric option that must be > 0 (None passes)."""
+    if value is None:
+        return None
+    if not (math.isfinite(value) and value > 0):
+        raise UserError(f"{name}: {value:g} {unit} must be > 0")
+    return value

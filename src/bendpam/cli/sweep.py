@@ -1,0 +1,101 @@
+"""``bendpam sweep``: actuator parameters crossed with pressures, in-process or on Dask."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import Annotated, Optional
+
+import numpy as np
+import typer
+
+from .app import app
+from .options import (
+    RANGE_HELP,
+    ActuatorOpt,
+    Model,
+    ModelOpt,
+    PresetOpt,
+    UserError,
+    load_actuator,
+    model_name,
+    parse_values,
+)
+
+
+def parse_param(text: str) -> tuple[str, list[float]]:
+    """``NAME=start:stop:count`` or ``NAME=v1,v2,...`` -> (name, values)."""
+    if "=" not in text:
+        raise UserError(f"--param {text!r}: expected NAME=start:stop:count or NAME=v1,v2 (e.g. alpha0_deg=60:80:41)")
+    name, vals = text.split("=", 1)
+    values = parse_values([vals], f"--param {name}")
+    if not values:
+        raise UserError(f"--param {text!r}: no values")
+    return name.strip(), values
+
+
+@app.command("sweep")
+def sweep_cmd(
+    preset: PresetOpt = None,
+    actuator: ActuatorOpt = None,
+    model: ModelOpt = Model.energy,
+    param: Annotated[
+        Optional[list[str]],
+        typer.Option("--param", metavar="NAME=VALUES",
+                     help=f"Swept parameter NAME=VALUES, {RANGE_HELP} (repeat for more)."),
+    ] = None,
+    pressure_kpa: Annotated[
+        Optional[list[str]], typer.Option("--pressure-kpa", metavar="KPA...", help=f"Pressures (kPa): {RANGE_HELP}.")
+    ] = None,
+    scheduler: Annotated[Optional[str], typer.Option("--scheduler", help="Dask scheduler address.")] = None,
+    workers: Annotated[Optional[int], typer.Option("--workers", help="Start a local Dask cluster of N processes.")]
+    = None,
+    chunk_cases: Annotated[int, typer.Option("--chunk-cases", min=1, max=1_000_000,
+                                             help="Actuator cases per block (memory bound).")] = 256,
+    max_points: Annotated[int, typer.Option("--max-points", min=1, help="Refuse sweeps larger than this many "
+                                            "(case, pressure) points.")] = 100_000_000,
+    out: Annotated[Optional[Path], typer.Option("--out", help="Output NetCDF file (.nc).")] = None,
+    plot: Annotated[Optional[Path], typer.Option("--plot", help="Quick figure (.png) of one output.")] = None,
+    plot_var: Annotated[str, typer.Option("--plot-var", help="Output to plot.")] = "free_angle_deg",
+    plot_x: Annotated[Optional[str], typer.Option("--plot-x", help="Parameter on the x axis (default: first).")]
+    = None,
+    plot_y: Annotated[
+        Optional[str], typer.Option("--plot-y", help="Parameter or 'pressure_kpa' on the y axis (default: second).")
+    ] = None,
+    progress: Annotated[bool, typer.Option("--progress/--no-progress", help="Progress bar.")] = True,
+):
+    """Design sweep: actuator parameters crossed with pressures (in-process or on Dask)."""
+    from .._io import atomic_path
+    from ..sweeps import SWEEP_PARAMETERS, sweep
+
+    if out is None and plot is None:
+        raise UserError("give --out FILE.nc and/or --plot FILE.png")
+    if out is not None and out.suffix.lower() != ".nc":
+        raise UserError(f"--out {str(out)!r}: the sweep is written as NetCDF; use a .nc file")
+    if scheduler and workers:
+        raise UserError("give either --scheduler or --workers, not both")
+    if workers is not None and workers < 1:
+        raise UserError(f"--workers {workers}: give at least 1 worker process")
+    act = load_actuator(preset, actuator, model)
+    params = dict(parse_param(p) for p in (param or []))
+    for name in params:
+        if name not in SWEEP_PARAMETERS:
+            raise UserError(f"--param {name}: cannot sweep it; choose from {', '.join(SWEEP_PARAMETERS)}")
+    P = parse_values(pressure_kpa, "--pressure-kpa")
+    if not P:
+        raise UserError("give the pressures with --pressure-kpa, e.g. 100:250:16")
+    n_points = len(P) * int(np.prod([len(v) for v in params.values()] or [1]))
+    if n_points > max_points:
+        raise UserError(f"the sweep has {n_points} (case, pressure) points, more than --max-points {max_points}; "
+                        "raise --max-points to run it")
+    ds = sweep(act, P, model_name(model), chunk_cases=chunk_cases, scheduler=scheduler, workers=workers,
+               progress=progress and sys.stderr.isatty(), **{k: np.asarray(v) for k, v in params.items()})
+    if out is not None:
+        with atomic_path(out) as tmp:
+            ds.to_netcdf(tmp)
+        typer.echo(f"wrote {out} ({' x '.join(f'{d}={n}' for d, n in ds.sizes.items())})")
+    if plot is not None:
+        from ..plots import save_figure, sweep_figure
+
+        save_figure(sweep_figure(ds, plot_var, plot_x, plot_y), plot)
+        typer.echo(f"wrote {plot}")
