@@ -55,7 +55,7 @@ from __future__ import annotations
 import json
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -65,11 +65,10 @@ from ._io import atomic_write_text, json_safe
 from .actuator import NEUTRAL_ANGLE_DEG, Actuator
 from .law import MomentLaw
 from .models import normalise_model
-from .errors import InputError
+from .errors import FileFormatError, FitError, InputError
 
-__all__ = ["PARAMETERS", "HYST_PARAMETERS", "Parameter", "FitResult", "Metrics", "fit", "score", "fit_tension",
-           "TensionFit", "parse_free", "developed_range", "tension_from_test", "predicted_loss_ratios",
-           "branch_nrmse"]
+__all__ = ["PARAMETERS", "HYST_PARAMETERS", "Parameter", "FitResult", "HysteresisFit", "LossRatio", "Metrics", "fit",
+           "score", "parse_free", "developed_range", "predicted_loss_ratios", "branch_nrmse"]
 
 #: Identifiable parameters: short name -> (Actuator field, unit).
 PARAMETERS = {
@@ -127,6 +126,11 @@ class Parameter:
     def to_dict(self) -> dict:
         return {"value": self.value, "stderr": self.stderr, "min": self.min, "max": self.max, "vary": self.vary,
                 "initial": self.initial, "unit": self.unit}
+
+    @classmethod
+    def from_dict(cls, name: str, field_name: str, d: dict) -> Parameter:
+        return cls(name, field_name, d["unit"], float(d["value"]), None if d["stderr"] is None else float(d["stderr"]),
+                   _num(d["min"]), _num(d["max"]), bool(d["vary"]), _num(d["initial"]))
 
 
 @dataclass
@@ -399,9 +403,62 @@ def _lag1(resid: np.ndarray, seg: np.ndarray) -> float:
     return num / den if den > 0 else 0.0
 
 
+@dataclass(frozen=True)
+class LossRatio:
+    """Energy-loss ratio of one test: measured (processing) and predicted (the fitted loop)."""
+
+    pressure_kpa: float
+    measured: float
+    predicted: float
+
+
+@dataclass
+class HysteresisFit:
+    """The loop part of a fit (``fit(..., hysteresis="pi")``): parameters, loss ratios, branch NRMSE."""
+
+    law: str
+    amplitude: str
+    parameters: dict[str, Parameter]
+    energy_loss_ratio: list[LossRatio]
+    nrmse_branches: float
+
+    def loop(self):
+        """The fitted :class:`bendpam.hysteresis.LoopModel`."""
+        from .hysteresis import LoopModel
+
+        return LoopModel(law=self.law, amplitude=self.amplitude,
+                         **{p.field: p.value for p in self.parameters.values()})
+
+    def to_dict(self) -> dict:
+        return {"law": self.law, "amplitude": self.amplitude,
+                "parameters": {p.field: p.to_dict() for p in self.parameters.values()},
+                "energy_loss_ratio": [asdict(e) for e in self.energy_loss_ratio],
+                "nrmse_branches": self.nrmse_branches}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> HysteresisFit:
+        names = {v[0]: k for k, v in HYST_PARAMETERS.items()}
+        params = {names[f]: Parameter.from_dict(names[f], f, v) for f, v in d["parameters"].items()}
+        return cls(d["law"], d.get("amplitude", "linear"), params,
+                   [LossRatio(**e) for e in d.get("energy_loss_ratio", [])], d.get("nrmse_branches", math.nan))
+
+
 @dataclass
 class FitResult:
-    """Result of :func:`fit`: a value you can print, save (JSON + TOML) and reuse."""
+    """Result of :func:`fit`: a value you can print, predict with, plot, save and load.
+
+    Attributes
+    ----------
+    model : the model fitted (``"energy"`` or ``"force_balance"``).
+    actuator : the fitted :class:`~bendpam.Actuator` (usable by every command).
+    parameters : short name -> :class:`Parameter` (value, standard error, bounds, vary flag, unit).
+    correlation, correlation_names : correlation matrix of the varied parameters.
+    metrics : :class:`Metrics` (eq 53-55).
+    converged, message, nfev, time_s : about the search.
+    flags : plain-language warnings (poorly identifiable pairs, parameters at a bound, folds).
+    autocorrelation : mean lag-1 autocorrelation of the residuals (used in the standard errors).
+    hysteresis : :class:`HysteresisFit` or None.
+    """
 
     model: str
     actuator: Actuator
@@ -415,8 +472,22 @@ class FitResult:
     time_s: float
     flags: list[str] = field(default_factory=list)
     autocorrelation: float = 0.0
-    hysteresis: dict | None = None
-    loop: object | None = None
+    hysteresis: HysteresisFit | None = None
+
+    @property
+    def loop(self):
+        """The fitted loop (:class:`bendpam.hysteresis.LoopModel`) or None."""
+        return None if self.hysteresis is None else self.hysteresis.loop()
+
+    def predict(self, pressure_kpa, curvature_per_mm) -> np.ndarray:
+        """The fitted model's quasi-static moment ``M(P, k')`` (N*mm), broadcasting (signed as the paper)."""
+        return MomentLaw.of(self.actuator, self.model).moment(pressure_kpa, curvature_per_mm)
+
+    def plot(self, processed, title: str = ""):
+        """Figure 7 (a matplotlib Figure): the fitted model against ``processed``."""
+        from .plots import figure7
+
+        return figure7(processed, self, title)
 
     def to_dict(self) -> dict:
         m = self.metrics.to_dict()
@@ -436,24 +507,57 @@ class FitResult:
             "time_s": self.time_s,
             "residual_autocorrelation": self.autocorrelation,
             "actuator": self.actuator.to_dict(),
-            **({"hysteresis": self.hysteresis} if self.hysteresis is not None else {}),
+            **({"hysteresis": self.hysteresis.to_dict()} if self.hysteresis is not None else {}),
         }
 
     def to_json(self) -> str:
-        return json.dumps(json_safe(self.to_dict()), indent=2)
+        return json.dumps(json_safe(self.to_dict()), indent=2, allow_nan=False)
 
     def save(self, out_dir) -> dict[str, str]:
-        """Write ``fit.json`` and ``fitted_actuator.toml`` atomically into ``out_dir``."""
+        """Write ``fit.json`` and ``fitted_actuator.toml`` atomically into the folder ``out_dir``."""
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
         atomic_write_text(out / "fit.json", self.to_json())
         text = self.actuator.to_toml()
-        if self.loop is not None:
+        loop = self.loop
+        if loop is not None:
             import tomli_w
 
-            text += "\n" + tomli_w.dumps({"hysteresis": self.loop.to_dict()})
+            text += "\n" + tomli_w.dumps({"hysteresis": loop.to_dict()})
         atomic_write_text(out / "fitted_actuator.toml", text)
         return {"fit.json": str(out / "fit.json"), "fitted_actuator.toml": str(out / "fitted_actuator.toml")}
+
+    @classmethod
+    def load(cls, path) -> FitResult:
+        """Read a fit written by :meth:`save` (the folder or its ``fit.json``)."""
+        p = Path(path)
+        fj = p / "fit.json" if p.is_dir() else p
+        try:
+            d = json.loads(fj.read_text(encoding="utf-8"))
+            act = Actuator.from_dict(d["actuator"], source=str(fj))
+            short = {v[0]: k for k, v in PARAMETERS.items()}
+            params = {short[f]: Parameter.from_dict(short[f], f, v) for f, v in d["parameters"].items()}
+            rev = {v[0]: k for k, v in {**PARAMETERS, **HYST_PARAMETERS}.items()}
+            metrics = Metrics(
+                nrmse_cycles=_num(d["nrmse"]["cycles"]), nrmse_blocked_moment=_num(d["nrmse"]["blocked_moment"]),
+                nrmse_free_curvature=_num(d["nrmse"]["free_curvature"]), rmse_cycles=_num(d["rmse"]["cycles_nmm"]),
+                rmse_blocked_moment=_num(d["rmse"]["blocked_moment_nmm"]),
+                rmse_free_curvature=_num(d["rmse"]["free_curvature_per_mm"]), per_pressure=d["per_pressure"],
+                no_equilibrium_kpa=d["no_equilibrium_kpa"])
+            return cls(
+                model=d["model"], actuator=act, parameters=params,
+                correlation=np.array(d["correlation"]["matrix"], dtype=float).reshape(
+                    len(d["correlation"]["names"]), len(d["correlation"]["names"])),
+                correlation_names=[rev[n] for n in d["correlation"]["names"]], metrics=metrics,
+                converged=bool(d["converged"]), message=str(d["message"]), nfev=int(d["nfev"]),
+                time_s=float(d["time_s"]), flags=list(d["flags"]),
+                autocorrelation=float(d.get("residual_autocorrelation", 0.0)),
+                hysteresis=HysteresisFit.from_dict(d["hysteresis"]) if d.get("hysteresis") else None,
+            )
+        except FileNotFoundError:
+            raise FileFormatError(f"{fj}: no such fit file; give the output folder of 'bendpam fit'") from None
+        except (OSError, UnicodeDecodeError, json.JSONDecodeError, KeyError, TypeError, ValueError) as exc:
+            raise FileFormatError(f"{fj}: not a bendpam fit.json ({type(exc).__name__}: {exc})") from None
 
     def __str__(self) -> str:
         lines = [f"{self.model.replace('_', '-')} model fit ({'converged' if self.converged else 'NOT converged'}, "
@@ -464,16 +568,20 @@ class FitResult:
         m = self.metrics
         lines.append(f"  NRMSE cycles {100 * m.nrmse_cycles:.2f} %, blocked moment {100 * m.nrmse_blocked_moment:.2f} %, "
                      f"free curvature {_pct(m.nrmse_free_curvature)}")
-        if self.hysteresis is not None:
-            hp = self.hysteresis["parameters"]
-            lines.append("  loop (" + self.hysteresis["law"] + "): " + ", ".join(
-                f"{k} = {v['value']:.4g}" + (f" ± {v['stderr']:.2g}" if v["stderr"] is not None else "")
-                for k, v in hp.items()) + f"; NRMSE of the branches {100 * self.hysteresis['nrmse_branches']:.2f} %")
+        h = self.hysteresis
+        if h is not None:
+            lines.append("  loop (" + h.law + "): " + ", ".join(
+                f"{p.field} = {p.value:.4g}" + (f" ± {p.stderr:.2g}" if p.stderr is not None else "")
+                for p in h.parameters.values()) + f"; NRMSE of the branches {100 * h.nrmse_branches:.2f} %")
             lines.append("  energy-loss ratio measured/predicted: " + ", ".join(
-                f"{e['pressure_kpa']:g} kPa {100 * e['measured']:.1f}/{100 * e['predicted']:.1f} %"
-                for e in self.hysteresis["energy_loss_ratio"]))
+                f"{e.pressure_kpa:g} kPa {100 * e.measured:.1f}/{100 * e.predicted:.1f} %"
+                for e in h.energy_loss_ratio))
         lines += [f"  note: {f}" for f in self.flags]
         return "\n".join(lines)
+
+
+def _num(x) -> float:
+    return math.nan if x is None else float(x)
 
 
 def _pct(x):
@@ -528,10 +636,14 @@ def score(processed, actuator: Actuator, model: str = "energy", *, order: int = 
 
 
 def fit(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C10", "C01"), *,
-        bounds: dict[str, tuple[float, float]] | None = None, tension: TensionFit | None = None, order: int = 32,
+        bounds: dict[str, tuple[float, float]] | None = None, tension=None, order: int = 32,
         eq19_factor: bool = True, grid_alpha: int = 41, grid_r0: int = 9, corr_flag: float = 0.95,
         fit_range: str = "developed", hysteresis: str | None = None) -> FitResult:
     """Identify ``free`` parameters of ``actuator`` for ``model`` from a processed test set.
+
+    The stages: :func:`_setup` (data, bounds, the problem), :func:`_start` (a global grid over the
+    nonlinear parameters with the linear ones projected), :func:`_search` (a trust-region search
+    on the projected problem), :func:`_uncertainty` (sandwich covariance) and :func:`_result`.
 
     Parameters
     ----------
@@ -540,7 +652,8 @@ def fit(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C
     model : ``"energy"`` or ``"force_balance"``.
     free : names among alpha0, C10, C01, P_start, E_f, R0_start (aliases such as ``alpha0_deg`` work).
     bounds : overrides of the default bounds, ``{name: (lo, hi)}`` in the parameter's unit.
-    tension : a :class:`TensionFit`; its C10 and C01 replace the actuator's before fitting.
+    tension : a tension-test fit with ``C10_kpa`` and ``C01_kpa``; they replace the actuator's
+        before fitting.
     fit_range : ``"developed"`` (default) fits each mean curve where the hysteresis loop is
         developed (see :func:`developed_range`): near the reversals a rounded loop biases the
         average of the branches.  ``"all"`` fits every point, as the paper did.  The metrics are
@@ -548,11 +661,8 @@ def fit(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C
     hysteresis : ``None`` (fit the mean curves), or a loop law (``"pi"`` or ``"dahl"``, see
         :mod:`bendpam.hysteresis`): fit both branches of every pressure with
         ``M = M_load - (a0 + a1 P_active) z`` on a steady cycle between the blocked state and each
-        test's free curvature.  ``a0`` and ``a1`` are linear parameters (projected like C10 and
-        C01), the law's angle ``theta_h`` is a nonlinear one (scanned and searched with alpha0).
-        The amplitude uses the starting ``P_start``.  The result gains ``hysteresis`` (parameters
-        with standard errors, the energy-loss ratio measured and predicted at each pressure, and the
-        NRMSE of the branches) and ``loop`` (a :class:`bendpam.hysteresis.LoopModel`).
+        test's free curvature.  ``a0`` (N*mm) and ``a1`` (N*mm/kPa) are linear parameters, the law's
+        angle ``theta_h`` a nonlinear one (scanned and searched with alpha0).
 
     Returns
     -------
@@ -560,6 +670,19 @@ def fit(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C
     """
     t0 = time.perf_counter()
     model = normalise_model(model)
+    prob, d, bnd, actuator, hysteresis = _setup(processed, actuator, model, free, bounds, tension, order,
+                                                eq19_factor, fit_range, hysteresis)
+    best, nfev = _start(prob, bnd, grid_alpha, grid_r0)
+    nl, lin, converged, message, n = _search(prob, bnd, best)
+    nfev += n
+    unc = _uncertainty(prob, d, bnd, nl, lin, corr_flag)
+    nfev += unc.nfev
+    return _result(processed, actuator, model, prob, bnd, unc, tension, hysteresis, converged, message, nfev,
+                   time.perf_counter() - t0, order, eq19_factor)
+
+
+def _setup(processed, actuator, model, free, bounds, tension, order, eq19_factor, fit_range, hysteresis):
+    """Stage 1: the data, the bounds and the projected least-squares problem."""
     free = parse_free(free)
     if tension is not None:
         actuator = actuator.replace(C10_kpa=tension.C10_kpa, C01_kpa=tension.C01_kpa)
@@ -584,10 +707,12 @@ def fit(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C
         raise InputError(
             f"P_start = {actuator.P_start_kpa:g} kPa is not below the lowest test pressure {d.P.min():g} kPa"
         )
-    prob = _Problem(actuator, d, model, free, bnd, order, eq19_factor, hysteresis)
-    nfev = 0
+    return _Problem(actuator, d, model, free, bnd, order, eq19_factor, hysteresis), d, bnd, actuator, hysteresis
 
-    # 1. global stage: grid over the nonlinear parameters, linear ones projected
+
+def _start(prob: _Problem, bnd, grid_alpha: int, grid_r0: int):
+    """Stage 2: a global grid over the nonlinear parameters, the linear ones projected exactly."""
+    nfev = 0
     grids = []
     for p in prob.nonlin:
         lo, hi = bnd[p]
@@ -595,22 +720,23 @@ def fit(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C
             grids.append(np.geomspace(0.5, 40.0, 14))
         else:
             grids.append(np.linspace(lo, hi, grid_alpha if p == "alpha0" else grid_r0))
-    best = (math.inf, {}, None)
-    if grids:
-        mesh = np.meshgrid(*grids, indexing="ij")
-        for idx in np.ndindex(mesh[0].shape):
-            nl = {p: float(m[idx]) for p, m in zip(prob.nonlin, mesh)}
-            r, lin = prob.project(nl)
-            nfev += 1
-            ssr = float(r @ r)
-            if ssr < best[0]:
-                best = (ssr, nl, lin)
-    else:
-        r, lin = prob.project({})
+    best: tuple[float, dict[str, float]] = (math.inf, {})
+    if not grids:
+        return best, nfev
+    mesh = np.meshgrid(*grids, indexing="ij")
+    for idx in np.ndindex(mesh[0].shape):
+        nl = {p: float(m[idx]) for p, m in zip(prob.nonlin, mesh)}
+        r, _ = prob.project(nl)
         nfev += 1
-        best = (float(r @ r), {}, lin)
+        ssr = float(r @ r)
+        if ssr < best[0]:
+            best = (ssr, nl)
+    return best, nfev
 
-    # 2. local stage on the projected problem
+
+def _search(prob: _Problem, bnd, best):
+    """Stage 3: a bounded trust-region search on the projected problem; the final linear solve."""
+    nfev = 0
     converged, message = True, "linear least squares (exact)"
     nl_best = best[1]
     if prob.nonlin:
@@ -625,13 +751,32 @@ def fit(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C
                             diff_step=1e-6, xtol=1e-12, ftol=1e-12, gtol=1e-12)
         nfev += sol.nfev * (1 + len(prob.nonlin))
         converged = bool(sol.status > 0)
-        message = sol.message
+        message = "converged" if converged else "the search stopped before converging (iteration limit)"
         nl_best = dict(zip(prob.nonlin, sol.x))
-    r, lin = prob.project(nl_best)
-    nfev += 1
-    x_int = np.concatenate([[nl_best[p] for p in prob.nonlin], lin])
+    _, lin = prob.project(nl_best)
+    return nl_best, lin, converged, message, nfev + 1
 
-    # 3. uncertainty from the joint Jacobian (nonlinear columns by central differences)
+
+@dataclass
+class _Uncertainty:
+    values: dict[str, float]
+    names: list[str]
+    sd: np.ndarray
+    corr: np.ndarray
+    flags: list[str]
+    rho: float
+    nfev: int
+
+
+def _uncertainty(prob: _Problem, d, bnd, nl_best, lin, corr_flag: float) -> _Uncertainty:
+    """Stage 4: sandwich covariance from the joint Jacobian (nonlinear columns by central differences).
+
+    The weights normalise each curve (eq 53), they are not inverse noise variances, so each curve
+    gets its own residual variance (with its AR(1) inflation).
+    """
+    nfev = 0
+    x_int = np.concatenate([[nl_best[p] for p in prob.nonlin], lin])
+    r = prob.residual_full(x_int)
     m = r.size
     J = np.empty((m, x_int.size))
     nn = len(prob.nonlin)
@@ -643,8 +788,6 @@ def fit(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C
         nfev += 2
     _, X = prob.design(nl_best)
     J[:, nn:] = prob.d.w[:, None] * X
-    # sandwich covariance: the weights normalise each curve (eq 53), they are not inverse noise
-    # variances, so each curve gets its own residual variance (with its AR(1) inflation)
     B = J.T @ J
     meat = np.zeros_like(B)
     share = 1.0 - x_int.size / max(m, 1)
@@ -657,23 +800,22 @@ def fit(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C
         rhos.append(rho_i)
         meat += (J[sel].T @ J[sel]) * var_i * (1.0 + rho_i) / (1.0 - rho_i)
     rho = float(np.mean(rhos)) if rhos else 0.0
-    # active bounds: parameters pinned at a bound get no standard error
     names_int = prob.nonlin + prob.lin_names()
     lo_all = np.concatenate([[bnd[p][0] for p in prob.nonlin], prob.lin_bounds()[0]])
     hi_all = np.concatenate([[bnd[p][1] for p in prob.nonlin], prob.lin_bounds()[1]])
     at_bound = (np.abs(x_int - lo_all) <= 1e-9 * np.maximum(1, np.abs(lo_all))) | (
         np.abs(x_int - hi_all) <= 1e-9 * np.maximum(1, np.abs(hi_all)))
-    Binv = np.linalg.pinv(B, rcond=1e-13)
+    try:
+        Binv = np.linalg.pinv(B, rcond=1e-13)
+    except np.linalg.LinAlgError:
+        raise FitError("the data do not determine the parameters (the Jacobian is degenerate: the curves at "
+                       "the tested pressures cannot separate them); fix some with a narrower --free") from None
     cov_int = Binv @ meat @ Binv
-    # map internal -> user parameters (S, C01) -> (C10, C01)
-    G = np.eye(x_int.size)
+    G = np.eye(x_int.size)  # internal (S, C01) -> user (C10, C01)
     if prob.sum_param:
-        iS = names_int.index("S")
-        i1 = names_int.index("C01")
-        G[iS, i1] = -1.0  # C10 = S - C01
+        G[names_int.index("S"), names_int.index("C01")] = -1.0  # C10 = S - C01
     cov = G @ cov_int @ G.T
     user_names = prob.nonlin + prob.lin
-    # user_names order: nonlinear first, then linear in the order of prob.lin (S slot -> C10)
     values = prob.to_user(nl_best, lin)
     sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -684,22 +826,29 @@ def fit(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C
             if np.isfinite(corr[i, j]) and abs(corr[i, j]) > corr_flag:
                 flags.append(f"{_label(user_names[i])} and {_label(user_names[j])} are poorly identifiable together "
                              f"(correlation {corr[i, j]:+.3f}): their combination is determined, not each one")
-    pinned = [names_int[i] for i in range(len(names_int)) if at_bound[i]]
-    for p in pinned:
-        flags.append(f"{'C10 + C01' if p == 'S' else p} is at a bound of its range; its standard error is not meaningful")
-    fitted = prob.actuator(values)
+    for i, p in enumerate(names_int):
+        if at_bound[i]:
+            flags.append(f"{'C10 + C01' if p == 'S' else p} is at a bound of its range; its standard error is not "
+                         "meaningful")
+    return _Uncertainty(values, user_names, sd, corr, flags, rho, nfev)
+
+
+def _result(processed, actuator, model, prob, bnd, unc: _Uncertainty, tension, hysteresis, converged, message,
+            nfev, time_s, order, eq19_factor) -> FitResult:
+    """Stage 5: the fitted actuator, its parameters, the metrics and the loop."""
+    flags = list(unc.flags)
+    fitted = prob.actuator(unc.values)
     fitted = fitted.replace(name=f"{actuator.name or actuator.kind} [fitted, {model.replace('_', '-')} model]")
     params = {}
     for n in _ORDER:
         field_, unit = PARAMETERS[n]
         val = float(getattr(fitted, field_))
-        if n in user_names:
-            i = user_names.index(n)
-            se = float(sd[i]) if np.isfinite(sd[i]) else None
-            lo_b, hi_b = bnd[n]
+        if n in unc.names:
+            i = unc.names.index(n)
+            se = float(unc.sd[i]) if np.isfinite(unc.sd[i]) else None
             start = PAPER_START.get(n, float(getattr(actuator, field_))) if tension is None else \
                 {"C10": tension.C10_kpa, "C01": tension.C01_kpa}.get(n, float(getattr(actuator, field_)))
-            params[n] = Parameter(n, field_, unit, val, se, lo_b, hi_b, True, start)
+            params[n] = Parameter(n, field_, unit, val, se, bnd[n][0], bnd[n][1], True, start)
         elif n in ("alpha0", "C10", "C01", "P_start"):
             params[n] = Parameter(n, field_, unit, val, None, bnd[n][0], bnd[n][1], False, val)
     metrics = score(processed, fitted, model, order=order, eq19_factor=eq19_factor)
@@ -707,28 +856,24 @@ def fit(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C
         flags.append("no free-bending equilibrium in the fitted model at " +
                      ", ".join(f"{p:g}" for p in metrics.no_equilibrium_kpa) + " kPa (fold); "
                      "those pressures are left out of the free-curvature metric")
-    hyst_out, loop = None, None
+    hyst = None
     if hysteresis is not None:
-        from .hysteresis import LoopModel
-
-        loop = LoopModel(law=hysteresis, a0_nmm=float(values["a0"]), a1_nmm_per_kpa=float(values["a1"]),
-                         theta_h_deg=float(values["theta_h"]))
         hp = {}
         for n in ("a0", "a1", "theta_h"):
-            i = user_names.index(n)
-            hp[HYST_PARAMETERS[n][0]] = {"value": float(values[n]),
-                                         "stderr": float(sd[i]) if np.isfinite(sd[i]) else None,
-                                         "min": bnd[n][0], "max": bnd[n][1], "unit": HYST_PARAMETERS[n][1]}
-        elr = predicted_loss_ratios(processed, fitted, loop, model, order=order, eq19_factor=eq19_factor)
-        hyst_out = {
-            "law": hysteresis, "amplitude": "linear", "parameters": hp,
-            "energy_loss_ratio": elr,
-            "nrmse_branches": branch_nrmse(processed, fitted, loop, model, order=order, eq19_factor=eq19_factor),
-        }
+            i = unc.names.index(n)
+            field_, unit = HYST_PARAMETERS[n]
+            hp[n] = Parameter(n, field_, unit, float(unc.values[n]),
+                              float(unc.sd[i]) if np.isfinite(unc.sd[i]) else None, bnd[n][0], bnd[n][1], True,
+                              math.nan)
+        hyst = HysteresisFit(hysteresis, "linear", hp, [], math.nan)
+        loop = hyst.loop()
+        hyst.energy_loss_ratio = [LossRatio(**e) for e in predicted_loss_ratios(
+            processed, fitted, loop, model, order=order, eq19_factor=eq19_factor)]
+        hyst.nrmse_branches = branch_nrmse(processed, fitted, loop, model, order=order, eq19_factor=eq19_factor)
     return FitResult(
-        model=model, actuator=fitted, parameters=params, correlation=corr, correlation_names=user_names,
-        metrics=metrics, converged=converged, message=str(message), nfev=nfev, time_s=time.perf_counter() - t0,
-        flags=flags, autocorrelation=rho, hysteresis=hyst_out, loop=loop,
+        model=model, actuator=fitted, parameters=params, correlation=unc.corr, correlation_names=unc.names,
+        metrics=metrics, converged=converged, message=message, nfev=nfev, time_s=time_s,
+        flags=flags, autocorrelation=unc.rho, hysteresis=hyst,
     )
 
 
@@ -761,73 +906,3 @@ def branch_nrmse(processed, actuator: Actuator, loop, model: str = "energy", *, 
         num += (rm / float(r.blocked_moment[0])) ** 2 * kf
         den += kf
     return math.sqrt(num / den)
-
-
-# ------------------------------------------------------------------------------------------------
-# the bladder's uniaxial tension test
-# ------------------------------------------------------------------------------------------------
-@dataclass
-class TensionFit:
-    """Mooney-Rivlin constants from a uniaxial tension test (kPa), with standard errors."""
-
-    C10_kpa: float
-    C01_kpa: float
-    C10_se_kpa: float
-    C01_se_kpa: float
-    correlation: float
-    rmse_kpa: float
-    max_stretch: float
-    n_points: int
-    source: str = ""
-
-    def to_dict(self) -> dict:
-        return json_safe(self.__dict__.copy())
-
-
-def fit_tension(stretch, nominal_stress_mpa, *, source: str = "") -> TensionFit:
-    """Fit C10, C01 to uniaxial data: ``P = 2 (l - l^-2)(C10 + C01 / l)`` is linear in both.
-
-    Parameters
-    ----------
-    stretch : array of stretches l = 1 + dL / L_gauge (> 1 for the loading part).
-    nominal_stress_mpa : array of nominal stresses F / A0 (MPa).
-    """
-    lam = np.asarray(stretch, dtype=float)
-    sig = np.asarray(nominal_stress_mpa, dtype=float)
-    sel = np.isfinite(lam) & np.isfinite(sig) & (lam > 1.0 + 1e-6)
-    if sel.sum() < 3:
-        raise InputError(f"{source or 'tension data'}: fewer than 3 points in tension (stretch > 1)")
-    lam, sig = lam[sel], sig[sel]
-    g = 2.0 * (lam - lam**-2)
-    X = np.column_stack([g, g / lam])
-    coef, *_ = np.linalg.lstsq(X, sig, rcond=None)
-    r = sig - X @ coef
-    dof = max(sig.size - 2, 1)
-    cov = np.linalg.inv(X.T @ X) * float(r @ r) / dof
-    se = np.sqrt(np.diag(cov))
-    return TensionFit(
-        C10_kpa=float(coef[0] * 1e3), C01_kpa=float(coef[1] * 1e3), C10_se_kpa=float(se[0] * 1e3),
-        C01_se_kpa=float(se[1] * 1e3), correlation=float(cov[0, 1] / (se[0] * se[1])) if se.all() else math.nan,
-        rmse_kpa=float(math.sqrt(float(r @ r) / sig.size) * 1e3), max_stretch=float(lam.max()), n_points=int(sig.size),
-        source=source,
-    )
-
-
-def tension_from_test(raw, *, gauge_length_mm: float, area_mm2: float) -> TensionFit:
-    """Stretch and nominal stress from a raw tension export (:class:`~bendpam.lab.RawTest`).
-
-    Uses the loading part up to the maximum extension; stretch ``1 + extension / gauge_length``,
-    nominal stress ``force / area``.
-    """
-    for name, v in (("gauge length", gauge_length_mm), ("area", area_mm2)):
-        if not (math.isfinite(v) and v > 0):
-            raise InputError(f"tension specimen {name} = {v!r} must be > 0")
-    ext = raw.data["stroke_mm"].to_numpy()
-    f = raw.data["force_n"].to_numpy()
-    ext = ext - ext[0]
-    if np.median(f) < 0:
-        f = -f
-    if np.median(ext) < 0:
-        ext = -ext
-    i = int(np.argmax(ext))
-    return fit_tension(1.0 + ext[: i + 1] / gauge_length_mm, f[: i + 1] / area_mm2, source=str(raw.path))

@@ -40,6 +40,9 @@ does not stop the report: the page shows a note in its place, and the note is re
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import Any
+
 import base64
 import contextlib
 import datetime as _dt
@@ -349,6 +352,37 @@ class _Steps:
 # ------------------------------------------------------------------------------------------------
 # the report
 # ------------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Report:
+    """What :func:`build_report` made: the page, and the values shown on it.
+
+    Attributes
+    ----------
+    html : the report's path.  files : the raw files read.  inputs : what was read from each.
+    processed : the :class:`~bendpam.lab.processing.ProcessedSet`.  summary : its summary (Table 2).
+    fits : model name -> :class:`~bendpam.identify.FitResult`.
+    table2, table3 : the tables' rows as shown (formatted strings).
+    figures : ids of the figures embedded.  stresses : where the stress figure was drawn (or None).
+    notes : warnings shown on the page.  version : bendpam's version.  bytes : the page's size.
+    progress_shown : whether a progress display was drawn.
+    """
+
+    html: Path
+    files: list
+    inputs: list
+    processed: Any
+    summary: dict
+    fits: dict
+    table2: list
+    table3: list
+    figures: list
+    stresses: Any
+    notes: list
+    version: str
+    bytes: int
+    progress_shown: bool
+
+
 def build_report(
     inputs,
     actuator: Actuator,
@@ -471,7 +505,6 @@ def build_report(
         if want_stress:
             fb_act = fits["force_balance"].actuator
             top = processed.results[-1]
-            p_mpa = top.pressure_kpa * 1e-3
             k_mag = 0.5 * float(top.free_curvature[0])
             k_signed = (fb_act.bend_sign or 1) * k_mag
             stresses = {"pressure_kpa": top.pressure_kpa, "curvature_per_mm": k_signed}
@@ -481,7 +514,7 @@ def build_report(
                    f"Force-balance model (fitted actuator): bladder and braid stresses around the cross-section "
                    f"at P = {top.pressure_kpa:g} kPa, the highest tested pressure, and k' = {k_signed:.5g} 1/mm, "
                    f"half the measured free-bending curvature there (k' = bend_sign · |k|/2).",
-                   lambda: plots.plot_internal_stresses(fb_act, p_mpa, k_signed))
+                   lambda: plots.plot_internal_stresses(fb_act, top.pressure_kpa, k_signed))
 
         with steps.step(f"writing {out.name}"):
             inputs_info = [
@@ -495,22 +528,12 @@ def build_report(
                 notes=notes, version=bendpam.__version__,
             )
             atomic_write_text(out, page)
-    return {
-        "html": out,
-        "files": files,
-        "inputs": inputs_info,
-        "processed": processed,
-        "summary": summary,
-        "fits": fits,
-        "table2": table2_rows(summary),
-        "table3": table3_rows(fits),
-        "figures": [fid for fid, h in figures.items() if "<img " in h],
-        "stresses": stresses,
-        "notes": notes,
-        "version": bendpam.__version__,
-        "bytes": len(page.encode("utf-8")),
-        "progress_shown": steps.shown,
-    }
+    return Report(
+        html=out, files=files, inputs=inputs_info, processed=processed, summary=summary, fits=fits,
+        table2=table2_rows(summary), table3=table3_rows(fits),
+        figures=[fid for fid, h in figures.items() if "<img " in h], stresses=stresses, notes=notes,
+        version=bendpam.__version__, bytes=len(page.encode("utf-8")), progress_shown=steps.shown,
+    )
 
 
 def _render(*, actuator, processed, summary, fits, figures, inputs_info, fixture, options, free, stresses, notes,

@@ -28,7 +28,7 @@ ThickOpt = Annotated[Optional[float], typer.Option("--thickness-mm", help="Tensi
 
 def tension_fit(path: Path, gauge_length_mm, area_mm2, width_mm, thickness_mm):
     """Read and fit a tension test from the command-line options."""
-    from ..identify import tension_from_test
+    from ..tension import tension_from_test
     from ..lab import read_test
 
     positive("--gauge-length-mm", gauge_length_mm, "mm")
@@ -117,6 +117,8 @@ def fit_material(
     if as_json:
         typer.echo(text)
         return
-    typer.echo(f"C10 = {tf.C10_kpa:.1f} ± {tf.C10_se_kpa:.1f} kPa, C01 = {tf.C01_kpa:.1f} ± {tf.C01_se_kpa:.1f} kPa "
-               f"(correlation {tf.correlation:+.3f}, RMSE {tf.rmse_kpa:.2f} kPa, {tf.n_points} points up to "
-               f"stretch {tf.max_stretch:.3f})")
+    typer.echo(f"C10 = {tf.C10_kpa:.1f} ± {tf.se_C10_kpa:.1f} kPa, C01 = {tf.C01_kpa:.1f} ± {tf.se_C01_kpa:.1f} kPa "
+               f"(initial shear modulus {tf.shear_modulus_kpa:.1f} ± {tf.se_shear_modulus_kpa:.1f} kPa, correlation "
+               f"{tf.correlation:+.3f}, RMSE {tf.rmse_kpa:.2f} kPa, {tf.n_points} points, stretch "
+               f"{tf.stretch_min:.3f} to {tf.stretch_max:.3f})")
+    typer.echo(tf.identifiable)

@@ -86,15 +86,15 @@ def _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, m
     res = build_report(files, act, out, models=[m.value for m in models], free=free, pressure_kpa=pressures,
                        fixture=fx, progress=progress)
 
-    summ = res["summary"]
-    for row in res["table2"]:
+    summ = res.summary
+    for row in res.table2:
         typer.echo(f"{row['pressure_kpa']:>6} kPa  {row['cycles']} cycles  blocked {row['blocked_moment_nmm']} N·mm  "
                    f"free k' {row['free_curvature_per_mm']} 1/mm  loss {row['energy_loss_percent']} %")
     typer.echo(f"deadband: {_num(summ['deadband_kpa'], '.4g')} ± {_num(summ['deadband_se_kpa'], '.2g')} kPa")
-    for row in res["table3"]:
+    for row in res.table3:
         typer.echo(f"{row['model']}: alpha0 {row['alpha0']} deg, C10 {row['C10']} kPa, C01 {row['C01']} kPa; NRMSE "
                    f"cycles {row['nrmse_cycles']} %, blocked moment {row['nrmse_blocked_moment']} %, free curvature "
                    f"{row['nrmse_free_curvature']} %")
-    for note in res["notes"]:
+    for note in res.notes:
         typer.echo(f"bendpam: warning: {note}", err=True)
-    typer.echo(f"wrote {out} ({res['bytes'] / 1024:.0f} KiB, {len(res['figures'])} figures)")
+    typer.echo(f"wrote {out} ({res.bytes / 1024:.0f} KiB, {len(res.figures)} figures)")

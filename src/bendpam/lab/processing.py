@@ -523,6 +523,47 @@ class ProcessedSet:
         )
         return ds
 
+    def plot(self, title: str = ""):
+        """Figure 4 of the paper for this set (a matplotlib Figure; see :func:`bendpam.plots.figure4`)."""
+        from ..plots import figure4
+
+        return figure4(self, title)
+
+    def save(self, out_dir, *, figure: bool = True) -> dict[str, str]:
+        """Write ``curves.nc`` (xarray/NetCDF), ``curves.csv``, ``summary.json`` and ``figure4.png``.
+
+        Every file is written atomically.  Returns ``{name: path}`` of the files written.
+        """
+        import json
+        from pathlib import Path
+
+        from .._io import atomic_path, atomic_write_text, json_safe
+
+        out = Path(out_dir)
+        if out.exists() and not out.is_dir():
+            raise ProcessingError(f"{str(out)!r} exists and is not a folder")
+        out.mkdir(parents=True, exist_ok=True)
+        written = {}
+        ds = self.to_dataset()
+        with atomic_path(out / "curves.nc") as tmp:
+            ds.to_netcdf(tmp)
+        written["curves.nc"] = str(out / "curves.nc")
+        atomic_write_text(out / "curves.csv", self.to_frame().to_csv(index=False, float_format="%.10g"))
+        written["curves.csv"] = str(out / "curves.csv")
+        atomic_write_text(out / "summary.json", json.dumps(json_safe(self.summary()), indent=2, allow_nan=False))
+        written["summary.json"] = str(out / "summary.json")
+        if figure:
+            from ..plots import save_figure
+
+            save_figure(self.plot(), out / "figure4.png")
+            written["figure4.png"] = str(out / "figure4.png")
+        return written
+
+    @classmethod
+    def load(cls, path) -> ProcessedSet:
+        """Read what :meth:`save` wrote (the folder or its ``curves.nc``)."""
+        return load_processed(path)
+
     def to_frame(self) -> pd.DataFrame:
         """Tidy table of the resampled branches: pressure, cycle, branch, curvature, moment."""
         rows = []
@@ -576,34 +617,8 @@ def process_tests(tests, *, fixture: Fixture = PAPER_FIXTURE, options: Processin
 # outputs
 # ------------------------------------------------------------------------------------------------
 def write_processed(processed: ProcessedSet, out_dir, *, figure: bool = True) -> dict[str, str]:
-    """Write ``curves.nc`` (xarray/NetCDF), ``curves.csv``, ``summary.json`` and ``figure4.png``.
-
-    Every file is written atomically.  Returns ``{name: path}`` of the files written.
-    """
-    import json
-    from pathlib import Path
-
-    from .._io import atomic_path, atomic_write_text, json_safe
-
-    out = Path(out_dir)
-    if out.exists() and not out.is_dir():
-        raise ProcessingError(f"--out {str(out)!r} exists and is not a folder")
-    out.mkdir(parents=True, exist_ok=True)
-    written = {}
-    ds = processed.to_dataset()
-    with atomic_path(out / "curves.nc") as tmp:
-        ds.to_netcdf(tmp)
-    written["curves.nc"] = str(out / "curves.nc")
-    atomic_write_text(out / "curves.csv", processed.to_frame().to_csv(index=False, float_format="%.10g"))
-    written["curves.csv"] = str(out / "curves.csv")
-    atomic_write_text(out / "summary.json", json.dumps(json_safe(processed.summary()), indent=2))
-    written["summary.json"] = str(out / "summary.json")
-    if figure:
-        from ..plots import figure4, save_figure
-
-        save_figure(figure4(processed), out / "figure4.png")
-        written["figure4.png"] = str(out / "figure4.png")
-    return written
+    """Write ``curves.nc``, ``curves.csv``, ``summary.json`` (and ``figure4.png``): :meth:`ProcessedSet.save`."""
+    return processed.save(out_dir, figure=figure)
 
 
 def load_processed(path) -> ProcessedSet:
@@ -622,6 +637,9 @@ def load_processed(path) -> ProcessedSet:
     need = {"moment_nmm", "blocked_moment_cycle_nmm", "free_curvature_cycle_per_mm", "energy_loss_ratio_cycle"}
     if not need <= set(ds.data_vars):
         raise ProcessingError(f"{nc}: not a bendpam processed-curves file (missing {sorted(need - set(ds.data_vars))})")
+    missing = [k for k in ("fixture_d_mm", "fixture_r_mm", "fixture_t_mm", "L0_mm") if k not in ds.attrs]
+    if missing:
+        raise ProcessingError(f"{nc}: not a bendpam processed-curves file (attribute(s) {', '.join(missing)} missing)")
     fx = Fixture(ds.attrs["fixture_d_mm"], ds.attrs["fixture_r_mm"], ds.attrs["fixture_t_mm"], ds.attrs["L0_mm"])
     results = []
     sources = str(ds.attrs.get("sources", "")).split("; ")
