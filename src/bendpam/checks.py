@@ -31,8 +31,8 @@ class UnitWarning(UserWarning):
 
 
 def _range_text(lo, hi, lo_open, hi_open) -> str:
-    lo_s = "(" if lo_open else "["
-    hi_s = ")" if hi_open else "]"
+    lo_s = "(" if lo_open or lo is None else "["
+    hi_s = ")" if hi_open or hi is None else "]"
     return f"{lo_s}{'-inf' if lo is None else f'{lo:g}'}, {'inf' if hi is None else f'{hi:g}'}{hi_s}"
 
 
