@@ -7,7 +7,7 @@ the same values in the package's internal units: mm, MPa (N/mm^2), N*mm, radians
 The deadband and prestrain corrections of section 3.3 are part of the description: the bladder is
 stress-free at ``P_start`` with outer radius ``R0_start`` and thickness ``t0_start`` given by eq 51-52
 (constant bladder cross-section area, constant length).  Both models use ``R0_start`` and
-``t0_start`` in place of ``R0`` and ``t0`` everywhere (NOTES.md item 11).
+``t0_start`` in place of ``R0`` and ``t0`` everywhere (docs/paper-reading.md item 13).
 """
 
 from __future__ import annotations

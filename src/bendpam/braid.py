@@ -1,4 +1,4 @@
-r"""Braid kinematics of a bending PAM (paper eq 1-5, with NOTES.md items 1-3).
+r"""Braid kinematics of a bending PAM (paper eq 1-5, with docs/paper-reading.md items 1-4).
 
 Coordinates: ``Phi = 0`` lies at the frame; the distance of a point of the braid circle from the
 frame is ``h = R (1 - cos Phi)`` with ``R`` the *deformed* radius.  With the frame curvature
@@ -372,7 +372,7 @@ class Kinematics:
     angle : theta = k' L0 (rad).
     axis_length : L = L0 (1 + k'R) (mm).
     mean_axial_stretch : lambda1_bar = 1 + k'R (eq 39).
-    mean_thickness : t_bar = t0_start / (lambda1_bar eta) (mm), eq 40 with NOTES.md item 10.
+    mean_thickness : t_bar = t0_start / (lambda1_bar eta) (mm), eq 40 with docs/paper-reading.md item 12.
     phi : quadrature angles (rad), shape (n,).
     weights : circle-mean weights, shape (n,).
     lambda1 : axial stretch around the section (eq 3/34), shape S + (n,).

@@ -6,7 +6,7 @@ and the connecting plates at the actuator's ends pitch by ``beta``.  With the ho
 
 * eq 6:  ``d tan(beta) + (sqrt(1 + tan^2 beta) - 1)(t + 2r) = ds``
 * eq 7:  ``M = F [d + (2r + t) sin(beta)] / (2 cos^2 beta)``   ("2 cos beta^2" read as 2 cos^2 beta,
-  NOTES.md item 14)
+  docs/paper-reading.md item 16)
 * eq 8:  ``k' = 2 beta / L0``
 
 The left side of eq 6 increases monotonically on ``[0, pi/2)`` from 0 to infinity, so each stroke

@@ -86,7 +86,7 @@ class MomentLaw:
         ``"force-balance"`` is accepted too.
     eq19_factor : bool
         Energy model only: keep eq 19's ``(1 + k'R)`` factor (default, as printed; see
-        docs/paper-reading.md).  Ignored by the force-balance model, which has no such factor.
+        docs/paper-reading.md item 7).  Ignored by the force-balance model, which has no such factor.
     order : int
         Gauss-Legendre nodes on [0, pi] for the section integrals (default 32).
 

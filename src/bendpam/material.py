@@ -1,7 +1,7 @@
 """Incompressible Mooney-Rivlin bladder material (paper eq 18, 32-33).
 
 The strain-energy density, with the paper's misprint in eq 18 read as ``(I2 - 3)``
-(see ``shared/paper/NOTES.md`` item 6) and ``C11 = 0``::
+(docs/paper-reading.md item 8) and ``C11 = 0``::
 
     W = C10 (I1 - 3) + C01 (I2 - 3)
 

@@ -8,7 +8,7 @@ the units a user types:
   A set of pressures whose every nonzero value is below 5 kPa raises a
   :class:`~bendpam.checks.UnitWarning` (MPa passed as kPa?).
 * curvature ``curvature_per_mm``: the frame curvature k', 1/mm, positive toward the frame.  BE-PAMs
-  bend freely with k' > 0, BC-PAMs with k' < 0 (docs/paper-reading.md).
+  bend freely with k' > 0, BC-PAMs with k' < 0 (docs/paper-reading.md item 17).
 * moments: N*mm; stiffness dM/dk': N*mm^2.
 
 All functions broadcast pressure against curvature and share the cached law of the actuator
@@ -119,7 +119,7 @@ def blocked_moment(actuator: Actuator, pressure_kpa, model: str = "energy", *, e
     """Blocked moment ``M(P, 0)`` in N*mm.
 
     Both models reduce to ``pi R0_start^3 (1 - 2 cot^2 alpha0) max(P - P_start, 0)`` at k' = 0
-    (docs/paper-reading.md); the result is negative for a BC-PAM.
+    (docs/paper-reading.md item 14); the result is negative for a BC-PAM.
 
     >>> import bendpam
     >>> round(float(bendpam.blocked_moment(bendpam.presets.be_pam(), 200.0)), 1)

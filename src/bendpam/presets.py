@@ -3,7 +3,7 @@
 ``be_pam(model="energy")`` and ``bc_pam(model="force_balance")`` etc. return an
 :class:`~bendpam.actuator.Actuator`.  The geometry is shared (Table 1, merged cells); each model has
 its own identified braid angle and Mooney-Rivlin constants (Table 3; the unit "kPa^-1" is read as
-kPa, NOTES.md item 6).  P_start is 68 kPa for the BE-PAM and 32 kPa for the BC-PAM (NOTES.md 13).
+kPa, docs/paper-reading.md item 8).  P_start is 68 kPa for the BE-PAM and 32 kPa for the BC-PAM (docs/paper-reading.md item 15).
 """
 
 from __future__ import annotations

@@ -6,18 +6,18 @@ angle ``theta = k' L0``::
     M_load = M_air - M_bl - M_f                                                   (eq 15, 21)
 
 * ``M_air = P dV/dtheta = pi P [(2R + 3 k' R^2) dR/dk' + R^3]``  (eq 13, with the printed ``k``
-  read as ``k'``, NOTES.md item 4).  It follows from ``V = pi R^2 L0 (1 + k'R)``.
+  read as ``k'``, docs/paper-reading.md item 5).  It follows from ``V = pi R^2 L0 (1 + k'R)``.
 * ``M_f = E_f I_f k'`` (eq 16).
 * ``M_bl = (1 + k'R) dU_bl/dk'`` (eq 19) with ``U_bl`` the bladder's stored energy per unit
   reference length, ``U_bl = \int_A W(lambda1(Phi), lambda2) dA`` over the reference annulus.  The
   bladder's hoop stretch ``lambda2 = R/R0`` is uniform (eq 17), so material and spatial angles
   coincide and ``U_bl = A_bl * mean_Phi W``.  ``dU_bl/dk'`` is the *total* derivative: it includes
-  the ``dR/dk'`` terms through both stretches (NOTES.md item 5).
+  the ``dR/dk'`` terms through both stretches (docs/paper-reading.md item 6).
 
   The factor ``(1 + k'R)`` is kept as printed (``eq19_factor=True``, the default); a strict reading
   of ``dU/dtheta = (1/L0) dU/dk'`` per unit reference length has no such factor, so it can be
   switched off (``eq19_factor=False``).  Dropping it moves the BE-PAM's free-bending angle at
-  200 kPa by about 15 deg (tested).
+  200 kPa by about 18 deg (tested).
 
 With the corrections of section 3.3 (eq 50-52), ``P`` is the active pressure ``max(P - P_start, 0)``
 and ``R0, t0`` are ``R0_start, t0_start``.  ``M`` is affine in the active pressure::

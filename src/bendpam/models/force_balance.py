@@ -7,7 +7,7 @@ Axial moment balance of a unit body about the frame (eq 23, 28)::
 * ``M_p = pi R^3 P`` as in eq 49.  Eq 49 writes ``pi R^3 P`` for the pressure term instead of eq
   26's ``pi (R - t)^2 P R``; the difference is the hydrostatic part ``-P`` of the bladder's axial
   stress acting over the wall (``pi R (R-t)^2 + 2 pi R^2 t ~ pi R^3``).  We follow eq 49 and
-  therefore leave ``-P`` out of the bladder term (NOTES.md item 7).
+  therefore leave ``-P`` out of the bladder term (docs/paper-reading.md item 9).
 * ``M_frame = E_f I_f k'`` (eq 27).
 * ``M_bl = \int sigma_bl,1^el h dA`` with ``h = R (1 - cos Phi)``, ``dA = t_bar R dPhi`` and the
   elastic part of eq 43::
@@ -15,14 +15,14 @@ Axial moment balance of a unit body about the frame (eq 23, 28)::
       sigma_bl,1^el(Phi) = 2C10 (lambda1^2 - 1/(lbar^2 eta^2)) - 2C01 (1/lambda1^2 - lbar^2 eta^2)
 
   where ``lbar = 1 + k'R`` (eq 39), ``eta = R/R0`` and ``t_bar = t0 / (lbar eta)`` (eq 40,
-  NOTES.md item 10).  Its Phi-independent part integrates to
+  docs/paper-reading.md item 12).  Its Phi-independent part integrates to
   ``-2 pi R^2 t_bar (2C10/(lbar^2 eta^2) - 2C01 lbar^2 eta^2)``, so in ``M_load`` it enters with a
-  *plus* sign.  Eq 49 prints a minus: a misprint (NOTES.md item 8).  With the sign derived here the
+  *plus* sign.  Eq 49 prints a minus: a misprint (docs/paper-reading.md item 10).  With the sign derived here the
   C10 and C01 terms cancel at ``k' = 0`` and both models give the same blocked moment.
 * ``M_br = \int sigma_br,1 h dA_br``.  The braid hoop stress is ``sigma_br,2 = P_e R / t_br``
   (eq 31), the fibre angle gives ``sigma_br,1 / sigma_br,2 = cot^2 alpha`` with
   ``cot^2 alpha = c^2 lambda1^2 / (1 - c^2 lambda1^2)`` (eq 46-47; alpha is measured from the axis,
-  NOTES.md item 9) and the interfacial pressure is eq 45::
+  docs/paper-reading.md item 11) and the interfacial pressure is eq 45::
 
       P_e R = P (R - t_bar) - sigma_bl,2 t_bar = P R - sigma_bl,2^el t_bar
 
