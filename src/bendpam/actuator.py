@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 import tomli_w
 
-from ._io import atomic_write_text
+from .atomic import atomic_write_text
 from .checks import number
 from .errors import FileFormatError, InputError
 from .material import MooneyRivlin

@@ -61,7 +61,7 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import least_squares, lsq_linear
 
-from ._io import atomic_write_text, json_safe
+from .atomic import atomic_write_text, json_safe
 from .actuator import NEUTRAL_ANGLE_DEG, Actuator
 from .law import MomentLaw
 from .models import normalise_model

@@ -16,7 +16,7 @@ if not os.environ.get("MPLBACKEND"):
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from ._io import atomic_path  # noqa: E402
+from .atomic import atomic_path  # noqa: E402
 from .braid import curvature_limits  # noqa: E402
 from .errors import InputError  # noqa: E402
 from .predict import active_pressure_kpa, free_curvature, internal_stresses, moment  # noqa: E402

@@ -55,7 +55,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ._io import atomic_write_text
+from .atomic import atomic_write_text
 from .actuator import Actuator
 from .fixture import PAPER_FIXTURE, Fixture
 from .presets import normalise_model

@@ -66,16 +66,14 @@ def main(argv: list[str] | None = None) -> int:
     if not args:
         args = ["--help"]
     debug = "--debug" in args
+    from ..outputs import Interrupted, interrupts
+
     try:
-        from ..outputs import interrupts
-    except ImportError:  # pragma: no cover
-        interrupts = None
-    try:
-        if interrupts is not None:
-            with interrupts():
-                app(args=args, prog_name="bendpam", standalone_mode=False)
-        else:  # pragma: no cover
+        with interrupts():
             app(args=args, prog_name="bendpam", standalone_mode=False)
+    except Interrupted as exc:
+        typer.echo("bendpam: interrupted; no outputs were changed", err=True)
+        return exc.exit_code
     except typer.Exit as exc:
         return exc.exit_code
     except (typer.Abort, KeyboardInterrupt):
@@ -96,10 +94,6 @@ def main(argv: list[str] | None = None) -> int:
         typer.echo(f"bendpam: error: {exc.strerror or _one_line(exc)}{where}", err=True)
         return 2
     except BaseException as exc:  # noqa: BLE001 - the last line of defence
-        code = getattr(exc, "exit_code", None)
-        if type(exc).__name__ == "Interrupted" and isinstance(code, int):
-            typer.echo("bendpam: interrupted; no outputs were changed", err=True)
-            return code
         if isinstance(exc, SystemExit):
             raise
         if debug:

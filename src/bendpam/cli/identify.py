@@ -17,6 +17,7 @@ from .options import (
     UserError,
     load_actuator,
     model_name,
+    output_set,
     positive,
 )
 
@@ -69,7 +70,6 @@ def fit(
     as_json: Annotated[bool, typer.Option("--json", help="Print fit.json to stdout.")] = False,
 ):
     """Identify model parameters (alpha0, C10, C01, ...) from processed cyclic tests (section 3.4)."""
-    from .._io import atomic_write_text
     from ..identify import fit as run_fit
     from ..lab.processing import load_processed
     from ..plots import figure7, save_figure
@@ -81,12 +81,13 @@ def fit(
     tfit = tension_fit(tension, gauge_length_mm, area_mm2, width_mm, thickness_mm) if tension else None
     res = run_fit(data, act, model_name(model), free=free, tension=tfit, fit_range=fit_range,
                   hysteresis=hysteresis_law if hysteresis else None)
-    res.save(out)
-    if tfit is not None:
-        obj = json.loads((out / "fit.json").read_text())
-        obj["tension"] = tfit.to_dict()
-        atomic_write_text(out / "fit.json", json.dumps(obj, indent=2))
-    save_figure(figure7(data, res), out / "figure7.png")
+    with output_set(out, [processed_dir, actuator, tension]) as o:
+        res.save(o.staging)
+        if tfit is not None:
+            obj = json.loads((o.staging / "fit.json").read_text())
+            obj["tension"] = tfit.to_dict()
+            o.write_json("fit.json", obj)
+        save_figure(figure7(data, res), o.path("figure7.png"))
     if as_json:
         typer.echo((out / "fit.json").read_text())
         return
@@ -105,15 +106,13 @@ def fit_material(
     as_json: Annotated[bool, typer.Option("--json", help="Print the result as JSON.")] = False,
 ):
     """Fit Mooney-Rivlin C10, C01 to a uniaxial tension test of the bladder material."""
-    from .._io import atomic_write_text
-
     if not tension_file.exists():
         raise UserError(f"{tension_file}: no such file")
     tf = tension_fit(tension_file, gauge_length_mm, area_mm2, width_mm, thickness_mm)
-    text = json.dumps(tf.to_dict(), indent=2)
+    text = json.dumps(tf.to_dict(), indent=2, allow_nan=False)
     if out is not None:
-        out.mkdir(parents=True, exist_ok=True)
-        atomic_write_text(out / "tension_fit.json", text)
+        with output_set(out, [tension_file]) as o:
+            o.write_text("tension_fit.json", text)
     if as_json:
         typer.echo(text)
         return

@@ -21,6 +21,7 @@ from .options import (
     fmt_num,
     load_actuator,
     model_name,
+    output_set,
     parse_values,
     pressures_kpa,
 )
@@ -50,7 +51,7 @@ def process(
     """Process raw four-point-bending cyclic tests into moment-curvature curves and Table 2 values."""
     from ..fixture import Fixture
     from ..lab import read_test
-    from ..lab.processing import ProcessingOptions, process_tests, write_processed
+    from ..lab.processing import ProcessingOptions, process_tests
 
     if out is None:
         raise UserError("give an output folder with --out OUTDIR")
@@ -66,9 +67,10 @@ def process(
     fx = Fixture.from_string(fixture, L0_mm=l0_mm)
     opts = ProcessingOptions(cutoff_hz=cutoff_hz, reversal_fraction=reversal_fraction, grid_points=grid_points,
                              tare_n=tare_n)
-    tests = [read_test(f, pressure_kpa=pressures[i] if pressures else None) for i, f in enumerate(files)]
-    processed = process_tests(tests, fixture=fx, options=opts)
-    write_processed(processed, out, figure=figure)
+    with output_set(out, inputs) as o:
+        tests = [read_test(f, pressure_kpa=pressures[i] if pressures else None) for i, f in enumerate(files)]
+        processed = process_tests(tests, fixture=fx, options=opts)
+        processed.save(o.staging, figure=figure)
     if as_json:
         typer.echo((out / "summary.json").read_text())
         return
@@ -125,8 +127,6 @@ def simulate_test_cmd(
 
     if out is None:
         raise UserError("give an output folder with --out DIR")
-    if out.exists() and not out.is_dir():
-        raise UserError(f"--out {str(out)!r} exists and is not a folder")
     act = load_actuator(preset, actuator, model)
     P = pressures_kpa(pressure_kpa, more)
     st = SimulationSettings(cycles=cycles, speed_mm_min=speed_mm_min, rate_hz=rate_hz, noise_n=noise_n,
@@ -135,7 +135,8 @@ def simulate_test_cmd(
                             hysteresis_offset_nmm=hysteresis_offset_nmm, dwell_s=dwell_s,
                             stroke_offset_mm=stroke_offset_mm, seed=seed)
     fx = Fixture.from_string(fixture, L0_mm=act.L0_mm)
-    truth = simulate_tests(act, P, out, model_name(model), dialect=fmt.value, fixture=fx, settings=st)
+    with output_set(out, [actuator]) as o:
+        truth = simulate_tests(act, P, o.staging, model_name(model), dialect=fmt.value, fixture=fx, settings=st)
     for t in truth["pressures"]:
         typer.echo(
             f"{t['file']}: {t['samples']} samples, blocked {t['blocked_moment_nmm']:.2f} N·mm, "

@@ -162,6 +162,28 @@ def collect_raw_files(paths: list[Path]) -> list[Path]:
     return collect(paths)
 
 
+def command_line() -> list[str]:
+    """The command line, for the manifests of output sets."""
+    import sys
+
+    return ["bendpam", *sys.argv[1:]]
+
+
+def output_set(out: Path, inputs=()):
+    """An :class:`~bendpam.outputs.OutputSet` for a command's output folder (whole set or nothing)."""
+    from ..outputs import OutputSet
+
+    return OutputSet(out, inputs=[p for p in inputs if p is not None], command=command_line())
+
+
+def output_file(out: Path, inputs=()):
+    """An :class:`~bendpam.outputs.OutputFile` for a command's single output file."""
+    from ..outputs import OutputFile
+
+    out.parent.mkdir(parents=True, exist_ok=True)
+    return OutputFile(out, inputs=[p for p in inputs if p is not None], command=command_line())
+
+
 def positive(name: str, value: float | None, unit: str) -> float | None:
     """A numeric option that must be > 0 (None passes)."""
     if value is None:

@@ -24,6 +24,7 @@ from .options import (
     format_prediction_table,
     load_actuator,
     model_name,
+    output_file,
     pressures_kpa,
 )
 
@@ -51,7 +52,7 @@ def predict(
     loop_angle_deg: Annotated[Optional[float], typer.Option("--loop-angle-deg", help="Loop angle (deg).")] = None,
 ):
     """Blocked moment and free bending curvature/angle at each pressure (and, with --cycle, the loop)."""
-    from .._io import json_safe
+    from ..atomic import json_safe
     from ..law import MomentLaw
     from ..predict import prediction_table
 
@@ -142,8 +143,6 @@ def curve(
     points: Annotated[int, typer.Option("--points", min=2, max=100000, help="Curvature points per curve.")] = 200,
 ):
     """Moment-curvature curves M(P, k') as CSV or a figure."""
-    from .._io import atomic_write_text
-
     if out is None:
         raise UserError("give an output file with --out FILE.csv or --out FILE.png")
     suffix = out.suffix.lower()
@@ -156,19 +155,20 @@ def curve(
     mname = model_name(model)
     from ..plots import moment_curves, plot_moment_curvature, save_figure
 
-    if suffix == ".csv":
-        k, M = moment_curves(act, P, mname, k_max, points)
-        rows = ["pressure_kpa,curvature_per_mm,moment_nmm"]
-        for i, p in enumerate(P):
-            rows.extend(f"{p:.10g},{kk:.12g},{mm:.12g}" for kk, mm in zip(k, M[i]))
-        atomic_write_text(out, "\n".join(rows) + "\n")
-    else:
-        import matplotlib.pyplot as plt
+    with output_file(out, [actuator]) as f:
+        if suffix == ".csv":
+            k, M = moment_curves(act, P, mname, k_max, points)
+            rows = ["pressure_kpa,curvature_per_mm,moment_nmm"]
+            for i, p in enumerate(P):
+                rows.extend(f"{p:.10g},{kk:.12g},{mm:.12g}" for kk, mm in zip(k, M[i], strict=True))
+            f.write_text("\n".join(rows) + "\n")
+        else:
+            import matplotlib.pyplot as plt
 
-        fig, ax = plt.subplots(figsize=(6.5, 4.5))
-        plot_moment_curvature(ax, act, P, mname, k_max, points)
-        fig.tight_layout()
-        save_figure(fig, out)
+            fig, ax = plt.subplots(figsize=(6.5, 4.5))
+            plot_moment_curvature(ax, act, P, mname, k_max, points)
+            fig.tight_layout()
+            save_figure(fig, f.path)
     typer.echo(f"wrote {out}")
 
 
@@ -181,7 +181,6 @@ def stresses(
     out: Annotated[Optional[Path], typer.Option("--out", help="Figure (.png/.pdf/.svg) or data (.nc/.csv).")] = None,
 ):
     """Force-balance internal stresses around the cross-section (eq 37-48)."""
-    from .._io import atomic_path, atomic_write_text
     from ..predict import internal_stresses
 
     act = load_actuator(preset, actuator, Model.force_balance)
@@ -190,19 +189,17 @@ def stresses(
     if out is None:
         raise UserError("give an output file with --out FILE.png (figure), FILE.nc or FILE.csv (data)")
     suffix = out.suffix.lower()
-    if suffix in FIGURE_SUFFIXES:
-        from ..plots import plot_internal_stresses, save_figure
-
-        save_figure(plot_internal_stresses(act, pressure_kpa, curvature), out)
-    elif suffix == ".nc":
-        ds = internal_stresses(act, pressure_kpa, curvature)
-        with atomic_path(out) as tmp:
-            ds.to_netcdf(tmp)
-    elif suffix == ".csv":
-        ds = internal_stresses(act, pressure_kpa, curvature)
-        atomic_write_text(out, ds.to_dataframe().to_csv())
-    else:
+    if suffix not in FIGURE_SUFFIXES | {".nc", ".csv"}:
         raise UserError(f"--out {str(out)!r}: unknown format {suffix or '(none)'}; use .png, .pdf, .svg, .nc or .csv")
+    with output_file(out, [actuator]) as f:
+        if suffix in FIGURE_SUFFIXES:
+            from ..plots import plot_internal_stresses, save_figure
+
+            save_figure(plot_internal_stresses(act, pressure_kpa, curvature), f.path)
+        elif suffix == ".nc":
+            internal_stresses(act, pressure_kpa, curvature).to_netcdf(f.path)
+        else:
+            f.write_text(internal_stresses(act, pressure_kpa, curvature).to_dataframe().to_csv())
     typer.echo(f"wrote {out}")
 
 
@@ -219,7 +216,8 @@ def actuator_cmd(
     act = load_actuator(preset, actuator, model)
     text = act.to_toml()
     if out is not None:
-        act.to_toml(out)
+        with output_file(out, [actuator]) as f:
+            f.write_text(text)
         typer.echo(f"wrote {out}")
         return
     lim = curvature_limits(act)
@@ -253,6 +251,6 @@ def demo(
             if br.kind == "fold":
                 typer.echo(f"fold: no free-bending equilibrium above {br.max_pressure_kpa:.4g} kPa")
             items.append((act, np.asarray(P, dtype=float), mname))
-    out.parent.mkdir(parents=True, exist_ok=True)
-    save_figure(demo_figure(items), out)
+    with output_file(out) as f:
+        save_figure(demo_figure(items), f.path)
     typer.echo(f"\nwrote {out}  ({time.perf_counter() - t0:.1f} s)")

@@ -56,7 +56,7 @@ def register(app: typer.Typer) -> None:
 def _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, model, progress) -> None:
     from ..fixture import Fixture
     from ..report import build_report
-    from .options import Model, UserError, collect_raw_files, load_actuator, parse_values
+    from .options import Model, UserError, collect_raw_files, load_actuator, output_file, parse_values
     from .options import fmt_num as _num
 
     if out is None:
@@ -83,8 +83,9 @@ def _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, m
             f"--pressure-kpa: got {len(pressures)} pressure(s) for {len(files)} file(s); give one per file, in order"
         )
     fx = Fixture.from_string(fixture, L0_mm=act.L0_mm if l0_mm is None else l0_mm)
-    res = build_report(files, act, out, models=[m.value for m in models], free=free, pressure_kpa=pressures,
-                       fixture=fx, progress=progress)
+    with output_file(out, [*files, actuator]) as f:
+        res = build_report(files, act, f.path, models=[m.value for m in models], free=free, pressure_kpa=pressures,
+                           fixture=fx, progress=progress)
 
     summ = res.summary
     for row in res.table2:

@@ -19,6 +19,7 @@ from .options import (
     UserError,
     load_actuator,
     model_name,
+    output_file,
     parse_values,
 )
 
@@ -65,7 +66,6 @@ def sweep_cmd(
     progress: Annotated[bool, typer.Option("--progress/--no-progress", help="Progress bar.")] = True,
 ):
     """Design sweep: actuator parameters crossed with pressures (in-process or on Dask)."""
-    from .._io import atomic_path
     from ..sweeps import SWEEP_PARAMETERS, sweep
 
     if out is None and plot is None:
@@ -91,11 +91,12 @@ def sweep_cmd(
     ds = sweep(act, P, model_name(model), chunk_cases=chunk_cases, scheduler=scheduler, workers=workers,
                progress=progress and sys.stderr.isatty(), **{k: np.asarray(v) for k, v in params.items()})
     if out is not None:
-        with atomic_path(out) as tmp:
-            ds.to_netcdf(tmp)
+        with output_file(out, [actuator]) as f:
+            ds.to_netcdf(f.path)
         typer.echo(f"wrote {out} ({' x '.join(f'{d}={n}' for d, n in ds.sizes.items())})")
     if plot is not None:
         from ..plots import save_figure, sweep_figure
 
-        save_figure(sweep_figure(ds, plot_var, plot_x, plot_y), plot)
+        with output_file(plot, [actuator]) as f:
+            save_figure(sweep_figure(ds, plot_var, plot_x, plot_y), f.path)
         typer.echo(f"wrote {plot}")

@@ -537,7 +537,7 @@ class ProcessedSet:
         import json
         from pathlib import Path
 
-        from .._io import atomic_path, atomic_write_text, json_safe
+        from ..atomic import atomic_path, atomic_write_text, json_safe
 
         out = Path(out_dir)
         if out.exists() and not out.is_dir():

@@ -32,7 +32,7 @@ import numpy as np
 import pandas as pd
 from scipy.optimize import brentq
 
-from .._io import atomic_write_text
+from ..atomic import atomic_write_text
 from ..fixture import PAPER_FIXTURE, Fixture
 from ..hysteresis import LAWS, make_law
 from ..braid import curvature_limits

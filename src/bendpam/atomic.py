@@ -12,12 +12,13 @@ import os
 import tempfile
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 __all__ = ["atomic_path", "atomic_write_text", "atomic_write_bytes", "json_safe"]
 
 # mkstemp creates files readable by the owner only; outputs get the usual permissions instead
-_UMASK = os.umask(0)
-os.umask(_UMASK)
+UMASK = os.umask(0)
+os.umask(UMASK)
 
 
 @contextlib.contextmanager
@@ -37,7 +38,7 @@ def atomic_path(path: str | os.PathLike, suffix: str | None = None) -> Iterator[
     try:
         yield tmp_path
         if tmp_path.exists():
-            os.chmod(tmp_path, 0o666 & ~_UMASK)
+            os.chmod(tmp_path, 0o666 & ~UMASK)
         os.replace(tmp_path, target)
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
@@ -57,14 +58,36 @@ def atomic_write_bytes(path: str | os.PathLike, data: bytes) -> None:
         tmp.write_bytes(data)
 
 
-def json_safe(obj):
-    """``obj`` with NumPy scalars made plain and non-finite floats made ``None`` (JSON ``null``)."""
+def json_safe(obj: Any) -> Any:
+    """``obj`` made fit for strict JSON (``json.dumps(..., allow_nan=False)``).
+
+    NumPy scalars become plain Python numbers and NumPy arrays nested lists;
+    non-finite floats (NaN, +-inf) become ``None`` (JSON ``null``); tuples become
+    lists; paths become strings; NumPy mapping keys become plain, non-finite float
+    keys strings.  Anything else is returned unchanged (``json.dumps`` decides).
+    """
     if isinstance(obj, dict):
-        return {k: json_safe(v) for k, v in obj.items()}
+        return {_json_key(k): json_safe(v) for k, v in obj.items()}
     if isinstance(obj, list | tuple):
         return [json_safe(v) for v in obj]
-    if hasattr(obj, "item") and not isinstance(obj, str | bytes):  # NumPy scalars
+    if isinstance(obj, str | bytes):
+        return obj
+    if isinstance(obj, os.PathLike):
+        return os.fspath(obj)
+    if hasattr(obj, "tolist") and getattr(obj, "ndim", 0) > 0:  # arrays, not 0-d
+        return json_safe(obj.tolist())
+    if hasattr(obj, "item"):  # NumPy scalars and 0-d arrays
         obj = obj.item()
     if isinstance(obj, float):
         return obj if math.isfinite(obj) else None
     return obj
+
+
+def _json_key(key: Any) -> Any:
+    if hasattr(key, "item") and not isinstance(key, str | bytes):
+        key = key.item()
+    if isinstance(key, float) and not math.isfinite(key):
+        return str(key)
+    if isinstance(key, os.PathLike):
+        return os.fspath(key)
+    return key
