@@ -225,7 +225,7 @@ def test_normal_set_and_manifest(tmp_path):
         assert entry["size"] == p.stat().st_size
         assert entry["sha256"] == sha(p.read_bytes())
     only(out_dir.parent, "out")
-    assert oct(out_dir.stat().st_mode & 0o777) == oct(0o777 & ~outputs._UMASK)
+    assert oct(out_dir.stat().st_mode & 0o777) == oct(0o777 & ~outputs.UMASK)
 
 
 def test_command_argument_and_empty_set(tmp_path):
@@ -687,7 +687,7 @@ def test_output_file(tmp_path):
         f.path.write_text("a,b\n1,2\n")
         assert not target.exists()
     assert target.read_text() == "a,b\n1,2\n"
-    assert oct(target.stat().st_mode & 0o777) == oct(0o666 & ~outputs._UMASK)
+    assert oct(target.stat().st_mode & 0o777) == oct(0o666 & ~outputs.UMASK)
     target.chmod(0o640)
     with OutputFile(target) as f:
         f.write_json({"x": float("nan")})

@@ -27,6 +27,44 @@ from .options import (
 )
 
 FixtureOpt = Annotated[str, typer.Option("--fixture", help="Fixture geometry d,r,t in mm.")]
+ColumnsOpt = Annotated[Optional[str], typer.Option(
+    "--columns", metavar="time=NAME,stroke=NAME,force=NAME",
+    help="Choose the file's channels by name (any of time, stroke, force); default: chosen and reported by the reader.")]
+RateOpt = Annotated[Optional[float], typer.Option(
+    "--rate-hz", help="Sampling rate (Hz) for a file without a time column (default: from its metadata).")]
+RepairOpt = Annotated[bool, typer.Option(
+    "--repair", help="Remove isolated spikes and non-increasing samples (reported) instead of refusing the file.")]
+
+
+@app.command()
+def inspect(
+    files: Annotated[list[Path], typer.Argument(help="Raw test files (or folders of them).", show_default=False)],
+    pressure_kpa: Annotated[Optional[float], typer.Option("--pressure-kpa", help="Pressure (kPa) to report.")] = None,
+    columns: ColumnsOpt = None,
+    rate_hz: RateOpt = None,
+    repair: RepairOpt = False,
+    as_json: Annotated[bool, typer.Option("--json", help="Print a JSON list, one object per file.")] = False,
+):
+    """What the reader understood of each file (format, encoding, channels, units, values), before processing."""
+    import json
+
+    from ..lab import format_inspection, inspect_file
+    from ..outputs import json_safe
+
+    paths = collect_raw_files(files)
+    infos = [inspect_file(p, pressure_kpa=pressure_kpa, columns=columns, rate_hz=rate_hz, repair=repair)
+             for p in paths]
+    if as_json:
+        typer.echo(json.dumps(json_safe(infos), indent=2, allow_nan=False, ensure_ascii=False))
+    else:
+        for info in infos:
+            typer.echo(format_inspection(info))
+            typer.echo("")
+    bad = [i for i in infos if "error" in i]
+    if bad:
+        for i in bad:
+            typer.echo(f"bendpam: error: {i['error']}", err=True)
+        raise typer.Exit(2)
 
 
 @app.command()
@@ -46,6 +84,9 @@ def process(
     grid_points: Annotated[int, typer.Option("--grid-points", min=5, max=100000,
                                              help="Points of the common curvature grid.")] = 101,
     figure: Annotated[bool, typer.Option("--figure/--no-figure", help="Write figure4.png.")] = True,
+    columns: ColumnsOpt = None,
+    rate_hz: RateOpt = None,
+    repair: RepairOpt = False,
     as_json: Annotated[bool, typer.Option("--json", help="Print summary.json to stdout.")] = False,
 ):
     """Process raw four-point-bending cyclic tests into moment-curvature curves and Table 2 values."""
@@ -68,7 +109,8 @@ def process(
     opts = ProcessingOptions(cutoff_hz=cutoff_hz, reversal_fraction=reversal_fraction, grid_points=grid_points,
                              tare_n=tare_n)
     with output_set(out, inputs) as o:
-        tests = [read_test(f, pressure_kpa=pressures[i] if pressures else None) for i, f in enumerate(files)]
+        tests = [read_test(f, pressure_kpa=pressures[i] if pressures else None, columns=columns, rate_hz=rate_hz,
+                           repair=repair) for i, f in enumerate(files)]
         processed = process_tests(tests, fixture=fx, options=opts)
         processed.save(o.staging, figure=figure)
     if as_json:

@@ -7,16 +7,19 @@
 * :mod:`bendpam.design.wrist`: four BC-PAMs around a column (the paper's Figure 9 wrist): bending
   angle and direction, holding capacity.
 
-Units: mm, N, N*mm, MPa for pressures passed to functions (kPa in table columns), rad (degrees in
-names ending ``_deg``), grams for masses.
+Units: mm, N, N*mm, kPa for every pressure (arguments ``pressure_kpa``/``pressures_kpa``, result
+fields and table columns), degrees in names ending ``_deg`` (rad inside), grams for masses.  Bad
+input raises :class:`bendpam.InputError`; a pressure that looks like MPa (every nonzero value
+below 5 kPa) warns with :class:`bendpam.UnitWarning`.  The moment law is the actuator's shared
+:class:`bendpam.MomentLaw`; :class:`StableBranch` is :class:`bendpam.StableBranch`.
 """
 
+from ..law import StableBranch
 from .finger import (
     BlockedTipForce,
     Finger,
     FingerLoads,
     FingerShape,
-    StableBranch,
     TipStiffness,
     blocked_tip_force,
     finger_sweep,
@@ -45,25 +48,25 @@ __all__ = [
     "Finger",
     "FingerLoads",
     "FingerShape",
-    "StableBranch",
-    "TipStiffness",
-    "blocked_tip_force",
-    "finger_sweep",
-    "free_tip_trajectory",
-    "linear_tip_compliance",
-    "plot_finger_shapes",
-    "solve_finger",
-    "stable_branch",
-    "tip_stiffness",
     "Grasp",
     "Gripper",
-    "grasp_sweep",
-    "plot_grasp",
-    "solve_grasp",
+    "StableBranch",
+    "TipStiffness",
     "Wrist",
     "WristHold",
     "WristState",
+    "blocked_tip_force",
+    "finger_sweep",
+    "free_tip_trajectory",
+    "grasp_sweep",
+    "linear_tip_compliance",
+    "plot_finger_shapes",
+    "plot_grasp",
     "plot_wrist",
+    "solve_finger",
+    "solve_grasp",
+    "stable_branch",
+    "tip_stiffness",
     "wrist_bend",
     "wrist_hold",
     "wrist_moment",

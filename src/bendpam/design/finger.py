@@ -13,15 +13,15 @@ where ``k'`` is the frame curvature of the paper (1/mm, > 0 toward the frame) an
 
     M_load(P, k'(s)) = M_ext(s)
 
-``M_load`` is the actuator's output moment (:func:`bendpam.moment`) and ``M_ext`` is the moment of
-every load beyond ``s`` about the point ``(x(s), y(s))``, written in the actuator's sign convention:
-``M_ext = -c m(s)`` where ``m(s)`` is the counterclockwise moment of those loads.  A load that
-resists bending gives ``M_ext`` of the sign of the blocked moment and a smaller ``|k'|``.  The loads
-are a tip force in any in-plane direction, a tip moment, a point mass at the fingertip, a
-distributed self-weight (mass per length), and the contact forces of :mod:`bendpam.design.grasp`.
-A rigid fingertip of length ``fingertip_mm`` continues the rod along its end tangent; its end point,
-shifted ``fingertip_offset_mm`` toward the bending side, is where tip loads act and is reported as
-the tip.
+``M_load`` is the actuator's output moment (the moment law, :class:`bendpam.MomentLaw`) and
+``M_ext`` is the moment of every load beyond ``s`` about the point ``(x(s), y(s))``, written in the
+actuator's sign convention: ``M_ext = -c m(s)`` where ``m(s)`` is the counterclockwise moment of
+those loads.  A load that resists bending gives ``M_ext`` of the sign of the blocked moment and a
+smaller ``|k'|``.  The loads are a tip force in any in-plane direction, a tip moment, a point mass
+at the fingertip, a distributed self-weight (mass per length), and the contact forces of
+:mod:`bendpam.design.grasp`.  A rigid fingertip of length ``fingertip_mm`` continues the rod along
+its end tangent; its end point, shifted ``fingertip_offset_mm`` toward the bending side, is where
+tip loads act and is reported as the tip.
 
 Mounting and signs
 ------------------
@@ -35,12 +35,13 @@ Numerics
 --------
 Collocation on ``n`` equally spaced nodes (default 81): the unknowns are the nodal curvatures;
 ``phi`` is their trapezoidal integral and every segment is integrated exactly as a circular arc of
-linearly varying angle, so a constant-curvature (free) shape is exact.  The moment law is
-tabulated once per actuator and model (8000 curvatures graded toward lock-up, cubic Hermite
-interpolation, relative error below 1e-6) and inverted only on the **stable branch**: the interval of ``k'`` around the
-straight state on which ``dM/dk' < 0``.  It ends at a fold of the moment law (the BC-PAM's N-shaped
-law, and the BE-PAM's at large curvature) or at braid lock-up.  Every Newton step is kept inside
-that interval, so a curvature on the unstable (snapped) part of the law is never returned.
+linearly varying angle, so a constant-curvature (free) shape is exact.  The moment law is the
+actuator's shared :class:`bendpam.MomentLaw` (``MomentLaw.of(actuator, model)``); the solver uses
+its **stable branch** (:meth:`bendpam.MomentLaw.stable_branch`, from the law's spline table: a C2
+cubic spline on Chebyshev-Lobatto knots, relative error below 1e-6): the interval of ``k'`` around
+the straight state on which ``dM/dk' < 0``.  It ends at a fold of the moment law (the BC-PAM's
+N-shaped law, and the BE-PAM's at large curvature) or at braid lock-up.  Every Newton step is kept
+inside that interval, so a curvature on the unstable (snapped) part of the law is never returned.
 
 The nonlinear equations are solved by a damped Newton method with an exact (complex-step)
 Jacobian, by continuation in the load fraction from the free shape (constant free curvature).
@@ -51,229 +52,155 @@ shape arrays and a note (snap-through at the fold, or lock-up); the last equilib
 loaded equilibrium on the stable branch directly and says so in the note.  Each equilibrium is also
 checked for structural stability (the weighted, symmetrised Jacobian must be negative definite:
 the second variation of the potential energy of dead loads).  The reported ``residual_nmm`` is
-``max |M(P, k'(s)) - M_ext(s)|`` along ``s`` with the exact model (not the table).
+``max |M(P, k'(s)) - M_ext(s)|`` along ``s`` with the exact law (:meth:`bendpam.MomentLaw.moment`,
+not the table).
 
-Units: mm, N, N*mm, MPa (the functions take pressures in MPa, as the rest of the library), rad.
-Masses are given in grams, weights use g = 9.80665 m/s^2.
+Units: mm, N, N*mm, kPa (every function takes and returns pressures in kPa, ``pressure_kpa``), rad
+inside (degrees in names ending ``_deg``).  Masses are given in grams, weights use
+g = 9.80665 m/s^2.  Bad input raises :class:`bendpam.InputError`; a pressure given in MPa by
+mistake (every nonzero value below 5 kPa) warns with :class:`bendpam.UnitWarning`.
 """
 
 from __future__ import annotations
 
 import math
+import sys
+import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
-from functools import lru_cache
 
 import numpy as np
 
-# public names from the package top level (robust to the modules being reorganised)
-from .. import Actuator, curvature_limits, free_curvature, moment
-from ..models import get_model
-from ..presets import normalise_model
+from ..actuator import Actuator
+from ..checks import UnitWarning, number
+from ..checks import pressure_kpa as _check_pressures
+from ..errors import InputError, NoEquilibrium
+from ..law import MomentLaw, StableBranch
+from ..models import normalise_model
 
 __all__ = [
     "G_N_PER_G",
+    "BlockedTipForce",
     "Finger",
     "FingerLoads",
     "FingerShape",
     "StableBranch",
-    "BlockedTipForce",
     "TipStiffness",
-    "stable_branch",
-    "solve_finger",
+    "blocked_tip_force",
     "finger_sweep",
     "free_tip_trajectory",
-    "blocked_tip_force",
-    "tip_stiffness",
     "linear_tip_compliance",
     "plot_finger_shapes",
+    "solve_finger",
+    "stable_branch",
+    "tip_stiffness",
 ]
 
 #: weight of one gram, N (standard gravity 9.80665 m/s^2)
 G_N_PER_G = 9.80665e-3
 
-_TABLE_POINTS = 8000
-_NEWTON_TOL = 1e-10  # on the residual divided by the moment scale
+NEWTON_TOL = 1e-10  # on the residual divided by the moment scale
 _MAX_NEWTON = 40
 _MIN_STEP = 1.0 / 2048
+_PACKAGE = __name__.rpartition(".")[0]  # "bendpam.design": warnings point at the first frame outside it
 
 
-def _num(name: str, value, lo=None, hi=None, *, lo_open=False, unit="") -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} = {value!r} is not a number") from None
-    rng = f"{'(' if lo_open else '['}{'-inf' if lo is None else f'{lo:g}'}, {'inf' if hi is None else f'{hi:g}'}]"
-    u = f" {unit}" if unit else ""
-    if not math.isfinite(v) or (lo is not None and (v <= lo if lo_open else v < lo)) or (hi is not None and v > hi):
-        raise ValueError(f"{name} = {v:g}{u} is outside the allowed range {rng}{u}")
-    return v
-
-
+# ------------------------------------------------------------------------------------------------
+# validation shared by the design modules (public within bendpam.design, not exported)
+# ------------------------------------------------------------------------------------------------
 def _pair(name: str, value, unit: str) -> tuple[float, float]:
+    if isinstance(value, str | bytes):
+        raise InputError(f"{name} = {value!r} must be two numbers ({unit})")
     try:
         a = np.asarray(value, dtype=float).ravel()
     except (TypeError, ValueError):
-        raise ValueError(f"{name} = {value!r} must be two numbers ({unit})") from None
+        raise InputError(f"{name} = {value!r} must be two numbers ({unit})") from None
     if a.size != 2 or not np.all(np.isfinite(a)):
-        raise ValueError(f"{name} = {value!r} must be two finite numbers ({unit})")
+        raise InputError(f"{name} = {value!r} must be two finite numbers ({unit})")
     return float(a[0]), float(a[1])
 
 
-def _pressure(pressure) -> float:
-    return _num("pressure", pressure, 0.0, unit="MPa")
+def _user_stacklevel() -> int:
+    """``stacklevel`` (for a ``warnings.warn`` in the caller) of the first frame outside bendpam.design."""
+    level, frame = 1, sys._getframe(1)
+    while frame is not None and frame.f_globals.get("__name__", "").startswith(_PACKAGE):
+        frame, level = frame.f_back, level + 1
+    return level
+
+
+def _numeric_pressures(value, name: str) -> np.ndarray:
+    """:func:`bendpam.checks.pressure_kpa`, refusing strings and bools inside a list too ([100, "150"]).
+
+    Its :class:`~bendpam.checks.UnitWarning` is reported at the user's call, not inside bendpam.design.
+    """
+    try:
+        kind = np.asarray(value).dtype.kind
+    except (TypeError, ValueError):  # ragged: left to the check's own message
+        kind = "O"
+    if kind in "USb":
+        raise InputError(f"{name} = {value!r} is not numeric (kPa expected)")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        p = _check_pressures(value, name)
+    if caught:
+        level = _user_stacklevel()
+        for w in caught:
+            warnings.warn(w.message, stacklevel=level)
+    return p
+
+
+def checked_pressure_kpa(value, name: str = "pressure_kpa") -> float:
+    """One gauge pressure in kPa as a float (:func:`bendpam.checks.pressure_kpa`, and a single value).
+
+    A negative, non-finite or non-numeric value raises :class:`~bendpam.errors.InputError`; a
+    nonzero value below 5 kPa warns with :class:`~bendpam.checks.UnitWarning` (MPa passed as kPa?).
+    """
+    p = _numeric_pressures(value, name)
+    if p.size != 1:
+        raise InputError(f"{name} has {p.size} values; give one pressure (kPa)")
+    return float(p.reshape(()))
+
+
+def checked_pressures_kpa(value, name: str = "pressures_kpa") -> np.ndarray:
+    """Gauge pressures in kPa as a 1-D float array (at least one), validated as :func:`checked_pressure_kpa`."""
+    p = np.atleast_1d(_numeric_pressures(value, name)).ravel()
+    if p.size == 0:
+        raise InputError(f"{name} is empty; give at least one pressure (kPa)")
+    return p
+
+
+@contextmanager
+def pressures_checked() -> Iterator[None]:
+    """Run the numerics of a public function whose pressures were already validated.
+
+    The entry point validates (and warns about a suspected MPa value) once; inside, the law is
+    evaluated many times at the same pressures and must not repeat the
+    :class:`~bendpam.checks.UnitWarning`.
+    """
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UnitWarning)
+        yield
 
 
 # ------------------------------------------------------------------------------------------------
 # the moment law on its stable branch
 # ------------------------------------------------------------------------------------------------
-class _Law:
-    """``A(k'), B(k')`` (``M = p_a A - B``) tabulated on a dense grid with their derivatives."""
+def stable_branch(actuator: Actuator, pressure_kpa, model: str = "energy",
+                  friction_nmm: float = 0.0) -> StableBranch:
+    """The stable branch of the moment law at ``pressure_kpa`` (kPa): see :class:`bendpam.StableBranch`.
 
-    def __init__(self, actuator: Actuator, model: str):
-        lim = curvature_limits(actuator)
-        span = lim.k_max - lim.k_min
-        n_neg = max(int(_TABLE_POINTS * (-lim.k_min) / span), 50)
-        n_pos = max(_TABLE_POINTS - n_neg, 50)
-        shrink = 1.0 - 1e-9
-        # graded toward the lock-up ends, where the law steepens: k = k_end sin(pi t / 2)
-        g_neg = np.sin(0.5 * np.pi * np.linspace(0.0, 1.0, n_neg + 1))
-        g_pos = np.sin(0.5 * np.pi * np.linspace(0.0, 1.0, n_pos + 1))
-        kg = np.concatenate([(lim.k_min * shrink * g_neg)[::-1][:-1], lim.k_max * shrink * g_pos])
-        A, B = get_model(model).coefficients(actuator, kg)
-        self.k = kg
-        self.A, self.B = A, B
-        self.dA = np.gradient(A, kg, edge_order=2)
-        self.dB = np.gradient(B, kg, edge_order=2)
-        self.i0 = n_neg  # index of k' = 0
-        self.P_start = actuator.P_start
-        self.k_min, self.k_max = float(kg[0]), float(kg[-1])
-
-
-@lru_cache(maxsize=32)
-def _law_cached(actuator: Actuator, model: str) -> _Law:
-    return _Law(actuator, model)
-
-
-def _law(actuator: Actuator, model: str) -> _Law:
-    # the section law does not depend on the length or the label: share one table
-    return _law_cached(actuator.replace(L0_mm=100.0, name=""), normalise_model(model))
-
-
-def _hermite(kg, f, df, x):
-    """Cubic Hermite interpolant of ``f`` (with slopes ``df``) and its derivative at ``x``.
-
-    ``x`` may be complex (complex-step derivatives): the interval comes from its real part.
-    """
-    xr = np.real(x)
-    j = np.clip(np.searchsorted(kg, xr, side="right") - 1, 0, kg.size - 2)
-    k0 = kg[j]
-    h = kg[j + 1] - k0
-    t = (x - k0) / h
-    t2 = t * t
-    f0, f1, d0, d1 = f[j], f[j + 1], df[j] * h, df[j + 1] * h
-    val = (1 + 2 * t) * (1 - t) ** 2 * f0 + t * (1 - t) ** 2 * d0 + t2 * (3 - 2 * t) * f1 + t2 * (t - 1) * d1
-    der = ((6 * t2 - 6 * t) * f0 + (3 * t2 - 4 * t + 1) * d0 + (6 * t - 6 * t2) * f1 + (3 * t2 - 2 * t) * d1) / h
-    return val, der
-
-
-@dataclass(frozen=True)
-class StableBranch:
-    """The stable part of the moment law ``M(P, k')`` at one pressure.
-
-    Along the branch connected to the straight state (``k' = 0``) ``M`` decreases strictly with
-    ``k'``; it is the only part of the law on which a loaded finger can rest (a segment with
-    ``dM/dk' > 0`` is unstable and snaps through).
-
-    Attributes
-    ----------
-    pressure : MPa.
-    k_lo, k_hi : ends of the branch, 1/mm (``k_lo < 0 < k_hi``).
-    moment_max, moment_min : ``M`` at ``k_lo`` and ``k_hi`` (N*mm): the range of moments the
-        actuator can balance at this pressure.
-    end_lo, end_hi : ``"fold"`` or ``"lock-up"``: what ends the branch on each side.
-    free_curvature : the free curvature on the branch (1/mm), NaN if ``M = 0`` is outside the range.
-    """
-
-    pressure: float
-    k_lo: float
-    k_hi: float
-    moment_max: float
-    moment_min: float
-    end_lo: str
-    end_hi: str
-    free_curvature: float
-    _law: _Law = field(repr=False, compare=False)
-    _m: np.ndarray = field(repr=False, compare=False)
-    _dm: np.ndarray = field(repr=False, compare=False)
-
-    def moment(self, k):
-        """``M`` (N*mm) and ``dM/dk'`` (N*mm^2) from the table (cubic Hermite), broadcasting ``k``."""
-        return _hermite(self._law.k, self._m, self._dm, k)
-
-    def curvature(self, m):
-        """Invert ``M(P, k') = m`` on the branch (1/mm); NaN outside ``[moment_min, moment_max]``."""
-        m = np.asarray(m, dtype=float)
-        lo = np.searchsorted(self._law.k, self.k_lo)
-        hi = np.searchsorted(self._law.k, self.k_hi, side="right")
-        kk, mm = self._law.k[lo:hi], self._m[lo:hi]
-        k = np.interp(-m, -mm, kk)
-        for _ in range(3):  # Newton polish on the Hermite law
-            f, d = self.moment(k)
-            k = np.clip(k - (f - m) / d, self.k_lo, self.k_hi)
-        return np.where((m <= self.moment_max) & (m >= self.moment_min), k, np.nan)
-
-    def describe_end(self, side: int) -> str:
-        k, kind = (self.k_hi, self.end_hi) if side > 0 else (self.k_lo, self.end_lo)
-        m = self.moment_min if side > 0 else self.moment_max
-        what = "a fold of the moment law (N-shaped: beyond it the actuator snaps through)" if kind == "fold" \
-            else "braid lock-up"
-        return f"{what} at k' = {k:.5g} 1/mm, M = {m:.4g} N*mm"
-
-
-def stable_branch(actuator, pressure, model: str = "energy", friction_nmm: float = 0.0) -> StableBranch:
-    """The stable branch of the moment law at ``pressure`` (MPa): see :class:`StableBranch`.
-
+    Shorthand for ``MomentLaw.of(actuator, model).stable_branch(pressure_kpa, friction_nmm)``.
     ``friction_nmm`` shifts the law by a saturated hysteretic moment, ``M = M_load - friction``
-    (signed, bendpam's convention): see :meth:`Finger.friction_nmm`.
+    (signed, bendpam's convention): see :meth:`Finger.friction_nmm`.  Raises
+    :class:`~bendpam.errors.NoEquilibrium` when the straight state is unstable at that pressure.
     """
     if not isinstance(actuator, Actuator):
         raise TypeError(f"actuator must be a bendpam.Actuator, got {type(actuator).__name__}")
-    P = _pressure(pressure)
-    model = normalise_model(model)
-    law = _law(actuator, model)
-    pa = max(P - law.P_start, 0.0)
-    m = pa * law.A - law.B - float(friction_nmm)
-    dm = pa * law.dA - law.dB
-    i0 = law.i0
-    if dm[i0] >= 0.0:
-        raise ValueError(
-            f"pressure = {P * 1e3:g} kPa: the straight state is unstable (dM/dk' = {dm[i0]:.4g} N*mm^2 >= 0 at "
-            "k' = 0), so the actuator has no stable branch to rest on"
-        )
-    bad = np.flatnonzero(dm >= 0.0)
-    left, right = bad[bad < i0], bad[bad > i0]
-    kg = law.k
-
-    def fold(i):  # dm changes sign between i and i+1: linear zero of dm
-        return kg[i] + (kg[i + 1] - kg[i]) * dm[i] / (dm[i] - dm[i + 1])
-
-    if right.size:
-        k_hi, end_hi = float(fold(right[0] - 1)), "fold"
-    else:
-        k_hi, end_hi = float(kg[-1]), "lock-up"
-    if left.size:
-        k_lo, end_lo = float(fold(left[-1])), "fold"
-    else:
-        k_lo, end_lo = float(kg[0]), "lock-up"
-    m_lo = float(_hermite(kg, m, dm, k_lo)[0])
-    m_hi = float(_hermite(kg, m, dm, k_hi)[0])
-    br = StableBranch(P, k_lo, k_hi, m_lo, m_hi, end_lo, end_hi, math.nan, law, m, dm)
-    if m_hi < 0.0 < m_lo:
-        kf = float(br.curvature(0.0))
-        br = replace(br, free_curvature=kf)
-    elif m_hi == 0.0 or m_lo == 0.0:
-        br = replace(br, free_curvature=0.0)
-    return br
+    P = checked_pressure_kpa(pressure_kpa)
+    fr = number("friction_nmm", friction_nmm, unit="N*mm")
+    with pressures_checked():
+        return MomentLaw.of(actuator, model).stable_branch(P, fr)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -327,46 +254,62 @@ class Finger:
         if not isinstance(self.actuator, Actuator):
             raise TypeError(f"actuator must be a bendpam.Actuator, got {type(self.actuator).__name__}")
         if self.actuator.bend_sign == 0:
-            raise ValueError(f"alpha0_deg = {self.actuator.alpha0_deg:g} deg is the neutral braid angle: "
+            raise InputError(f"alpha0_deg = {self.actuator.alpha0_deg:g} deg is the neutral braid angle: "
                              "the actuator does not bend, so it cannot be a finger")
         s(self, "model", normalise_model(self.model))
         s(self, "base_xy_mm", _pair("base_xy_mm", self.base_xy_mm, "mm"))
-        s(self, "base_angle_deg", _num("base_angle_deg", self.base_angle_deg, -720.0, 720.0, unit="deg"))
+        s(self, "base_angle_deg", number("base_angle_deg", self.base_angle_deg, -720.0, 720.0, unit="deg"))
         b = self.bend
         if isinstance(b, str):
             key = b.strip().lower()
             if key not in ("ccw", "cw"):
-                raise ValueError(f"bend = {b!r} is not allowed; choose 'ccw' (+1) or 'cw' (-1)")
+                raise InputError(f"bend = {b!r} is not allowed; choose 'ccw' (+1) or 'cw' (-1)")
             b = 1 if key == "ccw" else -1
-        if b not in (1, -1):
-            raise ValueError(f"bend = {b!r} is not allowed; choose +1 (ccw) or -1 (cw)")
+        if isinstance(b, bool) or b not in (1, -1):
+            raise InputError(f"bend = {b!r} is not allowed; choose +1 (ccw) or -1 (cw)")
         s(self, "bend", int(b))
-        s(self, "fingertip_mm", _num("fingertip_mm", self.fingertip_mm, 0.0, 1e4, unit="mm"))
-        s(self, "fingertip_offset_mm", _num("fingertip_offset_mm", self.fingertip_offset_mm, -1e4, 1e4, unit="mm"))
+        s(self, "fingertip_mm", number("fingertip_mm", self.fingertip_mm, 0.0, 1e4, unit="mm"))
+        s(self, "fingertip_offset_mm", number("fingertip_offset_mm", self.fingertip_offset_mm, -1e4, 1e4, unit="mm"))
         n = self.nodes
-        if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not 11 <= int(n) <= 1001:
-            raise ValueError(f"nodes = {n!r} is outside the allowed range [11, 1001] (an integer)")
+        if isinstance(n, bool) or not isinstance(n, int | np.integer) or not 11 <= int(n) <= 1001:
+            raise InputError(f"nodes = {n!r} is outside the allowed range [11, 1001] (an integer)")
         s(self, "nodes", int(n))
         if self.motion not in ("unloading", "loading"):
-            raise ValueError(f"motion = {self.motion!r}; choose 'unloading' or 'loading'")
+            raise InputError(f"motion = {self.motion!r}; choose 'unloading' or 'loading'")
         if self.loop is not None and not hasattr(self.loop, "amplitude_nmm"):
             raise TypeError("loop must be a bendpam.hysteresis.LoopModel")
 
-    def friction_nmm(self, pressure) -> float:
-        """Signed saturated friction moment ``A(P) z`` (N*mm) for the finger's motion; 0 without a loop.
+    def friction_nmm(self, pressure_kpa) -> float:
+        """Signed saturated friction moment ``A(P) z`` (N*mm) at ``pressure_kpa`` (kPa); 0 without a loop.
 
         ``z = bend_sign`` while the actuator opens toward its free shape (unloading) and
         ``-bend_sign`` while it is pushed back (loading); the law becomes ``M_load - A z``.
         """
+        P = checked_pressure_kpa(pressure_kpa)
         if self.loop is None:
             return 0.0
         z = self.actuator.bend_sign * (1.0 if self.motion == "unloading" else -1.0)
-        return float(self.loop.amplitude_nmm(self.actuator, float(pressure), 0.0)) * z
+        with pressures_checked():
+            return float(self.loop.amplitude_nmm(self.actuator, P, 0.0)) * z
+
+    @property
+    def law(self) -> MomentLaw:
+        """The actuator's shared moment law under the finger's model (:meth:`bendpam.MomentLaw.of`)."""
+        return MomentLaw.of(self.actuator, self.model)
+
+    def branch(self, pressure_kpa: float) -> StableBranch:
+        """The stable branch the finger rests on at ``pressure_kpa`` (kPa), shifted by its friction moment.
+
+        Raises :class:`~bendpam.errors.NoEquilibrium` when the straight state is unstable.
+        """
+        P = checked_pressure_kpa(pressure_kpa)
+        with pressures_checked():
+            return self.law.stable_branch(P, self.friction_nmm(P))
 
     @property
     def length(self) -> float:
         """Active length L0, mm."""
-        return self.actuator.L0
+        return self.actuator.L0_mm
 
     @property
     def frame_side(self) -> int:
@@ -413,14 +356,14 @@ class FingerLoads:
     def __post_init__(self):
         s = object.__setattr__
         s(self, "tip_force_n", _pair("tip_force_n", self.tip_force_n, "N"))
-        s(self, "tip_moment_nmm", _num("tip_moment_nmm", self.tip_moment_nmm, unit="N*mm"))
-        s(self, "tip_mass_g", _num("tip_mass_g", self.tip_mass_g, 0.0, unit="g"))
+        s(self, "tip_moment_nmm", number("tip_moment_nmm", self.tip_moment_nmm, unit="N*mm"))
+        s(self, "tip_mass_g", number("tip_mass_g", self.tip_mass_g, 0.0, unit="g"))
         s(self, "mass_per_length_g_per_mm",
-          _num("mass_per_length_g_per_mm", self.mass_per_length_g_per_mm, 0.0, unit="g/mm"))
+          number("mass_per_length_g_per_mm", self.mass_per_length_g_per_mm, 0.0, unit="g/mm"))
         g = _pair("gravity", self.gravity, "direction")
         ng = math.hypot(*g)
         if ng == 0.0:
-            raise ValueError("gravity = (0, 0) has no direction; give a non-zero vector, e.g. (0, -1)")
+            raise InputError("gravity = (0, 0) has no direction; give a non-zero vector, e.g. (0, -1)")
         s(self, "gravity", (g[0] / ng, g[1] / ng))
 
     @property
@@ -455,7 +398,7 @@ class FingerShape:
 
     Attributes
     ----------
-    pressure : MPa.
+    pressure_kpa : gauge pressure, kPa.
     s : arc length, mm.
     x, y : frame-line position, mm.
     angle : tangent angle phi, rad (counterclockwise from +x).
@@ -468,12 +411,12 @@ class FingerShape:
     load_fraction : fraction of the load reached by the continuation (1 on success).
     note : empty on a plain success, else what happened (snap-through, no free shape, ...).
     limit : on failure, the last equilibrium reached (a FingerShape at ``load_fraction``), else None.
-    branch : the :class:`StableBranch` used.
+    branch : the :class:`bendpam.StableBranch` used.
     """
 
     finger: Finger
     loads: FingerLoads
-    pressure: float
+    pressure_kpa: float
     s: np.ndarray
     x: np.ndarray
     y: np.ndarray
@@ -522,12 +465,16 @@ def _sinc(x):
     return np.where(small, 1.0 - x2 / 6.0 + x2 * x2 / 120.0, np.sin(xs) / xs)
 
 
-def _cross(ax, ay, bx, by):
+def cross(ax, ay, bx, by):
+    """z-component of the planar cross product ``a x b`` (batched; complex-step safe)."""
     return ax * by - ay * bx
 
 
-class _Rod:
-    """Geometry and load moments of the discretised finger (batched over leading axes)."""
+class Rod:
+    """Geometry and load moments of the discretised finger (batched over leading axes).
+
+    Shared by :mod:`bendpam.design.grasp`; not part of the public API of :mod:`bendpam.design`.
+    """
 
     def __init__(self, finger: Finger, loads: FingerLoads):
         self.f = finger
@@ -552,7 +499,7 @@ class _Rod:
         h = self.h
         kap = self.c * k
         inc = 0.5 * h * (kap[..., 1:] + kap[..., :-1])
-        zero = np.zeros(k.shape[:-1] + (1,), dtype=k.dtype)
+        zero = np.zeros((*k.shape[:-1], 1), dtype=k.dtype)
         phi = self.phi0 + np.concatenate([zero, np.cumsum(inc, axis=-1)], axis=-1)
         mid = 0.5 * (phi[..., 1:] + phi[..., :-1])
         sc = h * _sinc(0.5 * inc)
@@ -582,17 +529,17 @@ class _Rod:
     def load_moment(self, x, y, xt, yt, lam=1.0):
         """Counterclockwise moment m(s_j) of the dead loads beyond each node, N*mm."""
         Fx, Fy = self.F
-        m = lam * (self.Mt + _cross(xt[..., None] - x, yt[..., None] - y, Fx, Fy))
+        m = lam * (self.Mt + cross(xt[..., None] - x, yt[..., None] - y, Fx, Fy))
         qx, qy = self.q
         if qx or qy:
             w = self.h
             # X_j = int_{s_j}^L x du by the trapezoidal rule
             cx = np.cumsum(0.5 * w * (x[..., 1:] + x[..., :-1])[..., ::-1], axis=-1)[..., ::-1]
             cy = np.cumsum(0.5 * w * (y[..., 1:] + y[..., :-1])[..., ::-1], axis=-1)[..., ::-1]
-            zero = np.zeros(x.shape[:-1] + (1,), dtype=x.dtype)
+            zero = np.zeros((*x.shape[:-1], 1), dtype=x.dtype)
             X = np.concatenate([cx, zero], axis=-1)
             Y = np.concatenate([cy, zero], axis=-1)
-            m = m + lam * _cross(X - self.rem * x, Y - self.rem * y, qx, qy)
+            m = m + lam * cross(X - self.rem * x, Y - self.rem * y, qx, qy)
         return m
 
 
@@ -604,7 +551,7 @@ def _complex_jacobian(fun, u):
     return (np.imag(fun(U)) / eps).T
 
 
-def _newton(fun, u0, lo, hi, tol, maxit=_MAX_NEWTON):
+def newton(fun, u0, lo, hi, tol, maxit=_MAX_NEWTON):
     """Damped Newton on ``fun(u) = 0`` keeping ``lo < u < hi``.  Returns ``(u, ok, |r|_inf)``."""
     u = np.array(u0, dtype=float)
     r = np.real(fun(u[None, :]))[0]
@@ -643,22 +590,22 @@ def _newton(fun, u0, lo, hi, tol, maxit=_MAX_NEWTON):
     return u, nr < tol, nr
 
 
-def _moment_scale(branch: StableBranch, rod: _Rod) -> float:
+def _moment_scale(branch: StableBranch, rod: Rod) -> float:
     """Moment scale for the Newton tolerance: blocked moment, fold moments and load moments (not lock-up)."""
     load = abs(rod.Mt) + math.hypot(*rod.F) * (rod.L + rod.ell) + math.hypot(*rod.q) * rod.L ** 2
     folds = [abs(m) for m, e in ((branch.moment_max, branch.end_lo), (branch.moment_min, branch.end_hi)) if e == "fold"]
-    return max([abs(float(branch.moment(0.0)[0])), load, 1.0] + folds)
+    return max([abs(float(branch.moment(0.0)[0])), load, 1.0, *folds])
 
 
 def _k_bounds(branch: StableBranch, n: int):
     return np.full(n, branch.k_lo), np.full(n, branch.k_hi)
 
 
-def _dead_load_system(rod: _Rod, branch: StableBranch, scale: float):
+def _dead_load_system(rod: Rod, branch: StableBranch, scale: float):
     c = rod.c
 
     def fun(U, lam):
-        phi, x, y, xt, yt = rod.geometry(U)
+        _phi, x, y, xt, yt = rod.geometry(U)
         m_act = -c * rod.load_moment(x, y, xt, yt, lam)
         M, _ = branch.moment(U)
         return (M - m_act) / scale
@@ -676,16 +623,16 @@ def _stability(fun, k, w):
     return float(ev[0] / max(abs(ev[-1]), 1e-300))
 
 
-def _shape(rod: _Rod, k, branch, P, loads, *, lam=1.0, equilibrium=True, stable=True, note="", exact=True):
+def _shape(rod: Rod, k, branch, P, loads, *, lam=1.0, equilibrium=True, stable=True, note="", exact=True):
     f = rod.f
     phi, x, y, xt, yt = rod.geometry(k)
     m_act = -rod.c * rod.load_moment(x, y, xt, yt, lam)
-    res = float(np.max(np.abs(moment(f.actuator, P, k, f.model) - m_act))) if exact else math.nan
+    res = float(np.max(np.abs(f.law.moment(P, k) - m_act))) if exact else math.nan
     return FingerShape(f, loads, P, rod.s.copy(), x, y, phi, np.asarray(k, float), m_act, (float(xt), float(yt)),
                        float(phi[-1]), equilibrium, stable, res, lam, note, None, branch)
 
 
-def _failed(rod: _Rod, branch, P, loads, note, limit=None, lam=0.0):
+def _failed(rod: Rod, branch, P, loads, note, limit=None, lam=0.0):
     nan = np.full(rod.n, np.nan)
     return FingerShape(rod.f, loads, P, rod.s.copy(), nan, nan.copy(), nan.copy(), nan.copy(), nan.copy(),
                        (math.nan, math.nan), math.nan, False, False, math.nan, lam, note, limit, branch)
@@ -712,14 +659,14 @@ def _continue(system, u0):
     success; -1.0 if even the start does not converge).
     """
     fun, lo, hi = system(0.0)
-    u, ok, _ = _newton(fun, np.asarray(u0, dtype=float), lo, hi, _NEWTON_TOL)
+    u, ok, _ = newton(fun, np.asarray(u0, dtype=float), lo, hi, NEWTON_TOL)
     if not ok:
         return np.asarray(u0, dtype=float), -1.0
     t, step = 0.0, 1.0
     while t < 1.0:
         step = min(step, 1.0 - t)
         fun, lo, hi = system(t + step)
-        un, ok, _ = _newton(fun, u, lo, hi, _NEWTON_TOL)
+        un, ok, _ = newton(fun, u, lo, hi, NEWTON_TOL)
         if ok:
             u, t = un, t + step
             step *= 2.0
@@ -730,8 +677,17 @@ def _continue(system, u0):
     return u, t
 
 
-def solve_finger(finger: Finger, pressure, loads: FingerLoads | None = None) -> FingerShape:
-    """Equilibrium shape of ``finger`` at ``pressure`` (MPa) under ``loads``.
+def _check_finger(finger, loads) -> FingerLoads:
+    if not isinstance(finger, Finger):
+        raise TypeError(f"finger must be a bendpam.design.Finger, got {type(finger).__name__}")
+    loads = FingerLoads() if loads is None else loads
+    if not isinstance(loads, FingerLoads):
+        raise TypeError(f"loads must be a FingerLoads, got {type(loads).__name__}")
+    return loads
+
+
+def solve_finger(finger: Finger, pressure_kpa, loads: FingerLoads | None = None) -> FingerShape:
+    """Equilibrium shape of ``finger`` at ``pressure_kpa`` (kPa) under ``loads``.
 
     Returns a :class:`FingerShape`.  With no load the shape is the free shape (constant free
     curvature).  Otherwise the solution is continued in the load fraction from the free shape.  If
@@ -739,29 +695,30 @@ def solve_finger(finger: Finger, pressure, loads: FingerLoads | None = None) -> 
     a structural limit point), ``equilibrium`` is False, the arrays are NaN, the note says why and
     ``limit`` holds the last equilibrium reached.  Never a shape on the unstable branch.
     """
-    if not isinstance(finger, Finger):
-        raise TypeError(f"finger must be a bendpam.design.Finger, got {type(finger).__name__}")
-    loads = FingerLoads() if loads is None else loads
-    if not isinstance(loads, FingerLoads):
-        raise TypeError(f"loads must be a FingerLoads, got {type(loads).__name__}")
-    P = _pressure(pressure)
-    rod = _Rod(finger, loads)
+    loads = _check_finger(finger, loads)
+    P = checked_pressure_kpa(pressure_kpa)
+    with pressures_checked():
+        return _solve_finger(finger, P, loads)
+
+
+def _solve_finger(finger: Finger, P: float, loads: FingerLoads) -> FingerShape:
+    """:func:`solve_finger` with validated arguments (P in kPa)."""
+    rod = Rod(finger, loads)
     try:
-        br = stable_branch(finger.actuator, P, finger.model, finger.friction_nmm(P))
-    except ValueError as exc:
+        br = finger.branch(P)
+    except NoEquilibrium as exc:
         return _failed(rod, None, P, loads, str(exc))
     scale = _moment_scale(br, rod)
     fun = _dead_load_system(rod, br, scale)
     lo, hi = _k_bounds(br, rod.n)
     kf = br.free_curvature
     free_ok = np.isfinite(kf)
-    if free_ok:  # agree with free_curvature (same root, without the table's interpolation error)
-        fb = free_curvature(finger.actuator, P, finger.model)
-        if fb.status != "no-equilibrium" and np.isfinite(fb.curvature):
-            kf = float(fb.curvature)
+    fb = finger.law.free_curvature(P)
+    if free_ok and fb.status != "no-equilibrium" and np.isfinite(fb.curvature_per_mm):
+        # agree with the law's free curvature (same root, without the table's interpolation error)
+        kf = float(fb.curvature_per_mm)
     if loads.is_zero:
         if not free_ok:
-            fb = free_curvature(finger.actuator, P, finger.model)
             return _failed(rod, br, P, loads, f"no free-bending equilibrium: {fb.reason or br.describe_end(+1)}")
         return _shape(rod, np.full(rod.n, kf), br, P, loads)
 
@@ -794,18 +751,18 @@ def solve_finger(finger: Finger, pressure, loads: FingerLoads | None = None) -> 
     k_end, k_other = (br.k_hi, br.k_lo) if sgn > 0 else (br.k_lo, br.k_hi)
     guesses = [k_end - sgn * f * span for f in (0.02, 0.1, 0.3)] + [0.0, k_other + sgn * 0.1 * span]
     for g in guesses:
-        k, ok, _ = _newton(lambda U: fun(U, 1.0), np.full(rod.n, g), lo, hi, _NEWTON_TOL, maxit=60)
+        k, ok, _ = newton(lambda U: fun(U, 1.0), np.full(rod.n, g), lo, hi, NEWTON_TOL, maxit=60)
         if ok:
             return finish(k, "; no free shape at this pressure (fold of the moment law): the equilibrium exists "
                           "only under these loads")
-    note = (f"no equilibrium: at {P * 1e3:.4g} kPa the stable branch supplies only M in [{br.moment_min:.4g}, "
+    note = (f"no equilibrium: at {P:.4g} kPa the stable branch supplies only M in [{br.moment_min:.4g}, "
             f"{br.moment_max:.4g}] N*mm, not M = 0 (above the fold: {br.describe_end(sgn)}); where the load moment is "
             "smaller (toward the tip) the finger snaps through")
     return _failed(rod, br, P, loads, note)
 
 
-def finger_sweep(finger: Finger, pressures, loads: FingerLoads | None = None):
-    """Solve ``finger`` at each pressure (MPa).
+def finger_sweep(finger: Finger, pressures_kpa, loads: FingerLoads | None = None):
+    """Solve ``finger`` at each pressure of ``pressures_kpa`` (kPa).
 
     Returns ``(table, shapes)``: a :class:`pandas.DataFrame` with ``pressure_kpa``, ``tip_x_mm``,
     ``tip_y_mm``, ``tip_angle_deg``, ``bend_angle_deg``, ``base_moment_nmm``, ``residual_nmm``,
@@ -813,10 +770,12 @@ def finger_sweep(finger: Finger, pressures, loads: FingerLoads | None = None):
     """
     import pandas as pd
 
-    P = np.atleast_1d(np.asarray(pressures, dtype=float)).ravel()
-    shapes = [solve_finger(finger, p, loads) for p in P]
+    loads = _check_finger(finger, loads)
+    P = checked_pressures_kpa(pressures_kpa)
+    with pressures_checked():
+        shapes = [_solve_finger(finger, float(p), loads) for p in P]
     return pd.DataFrame({
-        "pressure_kpa": P * 1e3,
+        "pressure_kpa": P,
         "tip_x_mm": [sh.tip_xy[0] for sh in shapes],
         "tip_y_mm": [sh.tip_xy[1] for sh in shapes],
         "tip_angle_deg": [sh.tip_angle_deg for sh in shapes],
@@ -828,10 +787,10 @@ def finger_sweep(finger: Finger, pressures, loads: FingerLoads | None = None):
     }), shapes
 
 
-def free_tip_trajectory(finger: Finger, pressures):
-    """Tip pose of the unloaded finger against pressure (MPa), vectorised.
+def free_tip_trajectory(finger: Finger, pressures_kpa):
+    """Tip pose of the unloaded finger against pressure (kPa), vectorised.
 
-    The free shape is a circular arc of the free curvature (:func:`bendpam.free_curvature`) plus the
+    The free shape is a circular arc of the free curvature (:meth:`bendpam.MomentLaw.free_curvature`) plus the
     rigid fingertip.  Returns a :class:`pandas.DataFrame` with ``pressure_kpa``,
     ``free_curvature_per_mm``, ``tip_x_mm``, ``tip_y_mm``, ``tip_angle_deg``, ``bend_angle_deg``,
     ``status`` and ``note`` (NaN pose where there is no free equilibrium).
@@ -840,9 +799,10 @@ def free_tip_trajectory(finger: Finger, pressures):
 
     if not isinstance(finger, Finger):
         raise TypeError(f"finger must be a bendpam.design.Finger, got {type(finger).__name__}")
-    P = np.atleast_1d(np.asarray(pressures, dtype=float)).ravel()
-    fb = free_curvature(finger.actuator, P, finger.model)
-    k = fb.curvature
+    P = checked_pressures_kpa(pressures_kpa)
+    with pressures_checked():
+        fb = finger.law.free_curvature(P)
+    k = fb.curvature_per_mm
     kap = finger.frame_side * k
     L = finger.length
     th = kap * L
@@ -851,10 +811,11 @@ def free_tip_trajectory(finger: Finger, pressures):
     x0, y0 = finger.base_xy_mm
     pl = p0 + th
     b = finger.bend
-    xt = x0 + ln * np.cos(p0 + 0.5 * th) + finger.fingertip_mm * np.cos(pl) - b * finger.fingertip_offset_mm * np.sin(pl)
-    yt = y0 + ln * np.sin(p0 + 0.5 * th) + finger.fingertip_mm * np.sin(pl) + b * finger.fingertip_offset_mm * np.cos(pl)
+    ell, off = finger.fingertip_mm, finger.fingertip_offset_mm
+    xt = x0 + ln * np.cos(p0 + 0.5 * th) + ell * np.cos(pl) - b * off * np.sin(pl)
+    yt = y0 + ln * np.sin(p0 + 0.5 * th) + ell * np.sin(pl) + b * off * np.cos(pl)
     return pd.DataFrame({
-        "pressure_kpa": P * 1e3,
+        "pressure_kpa": P,
         "free_curvature_per_mm": k,
         "tip_x_mm": xt,
         "tip_y_mm": yt,
@@ -904,14 +865,14 @@ def _straight_tip(finger: Finger) -> tuple[float, float]:
     return x0 + L * math.cos(p) - o * math.sin(p), y0 + L * math.sin(p) + o * math.cos(p)
 
 
-def blocked_tip_force(finger: Finger, pressure, target_xy_mm=None, direction_deg=None,
+def blocked_tip_force(finger: Finger, pressure_kpa, target_xy_mm=None, direction_deg=None,
                       loads: FingerLoads | None = None) -> BlockedTipForce:
     """Force needed to hold the fingertip at a target point.
 
     Parameters
     ----------
     finger : Finger
-    pressure : float, MPa.
+    pressure_kpa : float, kPa.
     target_xy_mm : (x, y), optional
         Target point, mm.  Default: the straight (unpressurised) tip position, held by a roller
         normal to the base direction, as a force sensor measures a blocked force (a pin there would
@@ -927,31 +888,36 @@ def blocked_tip_force(finger: Finger, pressure, target_xy_mm=None, direction_deg
     is reached by continuation from the free (or loaded) tip.  If the holder cannot be reached on
     the stable branch (a fold: snap-through), ``equilibrium`` is False with a note.
     """
-    if not isinstance(finger, Finger):
-        raise TypeError(f"finger must be a bendpam.design.Finger, got {type(finger).__name__}")
-    loads = FingerLoads() if loads is None else loads
-    P = _pressure(pressure)
+    loads = _check_finger(finger, loads)
+    P = checked_pressure_kpa(pressure_kpa)
     if target_xy_mm is None:
         target = _straight_tip(finger)
         if direction_deg is None:
             p = finger.base_angle
             direction = (-finger.bend * math.sin(p), finger.bend * math.cos(p))
         else:
-            d = math.radians(_num("direction_deg", direction_deg, unit="deg"))
+            d = math.radians(number("direction_deg", direction_deg, unit="deg"))
             direction = (math.cos(d), math.sin(d))
     else:
         target = _pair("target_xy_mm", target_xy_mm, "mm")
         if direction_deg is None:
             direction = None
         else:
-            d = math.radians(_num("direction_deg", direction_deg, unit="deg"))
+            d = math.radians(number("direction_deg", direction_deg, unit="deg"))
             direction = (math.cos(d), math.sin(d))
+    with pressures_checked():
+        return _blocked_tip_force(finger, P, target, direction, target_xy_mm is not None, loads)
+
+
+def _blocked_tip_force(finger: Finger, P: float, target, direction, given_target: bool,
+                       loads: FingerLoads) -> BlockedTipForce:
+    """:func:`blocked_tip_force` with validated arguments (P in kPa, ``direction`` a unit vector or None)."""
     constraint = "pin" if direction is None else "roller"
-    start = solve_finger(finger, P, loads)
-    rod = _Rod(finger, loads)
+    start = _solve_finger(finger, P, loads)
+    rod = Rod(finger, loads)
     try:
-        br = stable_branch(finger.actuator, P, finger.model, finger.friction_nmm(P))
-    except ValueError as exc:
+        br = finger.branch(P)
+    except NoEquilibrium as exc:
         return BlockedTipForce((math.nan, math.nan), target, constraint, direction, start, False, str(exc))
     n = rod.n
     c = rod.c
@@ -961,7 +927,7 @@ def blocked_tip_force(finger: Finger, pressure, target_xy_mm=None, direction_deg
     nf = 2 if direction is None else 1
 
     def make(P_t, tx, ty):
-        b = stable_branch(finger.actuator, P_t, finger.model, finger.friction_nmm(P_t))
+        b = finger.branch(P_t)
 
         def fun(U):
             k = U[..., :n]
@@ -969,15 +935,16 @@ def blocked_tip_force(finger: Finger, pressure, target_xy_mm=None, direction_deg
                 gx, gy = U[..., n] * fscale, U[..., n + 1] * fscale
             else:
                 gx, gy = U[..., n] * fscale * direction[0], U[..., n] * fscale * direction[1]
-            phi, x, y, xt, yt = rod.geometry(k)
-            m = rod.load_moment(x, y, xt, yt) + _cross(xt[..., None] - x, yt[..., None] - y, gx[..., None], gy[..., None])
+            _phi, x, y, xt, yt = rod.geometry(k)
+            m = rod.load_moment(x, y, xt, yt) + cross(xt[..., None] - x, yt[..., None] - y,
+                                                      gx[..., None], gy[..., None])
             M, _ = b.moment(k)
             r1 = (M + c * m) / scale
             if direction is None:
                 extra = [((xt - tx) / Lr)[..., None], ((yt - ty) / Lr)[..., None]]
             else:
                 extra = [(((xt - tx) * direction[0] + (yt - ty) * direction[1]) / Lr)[..., None]]
-            return np.concatenate([r1] + extra, axis=-1)
+            return np.concatenate([r1, *extra], axis=-1)
 
         lo = np.concatenate([np.full(n, b.k_lo), np.full(nf, -np.inf)])
         hi = np.concatenate([np.full(n, b.k_hi), np.full(nf, np.inf)])
@@ -985,9 +952,9 @@ def blocked_tip_force(finger: Finger, pressure, target_xy_mm=None, direction_deg
 
     tgt = np.array(target)
     straight = np.array(_straight_tip(finger))
-    P0 = min(P, finger.actuator.P_start)
+    P0 = min(P, finger.actuator.P_start_kpa)
     paths = []
-    if target_xy_mm is not None and start.equilibrium:
+    if given_target and start.equilibrium:
         # move the holder from the free tip to the target at the working pressure
         t0 = np.array(start.tip_xy)
         paths.append((np.concatenate([start.curvature, np.zeros(nf)]),
@@ -1015,7 +982,7 @@ def blocked_tip_force(finger: Finger, pressure, target_xy_mm=None, direction_deg
     else:
         F = (float(u[n] * fscale * direction[0]), float(u[n] * fscale * direction[1]))
     total = replace(loads, tip_force_n=(loads.tip_force_n[0] + F[0], loads.tip_force_n[1] + F[1]))
-    sh = _shape(_Rod(finger, total), u[:n], br, P, total)
+    sh = _shape(Rod(finger, total), u[:n], br, P, total)
     return BlockedTipForce(F, target, constraint, direction, sh, True, "")
 
 
@@ -1033,13 +1000,19 @@ class TipStiffness:
     shape: FingerShape
 
 
-def tip_stiffness(finger: Finger, pressure, loads: FingerLoads | None = None) -> TipStiffness:
-    """Tip stiffness matrix (3x3) at the equilibrium under ``loads``: from the exact Jacobian."""
-    loads = FingerLoads() if loads is None else loads
-    sh = solve_finger(finger, pressure, loads)
+def tip_stiffness(finger: Finger, pressure_kpa, loads: FingerLoads | None = None) -> TipStiffness:
+    """Tip stiffness matrix (3x3) at the equilibrium at ``pressure_kpa`` (kPa) under ``loads``.
+
+    From the exact (complex-step) Jacobian.  Raises :class:`~bendpam.errors.NoEquilibrium` where the
+    finger has no stable equilibrium under these loads.
+    """
+    loads = _check_finger(finger, loads)
+    P = checked_pressure_kpa(pressure_kpa)
+    with pressures_checked():
+        sh = _solve_finger(finger, P, loads)
     if not sh.equilibrium:
-        raise ValueError(f"no equilibrium at pressure = {float(pressure) * 1e3:g} kPa under these loads: {sh.note}")
-    rod = _Rod(finger, loads)
+        raise NoEquilibrium(f"no equilibrium at pressure_kpa = {P:g} kPa under these loads: {sh.note}")
+    rod = Rod(finger, loads)
     br = sh.branch
     n = rod.n
     c = rod.c
@@ -1047,48 +1020,57 @@ def tip_stiffness(finger: Finger, pressure, loads: FingerLoads | None = None) ->
 
     def fun(U):  # unknowns k, then the load increment (dFx, dFy, dM)
         kk = U[..., :n]
-        phi, x, y, xt, yt = rod.geometry(kk)
+        _phi, x, y, xt, yt = rod.geometry(kk)
         dF = U[..., n:]
-        m = rod.load_moment(x, y, xt, yt) + dF[..., 2:3] + _cross(xt[..., None] - x, yt[..., None] - y,
+        m = rod.load_moment(x, y, xt, yt) + dF[..., 2:3] + cross(xt[..., None] - x, yt[..., None] - y,
                                                                   dF[..., 0:1], dF[..., 1:2])
         M, _ = br.moment(kk)
         return M + c * m
 
     def pose(U):
-        phi, x, y, xt, yt = rod.geometry(U[..., :n])
+        phi, _x, _y, xt, yt = rod.geometry(U[..., :n])
         return np.stack([xt, yt, phi[..., -1]], axis=-1)
 
     u = np.concatenate([k, np.zeros(3)])
     J = _complex_jacobian(fun, u)
     Jk, JF = J[:, :n], J[:, n:]
-    dk = -np.linalg.solve(Jk, JF)
-    Q = _complex_jacobian(pose, u)
-    C = Q[:, :n] @ dk
-    return TipStiffness(np.linalg.inv(C), C, sh)
+    try:
+        dk = -np.linalg.solve(Jk, JF)
+        Q = _complex_jacobian(pose, u)
+        C = Q[:, :n] @ dk
+        K = np.linalg.inv(C)
+    except np.linalg.LinAlgError:
+        raise NoEquilibrium(
+            f"pressure_kpa = {sh.pressure_kpa:g}: the tip compliance is singular (the finger is straight and "
+            "inextensible, so its tip stiffness along its axis is unbounded); use linear_tip_compliance or a "
+            "pressure that bends it") from None
+    return TipStiffness(K, C, sh)
 
 
-def linear_tip_compliance(finger: Finger, pressure) -> np.ndarray:
+def linear_tip_compliance(finger: Finger, pressure_kpa) -> np.ndarray:
     """Linear beam-theory compliance (3x3) of the free finger: reference for the nonlinear solver.
 
     With the free (constant) curvature and the tangent stiffness ``K = dM/dk'`` there (negative), a
     small tip load changes the curvature by ``dk' = dM_ext / K`` and the tip pose by the integral of
-    the rotations, with no geometric stiffness (the finger is unloaded).  Integrated on 2001 points.
+    the rotations, with no geometric stiffness (the finger is unloaded).  Integrated on 1001 nodes.
+    Pressure in kPa; raises :class:`~bendpam.errors.NoEquilibrium` above the free branch.
     """
-    from .. import tangent_stiffness
-
-    P = _pressure(pressure)
-    fb = free_curvature(finger.actuator, P, finger.model)
-    if fb.status == "no-equilibrium":
-        raise ValueError(f"pressure = {P * 1e3:g} kPa has no free-bending equilibrium: {fb.reason}")
-    k = float(fb.curvature)
-    K = float(tangent_stiffness(finger.actuator, P, k, finger.model))
+    _check_finger(finger, None)
+    P = checked_pressure_kpa(pressure_kpa)
+    law = finger.law
+    with pressures_checked():
+        fb = law.free_curvature(P)
+        if fb.status == "no-equilibrium":
+            raise NoEquilibrium(f"pressure_kpa = {P:g} kPa has no free-bending equilibrium: {fb.reason}")
+        k = float(fb.curvature_per_mm)
+        K = float(law.tangent_stiffness(P, k))
     fine = replace(finger, nodes=1001)
-    rod = _Rod(fine, FingerLoads())
-    phi, x, y, xt, yt = rod.geometry(np.full((1, rod.n), k))
+    rod = Rod(fine, FingerLoads())
+    _phi, x, y, xt, yt = rod.geometry(np.full((1, rod.n), k))
     x, y, xt, yt = x[0], y[0], float(xt[0]), float(yt[0])
     ax, ay = xt - x, yt - y  # lever from each section to the tip
     # unit loads: Fx, Fy, M -> m(s) (counterclockwise moment) -> dkappa = c dk' = c (-c m)/K = -m/K
-    ms = [_cross(ax, ay, 1.0, 0.0), _cross(ax, ay, 0.0, 1.0), np.ones_like(ax)]
+    ms = [cross(ax, ay, 1.0, 0.0), cross(ax, ay, 0.0, 1.0), np.ones_like(ax)]
     C = np.zeros((3, 3))
     for j, m in enumerate(ms):
         dkap = -m / K
@@ -1107,7 +1089,7 @@ def plot_finger_shapes(shapes, ax=None, title: str | None = None):
 
     Shapes without equilibrium are drawn dashed from their last equilibrium (``limit``) if any.
     """
-    from .. import plots  # noqa: F401  (selects the Agg backend unless the caller chose one)
+    from .. import plots  # noqa: F401, I001  (first: selects the Agg backend unless the caller chose one)
     import matplotlib.pyplot as plt
 
     if ax is None:
@@ -1116,9 +1098,9 @@ def plot_finger_shapes(shapes, ax=None, title: str | None = None):
         fig = ax.figure
     shapes = list(shapes)
     colors = plt.cm.viridis(np.linspace(0.0, 0.9, max(len(shapes), 1)))
-    for sh, col in zip(shapes, colors):
+    for sh, col in zip(shapes, colors, strict=False):
         draw, style = (sh, "-") if sh.equilibrium else (sh.limit, "--")
-        label = f"{sh.pressure * 1e3:g} kPa" + ("" if sh.equilibrium else " (no equilibrium)")
+        label = f"{sh.pressure_kpa:g} kPa" + ("" if sh.equilibrium else " (no equilibrium)")
         if draw is None:
             ax.plot([], [], style, color=col, label=label)
             continue

@@ -13,9 +13,9 @@ Model and assumptions
   plane with the same statics; the planar finger model of :mod:`bendpam.design.finger` applies
   (coordinates: ``x`` radial outward from the axis, ``y`` up, base at ``(R_b, 0)``).
 * **Contact surface.**  A BE-PAM finger bends toward its frame, so the frame faces the sphere; a
-  BC-PAM finger bends away from it, so the bladder side (about ``2 R0_start`` from the frame) faces
-  the sphere.  ``contact_offset_mm`` (default: half the frame thickness for a BE-PAM, ``2
-  R0_start`` for a BC-PAM) is that distance.  The rod's frame line then touches the sphere of radius
+  BC-PAM finger bends away from it, so the bladder side (about ``2 R0_start_mm`` from the frame)
+  faces the sphere.  ``contact_offset_mm`` (default: half the frame thickness for a BE-PAM, ``2
+  R0_start_mm`` for a BC-PAM) is that distance.  The rod's frame line then touches the sphere of radius
   ``D/2 + offset`` (body contact, tangent), or the fingertip point, at the end of a rigid
   fingertip of length ``fingertip_mm`` shifted by the offset toward the sphere, touches the sphere
   itself (tip contact).
@@ -54,7 +54,8 @@ Model and assumptions
   would hold a larger force on big spheres), gravity on the fingers and the sphere's weight (a
   fixed sphere), out-of-plane finger deformation, and finger-finger and palm contacts.
 
-Units: mm, N, MPa for pressures passed to functions (kPa in tables), degrees in names ending _deg.
+Units: mm, N, kPa (every function takes and returns pressures in kPa, ``pressure_kpa``), degrees in
+names ending ``_deg``.  Bad input raises :class:`bendpam.InputError`.
 """
 
 from __future__ import annotations
@@ -64,31 +65,33 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import Actuator, curvature_limits, free_curvature
-from .. import moment as _moment
-from ..presets import normalise_model
+from ..actuator import Actuator
+from ..checks import number
+from ..errors import InputError, NoEquilibrium
+from ..law import MomentLaw, StableBranch
+from ..models import normalise_model
 from .finger import (
+    NEWTON_TOL,
     Finger,
     FingerLoads,
     FingerShape,
-    StableBranch,
-    _cross,
-    _newton,
-    _num,
-    _pressure,
-    _Rod,
-    _NEWTON_TOL,
-    stable_branch,
+    Rod,
+    checked_pressure_kpa,
+    checked_pressures_kpa,
+    cross,
+    newton,
+    pressures_checked,
+    solve_finger,
 )
 
 __all__ = [
     "DEFAULT_BASE_RADIUS_MM",
     "DEFAULT_FINGERTIP_MM",
-    "Gripper",
     "Grasp",
-    "solve_grasp",
+    "Gripper",
     "grasp_sweep",
     "plot_grasp",
+    "solve_grasp",
 ]
 
 #: default base-circle radius of the fingers' frame lines, mm (see :class:`Gripper`)
@@ -119,7 +122,7 @@ class Gripper:
         Rigid fingertip (tip pad) length, mm (default 10).
     contact_offset_mm : float, optional
         Distance from the frame line to the finger's contact surface on the sphere's side, mm.
-        Default: half the frame thickness for a BE-PAM, ``2 R0_start`` for a BC-PAM.
+        Default: half the frame thickness for a BE-PAM, ``2 R0_start_mm`` for a BC-PAM.
     mu : float
         Friction coefficient pad-sphere for the pull-out, in [0, 5] (default 0.5).
     center_depth_mm : float, optional
@@ -149,21 +152,21 @@ class Gripper:
             raise TypeError(f"actuator must be a bendpam.Actuator, got {type(self.actuator).__name__}")
         s(self, "model", normalise_model(self.model))
         nf = self.fingers
-        if isinstance(nf, bool) or not isinstance(nf, (int, np.integer)) or not 2 <= int(nf) <= 12:
-            raise ValueError(f"fingers = {nf!r} is outside the allowed range [2, 12] (an integer)")
+        if isinstance(nf, bool) or not isinstance(nf, int | np.integer) or not 2 <= int(nf) <= 12:
+            raise InputError(f"fingers = {nf!r} is outside the allowed range [2, 12] (an integer)")
         s(self, "fingers", int(nf))
-        s(self, "base_radius_mm", _num("base_radius_mm", self.base_radius_mm, 0.0, 1e4, lo_open=True, unit="mm"))
-        s(self, "fingertip_mm", _num("fingertip_mm", self.fingertip_mm, 0.0, 1e4, unit="mm"))
+        s(self, "base_radius_mm", number("base_radius_mm", self.base_radius_mm, 0.0, 1e4, lo_open=True, unit="mm"))
+        s(self, "fingertip_mm", number("fingertip_mm", self.fingertip_mm, 0.0, 1e4, unit="mm"))
         if self.contact_offset_mm is None:
             off = (self.actuator.frame_thickness_mm / 2.0 if self.actuator.bend_sign > 0
-                   else 2.0 * self.actuator.R0_start)
+                   else 2.0 * self.actuator.R0_start_mm)
             s(self, "contact_offset_mm", off)
         else:
-            s(self, "contact_offset_mm", _num("contact_offset_mm", self.contact_offset_mm, 0.0, 1e3, unit="mm"))
-        s(self, "mu", _num("mu", self.mu, 0.0, 5.0))
+            s(self, "contact_offset_mm", number("contact_offset_mm", self.contact_offset_mm, 0.0, 1e3, unit="mm"))
+        s(self, "mu", number("mu", self.mu, 0.0, 5.0))
         if self.center_depth_mm is not None:
-            s(self, "center_depth_mm", _num("center_depth_mm", self.center_depth_mm, unit="mm"))
-        s(self, "splay_deg", _num("splay_deg", self.splay_deg, -45.0, 45.0, unit="deg"))
+            s(self, "center_depth_mm", number("center_depth_mm", self.center_depth_mm, unit="mm"))
+        s(self, "splay_deg", number("splay_deg", self.splay_deg, -45.0, 45.0, unit="deg"))
         # the finger validates nodes and the actuator
         self.finger()
 
@@ -175,9 +178,15 @@ class Gripper:
                       bend=-1, fingertip_mm=self.fingertip_mm, fingertip_offset_mm=self.contact_offset_mm,
                       nodes=self.nodes)
 
+    @property
+    def law(self) -> MomentLaw:
+        """The finger actuator's shared moment law under the gripper's model (:meth:`bendpam.MomentLaw.of`)."""
+        return MomentLaw.of(self.actuator, self.model)
+
     def center_depth(self, diameter_mm: float) -> float:
         """Depth of the sphere's centre below the base plane, mm (placement rule or the given value)."""
-        return _landing(self, 0.5 * float(diameter_mm))[0]
+        D = number("diameter_mm", diameter_mm, 0.0, 1e5, lo_open=True, unit="mm")
+        return _landing(self, 0.5 * D)[0]
 
 
 @dataclass(frozen=True)
@@ -186,7 +195,7 @@ class Grasp:
 
     Attributes
     ----------
-    diameter_mm, pressure : sphere diameter (mm), pressure (MPa).
+    diameter_mm, pressure_kpa : sphere diameter (mm), gauge pressure (kPa).
     contact : ``"tip"``, ``"body"``, ``"tip+body"`` or ``"none"``.
     normal_force_n : normal (contact) force per finger, N (sum over its contacts; 0 for none).
     grip_force_n : pull-out force of the whole gripper, N.
@@ -200,7 +209,7 @@ class Grasp:
     """
 
     diameter_mm: float
-    pressure: float
+    pressure_kpa: float
     contact: str
     normal_force_n: float
     grip_force_n: float
@@ -220,7 +229,7 @@ def _none(D, P, depth, note, shape=None, equilibrium=True):
 class _Contact:
     """Residuals of one finger in contact with the sphere (tip, body or both)."""
 
-    def __init__(self, rod: _Rod, cx, cy, R, delta, mode: str, scale: float):
+    def __init__(self, rod: Rod, cx, cy, R, delta, mode: str, scale: float):
         self.rod, self.cx, self.cy, self.R, self.delta, self.mode = rod, cx, cy, R, delta, mode
         self.scale = scale
         self.Lr = rod.L + rod.ell
@@ -271,16 +280,16 @@ class _Contact:
             extra = []
             if "tip" in g:
                 N, px, py, nx, ny, d = g["tip"]
-                m = m + _cross(px[..., None] - x, py[..., None] - y, (N * nx)[..., None], (N * ny)[..., None])
+                m = m + cross(px[..., None] - x, py[..., None] - y, (N * nx)[..., None], (N * ny)[..., None])
                 extra.append(((d - self.R) / self.Lr)[..., None])
             if "body" in g:
                 N, px, py, nx, ny, d, sc, pc = g["body"]
                 beyond = (rod.s < np.real(sc)[..., None]).astype(float)
-                m = m + beyond * _cross(px[..., None] - x, py[..., None] - y, (N * nx)[..., None], (N * ny)[..., None])
+                m = m + beyond * cross(px[..., None] - x, py[..., None] - y, (N * nx)[..., None], (N * ny)[..., None])
                 extra.append(((d - self.R) / self.Lr)[..., None])
                 extra.append((np.cos(pc) * nx + np.sin(pc) * ny)[..., None])
             M, _ = branch.moment(g["k"])
-            return np.concatenate([(M + c * m) / self.scale] + extra, axis=-1)
+            return np.concatenate([(M + c * m) / self.scale, *extra], axis=-1)
 
         lo = np.full(self.size, -np.inf)
         hi = np.full(self.size, np.inf)
@@ -417,7 +426,7 @@ def _unpack(n, mode, u):
 class _Ctx:
     """Everything one grasp needs: the finger rod, the sphere and the moment scale."""
 
-    def __init__(self, gripper: Gripper, rod: _Rod, cx, cy, R, delta, scale):
+    def __init__(self, gripper: Gripper, rod: Rod, cx, cy, R, delta, scale):
         self.gripper, self.rod, self.cx, self.cy, self.R, self.delta, self.scale = gripper, rod, cx, cy, R, delta, scale
         self._sys = {}
 
@@ -427,7 +436,7 @@ class _Ctx:
         return self._sys[mode]
 
     def branch(self, P) -> StableBranch:
-        return stable_branch(self.gripper.actuator, P, self.gripper.model)
+        return self.gripper.law.stable_branch(P)
 
 
 def _check(ctx: _Ctx, mode: str, u):
@@ -474,7 +483,7 @@ def _check(ctx: _Ctx, mode: str, u):
 
 def _solve_at(ctx: _Ctx, mode, u, br, maxit=40):
     fun, lo, hi = ctx.contact(mode).system(br)
-    return _newton(fun, u, lo, hi, _NEWTON_TOL, maxit=maxit)[:2]
+    return newton(fun, u, lo, hi, NEWTON_TOL, maxit=maxit)[:2]
 
 
 def _settle(ctx: _Ctx, mode, u, br, max_switch=4):
@@ -505,7 +514,7 @@ def _track(ctx: _Ctx, P0: float, P1: float, mode: str, u):
         br = ctx.branch(Pt)
         un, ok = _solve_at(ctx, mode, u, br)
         if ok:
-            m2, u2, why = _settle(ctx, mode, un, br)
+            m2, u2, _why = _settle(ctx, mode, un, br)
             if m2 is not None:
                 mode, u, t = m2, u2, t + step
                 step *= 2.0
@@ -532,22 +541,28 @@ def _track(ctx: _Ctx, P0: float, P1: float, mode: str, u):
     return mode, u, t
 
 
-def solve_grasp(gripper: Gripper, diameter_mm, pressure) -> Grasp:
-    """Grasp of a sphere of ``diameter_mm`` at ``pressure`` (MPa): contact, normal and gripping force.
+def solve_grasp(gripper: Gripper, diameter_mm, pressure_kpa) -> Grasp:
+    """Grasp of a sphere of ``diameter_mm`` at ``pressure_kpa`` (kPa): contact, normal and gripping force.
 
     See the module docstring for the model.  A sphere that does not fit, or that the fingers do
     not reach at this pressure, gives contact ``"none"`` and zero force (not an error); where the
     fingers have no stable equilibrium in contact, ``equilibrium`` is False and the forces NaN.
     """
-    return _grasp_path(gripper, diameter_mm, [pressure])[0]
+    _check_gripper(gripper)
+    D = number("diameter_mm", diameter_mm, 0.0, 1e5, lo_open=True, unit="mm")
+    P = checked_pressure_kpa(pressure_kpa)
+    with pressures_checked():
+        return _grasp_path(gripper, D, [P])[0]
 
 
-def _grasp_path(gripper: Gripper, diameter_mm, pressures) -> list[Grasp]:
-    """Grasps of one sphere at several pressures, inflating quasi-statically (ascending pressure)."""
+def _check_gripper(gripper) -> None:
     if not isinstance(gripper, Gripper):
         raise TypeError(f"gripper must be a bendpam.design.Gripper, got {type(gripper).__name__}")
-    D = _num("diameter_mm", diameter_mm, 0.0, 1e5, lo_open=True, unit="mm")
-    Ps = [_pressure(p) for p in pressures]
+
+
+def _grasp_path(gripper: Gripper, D: float, Ps: list[float]) -> list[Grasp]:
+    """Grasps of a sphere of diameter ``D`` (mm) at pressures ``Ps`` (kPa, validated), inflating
+    quasi-statically (in ascending pressure)."""
     order = np.argsort(Ps, kind="stable")
     out: list[Grasp | None] = [None] * len(Ps)
     R = 0.5 * D
@@ -560,30 +575,29 @@ def _grasp_path(gripper: Gripper, diameter_mm, pressures) -> list[Grasp]:
         return [_none(D, P, depth, note) for P in Ps]
     finger = gripper.finger()
     act = gripper.actuator
+    law = gripper.law
     cx, cy = 0.0, -depth
-    lim = curvature_limits(act)
+    lim = law.limits
     k_lock = lim.k_max if act.bend_sign > 0 else lim.k_min
     kap_c, kind, sig_c = _min_touch_curvature(finger, cx, cy, R, delta, 0.98 * abs(k_lock))
     if not np.isfinite(kap_c):
         return [_none(D, P, depth, "too small: the fingers do not touch the sphere even fully curled") for P in Ps]
-    p_on = _onset_pressure(act, gripper.model, kap_c)
-    rod = _Rod(finger, FingerLoads())
+    p_on = _onset_pressure_kpa(law, kap_c)
+    rod = Rod(finger, FingerLoads())
     n = rod.n
     k_c = act.bend_sign * kap_c  # frame curvature at the onset
     Lr = rod.L + rod.ell
     sig0 = min(max(sig_c, 0.02 * Lr), 0.98 * Lr) / Lr
-    scale = max(abs(float(stable_branch(act, max(Ps), gripper.model).moment(0.0)[0])), 1.0)
+    scale = max(abs(float(law.blocked_moment(max(Ps)))), 1.0)
     ctx = _Ctx(gripper, rod, cx, cy, R, delta, scale)
     state = (p_on, kind, _pack(n, kind, np.full(n, k_c), sig=sig0)) if np.isfinite(p_on) else None
     stuck = None  # note once the quasi-static path has no equilibrium
     for i in order:
         P = Ps[i]
-        fb = free_curvature(act, P, gripper.model)
-        free_ok = bool(fb.status != "no-equilibrium") and bool(np.isfinite(fb.curvature))
-        if free_ok and abs(float(fb.curvature)) < kap_c:
-            from .finger import solve_finger
-
-            on = f"; contact from {p_on * 1e3:.4g} kPa" if np.isfinite(p_on) else ""
+        fb = law.free_curvature(P)
+        free_ok = bool(fb.status != "no-equilibrium") and bool(np.isfinite(fb.curvature_per_mm))
+        if free_ok and abs(float(fb.curvature_per_mm)) < kap_c:
+            on = f"; contact from {p_on:.4g} kPa" if np.isfinite(p_on) else ""
             out[i] = _none(D, P, depth, f"too small for this pressure: the fingers do not reach the sphere{on}",
                            solve_finger(finger, P))
             continue
@@ -591,8 +605,8 @@ def _grasp_path(gripper: Gripper, diameter_mm, pressures) -> list[Grasp]:
             out[i] = _none(D, P, depth, stuck[0], equilibrium=stuck[1])
             continue
         try:
-            br_P = stable_branch(act, P, gripper.model)
-        except ValueError as exc:
+            br_P = law.stable_branch(P)
+        except NoEquilibrium as exc:
             out[i] = _none(D, P, depth, str(exc), equilibrium=False)
             continue
         if state is not None:
@@ -607,11 +621,11 @@ def _grasp_path(gripper: Gripper, diameter_mm, pressures) -> list[Grasp]:
             beta = math.degrees(math.atan2(float(np.real(g["tip"][3][0])), -float(np.real(g["tip"][4][0])))) \
                 if "tip" in g else math.nan
             if "tip" in mode and beta > 90.0:
-                stuck = (f"the fingertip slides up and over the sphere at {P_reached * 1e3:.4g} kPa (frictionless "
+                stuck = (f"the fingertip slides up and over the sphere at {P_reached:.4g} kPa (frictionless "
                          f"closing, contact at beta = {beta:.0f} deg): no grasp", True)
             else:
                 reason = fb.reason if not free_ok else "a limit point of the contact equilibrium"
-                stuck = (f"no stable contact equilibrium above {P_reached * 1e3:.4g} kPa ({reason}); the finger "
+                stuck = (f"no stable contact equilibrium above {P_reached:.4g} kPa ({reason}); the finger "
                          "snaps through", False)
             out[i] = _none(D, P, depth, stuck[0], equilibrium=stuck[1])
             continue
@@ -619,7 +633,7 @@ def _grasp_path(gripper: Gripper, diameter_mm, pressures) -> list[Grasp]:
         res = _direct(ctx, gripper, D, P, depth, br_P, kind, k_c, sig0)
         if res is None:
             reason = fb.reason if not free_ok else "the contact needs more curvature than the stable branch reaches"
-            res = _none(D, P, depth, f"no stable contact equilibrium at {P * 1e3:.4g} kPa ({reason}); near the "
+            res = _none(D, P, depth, f"no stable contact equilibrium at {P:.4g} kPa ({reason}); near the "
                         "fingertip the contact moment is too small for the stable branch, so the finger snaps "
                         "through", equilibrium=False)
         out[i] = res
@@ -641,17 +655,18 @@ def _direct(ctx: _Ctx, gripper, D, P, depth, br_P, kind, k_c, sig0):
     return None
 
 
-def _onset_pressure(act: Actuator, model: str, kap_c: float) -> float:
-    """Pressure (MPa) at which the free curvature reaches ``kap_c`` (NaN beyond the free branch)."""
-    from .. import branch_info
+def _onset_pressure_kpa(law: MomentLaw, kap_c: float) -> float:
+    """Gauge pressure (kPa) at which the free curvature reaches ``|k'| = kap_c`` (NaN beyond the free branch).
 
-    br = branch_info(act, model)
-    kt, pt = np.abs(br.k_table), br.p_table
+    From the law's sampled free-bending branch (active pressure, kPa, monotone along the branch).
+    """
+    br = law.free_branch()
+    kt, pt = np.abs(br.k_table_per_mm), br.p_table_kpa
     ok = np.isfinite(pt)
     kt, pt = kt[ok], pt[ok]
     if kap_c > kt[-1]:
         return math.nan
-    return act.P_start + float(np.interp(kap_c, kt, pt))
+    return float(law.P_start_kpa) + float(np.interp(kap_c, kt, pt))
 
 
 def _finish(gripper: Gripper, D, P, depth, sysm: _Contact, u, br, mode) -> Grasp:
@@ -682,18 +697,25 @@ def _finish(gripper: Gripper, D, P, depth, sysm: _Contact, u, br, mode) -> Grasp
         if key in g:
             N, px, py, nx, ny = (float(np.real(v[0])) for v in g[key][:5])
             mask = np.ones(rod.n) if key == "tip" else (rod.s < float(np.real(g["body"][6][0]))).astype(float)
-            m = m + mask * _cross(px - x, py - y, N * nx, N * ny)
+            m = m + mask * cross(px - x, py - y, N * nx, N * ny)
     m_act = -rod.c * m
-    act = gripper.actuator
-    res = float(np.max(np.abs(_moment(act, P, k, gripper.model) - m_act)))
+    res = float(np.max(np.abs(gripper.law.moment(P, k) - m_act)))
     shape = FingerShape(rod.f, loads, P, rod.s.copy(), x, y, phi, k.copy(), m_act, (float(xt[0]), float(yt[0])),
                         float(phi[-1]), True, True, res, 1.0, f"in {mode} contact (normal force {total_N:.4g} N)",
                         None, br)
     return Grasp(D, P, mode, total_N, gripper.fingers * grip, tuple(pts), betas[main], depth, True, "", shape)
 
 
-def grasp_sweep(gripper: Gripper, diameters_mm, pressures):
-    """Grasps over diameters (mm) and pressures (MPa): an :class:`xarray.Dataset`.
+def _diameters_mm(value) -> np.ndarray:
+    """Sphere diameters (mm) as a 1-D float array, each positive and finite, else an InputError."""
+    arr = np.atleast_1d(np.asarray(value, dtype=object)).ravel()
+    if arr.size == 0:
+        raise InputError("diameters_mm is empty; give at least one sphere diameter (mm)")
+    return np.array([number("diameters_mm", d, 0.0, 1e5, lo_open=True, unit="mm") for d in arr])
+
+
+def grasp_sweep(gripper: Gripper, diameters_mm, pressures_kpa):
+    """Grasps over diameters (mm) and pressures (kPa): an :class:`xarray.Dataset`.
 
     Dimensions ``diameter_mm`` and ``pressure_kpa``; variables ``grip_force_n`` (N),
     ``contact_force_n`` (N, per finger), ``contact`` (str), ``contact_angle_deg``, ``equilibrium``
@@ -701,8 +723,9 @@ def grasp_sweep(gripper: Gripper, diameters_mm, pressures):
     """
     import xarray as xr
 
-    Ds = np.atleast_1d(np.asarray(diameters_mm, dtype=float)).ravel()
-    Ps = np.atleast_1d(np.asarray(pressures, dtype=float)).ravel()
+    _check_gripper(gripper)
+    Ds = _diameters_mm(diameters_mm)
+    Ps = checked_pressures_kpa(pressures_kpa)
     shape = (Ds.size, Ps.size)
     grip = np.full(shape, np.nan)
     normal = np.full(shape, np.nan)
@@ -711,7 +734,9 @@ def grasp_sweep(gripper: Gripper, diameters_mm, pressures):
     eq = np.zeros(shape, dtype=bool)
     note = np.empty(shape, dtype=object)
     for i, D in enumerate(Ds):
-        for j, g in enumerate(_grasp_path(gripper, D, Ps)):
+        with pressures_checked():
+            path = _grasp_path(gripper, float(D), [float(p) for p in Ps])
+        for j, g in enumerate(path):
             grip[i, j], normal[i, j], beta[i, j] = g.grip_force_n, g.normal_force_n, g.contact_angle_deg
             contact[i, j], eq[i, j], note[i, j] = g.contact, g.equilibrium, g.note
     dims = ("diameter_mm", "pressure_kpa")
@@ -725,7 +750,7 @@ def grasp_sweep(gripper: Gripper, diameters_mm, pressures):
             "equilibrium": (dims, eq),
             "note": (dims, note.astype(str)),
         },
-        coords={"diameter_mm": Ds, "pressure_kpa": Ps * 1e3},
+        coords={"diameter_mm": Ds, "pressure_kpa": Ps},
     )
     ds.attrs.update(actuator=gripper.actuator.name or gripper.actuator.kind, model=gripper.model,
                     fingers=gripper.fingers, base_radius_mm=gripper.base_radius_mm, mu=gripper.mu,
@@ -736,7 +761,7 @@ def grasp_sweep(gripper: Gripper, diameters_mm, pressures):
 
 def plot_grasp(ds, ax=None, title: str | None = None):
     """Grip force against sphere diameter, one line per pressure (cf. the paper's Figure 8(c, d))."""
-    from .. import plots  # noqa: F401  (Agg backend unless chosen)
+    from .. import plots  # noqa: F401, I001  (first: the Agg backend unless chosen)
     import matplotlib.pyplot as plt
 
     if ax is None:

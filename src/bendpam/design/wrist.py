@@ -15,7 +15,7 @@ Model and assumptions
 
       m(kappa, psi) = sum_i [ s M(P_i, k'_i) e_i  -  EI_lat kappa sin(psi - theta_i) e_i_perp ]  -  EI_col kappa e_psi
 
-  with ``M`` the paper's moment law (:func:`bendpam.moment`; an inactive actuator gives its
+  with ``M`` the paper's moment law (:class:`bendpam.MomentLaw`; an inactive actuator gives its
   passive moment at ``P = 0``), ``EI_lat`` the out-of-plane (lateral) bending stiffness of one
   actuator and ``EI_col`` that of the column.  The default ``EI_lat`` is the frame strip bent about
   its strong axis, ``E_f t w^3 / 12`` (35 400 N*mm^2 for the paper's frame); bendpam has no model
@@ -39,8 +39,8 @@ Model and assumptions
   ``L m(kappa) = W dz/dkappa`` (at ``kappa = 0``: the load moment about the wrist's mid-length,
   ``W (L/2 + lever)``).
 
-Units: mm, N, N*mm, MPa for pressures passed to functions (kPa in tables), grams, degrees in names
-ending ``_deg``.
+Units: mm, N, N*mm, kPa (every function takes and returns pressures in kPa), grams, degrees in
+names ending ``_deg``.  Bad input raises :class:`bendpam.InputError`.
 """
 
 from __future__ import annotations
@@ -50,23 +50,27 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import Actuator, presets
-from ..presets import normalise_model
-from .finger import G_N_PER_G, StableBranch, _num, _pressure, stable_branch
+from .. import presets
+from ..actuator import Actuator
+from ..checks import number
+from ..errors import InputError
+from ..law import MomentLaw, StableBranch
+from ..models import normalise_model
+from .finger import G_N_PER_G, checked_pressure_kpa, checked_pressures_kpa, pressures_checked
 
 __all__ = [
-    "DEFAULT_RADIUS_MM",
-    "DEFAULT_LEVER_MM",
     "BOTTLE_G",
+    "DEFAULT_LEVER_MM",
+    "DEFAULT_RADIUS_MM",
     "Wrist",
-    "WristState",
     "WristHold",
-    "wrist_pressures",
-    "wrist_bend",
-    "wrist_moment",
-    "wrist_hold",
-    "wrist_sweep",
+    "WristState",
     "plot_wrist",
+    "wrist_bend",
+    "wrist_hold",
+    "wrist_moment",
+    "wrist_pressures",
+    "wrist_sweep",
 ]
 
 #: default mounting radius of the actuators around the column, mm
@@ -116,21 +120,27 @@ class Wrist:
         if not isinstance(self.actuator, Actuator):
             raise TypeError(f"actuator must be a bendpam.Actuator, got {type(self.actuator).__name__}")
         if self.actuator.bend_sign == 0:
-            raise ValueError("the actuator has the neutral braid angle (54.74 deg): it does not bend")
-        s(self, "radius_mm", _num("radius_mm", self.radius_mm, 0.0, 1e3, unit="mm"))
+            raise InputError("the actuator has the neutral braid angle (54.74 deg): it does not bend")
+        s(self, "radius_mm", number("radius_mm", self.radius_mm, 0.0, 1e3, unit="mm"))
         L = self.actuator.L0_mm if self.length_mm is None else self.length_mm
-        s(self, "length_mm", _num("length_mm", L, 0.0, 1e4, lo_open=True, unit="mm"))
+        s(self, "length_mm", number("length_mm", L, 0.0, 1e4, lo_open=True, unit="mm"))
         if self.lateral_stiffness_nmm2 is None:
             a = self.actuator
             s(self, "lateral_stiffness_nmm2", a.frame_modulus_mpa * a.frame_thickness_mm * a.frame_width_mm ** 3 / 12.0)
         else:
             s(self, "lateral_stiffness_nmm2",
-              _num("lateral_stiffness_nmm2", self.lateral_stiffness_nmm2, 0.0, unit="N*mm^2"))
-        s(self, "column_stiffness_nmm2", _num("column_stiffness_nmm2", self.column_stiffness_nmm2, 0.0, unit="N*mm^2"))
-        pos = tuple(float(_num("positions_deg", p, -360.0, 360.0, unit="deg")) for p in self.positions_deg)
+              number("lateral_stiffness_nmm2", self.lateral_stiffness_nmm2, 0.0, unit="N*mm^2"))
+        s(self, "column_stiffness_nmm2",
+          number("column_stiffness_nmm2", self.column_stiffness_nmm2, 0.0, unit="N*mm^2"))
+        pos = tuple(number("positions_deg", p, -360.0, 360.0, unit="deg") for p in self.positions_deg)
         if len(pos) != 4:
-            raise ValueError(f"positions_deg = {self.positions_deg!r} must give 4 angles (deg)")
+            raise InputError(f"positions_deg = {self.positions_deg!r} must give 4 angles (deg)")
         s(self, "positions_deg", pos)
+
+    @property
+    def law(self) -> MomentLaw:
+        """The actuators' shared moment law under the wrist's model (:meth:`bendpam.MomentLaw.of`)."""
+        return MomentLaw.of(self.actuator, self.model)
 
     @property
     def directions(self) -> np.ndarray:
@@ -145,7 +155,7 @@ class WristState:
 
     Attributes
     ----------
-    pressures : the four pressures, MPa.
+    pressures_kpa : the four pressures, kPa.
     curvature : kappa, 1/mm (>= 0).
     direction_deg : bending direction psi in the cross-section, deg (NaN when straight).
     angle_deg : bending angle theta = kappa L, deg.
@@ -155,7 +165,7 @@ class WristState:
     note : why not, else empty.
     """
 
-    pressures: tuple
+    pressures_kpa: tuple
     curvature: float
     direction_deg: float
     angle_deg: float
@@ -165,11 +175,16 @@ class WristState:
     note: str
 
 
-def wrist_pressures(direction_deg: float, pressure, positions_deg=(0.0, 90.0, 180.0, 270.0)) -> tuple:
-    """The four pressures that bend the wrist toward ``direction_deg``: the actuator there, or the two
-    neighbours at the same pressure for a direction halfway between them (multiples of 45 deg)."""
-    P = _pressure(pressure)
-    d = float(_num("direction_deg", direction_deg, -720.0, 720.0, unit="deg")) % 360.0
+def wrist_pressures(direction_deg: float, pressure_kpa, positions_deg=(0.0, 90.0, 180.0, 270.0)) -> tuple:
+    """The four pressures (kPa) that bend the wrist toward ``direction_deg``: the actuator there at
+    ``pressure_kpa``, or the two neighbours at that pressure for a direction halfway between them
+    (multiples of 45 deg)."""
+    P = checked_pressure_kpa(pressure_kpa)
+    return _wrist_pressures(direction_deg, P, positions_deg)
+
+
+def _wrist_pressures(direction_deg, P: float, positions_deg) -> tuple:
+    d = number("direction_deg", direction_deg, -720.0, 720.0, unit="deg") % 360.0
     pos = np.mod(np.asarray(positions_deg, dtype=float), 360.0)
     diff = np.abs((pos - d + 180.0) % 360.0 - 180.0)
     on = diff < 1e-9
@@ -177,7 +192,7 @@ def wrist_pressures(direction_deg: float, pressure, positions_deg=(0.0, 90.0, 18
         return tuple(P if o else 0.0 for o in on)
     two = np.argsort(diff)[:2]
     if abs(diff[two[0]] - diff[two[1]]) > 1e-9:
-        raise ValueError(f"direction_deg = {direction_deg:g} is neither an actuator's direction nor halfway between "
+        raise InputError(f"direction_deg = {direction_deg:g} is neither an actuator's direction nor halfway between "
                          f"two (actuators at {', '.join(f'{p:g}' for p in positions_deg)} deg)")
     return tuple(P if i in two else 0.0 for i in range(4))
 
@@ -189,7 +204,8 @@ class _WristLaw:
         self.e = wrist.directions
         self.ep = np.stack([-self.e[:, 1], self.e[:, 0]], axis=1)
         self.P = tuple(float(p) for p in pressures)
-        self.br: list[StableBranch] = [stable_branch(wrist.actuator, p, wrist.model) for p in self.P]
+        law = wrist.law
+        self.br: list[StableBranch] = [law.stable_branch(p) for p in self.P]
 
     def kprime(self, b):
         return self.s * (self.e @ b)
@@ -213,21 +229,27 @@ class _WristLaw:
         for i, br in enumerate(self.br):
             if not br.k_lo < kp[i] < br.k_hi:
                 side = +1 if kp[i] >= br.k_hi else -1
-                return False, (f"actuator {i} (at {self.w.positions_deg[i]:g} deg, {self.P[i] * 1e3:g} kPa) "
+                return False, (f"actuator {i} (at {self.w.positions_deg[i]:g} deg, {self.P[i]:g} kPa) "
                                f"leaves its stable branch: {br.describe_end(side)}")
         return True, ""
 
 
-def _solve(wrist: Wrist, pressures, load_fn=None, b0=None):
-    """Newton with continuation in the pressures (and the load) from the straight, unpressurised wrist."""
-    P = np.array([_pressure(p) for p in pressures], dtype=float)
+def _four_pressures_kpa(pressures_kpa) -> np.ndarray:
+    """The four actuator pressures (kPa), validated, as a float array of shape (4,)."""
+    P = checked_pressures_kpa(pressures_kpa, "pressures_kpa")
     if P.shape != (4,):
-        raise ValueError(f"pressures = {pressures!r} must give 4 pressures (MPa), one per actuator")
+        raise InputError(f"pressures_kpa has {P.size} values; give 4 pressures (kPa), one per actuator")
+    return P
+
+
+def _solve(wrist: Wrist, P: np.ndarray, load_fn=None, b0=None):
+    """Newton with continuation in the pressures (kPa, validated) and the load from the straight,
+    unpressurised wrist."""
     b = np.zeros(2) if b0 is None else np.array(b0, dtype=float)
     t, step = 0.0, 1.0
     law = None
     note = ""
-    scale = max(1.0, float(np.max(np.abs([stable_branch(wrist.actuator, p, wrist.model).moment(0.0)[0] for p in P]))))
+    scale = max(1.0, float(np.max(np.abs(wrist.law.blocked_moment(P)))))
     while t < 1.0:
         step = min(step, 1.0 - t)
         tt = t + step
@@ -270,7 +292,7 @@ def _solve(wrist: Wrist, pressures, load_fn=None, b0=None):
         else:
             step *= 0.5
             if step < 1.0 / 2048:
-                inside, why = law_t.inside(bb)
+                _inside, why = law_t.inside(bb)
                 note = (f"no equilibrium: the wrist snaps through at {t:.3g} of the load/pressure path"
                         + (f" ({why})" if why else " (its combined moment law folds)"))
                 break
@@ -280,7 +302,7 @@ def _solve(wrist: Wrist, pressures, load_fn=None, b0=None):
 def _state(wrist: Wrist, P, b, t, law, note, load_moment=(0.0, 0.0)) -> WristState:
     if t < 1.0:
         nan = math.nan
-        return WristState(tuple(P), nan, nan, nan, (nan,) * 4, tuple(load_moment), False, note)
+        return WristState(tuple(float(p) for p in P), nan, nan, nan, (nan,) * 4, tuple(load_moment), False, note)
     kap = float(np.hypot(*b))
     psi = math.degrees(math.atan2(b[1], b[0])) % 360.0 if kap > 1e-15 else math.nan
     if psi > 360.0 - 1e-6:
@@ -289,33 +311,48 @@ def _state(wrist: Wrist, P, b, t, law, note, load_moment=(0.0, 0.0)) -> WristSta
                       tuple(float(k) for k in law.kprime(b)), tuple(load_moment), True, note)
 
 
-def wrist_bend(wrist: Wrist, pressures=None, *, direction_deg=None, pressure=None) -> WristState:
-    """Free bending of the wrist.
-
-    Give the four ``pressures`` (MPa), or ``direction_deg`` and ``pressure`` (MPa) to inflate the
-    actuator(s) of that direction (:func:`wrist_pressures`).
-    """
+def _check_wrist(wrist) -> None:
     if not isinstance(wrist, Wrist):
         raise TypeError(f"wrist must be a bendpam.design.Wrist, got {type(wrist).__name__}")
-    if pressures is None:
-        if direction_deg is None or pressure is None:
-            raise ValueError("give the four pressures, or direction_deg and pressure")
-        pressures = wrist_pressures(direction_deg, pressure, wrist.positions_deg)
-    b, t, law, note = _solve(wrist, pressures)
-    return _state(wrist, pressures, b, t, law, note)
 
 
-def wrist_moment(wrist: Wrist, pressures, angle_deg, direction_deg):
+def wrist_bend(wrist: Wrist, pressures_kpa=None, *, direction_deg=None, pressure_kpa=None) -> WristState:
+    """Free bending of the wrist.
+
+    Give the four ``pressures_kpa`` (kPa), or ``direction_deg`` and ``pressure_kpa`` (kPa) to inflate
+    the actuator(s) of that direction (:func:`wrist_pressures`).
+    """
+    _check_wrist(wrist)
+    if pressures_kpa is None:
+        if direction_deg is None or pressure_kpa is None:
+            raise InputError("give the four pressures_kpa, or direction_deg and pressure_kpa")
+        P = np.array(_wrist_pressures(direction_deg, checked_pressure_kpa(pressure_kpa), wrist.positions_deg))
+    elif direction_deg is not None or pressure_kpa is not None:
+        raise InputError("give either the four pressures_kpa or direction_deg and pressure_kpa, not both")
+    else:
+        P = _four_pressures_kpa(pressures_kpa)
+    return _bend(wrist, P)
+
+
+def _bend(wrist: Wrist, P: np.ndarray) -> WristState:
+    with pressures_checked():
+        b, t, law, note = _solve(wrist, P)
+    return _state(wrist, P, b, t, law, note)
+
+
+def wrist_moment(wrist: Wrist, pressures_kpa, angle_deg, direction_deg):
     """The moment the wrist exerts when held at ``angle_deg`` toward ``direction_deg`` (N*mm vector).
 
-    This is the load it holds there: an external moment ``-m`` keeps it at that angle.  Returns
-    ``(m, on_branch, note)``; ``on_branch`` is False (with a note) where an actuator is beyond its
-    stable branch at that curvature.
+    ``pressures_kpa``: the four pressures (kPa).  This is the load it holds there: an external
+    moment ``-m`` keeps it at that angle.  Returns ``(m, on_branch, note)``; ``on_branch`` is False
+    (with a note) where an actuator is beyond its stable branch at that curvature.
     """
-    P = tuple(_pressure(p) for p in pressures)
-    law = _WristLaw(wrist, P)
-    kap = math.radians(_num("angle_deg", angle_deg, unit="deg")) / wrist.length_mm
-    d = math.radians(_num("direction_deg", direction_deg, unit="deg"))
+    _check_wrist(wrist)
+    P = _four_pressures_kpa(pressures_kpa)
+    kap = math.radians(number("angle_deg", angle_deg, unit="deg")) / wrist.length_mm
+    d = math.radians(number("direction_deg", direction_deg, unit="deg"))
+    with pressures_checked():
+        law = _WristLaw(wrist, P)
     b = kap * np.array([math.cos(d), math.sin(d)])
     ok, why = law.inside(b)
     m, _ = law.moment(b)
@@ -328,7 +365,7 @@ class WristHold:
 
     Attributes
     ----------
-    pressure : MPa, in the upper actuator.
+    pressure_kpa : gauge pressure of the upper actuator, kPa.
     load_g, lever_mm, hand_mass_g, hand_lever_mm : the load case.
     angle_deg : equilibrium bending angle, deg: > 0 the hand is raised above horizontal, < 0 it droops.
     holds_horizontal : ``angle_deg >= 0`` (the wrist keeps the hand at or above horizontal).
@@ -338,7 +375,7 @@ class WristHold:
     equilibrium, note : as in :class:`WristState`.
     """
 
-    pressure: float
+    pressure_kpa: float
     load_g: float
     lever_mm: float
     hand_mass_g: float
@@ -365,23 +402,23 @@ def _dz(kap, L, lever):
     return d1, d2
 
 
-def wrist_hold(wrist: Wrist, pressure, *, load_g: float = BOTTLE_G, lever_mm: float = DEFAULT_LEVER_MM,
+def wrist_hold(wrist: Wrist, pressure_kpa, *, load_g: float = BOTTLE_G, lever_mm: float = DEFAULT_LEVER_MM,
                hand_mass_g: float = 0.0, hand_lever_mm: float = 50.0, up_deg: float = 90.0) -> WristHold:
-    """The wrist, forearm horizontal, holding ``load_g`` at ``lever_mm`` with the upper actuator at ``pressure``.
+    """The wrist, forearm horizontal, holding ``load_g`` at ``lever_mm``, upper actuator at ``pressure_kpa`` (kPa).
 
     The actuator at ``up_deg`` (default 90) is on top and inflated; the others are at P = 0.
     Gravity acts toward ``up_deg + 180``.  See the module docstring for the model.
     """
-    if not isinstance(wrist, Wrist):
-        raise TypeError(f"wrist must be a bendpam.design.Wrist, got {type(wrist).__name__}")
-    P = _pressure(pressure)
-    mL = _num("load_g", load_g, 0.0, unit="g")
-    lev = _num("lever_mm", lever_mm, 0.0, unit="mm")
-    mh = _num("hand_mass_g", hand_mass_g, 0.0, unit="g")
-    levh = _num("hand_lever_mm", hand_lever_mm, 0.0, unit="mm")
-    pressures = wrist_pressures(up_deg, P, wrist.positions_deg)
-    if sum(p > 0 for p in pressures) != 1:
-        raise ValueError(f"up_deg = {up_deg:g} must be the direction of one actuator ({wrist.positions_deg} deg)")
+    _check_wrist(wrist)
+    P = checked_pressure_kpa(pressure_kpa)
+    mL = number("load_g", load_g, 0.0, unit="g")
+    lev = number("lever_mm", lever_mm, 0.0, unit="mm")
+    mh = number("hand_mass_g", hand_mass_g, 0.0, unit="g")
+    levh = number("hand_lever_mm", hand_lever_mm, 0.0, unit="mm")
+    # which actuator is on top (a pressure of 1 kPa marks it: the layout does not depend on P)
+    top = _wrist_pressures(up_deg, 1.0, wrist.positions_deg)
+    if sum(p > 0 for p in top) != 1:
+        raise InputError(f"up_deg = {up_deg:g} must be the direction of one actuator ({wrist.positions_deg} deg)")
     L = wrist.length_mm
     u = np.array([math.cos(math.radians(up_deg)), math.sin(math.radians(up_deg))])
     W1, W2 = mL * G_N_PER_G, mh * G_N_PER_G
@@ -395,35 +432,43 @@ def wrist_hold(wrist: Wrist, pressure, *, load_g: float = BOTTLE_G, lever_mm: fl
         dml = -t * (W1 * d2a + W2 * d2b) / L
         return ml * u, dml * np.outer(u, u)
 
-    b, t, law, note = _solve(wrist, pressures, load_fn)
+    pressures = np.array([P if p > 0 else 0.0 for p in top])
+    with pressures_checked():
+        b, t, _, note = _solve(wrist, pressures, load_fn)
     M0 = (W1 * (L / 2 + lev) + W2 * (L / 2 + levh))
     # capacity and pressure needed: at kappa = 0 only the upper actuator's blocked moment acts
-    br = stable_branch(wrist.actuator, P, wrist.model)
-    s = wrist.actuator.bend_sign
-    m_block = s * float(br.moment(0.0)[0])  # the upper actuator's blocked moment magnitude
-    cap = max((m_block - W2 * (L / 2 + levh)) / (G_N_PER_G * (L / 2 + lev)), 0.0)
+    law = wrist.law
     act = wrist.actuator
-    slope = abs(math.pi * act.R0_start ** 3 * (1.0 - 2.0 / math.tan(act.alpha0) ** 2))  # dM_blocked/dP (eq 49 closed form)
-    p_need = (act.P_start + M0 / slope) * 1e3
+    s = act.bend_sign
+    with pressures_checked():
+        m_block = s * float(law.blocked_moment(P))  # the upper actuator's blocked moment magnitude
+        # dM_blocked/dP (N*mm per kPa of active pressure): the blocked moment is linear in P_a (eq 50)
+        slope = abs(float(law.blocked_moment(act.P_start_kpa + 1.0)))
+    cap = max((m_block - W2 * (L / 2 + levh)) / (G_N_PER_G * (L / 2 + lev)), 0.0)
+    p_need = act.P_start_kpa + M0 / slope
     if t < 1.0:
         return WristHold(P, mL, lev, mh, levh, math.nan, False, cap, p_need, M0, False, note)
     ang = math.degrees(float(b @ u) * L)
     return WristHold(P, mL, lev, mh, levh, ang, ang >= -1e-9, cap, p_need, M0, True, "")
 
 
-def wrist_sweep(wrist: Wrist, pressures, directions_deg=(0.0, 90.0, 180.0, 270.0)):
-    """Free bending against pressure (MPa) in each direction: a :class:`pandas.DataFrame`.
+def wrist_sweep(wrist: Wrist, pressures_kpa, directions_deg=(0.0, 90.0, 180.0, 270.0)):
+    """Free bending against pressure (kPa) in each direction: a :class:`pandas.DataFrame`.
 
     Columns ``direction_deg``, ``pressure_kpa``, ``angle_deg``, ``bend_direction_deg``,
     ``curvature_per_mm``, ``equilibrium``, ``note``.
     """
     import pandas as pd
 
+    _check_wrist(wrist)
+    Ps = checked_pressures_kpa(pressures_kpa)
+    dirs = [number("directions_deg", d, -720.0, 720.0, unit="deg")
+            for d in np.atleast_1d(np.asarray(directions_deg, dtype=object)).ravel()]
     rows = []
-    for d in directions_deg:
-        for p in np.atleast_1d(np.asarray(pressures, dtype=float)).ravel():
-            st = wrist_bend(wrist, direction_deg=d, pressure=p)
-            rows.append({"direction_deg": float(d), "pressure_kpa": float(p) * 1e3, "angle_deg": st.angle_deg,
+    for d in dirs:
+        for p in Ps:
+            st = _bend(wrist, np.array(_wrist_pressures(d, float(p), wrist.positions_deg)))
+            rows.append({"direction_deg": d, "pressure_kpa": float(p), "angle_deg": st.angle_deg,
                          "bend_direction_deg": st.direction_deg, "curvature_per_mm": st.curvature,
                          "equilibrium": st.equilibrium, "note": st.note})
     return pd.DataFrame(rows)
@@ -431,7 +476,7 @@ def wrist_sweep(wrist: Wrist, pressures, directions_deg=(0.0, 90.0, 180.0, 270.0
 
 def plot_wrist(table, holds=(), ax=None, title: str | None = None):
     """Bending angle against pressure per direction (and the holding angles with the load, dashed)."""
-    from .. import plots  # noqa: F401  (Agg backend unless chosen)
+    from .. import plots  # noqa: F401, I001  (first: the Agg backend unless chosen)
     import matplotlib.pyplot as plt
 
     if ax is None:
@@ -442,7 +487,7 @@ def plot_wrist(table, holds=(), ax=None, title: str | None = None):
         ax.plot(grp["pressure_kpa"], grp["angle_deg"], "o-", label=f"free, toward {d:g} deg")
     holds = list(holds)
     if holds:
-        ax.plot([h.pressure * 1e3 for h in holds], [h.angle_deg for h in holds], "s--", color="k",
+        ax.plot([h.pressure_kpa for h in holds], [h.angle_deg for h in holds], "s--", color="k",
                 label=f"holding {holds[0].load_g:g} g at {holds[0].lever_mm:g} mm")
         ax.axhline(0.0, color="0.5", lw=0.8)
     ax.axhline(30.0, color="tab:red", lw=0.8, ls=":", label="30 deg")

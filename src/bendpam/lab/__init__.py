@@ -1,8 +1,12 @@
 """Raw four-point-bending tests: read and write testing-machine exports.
 
 A raw test at one pressure is a time series of time (s), crosshead stroke (mm) and force (N).
-:func:`read_test` reads plain CSV, Zwick testXpert, Instron Bluehill and MTS TestSuite exports
-(detected from the content) into a :class:`RawTest`; :func:`write_test` writes them.
+:func:`read_test` reads the exports of real testing machines (Zwick testXpert, Instron
+Bluehill/WaveMatrix/console, MTS 793 and TestSuite, Shimadzu Trapezium, plain CSV, ``.xlsx``/
+``.xls`` workbooks; the layout, encoding and channels are found from the content) into a
+:class:`RawTest`; :func:`inspect_file` reports how a file reads; :func:`write_test` writes
+synthetic exports; :func:`check_cycle_count` compares a segmentation with the machine's cycle
+counter.
 """
 
 from __future__ import annotations
@@ -10,9 +14,15 @@ from __future__ import annotations
 from .readers import (
     COLUMNS,
     DIALECTS,
+    FORMATS,
+    PRESSURE_RANGE_KPA,
     RawTest,
     ReadError,
+    check_cycle_count,
     detect_dialect,
+    format_inspection,
+    inspect_file,
+    parse_columns,
     parse_pressure,
     pressure_from_filename,
     read_test,
@@ -22,9 +32,15 @@ from .writers import write_test
 __all__ = [
     "COLUMNS",
     "DIALECTS",
+    "FORMATS",
+    "PRESSURE_RANGE_KPA",
     "RawTest",
     "ReadError",
+    "check_cycle_count",
     "detect_dialect",
+    "format_inspection",
+    "inspect_file",
+    "parse_columns",
     "parse_pressure",
     "pressure_from_filename",
     "read_test",

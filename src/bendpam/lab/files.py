@@ -9,7 +9,7 @@ from pathlib import Path
 __all__ = ["RAW_SUFFIXES", "collect_raw_files"]
 
 #: File suffixes taken from a folder as raw testing-machine exports.
-RAW_SUFFIXES = frozenset({".csv", ".txt", ".tsv", ".dat", ".asc", ".tra"})
+RAW_SUFFIXES = frozenset({".csv", ".txt", ".tsv", ".dat", ".asc", ".tra", ".xlsx", ".xls"})
 
 
 def collect_raw_files(inputs) -> list[Path]:

@@ -37,6 +37,7 @@ model sign convention (multiply by ``actuator.bend_sign`` to compare).
 from __future__ import annotations
 
 from ..errors import ProcessingError
+from .readers import check_cycle_count
 
 import math
 import warnings
@@ -605,8 +606,13 @@ def process_tests(tests, *, fixture: Fixture = PAPER_FIXTURE, options: Processin
         d = rt.data
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
-            results.append(process_series(d["time_s"].to_numpy(), d["stroke_mm"].to_numpy(), d["force_n"].to_numpy(),
-                                          p, fixture=fixture, options=options, source=src, keep_series=keep_series))
+            res = process_series(d["time_s"].to_numpy(), d["stroke_mm"].to_numpy(), d["force_n"].to_numpy(),
+                                 p, fixture=fixture, options=options, source=src, keep_series=keep_series)
+        res.notes.extend(getattr(rt, "warnings", []) or [])
+        mismatch = check_cycle_count(rt, res.n_cycles)
+        if mismatch:
+            res.notes.append(mismatch)
+        results.append(res)
     if not results:
         raise ProcessingError("no tests to process")
     results.sort(key=lambda r: r.pressure_kpa)

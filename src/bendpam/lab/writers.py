@@ -27,8 +27,8 @@ import os
 import numpy as np
 import pandas as pd
 
-from .._io import atomic_write_bytes
-from .readers import COLUMNS, DIALECTS, FORCE_UNITS, _pressure_key
+from ..atomic import atomic_write_bytes
+from .readers import COLUMNS, DIALECTS, FORCE_UNITS, is_pressure_key
 
 __all__ = ["write_test"]
 
@@ -145,7 +145,7 @@ def write_test(
             raise ValueError(f"pressure_kpa must be finite, got {pressure_kpa!r}")
     items = _check_metadata(metadata)
     if pressure_kpa is not None:
-        items = [(k, v) for k, v in items if not _pressure_key(k)[0]]
+        items = [(k, v) for k, v in items if not is_pressure_key(k)[0]]
 
     lang = language if dialect == "testxpert" else "en"
     names = [n.format(unit=funit) for n in _NAMES[(dialect, lang)]]

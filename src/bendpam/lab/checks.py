@@ -1,0 +1,107 @@
+"""Checks of the values read from an export: spikes, time order and gaps.
+
+Nothing read from a file reaches a result unchecked.  :func:`find_spikes` finds isolated
+samples that lie orders of magnitude off their neighbours (a glitch such as ``2,451502E9`` in a
+column of ``2,45``); :func:`time_problems` finds time that does not increase and gaps in the
+sampling.  Both work on whole columns with NumPy (linear time, a few temporary arrays).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage
+
+__all__ = ["GAP_FACTOR", "GAP_MIN_S", "SPIKE_FACTOR", "TimeProblems", "find_spikes", "time_problems"]
+
+#: A sample is a spike when it lies this many robust column ranges off the median of its
+#: neighbourhood (5 samples).
+SPIKE_FACTOR = 10.0
+#: A time step is a gap when it exceeds this many median steps and :data:`GAP_MIN_S`.
+GAP_FACTOR = 50.0
+#: Shortest gap reported (s).
+GAP_MIN_S = 2.0
+
+
+def find_spikes(x: np.ndarray) -> np.ndarray:
+    """Indices of isolated spikes in one column.
+
+    A sample is a spike when its distance to the median of the 5 samples around it exceeds
+    :data:`SPIKE_FACTOR` times the column's robust range (its values without the 0.5 % most
+    extreme on each side, at least two), i.e. it lies
+    an order of magnitude or more outside the values the column otherwise takes.  Up to two
+    adjacent bad samples are found.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        The column (finite values).
+
+    Returns
+    -------
+    numpy.ndarray
+        Sorted indices (int64) of the spikes.
+    """
+    n = x.size
+    if n < 5:
+        return np.empty(0, dtype=np.int64)
+    k = max(2, int(np.ceil(0.005 * n)))  # leave out the k most extreme values on each side
+    part = np.partition(x, [k, n - 1 - k])
+    scale = float(part[n - 1 - k] - part[k])
+    del part
+    mag = float(np.median(np.abs(x)))
+    floor = max(1e-9 * max(mag, 1.0), 1e-12)
+    scale = max(scale, floor)
+    dev = ndimage.median_filter(x, size=5, mode="nearest")
+    np.subtract(x, dev, out=dev)
+    np.abs(dev, out=dev)
+    return np.flatnonzero(dev > SPIKE_FACTOR * scale).astype(np.int64)
+
+
+@dataclass(frozen=True)
+class TimeProblems:
+    """Where time does not increase, and where it jumps.
+
+    Attributes
+    ----------
+    backwards : numpy.ndarray
+        Indices ``i`` with ``t[i] <= max(t[:i])`` (time repeats or goes back).
+    gaps : numpy.ndarray
+        Indices ``i`` with ``t[i] - t[i-1]`` a gap (see :data:`GAP_FACTOR`).
+    median_step_s : float
+        Median positive time step (s), NaN if none.
+    """
+
+    backwards: np.ndarray
+    gaps: np.ndarray
+    median_step_s: float
+
+
+def time_problems(t: np.ndarray) -> TimeProblems:
+    """Find time that does not increase and gaps in a time column (s).
+
+    Parameters
+    ----------
+    t : numpy.ndarray
+        Time in s, finite.
+
+    Returns
+    -------
+    TimeProblems
+    """
+    if t.size < 2:
+        e = np.empty(0, dtype=np.int64)
+        return TimeProblems(e, e, float("nan"))
+    running = np.maximum.accumulate(t)
+    backwards = np.flatnonzero(t[1:] <= running[:-1]) + 1
+    del running
+    dt = np.diff(t)
+    pos = dt[dt > 0]
+    med = float(np.median(pos)) if pos.size else float("nan")
+    if pos.size:
+        limit = max(GAP_FACTOR * med, GAP_MIN_S)
+        gaps = np.flatnonzero(dt > limit) + 1
+    else:
+        gaps = np.empty(0, dtype=np.int64)
+    return TimeProblems(backwards.astype(np.int64), gaps.astype(np.int64), med)

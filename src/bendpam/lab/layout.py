@@ -1,0 +1,358 @@
+"""Text layout of testing-machine exports: lines, cells, numbers, metadata lines.
+
+The helpers here know nothing about channels; they split lines into cells (tab, ``;`` or ``,``,
+quoted or not), read numbers with a decimal point or comma (exponents like ``e-005``, a
+thousands separator only where it cannot be mistaken for the decimal mark), parse the metadata
+grammars seen in real exports and the first line of an MTS 793 export.
+
+Metadata grammars (one per line, all seen in real files)::
+
+    "Key"<TAB>value<TAB>"unit"          Zwick testXpert II
+    Key;value;unit  /  Key,value,unit    testXpert (synthetic), MTS TestSuite
+    Category : Name,"value",unit        Instron Bluehill 2
+    "Key : value"  /  Key : value        Instron Bluehill, MTS 793
+    Key:<TAB>value<TAB>unit              Instron console (8852)
+    # key: value  /  Key=value           plain CSV
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import re
+from collections import deque
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass
+from itertools import islice
+
+from .channels import is_unit_token
+
+__all__ = [
+    "DELIMITERS",
+    "NONFINITE_TOKENS",
+    "LineReader",
+    "MetaItem",
+    "Mts793Header",
+    "NumberParse",
+    "has_control_chars",
+    "infer_decimal",
+    "is_blank",
+    "is_number",
+    "numeric_cells",
+    "parse_metadata_line",
+    "parse_mts793",
+    "parse_number",
+    "split_cells",
+]
+
+#: Cell delimiters tried, in order of preference.
+DELIMITERS: tuple[str, ...] = ("\t", ";", ",")
+
+#: Cell texts that stand for a missing or non-finite number (lower case).
+NONFINITE_TOKENS = frozenset(
+    {
+        "nan", "-nan", "+nan", "inf", "-inf", "+inf", "infinity", "-infinity", "+infinity",
+        "na", "n/a", "#n/a", "-1.#ind", "1.#qnan", "-1.#inf", "1.#inf", "#num!", "#value!",
+        "#div/0!", "null", "none", "-1,#ind", "1,#qnan", "-1,#inf", "1,#inf",
+    }
+)  # fmt: skip
+
+_NUM_ANY = re.compile(r"[+-]?(?:\d+(?:[.,]\d*)?|[.,]\d+)(?:[eE][+-]?\d+)?")
+_NUM_DOT = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
+_NUM_COMMA = re.compile(r"[+-]?(?:\d+,?\d*|,\d+)(?:[eE][+-]?\d+)?")
+# digit grouping: unambiguous with the other decimal mark, or with two or more groups
+_GROUP_COMMA_DOT = re.compile(r"[+-]?\d{1,3}(?:,\d{3})+\.\d*(?:[eE][+-]?\d+)?")
+_GROUP_DOT_COMMA = re.compile(r"[+-]?\d{1,3}(?:\.\d{3})+,\d*(?:[eE][+-]?\d+)?")
+_GROUP_COMMAS = re.compile(r"[+-]?\d{1,3}(?:,\d{3}){2,}")
+_GROUP_DOTS = re.compile(r"[+-]?\d{1,3}(?:\.\d{3}){2,}")
+_COLLIDE_COMMA = re.compile(r"[+-]?\d{1,3}(?:,\d{3})+,\d+(?:[eE][+-]?\d+)?")
+_COLLIDE_DOT = re.compile(r"[+-]?\d{1,3}(?:\.\d{3})+\.\d+(?:[eE][+-]?\d+)?")
+_CONTROL = re.compile(r"[\x00-\x08\x0e-\x19\x1b-\x1f\x7f]")
+_BLANK_CHARS = ' \t"\x1a\x0c\x0b\ufeff'
+
+
+def split_cells(line: str, sep: str | None) -> list[str]:
+    """Split one line at ``sep`` honouring double quotes; cells are stripped and unquoted."""
+    if sep is None:
+        return [line.strip().strip('"').strip()]
+    if '"' not in line:
+        return [c.strip() for c in line.split(sep)]
+    try:
+        cells = next(csv.reader([line], delimiter=sep, quotechar='"', skipinitialspace=True), [])
+    except csv.Error:
+        return [c.strip().strip('"').strip() for c in line.split(sep)]
+    return [c.strip() for c in cells]
+
+
+def is_blank(line: str, sep: str | None = None) -> bool:
+    """Empty, or only separators, quotes and whitespace (``;;;`` rows from spreadsheets)."""
+    return not line.strip(_BLANK_CHARS + (sep or ""))
+
+
+def has_control_chars(line: str) -> bool:
+    """Does the line hold control characters (binary data)?"""
+    return _CONTROL.search(line) is not None
+
+
+def is_number(cell: str) -> bool:
+    """A number with a decimal point or comma (or a non-finite token such as ``nan``)."""
+    c = cell.strip()
+    return _NUM_ANY.fullmatch(c) is not None or c.lower() in NONFINITE_TOKENS
+
+
+def numeric_cells(cells: list[str]) -> tuple[int, int]:
+    """``(numbers, non-empty cells)`` of a split line."""
+    num = nonempty = 0
+    for c in cells:
+        if c:
+            nonempty += 1
+            if _NUM_ANY.fullmatch(c) is not None:
+                num += 1
+    return num, nonempty
+
+
+@dataclass(frozen=True)
+class NumberParse:
+    """Result of :func:`parse_number`: ``value`` or, when None, ``problem``.
+
+    ``problem`` is ``"empty"``, ``"nonfinite"``, ``"thousands"`` (a digit grouping that collides
+    with the decimal mark) or ``"text"``.
+    """
+
+    value: float | None
+    problem: str | None = None
+
+
+def parse_number(cell: str, decimal: str) -> NumberParse:
+    """Read a number written with ``decimal`` (``"."`` or ``","``) as the decimal mark.
+
+    Parameters
+    ----------
+    cell : str
+        The cell text (quotes already removed).
+    decimal : {".", ","}
+        The decimal mark of the file.
+
+    Returns
+    -------
+    NumberParse
+    """
+    c = cell.strip().replace("\u2212", "-")
+    if not c:
+        return NumberParse(None, "empty")
+    if decimal == ",":
+        if _NUM_COMMA.fullmatch(c):
+            v = float(c.replace(",", "."))
+        elif _GROUP_DOT_COMMA.fullmatch(c):
+            v = float(c.replace(".", "").replace(",", "."))
+        elif _GROUP_DOTS.fullmatch(c):
+            v = float(c.replace(".", ""))
+        elif _COLLIDE_COMMA.fullmatch(c) or _GROUP_COMMAS.fullmatch(c):
+            return NumberParse(None, "thousands")
+        elif c.lower() in NONFINITE_TOKENS:
+            return NumberParse(None, "nonfinite")
+        else:
+            return NumberParse(None, "text")
+    else:
+        if _NUM_DOT.fullmatch(c):
+            v = float(c)
+        elif _GROUP_COMMA_DOT.fullmatch(c) or _GROUP_COMMAS.fullmatch(c):
+            v = float(c.replace(",", ""))
+        elif _COLLIDE_DOT.fullmatch(c) or _GROUP_DOTS.fullmatch(c):
+            return NumberParse(None, "thousands")
+        elif c.lower() in NONFINITE_TOKENS:
+            return NumberParse(None, "nonfinite")
+        else:
+            return NumberParse(None, "text")
+    if not math.isfinite(v):
+        return NumberParse(None, "nonfinite")
+    return NumberParse(v)
+
+
+def infer_decimal(rows: Iterable[list[str]], sep: str) -> tuple[str | None, int, int]:
+    """Decimal mark shown by data cells: ``(mark or None, cells with ',', cells with '.')``.
+
+    A cell like ``1,000.5`` counts for the point, ``1.000,5`` for the comma; ``1,000,292``
+    (a grouping that collides with a decimal comma) counts for the comma, so that the reader
+    refuses it with its line.  The majority wins; the minority cells fail later with their line.
+    """
+    comma = dot = 0
+    for cells in rows:
+        for c in cells:
+            if not c or (not c[-1:].isdigit() and c[-1:] not in ".,"):
+                continue
+            if _GROUP_COMMA_DOT.fullmatch(c):
+                dot += 1
+            elif _GROUP_DOT_COMMA.fullmatch(c):
+                comma += 1
+            elif "," in c and _NUM_COMMA.fullmatch(c) and re.search(r"\d,\d", c):
+                comma += 1
+            elif "." in c and _NUM_DOT.fullmatch(c) and re.search(r"\d\.\d", c):
+                dot += 1
+            elif _COLLIDE_COMMA.fullmatch(c) or _GROUP_COMMAS.fullmatch(c):
+                comma += 1
+    if comma > dot:
+        return ",", comma, dot
+    if dot > comma:
+        return ".", comma, dot
+    return None, comma, dot
+
+
+@dataclass(frozen=True)
+class MetaItem:
+    """One metadata line: ``key``, ``value`` and ``unit`` (``""`` when none)."""
+
+    key: str
+    value: str
+    unit: str = ""
+
+    @property
+    def shown(self) -> str:
+        """Value with its unit after a space (as stored in ``RawTest.metadata``)."""
+        if self.unit and self.value:
+            return f"{self.value} {self.unit}"
+        return self.value or self.unit
+
+
+def _line_sep(s: str) -> str | None:
+    bare = re.sub(r'"[^"]*"', "", s)  # delimiters inside quotes do not count
+    for sep in DELIMITERS:
+        if sep in bare:
+            return sep
+    return None
+
+
+def parse_metadata_line(line: str) -> MetaItem | None:
+    """Key, value and unit of a metadata line in any of the grammars above, or None.
+
+    Lines without a value (section titles such as ``Bediener Information Ende``), ``$``
+    comment lines and blank lines give None.
+    """
+    s = line.strip().lstrip("\ufeff")
+    if s.startswith("#"):
+        s = s.lstrip("#").strip()
+    if not s or s.startswith("$"):
+        return None
+    sep = _line_sep(s)
+    if sep is not None and sep != "\t":
+        head = split_cells(s, sep)[0] if s.startswith('"') else s.split(sep, 1)[0]
+        if ":" in head:
+            after = head.split(":", 1)[1]
+            # 'Key: a, b' (a value holding the delimiter) vs 'Category : Name,value'
+            if after.strip() and (" : " not in head or re.search(r"\d", after)):
+                sep = None
+    if sep is not None:
+        cells = split_cells(s, sep)
+    elif len(s) >= 2 and s[0] == '"' and s[-1] == '"' and s.count('"') % 2 == 0:
+        cells = [s[1:-1].replace('""', '"').strip()]
+    else:
+        cells = [s]
+    cells = [c for c in cells if c]
+    if not cells:
+        return None
+    first = cells[0]
+    if len(cells) == 1:
+        if " : " in first:
+            key, value = first.split(" : ", 1)
+        elif ":" in first:
+            key, value = first.split(":", 1)
+        elif "=" in first:
+            key, value = first.split("=", 1)
+        else:
+            return None
+        key, value = key.strip().strip('"'), value.strip()
+        return MetaItem(key, value) if key else None
+    rest = cells[1:]
+    if first.endswith(":"):
+        key = first[:-1].strip()
+    elif " : " in first:
+        cat, key = first.split(" : ", 1)
+        key = key.strip() or cat.strip()
+    elif first.endswith("=") or first.endswith(":"):
+        key = first[:-1].strip()
+    else:
+        key = first
+    if rest and rest[0].endswith(":") and len(rest) > 1:  # 'Section<TAB>Zeit:<TAB>33,0<TAB>s'
+        key = f"{key} {rest[0][:-1].strip()}"
+        rest = rest[1:]
+    value = rest[0]
+    unit = ""
+    more = rest[1:]
+    if more and is_unit_token(more[0]) and len(more[0]) <= 12:
+        unit, more = more[0], more[1:]
+    if more and not unit:
+        value = " ".join([value, *more])
+    elif more:
+        unit = " ".join([unit, *more])
+    key = key.strip().strip('"').strip()
+    if not key:
+        return None
+    return MetaItem(key, value.strip(), unit.strip())
+
+
+@dataclass(frozen=True)
+class Mts793Header:
+    """First line of an MTS 793 export: ``MTS793|MPT|DEU|1|2|,|.|:|49|1|1|A``.
+
+    Fields: program, application, language, version, delimiter code (2 = tab), decimal mark,
+    date separator, time separator, ...
+    """
+
+    program: str
+    application: str
+    language: str
+    delimiter: str | None
+    decimal: str | None
+
+
+_MTS_DELIMITERS = {"2": "\t", "0": ",", "1": ";", "3": " "}
+
+
+def parse_mts793(line: str) -> Mts793Header | None:
+    """Parse the first line of an MTS 793 export, or None if ``line`` is not one."""
+    s = line.strip().lstrip("\ufeff")
+    if not s.upper().startswith("MTS") or s.count("|") < 6:
+        return None
+    f = s.split("|")
+    decimal = f[5] if len(f) > 5 and f[5] in (".", ",") else None
+    return Mts793Header(f[0], f[1], f[2], _MTS_DELIMITERS.get(f[4].strip()), decimal)
+
+
+class LineReader:
+    """Lines of a text stream with their 1-based numbers, with look-ahead and push-back.
+
+    Line ends are ``\\r\\n``, ``\\r`` or ``\\n`` (the stream must be opened with universal
+    newlines); the returned lines have no line end.
+    """
+
+    def __init__(self, lines: Iterable[str]) -> None:
+        self._it: Iterator[str] = iter(lines)
+        self._pending: deque[str] = deque()
+        self.lineno = 0  # number of the last line handed out
+
+    def next(self) -> str | None:
+        """The next line, or None at the end."""
+        if self._pending:
+            line = self._pending.popleft()
+        else:
+            raw = next(self._it, None)
+            if raw is None:
+                return None
+            line = raw.rstrip("\r\n")
+        self.lineno += 1
+        return line
+
+    def take(self, n: int) -> list[str]:
+        """Up to ``n`` next lines (fewer at the end); ``lineno`` is then the last one's."""
+        out: list[str] = []
+        while self._pending and len(out) < n:
+            out.append(self._pending.popleft())
+        if len(out) < n:
+            out.extend(raw.rstrip("\r\n") for raw in islice(self._it, n - len(out)))
+        self.lineno += len(out)
+        return out
+
+    def push_back(self, lines: list[str]) -> None:
+        """Return ``lines`` (the last ones handed out, in order) to the reader."""
+        self._pending.extendleft(reversed(lines))
+        self.lineno -= len(lines)
