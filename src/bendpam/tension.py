@@ -42,7 +42,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._io import json_safe
+from .atomic import json_safe
 from .checks import number
 from .errors import FitError, InputError, ProcessingError
 from .material import MooneyRivlin, _within, admissible_shape_range
