@@ -48,10 +48,10 @@ import numpy as np
 from .actuator import Actuator, ModelParams
 from .braid import DEFAULT_ORDER
 from .errors import InputError
-from .law import BRANCH_END, MomentLaw
+from .law import MomentLaw
 from .models import normalise_model
 
-__all__ = ["sweep", "SWEEP_PARAMETERS", "evaluate_cases", "build_cases"]
+__all__ = ["SWEEP_PARAMETERS", "build_cases", "evaluate_cases", "sweep"]
 
 #: Parameters that can be swept (Actuator field names; units in the names).
 SWEEP_PARAMETERS = (
@@ -85,7 +85,7 @@ def build_cases(base: Actuator, values: dict[str, np.ndarray]) -> ModelParams:
     if "R0_start_mm" in values:
         R0s = np.broadcast_to(np.asarray(values["R0_start_mm"], dtype=float), n)
     else:
-        R0s = get["R0_mm"] * (base.R0_start_mm / base.R0_mm)
+        R0s = get["R0_mm"] * (float(base.params.R0_start) / base.R0_mm)
     _validate(get, R0s)
     return ModelParams.build(R0_start_mm=np.array(R0s, dtype=float), braid_thickness_mm=base.braid_thickness_mm,
                              **{k: np.array(v, dtype=float) for k, v in get.items()})
@@ -215,6 +215,7 @@ def sweep(base_actuator: Actuator, pressure_kpa, model: str = "energy", *, chunk
     n_blocks = int(np.prod([len(c) for c in chunks])) if shape else 1
     show = progress if progress is not None else (n_blocks >= 20 and sys.stderr.isatty())
     fn = _block_fn(base_actuator, model, names, grids, P, order, eq19_factor)
+    da: Any
     try:
         import dask.array as da
     except ImportError:
@@ -304,7 +305,8 @@ def _compute(arr, scheduler, workers, show):
     import dask
 
     if scheduler or workers:
-        from distributed import Client, LocalCluster, progress as dprogress
+        from distributed import Client, LocalCluster
+        from distributed import progress as dprogress
 
         if scheduler:
             client = Client(scheduler)
