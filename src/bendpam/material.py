@@ -72,7 +72,6 @@ from functools import lru_cache
 from typing import Any
 
 import numpy as np
-from scipy.optimize import brentq
 
 from .errors import InputError
 
@@ -505,6 +504,8 @@ def _uniaxial_turning_point(beta: float, a: float, b: float) -> float:
     """Stretch where ``dP/dl = 0`` for a shape outside the uniaxial interval."""
     target = 3.0 / (beta - 1.0)  # q(l) = target there
     lo, hi = (1.0, b) if beta > 1.0 else (a, 1.0)
+    from scipy.optimize import brentq
+
     return float(brentq(lambda x: _q(x) - target, lo, hi, xtol=1e-14))
 
 
