@@ -29,7 +29,7 @@ from .checks import number
 from .errors import FileFormatError, InputError
 from .material import MooneyRivlin
 
-__all__ = ["Actuator", "ModelParams", "NEUTRAL_ANGLE_DEG", "bladder_area_mm2", "frame_inertia_mm4", "t0_start_mm"]
+__all__ = ["NEUTRAL_ANGLE_DEG", "Actuator", "ModelParams", "bladder_area_mm2", "frame_inertia_mm4", "t0_start_mm"]
 
 #: The braid angle at which a McKibben sleeve has maximum volume, arctan(sqrt 2) = 54.7356 deg.
 NEUTRAL_ANGLE_DEG = math.degrees(math.atan(math.sqrt(2.0)))
@@ -78,7 +78,7 @@ class ModelParams:
     frame_stiffness : E_f I_f, N*mm^2 (eq 16, 27).
     frame_modulus : E_f, MPa.  frame_thickness : h_f, mm.
     C10, C01 : Mooney-Rivlin constants, MPa.
-    P_start : threshold pressure, MPa (eq 50).
+    P_start : threshold pressure, MPa (eq 50); ``P_start_kpa`` the same in kPa, exactly as given.
     L0 : active length, mm.  braid_thickness : t_br, mm.
     """
 
@@ -94,6 +94,7 @@ class ModelParams:
     P_start: Any
     L0: Any
     braid_thickness: Any
+    P_start_kpa: Any = 0.0
 
     @classmethod
     def build(cls, *, alpha0_deg, R0_mm, t0_mm, L0_mm, frame_thickness_mm, frame_width_mm, frame_modulus_mpa,
@@ -105,7 +106,7 @@ class ModelParams:
             frame_stiffness=frame_modulus_mpa * frame_inertia_mm4(frame_width_mm, frame_thickness_mm),
             frame_modulus=frame_modulus_mpa * 1.0, frame_thickness=frame_thickness_mm * 1.0,
             C10=C10_kpa * 1e-3, C01=C01_kpa * 1e-3, P_start=P_start_kpa * 1e-3, L0=L0_mm * 1.0,
-            braid_thickness=braid_thickness_mm * 1.0,
+            braid_thickness=braid_thickness_mm * 1.0, P_start_kpa=P_start_kpa * 1.0,
         )
 
     @property

@@ -55,15 +55,15 @@ from .errors import InputError
 
 __all__ = [
     "DEFAULT_ORDER",
-    "Kinematics",
-    "CurvatureLimits",
-    "gauss_nodes",
-    "kinematics",
-    "curvature_limits",
-    "limits",
-    "solve_u",
     "LOCK_FRACTION",
     "MIN_FAR_STRETCH",
+    "CurvatureLimits",
+    "Kinematics",
+    "curvature_limits",
+    "gauss_nodes",
+    "kinematics",
+    "limits",
+    "solve_u",
 ]
 
 DEFAULT_ORDER = 32
@@ -98,7 +98,7 @@ def case_column(x):
     return x[..., None] if np.ndim(x) else x
 
 
-def _ibar(u, c, omc, wbar):
+def ibar(u, c, omc, wbar):
     """Circle means Ibar(u) and dIbar/du; ``u`` has shape S, ``omc = 1 - cos(phi)`` shape (n,).
 
     ``c = cos(alpha0)`` is a scalar or an array broadcasting against ``u`` (vectorised sweeps).
@@ -152,7 +152,7 @@ def solve_u(q_target, alpha0: float, order: int = DEFAULT_ORDER, u_bounds: tuple
         u0 = _universal_start(q, np.broadcast_to(alpha0, q.shape), int(order))
     u = np.where(q == 0.0, 0.0, np.clip(u0, lo + eps, hi - eps))
     for _ in range(_NEWTON_MAXITER):
-        ib, dib = _ibar(u, c, omc, wbar)
+        ib, dib = ibar(u, c, omc, wbar)
         f = s * u * ib - q
         # maintain the bracket (q is increasing in u)
         lo = np.where(f < 0.0, u, lo)
@@ -165,7 +165,7 @@ def solve_u(q_target, alpha0: float, order: int = DEFAULT_ORDER, u_bounds: tuple
         u = np.where(f == 0.0, u, un)
         if np.all(done):
             break
-    ib, dib = _ibar(u, c, omc, wbar)
+    ib, dib = ibar(u, c, omc, wbar)
     return u, ib, dib
 
 
@@ -181,7 +181,7 @@ def _universal_table(order: int) -> np.ndarray:
     c, s = np.cos(_A_GRID)[:, None], np.sin(_A_GRID)[:, None]
     u_lock = (1.0 / c - 1.0) / 2.0
     u = np.where(_NU < 0.0, 0.5 * _NU, _NU * u_lock)
-    ib, _ = _ibar(u, c, 1.0 - np.cos(phi), wbar)
+    ib, _ = ibar(u, c, 1.0 - np.cos(phi), wbar)
     q = s * u * ib
     q.setflags(write=False)
     return q
@@ -221,7 +221,7 @@ def _inverse_table(alpha0: float, order: int) -> tuple[np.ndarray, np.ndarray]:
     t = np.linspace(0.0, 1.0, 257)
     u = np.concatenate([-0.5 * (1.0 - (1.0 - t[::-1]) ** 2)[:-1] * 0.9999, u_lock * (1.0 - (1.0 - t) ** 2) * 0.9999])
     phi, wbar = gauss_nodes(order)
-    ib, _ = _ibar(u, c, 1.0 - np.cos(phi), wbar)
+    ib, _ = ibar(u, c, 1.0 - np.cos(phi), wbar)
     q = s * u * ib
     q.setflags(write=False)
     u.setflags(write=False)
@@ -293,7 +293,7 @@ def limits(params, order: int = DEFAULT_ORDER) -> CurvatureLimits:
     u_lock = (1.0 / c - 1.0) / 2.0
 
     def xi(u, cc, ss):
-        ib, _ = _ibar(u, cc, omc, wbar)
+        ib, _ = ibar(u, cc, omc, wbar)
         return 1.0 / (ss * ib)
 
     def lumen(u):  # R - t_bar, scaled: R0 xi^2 (1 + u) - t0  (t_bar = t0 / ((1 + u) xi))
@@ -406,17 +406,35 @@ class Kinematics:
         return np.pi * self.radius**2 * self.axis_length
 
 
-def radius_terms(kprime, alpha0: float, R0: float, order: int = DEFAULT_ORDER):
-    """Core of eq 5 for the models: ``u, R, dR/dk', Ibar`` at ``kprime`` (no limit checks)."""
-    k = np.asarray(kprime, dtype=float)
+def radius_from_u(u, ib, dib, alpha0, R0, k=None):
+    """``R, dR/dk', k'`` from ``u = k'R`` and the circle means ``Ibar(u)``, ``dIbar/du`` (eq 5).
+
+    ``R = R0 xi(u)`` with ``xi = 1 / (s Ibar)``; ``dR/dk' = R0 xi' R / (1 - R0 xi' k')`` (implicit
+    differentiation).  ``k'`` is ``u / R`` unless given.  Scalars or arrays that broadcast.
+    """
     s = np.sin(alpha0)
-    u, ib, dib = solve_u(k * R0, alpha0, order)
     # eta(0) = 1 and xi'(0) = -cot^2 alpha0 hold exactly; don't let quadrature rounding blur them
     at0 = u == 0.0
     xi = np.where(at0, 1.0, 1.0 / (s * ib))
     R = R0 * xi
+    if k is None:
+        k = u / R
     dxi = np.where(at0, -1.0 / np.tan(alpha0) ** 2, -xi * dib / ib)
     dR = R0 * dxi * R / (1.0 - R0 * dxi * k)
+    return R, dR, k
+
+
+def radius_state(kprime, alpha0, R0, order: int = DEFAULT_ORDER):
+    """Eq 5 at ``kprime``: ``u, R, dR/dk', Ibar, dIbar/du`` (no limit checks)."""
+    k = np.asarray(kprime, dtype=float)
+    u, ib, dib = solve_u(k * R0, alpha0, order)
+    R, dR, _ = radius_from_u(u, ib, dib, alpha0, R0, k)
+    return u, R, dR, ib, dib
+
+
+def radius_terms(kprime, alpha0: float, R0: float, order: int = DEFAULT_ORDER):
+    """Core of eq 5 for the models: ``u, R, dR/dk'`` at ``kprime`` (no limit checks)."""
+    u, R, dR, _, _ = radius_state(kprime, alpha0, R0, order)
     return u, R, dR
 
 

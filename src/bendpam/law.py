@@ -41,20 +41,20 @@ from typing import Any
 
 import numpy as np
 
-from .actuator import Actuator, ModelParams
-from .braid import DEFAULT_ORDER, CurvatureLimits, curvature_limits
+from .actuator import NEUTRAL_ANGLE_DEG, Actuator, ModelParams
+from .braid import DEFAULT_ORDER, LOCK_FRACTION, MIN_FAR_STRETCH, CurvatureLimits, curvature_limits, radius_from_u
 from .checks import pressure_kpa as _check_pressure
 from .errors import InputError, NoEquilibrium
 from .models import energy, force_balance, normalise_model
 
 __all__ = [
-    "MomentLaw",
-    "FreeBranch",
-    "FreeBending",
-    "BranchTable",
-    "StableBranch",
-    "MomentTable",
     "BRANCH_END",
+    "BranchTable",
+    "FreeBending",
+    "FreeBranch",
+    "MomentLaw",
+    "MomentTable",
+    "StableBranch",
     "illinois",
 ]
 
@@ -143,8 +143,8 @@ class MomentLaw:
     # ---- the numerics layer -------------------------------------------------------------------
     @property
     def P_start_kpa(self):
-        """Threshold pressure (kPa), float or per-case array."""
-        return self.params.P_start * 1e3
+        """Threshold pressure (kPa), float or per-case array (exactly the actuator's ``P_start_kpa``)."""
+        return self.params.P_start_kpa
 
     @cached_property
     def limits(self) -> CurvatureLimits:
@@ -346,7 +346,9 @@ class BranchTable:
     ``inf`` after it.  ``kind`` holds :data:`BRANCH_END` codes; ``p_end`` is the active
     pressure (kPa) at the end (``inf`` when unbounded or neutral); ``k_end`` the curvature there;
     ``k_lim`` the lock-up limit in the bending direction; ``last`` the last table index on the
-    branch; ``k_fold``/``use_ref`` the refined fold where it lies between samples.
+    branch; ``k_fold``/``use_ref`` the refined fold where it lies between samples.  ``xt``,
+    ``x_end``, ``x_fold`` are the same in the path's branch parameter (k' on the exact path, u = k'R
+    on the shared-table path) and ``path`` evaluates the law in it.
     """
 
     sgn: np.ndarray
@@ -359,9 +361,10 @@ class BranchTable:
     pt: np.ndarray = field(repr=False)
     k_fold: np.ndarray = field(repr=False)
     use_ref: np.ndarray = field(repr=False)
-
-    def take(self, rows) -> BranchTable:
-        return BranchTable(**{k: np.asarray(v)[rows] for k, v in self.__dict__.items()})
+    xt: np.ndarray = field(repr=False)
+    x_end: np.ndarray = field(repr=False)
+    x_fold: np.ndarray = field(repr=False)
+    path: Any = field(repr=False, compare=False)
 
 
 def _flat_params(law: MomentLaw) -> ModelParams:
@@ -370,43 +373,223 @@ def _flat_params(law: MomentLaw) -> ModelParams:
     return ModelParams(**{k: np.asarray(v).reshape(-1) for k, v in p.__dict__.items()})
 
 
+class _ExactPath:
+    """The branch parameter is the curvature k' itself; every value is computed exactly (eq 5 solved)."""
+
+    def __init__(self, law: MomentLaw):
+        self.law = law
+        self.cs = _flat_params(law)
+        self.scalar = not law.is_cases
+        lim = curvature_limits(law.params if self.scalar else self.cs, law.order)
+        self.k_min = np.atleast_1d(np.asarray(lim.k_min, dtype=float))
+        self.k_max = np.atleast_1d(np.asarray(lim.k_max, dtype=float))
+        self.x_min, self.x_max = self.k_min, self.k_max
+
+    def coef(self, x, rows):
+        """``(A per kPa, B)`` at branch parameters ``x`` of the cases ``rows`` (broadcasting)."""
+        return self.law.coefficients(x, None if self.scalar else self.cs.take(rows))
+
+    def to_k(self, x, rows):
+        return x
+
+
+class SectionTables:
+    """Spline tables of a model's section means over ``u = k'R``, one per distinct braid angle.
+
+    The section integrals of both models depend on ``u`` and the braid angle only
+    (``section_means`` of :mod:`bendpam.models.energy` and :mod:`~bendpam.models.force_balance`);
+    everything else is per-actuator arithmetic.  Cases that share a braid angle (a sweep over a grid)
+    therefore share one table: the means at Chebyshev-Lobatto knots of ``u`` on each side of 0
+    (clustered toward the braid limits, where they steepen), interpolated by a C2 cubic spline.
+    The knots are doubled until the interpolation error at every interval's midpoint, relative to
+    each mean's largest magnitude, is below ``tol`` (:attr:`max_rel_error`).
+    """
+
+    def __init__(self, mod, alpha0, order: int, *, knots: int = 513, tol: float = 1e-7, max_knots: int = 4097):
+        self.alpha0 = np.atleast_1d(np.asarray(alpha0, dtype=float))
+        c = np.cos(self.alpha0)
+        # one side per angle: the bending direction (k' > 0 above the neutral angle, k' < 0 below)
+        self.side = np.where(np.degrees(self.alpha0) < NEUTRAL_ANGLE_DEG, -1.0, 1.0)
+        self.u_end = np.where(self.side > 0, LOCK_FRACTION * (1.0 / c - 1.0) / 2.0, -0.5 * (1.0 - MIN_FAR_STRETCH))
+        # the knot count is chosen on the extreme angles (the error hardly depends on the angle), then
+        # every angle is tabulated once at that count
+        probe = np.unique([int(np.argmin(self.alpha0)), int(np.argmax(self.alpha0))])
+        n = int(knots)
+        while True:
+            uj, coef, keys = self._build(mod, probe, order, n)
+            self._n, self._uj, self._coef, self.keys = n, uj, coef, keys
+            um = 0.5 * (uj[:, 1:] + uj[:, :-1])
+            me = mod.section_means(um, self.alpha0[probe][:, None], order)
+            E = np.stack([me[k] for k in keys], axis=-1)
+            F = self._eval(np.broadcast_to(np.arange(probe.size)[:, None], um.shape), um, side=self.side[probe],
+                           u_end=self.u_end[probe])
+            scale = np.max(np.abs(coef[..., 3, :]), axis=1, keepdims=True) + 1e-300
+            self.max_rel_error = float(np.max(np.abs(F - E) / scale))
+            if self.max_rel_error <= tol or n >= max_knots:
+                break
+            n = 2 * n - 1
+        if probe.size < self.alpha0.size:
+            self._uj, self._coef, _ = self._build(mod, np.arange(self.alpha0.size), order, n)
+        self.knots = n
+
+    def _build(self, mod, which, order, n):
+        """Knots and spline coefficients of the angles ``which`` at ``n`` knots."""
+        from scipy.interpolate import CubicSpline
+
+        t = np.cos(np.linspace(0.0, np.pi, n))
+        uj = np.sort(0.5 * self.u_end[which][:, None] * (1.0 - t), axis=1)  # Chebyshev-Lobatto on [0, u_end]
+        m = mod.section_means(uj, self.alpha0[which][:, None], order)
+        keys = list(m)
+        Y = np.stack([m[k] for k in keys], axis=-1)  # (angles, knots, keys)
+        coef = np.empty((len(which), n - 1, 4, len(keys)))
+        for i in range(len(which)):  # one spline per distinct angle (not per point)
+            coef[i] = np.moveaxis(CubicSpline(uj[i], Y[i]).c, 0, 1)
+        return uj, coef, keys
+
+    def _eval(self, ia, u, cols=None, side=None, u_end=None):
+        n = self._n
+        side = self.side if side is None else side
+        u_end = self.u_end if u_end is None else u_end
+        t = np.clip(1.0 - 2.0 * u / u_end[ia], -1.0, 1.0)  # knots at u_end (1 - cos(pi i/(n-1)))/2
+        j = np.floor(np.arccos(t) * ((n - 1) / np.pi)).astype(np.intp)
+        j = np.where(side[ia] < 0, (n - 2) - j, j)  # the negative side's knots are stored increasing
+        np.clip(j, 0, n - 2, out=j)
+        c = self._coef[ia, j] if cols is None else self._coef[ia, j][..., cols]  # (..., 4, keys)
+        dx = (u - self._uj[ia, j])[..., None]
+        return ((c[..., 0, :] * dx + c[..., 1, :]) * dx + c[..., 2, :]) * dx + c[..., 3, :]
+
+    def ibar(self, ia, u):
+        """The interpolated ``Ibar(u)`` alone (eq 5), for the lumen limit."""
+        ia, u = np.broadcast_arrays(np.asarray(ia), np.asarray(u, dtype=float))
+        n = self._n
+        t = np.clip(1.0 - 2.0 * u / self.u_end[ia], -1.0, 1.0)
+        j = np.floor(np.arccos(t) * ((n - 1) / np.pi)).astype(np.intp)
+        j = np.clip(np.where(self.side[ia] < 0, (n - 2) - j, j), 0, n - 2)
+        c = self._coef[ia, j, :, 0]
+        dx = u - self._uj[ia, j]
+        return ((c[..., 0] * dx + c[..., 1]) * dx + c[..., 2]) * dx + c[..., 3]
+
+    def means(self, ia, u) -> dict:
+        """The interpolated means at ``u`` for the angles ``ia`` (indices into :attr:`alpha0`)."""
+        ia, u = np.broadcast_arrays(np.asarray(ia), np.asarray(u, dtype=float))
+        v = self._eval(ia, u)
+        return {k: v[..., i] for i, k in enumerate(self.keys)}
+
+
+class _TablePath:
+    """The branch parameter is ``u = k'R``; the section means come from shared :class:`SectionTables`."""
+
+    def __init__(self, law: MomentLaw, cs: ModelParams, uniq, inverse):
+        self.law, self.cs = law, cs
+        self.tables = SectionTables(law._mod, uniq, law.order)
+        self.ia = inverse
+        self.x_min, self.x_max = self._u_limits()
+        self.k_min = self.to_k(self.x_min, np.arange(self.ia.size))  # 0 on the side that is not tabulated
+        self.k_max = self.to_k(self.x_max, np.arange(self.ia.size))
+
+    def _state(self, u, rows):
+        sub = self.cs.take(rows)
+        m = self.tables.means(self.ia[rows], u)
+        R, dR, k = radius_from_u(u, m["ib"], m["dib"], sub.alpha0, sub.R0_start)
+        return sub, m, R, dR, k
+
+    def coef(self, u, rows):
+        sub, m, R, dR, k = self._state(u, rows)
+        law = self.law
+        if law.model == "energy":
+            A, b10, b01 = law._mod.assemble(sub, k, u, R, dR, m, eq19_factor=law.eq19_factor)
+        else:
+            A, b10, b01 = law._mod.assemble(sub, k, u, R, dR, m)
+        return A * _PER_KPA, sub.C10 * b10 + sub.C01 * b01 + sub.frame_stiffness * k
+
+    def to_k(self, u, rows):
+        m = self.tables.means(self.ia[rows], u)
+        sub = self.cs.take(rows)
+        return radius_from_u(u, m["ib"], m["dib"], sub.alpha0, sub.R0_start)[2]
+
+    def _u_limits(self):
+        """The braid limit in u on the bending side, cut where the bladder lumen closes (``R = t_bar``)."""
+        n = self.ia.size
+        rows = np.arange(n)[:, None]
+        end = self.tables.u_end[self.ia]
+        grid = end[:, None] * np.linspace(0.0, 1.0, 65)
+
+        def lumen(u, rows=rows):
+            sub = self.cs.take(rows)
+            xi = 1.0 / (np.sin(sub.alpha0) * self.tables.ibar(self.ia[rows], u))
+            return sub.R0_start * xi * xi * (1.0 + u) - sub.t0_start
+
+        neg = lumen(grid) <= 0.0
+        has = neg.any(axis=-1)
+        j = np.where(has, np.argmax(neg, axis=-1), 1)
+        a = np.take_along_axis(grid, (j - 1)[:, None], -1)[:, 0]
+        b = np.take_along_axis(grid, j[:, None], -1)[:, 0]
+        if has.any():
+            for _ in range(64):
+                mid = 0.5 * (a + b)
+                pos = lumen(mid, np.arange(n)) > 0
+                a, b = np.where(pos, mid, a), np.where(pos, b, mid)
+        u_end = np.where(has, 0.5 * (a + b), end)
+        pos_side = self.tables.side[self.ia] > 0
+        return np.where(pos_side, 0.0, u_end), np.where(pos_side, u_end, 0.0)
+
+
+#: A block of cases uses the shared section tables when it has at least this many cases per angle.
+TABLE_MIN_CASES_PER_ANGLE = 8
+
+
+def _path(law: MomentLaw):
+    """The exact path, or the shared-table path for blocks of cases with few distinct braid angles."""
+    if law.is_cases:
+        cs = _flat_params(law)
+        uniq, inverse = np.unique(cs.alpha0, return_inverse=True)
+        if cs.alpha0.size >= TABLE_MIN_CASES_PER_ANGLE * uniq.size:
+            return _TablePath(law, cs, uniq, inverse.reshape(-1))
+    return _ExactPath(law)
+
+
 def _branch_table(law: MomentLaw, samples: int) -> BranchTable:
-    """Sample ``p(k') = B/A`` along each case's bending direction; find its end (fold, lock-up)."""
-    cs = _flat_params(law)
+    """Sample ``P_a(x) = B/A`` along each case's bending direction; find its end (fold, lock-up).
+
+    ``x`` is the branch parameter of the path (:func:`_path`): k' (exact) or u = k'R (tables).
+    """
+    ev = _path(law)
+    cs = ev.cs
     sgn = cs.bend_sign
-    lim = curvature_limits(cs, law.order)
-    k_lim = np.where(sgn > 0, lim.k_max, lim.k_min)
+    ncase = sgn.size
+    x_lim = np.where(sgn > 0, ev.x_max, ev.x_min)
+    k_lim = np.where(sgn > 0, ev.k_max, ev.k_min)
     frac = np.linspace(0.0, 1.0, samples + 1)[1:] ** 1.5  # graded: denser near 0 where the curve starts
-    kg = k_lim[:, None] * frac
-    A, B = law.coefficients(kg, cs.col())
+    xg = x_lim[:, None] * frac
+    allrows = np.arange(ncase)[:, None]
+    A, B = ev.coef(xg, allrows)
     sA = sgn[:, None] * A
     with np.errstate(divide="ignore", invalid="ignore"):
         p = np.where(sA > 0.0, B / A, np.nan)
-    n = kg.shape[-1]
+    n = xg.shape[-1]
     bad_a = ~(sA > 0.0)
     n_ok = np.where(bad_a.any(-1), np.argmax(bad_a, -1), n)
-    pk = np.concatenate([np.zeros((kg.shape[0], 1)), p], axis=-1)
-    kk = np.concatenate([np.zeros((kg.shape[0], 1)), kg], axis=-1)
+    pk = np.concatenate([np.zeros((ncase, 1)), p], axis=-1)
+    xk = np.concatenate([np.zeros((ncase, 1)), xg], axis=-1)
     idx = np.arange(n + 1)
     valid = idx[None, :] <= n_ok[:, None]
     pk_valid = np.where(valid, pk, np.nan)
     dec = (np.diff(pk_valid, axis=-1) <= 0.0) & valid[:, 1:]
     has_dec = dec.any(-1)
     j = np.where(has_dec, np.argmax(dec, -1), 0)
-    # fold refinement: golden-section maximisation of p on [kk[j-1], kk[j+1]]
-    lo = np.take_along_axis(kk, np.clip(j - 1, 0, n)[:, None], -1)[:, 0]
-    hi = np.take_along_axis(kk, np.clip(j + 1, 0, n)[:, None], -1)[:, 0]
+    # fold refinement: golden-section maximisation of p on [xk[j-1], xk[j+1]]
+    lo = np.take_along_axis(xk, np.clip(j - 1, 0, n)[:, None], -1)[:, 0]
+    hi = np.take_along_axis(xk, np.clip(j + 1, 0, n)[:, None], -1)[:, 0]
     a_, b_ = np.minimum(lo, hi), np.maximum(lo, hi)
     rows = np.flatnonzero(has_dec & (j > 0))
-    k_fold = np.take_along_axis(kk, j[:, None], -1)[:, 0].copy()
+    x_fold = np.take_along_axis(xk, j[:, None], -1)[:, 0].copy()
     pj = np.take_along_axis(pk, j[:, None], -1)[:, 0]
     p_fold = pj.copy()
-    use_ref = np.zeros(kg.shape[0], dtype=bool)
+    use_ref = np.zeros(ncase, dtype=bool)
     if rows.size:
-        sub = cs.take(rows)
 
         def p_of(x):
-            Ax, Bx = law.coefficients(x, sub)
+            Ax, Bx = ev.coef(x, rows)
             with np.errstate(divide="ignore", invalid="ignore"):
                 return Bx / Ax
 
@@ -414,7 +597,7 @@ def _branch_table(law: MomentLaw, samples: int) -> BranchTable:
         g = (math.sqrt(5.0) - 1.0) / 2.0
         x1, x2 = b - g * (b - a), a + g * (b - a)
         f1, f2 = p_of(x1), p_of(x2)
-        for _ in range(60):
+        for _ in range(48):  # the bracket shrinks by 0.618^48 ~ 1e-10 of a sample interval
             left = f1 > f2  # the maximum lies in [a, x2]
             b = np.where(left, x2, b)
             a = np.where(left, a, x1)
@@ -426,7 +609,7 @@ def _branch_table(law: MomentLaw, samples: int) -> BranchTable:
         pm = p_of(xm)
         ref = np.isfinite(pm) & (pm > pj[rows])
         use_ref[rows] = ref
-        k_fold[rows] = np.where(ref, xm, k_fold[rows])
+        x_fold[rows] = np.where(ref, xm, x_fold[rows])
         p_fold[rows] = np.where(ref, pm, p_fold[rows])
     kind = np.where(has_dec, BRANCH_END["fold"], np.where(n_ok < n, BRANCH_END["unbounded"], BRANCH_END["lock-up"]))
     kind = np.where(sgn == 0, BRANCH_END["neutral"], kind)
@@ -438,12 +621,15 @@ def _branch_table(law: MomentLaw, samples: int) -> BranchTable:
     last = np.where(kind == BRANCH_END["fold"], j, np.minimum(n_ok, n))
     pt = np.where(idx[None, :] <= last[:, None], pk, np.inf)
     nxt = np.clip(last + 1, 0, n)
-    k_after = np.take_along_axis(kk, nxt[:, None], -1)[:, 0]
-    k_end = np.where(kind == BRANCH_END["fold"], np.where(unstable, 0.0, k_fold),
-                     np.where(kind == BRANCH_END["unbounded"], k_after, k_lim))
-    k_end = np.where(kind == BRANCH_END["neutral"], 0.0, k_end)
-    return BranchTable(sgn=sgn, k_lim=k_lim, kind=kind, p_end=p_end, k_end=k_end, last=last, kt=kk, pt=pt,
-                       k_fold=k_fold, use_ref=use_ref)
+    x_after = np.take_along_axis(xk, nxt[:, None], -1)[:, 0]
+    x_end = np.where(kind == BRANCH_END["fold"], np.where(unstable, 0.0, x_fold),
+                     np.where(kind == BRANCH_END["unbounded"], x_after, x_lim))
+    x_end = np.where(kind == BRANCH_END["neutral"], 0.0, x_end)
+    every = np.arange(ncase)
+    kt = ev.to_k(xk, allrows)
+    return BranchTable(sgn=sgn, k_lim=k_lim, kind=kind, p_end=p_end, k_end=ev.to_k(x_end, every), last=last, kt=kt,
+                       pt=pt, k_fold=ev.to_k(x_fold, every), use_ref=use_ref, xt=xk, x_end=x_end, x_fold=x_fold,
+                       path=ev)
 
 
 def illinois(F, a, b, tol, maxiter: int = 100):
@@ -498,27 +684,26 @@ def _solve_free(law: MomentLaw, tab: BranchTable, pa: np.ndarray, xtol: float) -
         return k
     case, col = np.nonzero(solve)
     q = pa[case, col]
-    kt, pt = tab.kt[case], tab.pt[case]
+    xt, pt = tab.xt[case], tab.pt[case]
     # bracket: first table index with p >= q (the table is increasing up to its end, then inf)
-    j = np.clip((pt < q[:, None]).sum(-1), 1, kt.shape[-1] - 1)
-    a = np.take_along_axis(kt, (j - 1)[:, None], -1)[:, 0]
-    b = np.take_along_axis(kt, j[:, None], -1)[:, 0]
+    j = np.clip((pt < q[:, None]).sum(-1), 1, xt.shape[-1] - 1)
+    a = np.take_along_axis(xt, (j - 1)[:, None], -1)[:, 0]
+    b = np.take_along_axis(xt, j[:, None], -1)[:, 0]
     last = tab.last[case]
     beyond = j > last
     fold_end = (tab.kind[case] == BRANCH_END["fold"]) & tab.use_ref[case] & beyond
     unb = (tab.kind[case] == BRANCH_END["unbounded"]) & beyond
-    b = np.where(fold_end, tab.k_fold[case], np.where(unb, tab.k_end[case], b))
-    a = np.where(fold_end | unb, np.take_along_axis(kt, last[:, None], -1)[:, 0], a)
+    b = np.where(fold_end, tab.x_fold[case], np.where(unb, tab.x_end[case], b))
+    a = np.where(fold_end | unb, np.take_along_axis(xt, last[:, None], -1)[:, 0], a)
     sgn = tab.sgn[case]
-    cs = _flat_params(law) if law.is_cases else law.params
+    ev = tab.path
 
     def F(x, idx):
-        sub = cs.take(case[idx]) if law.is_cases else None
-        A, B = law.coefficients(x, sub)
+        A, B = ev.coef(x, case[idx])
         return sgn[idx] * (q[idx] * A - B)
 
-    tol = xtol * np.abs(tab.k_end[case]) + 1e-300
-    k[case, col] = illinois(F, a, b, tol)
+    tol = xtol * np.abs(tab.x_end[case]) + 1e-300
+    k[case, col] = ev.to_k(illinois(F, a, b, tol), case)
     return k
 
 

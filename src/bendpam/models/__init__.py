@@ -12,7 +12,7 @@ from __future__ import annotations
 from ..errors import InputError
 from . import energy, force_balance
 
-__all__ = ["energy", "force_balance", "get_model", "normalise_model", "MODEL_NAMES"]
+__all__ = ["MODEL_NAMES", "energy", "force_balance", "get_model", "normalise_model"]
 
 MODEL_NAMES = ("energy", "force_balance")
 

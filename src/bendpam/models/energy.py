@@ -29,13 +29,12 @@ which is what :func:`coefficients` returns; the kinematics are computed once per
 
 from __future__ import annotations
 
-
 import numpy as np
 
-from ..braid import DEFAULT_ORDER, gauss_nodes, radius_terms
+from ..braid import DEFAULT_ORDER, gauss_nodes, ibar, radius_state, radius_terms
 from ..material import MooneyRivlin
 
-__all__ = ["basis", "coefficients", "terms", "bladder_energy"]
+__all__ = ["basis", "bladder_energy", "coefficients", "terms"]
 
 
 def _state(params, k, order):
@@ -53,19 +52,47 @@ def _air_coefficient(k, R, dR):
 
 _UNIT10 = MooneyRivlin(1.0, 0.0)
 _UNIT01 = MooneyRivlin(0.0, 1.0)
+#: Names of the section means of :func:`section_means` (besides ``ib`` and ``dib``).
+MEANS = ("d1_10", "d2_10", "d1_01", "d2_01")
 
 
-def _bladder_basis(params, k, u, R, dR, omc, wbar, lam1, eq19_factor):
-    """Bladder moment per unit C10 and per unit C01 (N*mm/MPa): M_bl = C10 b10 + C01 b01 (eq 19)."""
-    eta = (R / params.R0_start)[..., None]
-    dl1 = (R + k * dR)[..., None] * omc  # d lambda1 / dk'
-    dl2 = (dR / params.R0_start)[..., None]  # d lambda2 / dk'
-    fac = params.bladder_area * ((1.0 + u) if eq19_factor else 1.0)
-    out = []
-    for mat in (_UNIT10, _UNIT01):
-        dW = mat.dW_dl1(lam1, eta) * dl1 + mat.dW_dl2(lam1, eta) * dl2
-        out.append(fac * (dW @ wbar))
+def section_means(u, alpha0, order: int = DEFAULT_ORDER, ib=None, dib=None) -> dict:
+    """The section integrals of the energy model that depend on ``u = k'R`` and ``alpha0`` only.
+
+    ``ib, dib``: the circle mean ``Ibar(u)`` of eq 5 and its derivative; ``d1_10, d2_10`` (and
+    ``_01``): the circle means of ``dW/dlambda1 (1 - cos Phi)`` and ``dW/dlambda2`` for a unit C10
+    (C01) at the stretches ``lambda1 = 1 + u (1 - cos Phi)``, ``lambda2 = xi(u)`` (eq 17-19).
+    Everything else in the moment is per-actuator arithmetic (:func:`assemble`), so actuators that
+    share a braid angle share these (the sweeps tabulate them once per angle).
+    """
+    phi, wbar = gauss_nodes(order)
+    omc = 1.0 - np.cos(phi)
+    c, s = np.cos(alpha0), np.sin(alpha0)
+    u = np.asarray(u, dtype=float)
+    if ib is None or dib is None:
+        ib, dib = ibar(u, c, omc, wbar)
+    xi = np.where(u == 0.0, 1.0, 1.0 / (s * ib))
+    lam1 = 1.0 + u[..., None] * omc
+    eta = xi[..., None]
+    out = {"ib": ib, "dib": dib}
+    for key, mat in (("10", _UNIT10), ("01", _UNIT01)):
+        out["d1_" + key] = (mat.dW_dl1(lam1, eta) * omc) @ wbar
+        out["d2_" + key] = mat.dW_dl2(lam1, eta) @ wbar
     return out
+
+
+def assemble(params, k, u, R, dR, means, *, eq19_factor: bool = True):
+    """``(A, b10, b01)`` (per MPa) from the kinematics and :func:`section_means` (eq 13, 19).
+
+    ``A = pi[(2R + 3k'R^2) dR/dk' + R^3]`` (eq 13) and ``M_bl = C10 b10 + C01 b01`` with
+    ``b = A_bl (1 + k'R) [(R + k' dR/dk') mean(dW/dl1 (1 - cos Phi)) + (dR/dk' / R0) mean(dW/dl2)]``.
+    """
+    fac = params.bladder_area * ((1.0 + u) if eq19_factor else 1.0)
+    g1 = R + k * dR  # d lambda1 / dk' over (1 - cos Phi)
+    g2 = dR / params.R0_start  # d lambda2 / dk'
+    b10 = fac * (g1 * means["d1_10"] + g2 * means["d2_10"])
+    b01 = fac * (g1 * means["d1_01"] + g2 * means["d2_01"])
+    return _air_coefficient(k, R, dR), b10, b01
 
 
 def basis(params, curvature, *, order: int = DEFAULT_ORDER, eq19_factor: bool = True):
@@ -75,9 +102,9 @@ def basis(params, curvature, *, order: int = DEFAULT_ORDER, eq19_factor: bool = 
     identification can solve for C10, C01, E_f and P_start by linear least squares.
     """
     k = np.asarray(curvature, dtype=float)
-    u, R, dR, omc, wbar, lam1 = _state(params, k, order)
-    b10, b01 = _bladder_basis(params, k, u, R, dR, omc, wbar, lam1, eq19_factor)
-    return _air_coefficient(k, R, dR), b10, b01
+    u, R, dR, ib, dib = radius_state(k, params.alpha0, params.R0_start, order)
+    means = section_means(u, params.alpha0, order, ib, dib)
+    return assemble(params, k, u, R, dR, means, eq19_factor=eq19_factor)
 
 
 def coefficients(params, curvature, *, order: int = DEFAULT_ORDER, eq19_factor: bool = True):
@@ -96,9 +123,8 @@ def terms(params, p_active, curvature, *, order: int = DEFAULT_ORDER, eq19_facto
     ``p_active`` is ``max(P - P_start, 0)`` in MPa and broadcasts against ``curvature``.
     """
     k = np.asarray(curvature, dtype=float)
-    u, R, dR, omc, wbar, lam1 = _state(params, k, order)
-    m_air = np.asarray(p_active, dtype=float) * _air_coefficient(k, R, dR)
-    b10, b01 = _bladder_basis(params, k, u, R, dR, omc, wbar, lam1, eq19_factor)
+    A, b10, b01 = basis(params, k, order=order, eq19_factor=eq19_factor)
+    m_air = np.asarray(p_active, dtype=float) * A
     m_bl = params.C10 * b10 + params.C01 * b01
     m_f = params.frame_stiffness * k
     m_bl, m_f = np.broadcast_arrays(m_bl, m_f)

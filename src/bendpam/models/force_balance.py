@@ -37,12 +37,11 @@ With the corrections of section 3.3, ``P`` is the active pressure ``max(P - P_st
 
 from __future__ import annotations
 
-
 import numpy as np
 
-from ..braid import DEFAULT_ORDER, case_column, gauss_nodes, radius_terms
+from ..braid import DEFAULT_ORDER, case_column, gauss_nodes, ibar, radius_state, radius_terms
 
-__all__ = ["basis", "coefficients", "terms", "stress_state"]
+__all__ = ["basis", "coefficients", "stress_state", "terms"]
 
 
 def _state(params, k, order):
@@ -68,22 +67,58 @@ def _state(params, k, order):
                 omc=omc, wbar=wbar)
 
 
+#: Names of the section means of :func:`section_means` (besides ``ib`` and ``dib``).
+MEANS = ("J", "L2", "Lm2")
+
+
+def section_means(u, alpha0, order: int = DEFAULT_ORDER, ib=None, dib=None) -> dict:
+    """The section integrals of the force-balance model that depend on ``u = k'R`` and ``alpha0`` only.
+
+    ``ib, dib`` (eq 5), ``J = int_0^2pi lambda1^2 (1 - cos Phi) / (1 - c^2 lambda1^2) dPhi`` (eq 46-48),
+    ``L2`` and ``Lm2``: the circle means of ``lambda1^2 (1 - cos Phi)`` and ``(1 - cos Phi) / lambda1^2``
+    (eq 43).  The rest is per-actuator arithmetic (:func:`assemble`).
+    """
+    phi, wbar = gauss_nodes(order)
+    omc = 1.0 - np.cos(phi)
+    c = np.cos(alpha0)
+    u = np.asarray(u, dtype=float)
+    if ib is None or dib is None:
+        ib, dib = ibar(u, c, omc, wbar)
+    lam1 = 1.0 + u[..., None] * omc
+    l2 = lam1 * lam1
+    cl2 = case_column(c * c) * l2
+    return {"ib": ib, "dib": dib, "J": 2.0 * np.pi * ((l2 * omc / (1.0 - cl2)) @ wbar),
+            "L2": (l2 * omc) @ wbar, "Lm2": (omc / l2) @ wbar}
+
+
+def assemble(params, k, u, R, dR, means):
+    """``(A, b10, b01)`` (per MPa) from the kinematics and :func:`section_means` (eq 43-49).
+
+    ``B = M_bl - sigma_bl,2^el t_bar R^2 c^2 J`` is linear in C10 and C01; ``b10`` and ``b01`` are
+    its coefficients, and ``A = R^3 (pi - c^2 J)``.
+    """
+    c2 = np.cos(params.alpha0) ** 2
+    eta = R / params.R0_start
+    lbar = 1.0 + u
+    tb = params.t0_start / (lbar * eta)
+    le2 = (lbar * eta) ** 2
+    e2 = eta * eta
+    J = means["J"]
+    w = tb * R * R
+    br = w * c2 * J  # sigma_bl,2^el enters as - sigma2e * t_bar R^2 c^2 J
+    b10 = w * 2.0 * np.pi * (2.0 * means["L2"] - 2.0 / le2) - 2.0 * (e2 - 1.0 / le2) * br
+    b01 = w * 2.0 * np.pi * (-2.0 * means["Lm2"] + 2.0 * le2) + 2.0 * (1.0 / e2 - le2) * br
+    return R**3 * (np.pi - c2 * J), b10, b01
+
+
 def basis(params, curvature, *, order: int = DEFAULT_ORDER):
     """Linear decomposition ``M = P_active A - E_f I_f k' - C10 b10 - C01 b01`` (C in MPa).
 
-    ``B = M_bl - sigma_bl,2^el t_bar R^2 c^2 J`` is linear in C10 and C01; ``b10`` and ``b01`` are
-    its coefficients.  Returns ``(A, b10, b01)``.
+    Returns ``(A, b10, b01)``, see :func:`assemble`.
     """
     k = np.asarray(curvature, dtype=float)
-    st = _state(params, k, order)
-    R, c, J, tb, lam1, omc, wbar = st["R"], st["c"], st["J"], st["tbar"], st["lam1"], st["omc"], st["wbar"]
-    le2 = (st["lbar"] * st["eta"]) ** 2
-    e2 = st["eta"] ** 2
-    w = tb * R * R
-    br = w * c * c * J  # sigma_bl,2^el enters as - sigma2e * t_bar R^2 c^2 J
-    b10 = w * 2.0 * np.pi * (((2.0 * lam1 * lam1) * omc) @ wbar - 2.0 / le2) - 2.0 * (e2 - 1.0 / le2) * br
-    b01 = w * 2.0 * np.pi * (((-2.0 / (lam1 * lam1)) * omc) @ wbar + 2.0 * le2) + 2.0 * (1.0 / e2 - le2) * br
-    return R**3 * (np.pi - c * c * J), b10, b01
+    u, R, dR, ib, dib = radius_state(k, params.alpha0, params.R0_start, order)
+    return assemble(params, k, u, R, dR, section_means(u, params.alpha0, order, ib, dib))
 
 
 def coefficients(params, curvature, *, order: int = DEFAULT_ORDER):
