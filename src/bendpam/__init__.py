@@ -43,6 +43,7 @@ from .predict import (
 __version__ = "0.2.0"
 
 __all__ = [
+    "NEUTRAL_ANGLE_DEG",
     "Actuator",
     "BendpamError",
     "CurvatureLimits",
@@ -56,7 +57,6 @@ __all__ = [
     "MomentLaw",
     "MomentTable",
     "MooneyRivlin",
-    "NEUTRAL_ANGLE_DEG",
     "NoEquilibrium",
     "ProcessingError",
     "StableBranch",

@@ -14,7 +14,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-__all__ = ["atomic_path", "atomic_write_text", "atomic_write_bytes", "json_safe"]
+__all__ = ["atomic_path", "atomic_write_bytes", "atomic_write_text", "json_safe"]
 
 # mkstemp creates files readable by the owner only; outputs get the usual permissions instead
 UMASK = os.umask(0)

@@ -316,7 +316,8 @@ def limits(params, order: int = DEFAULT_ORDER) -> CurvatureLimits:
     k_max = u_hi / (R0 * xi(u_hi[:, None], c[:, None], s[:, None])[:, 0])
     k_min = u_lo / (R0 * xi(u_lo[:, None], c[:, None], s[:, None])[:, 0])
     if closes[0][0]:
-        reason_max = f"bladder lumen closes (R = t_bar) at u = k'R = {u_hi[0]:.4g}, before braid lock-up u_lock = {u_lock[0]:.4g}"
+        reason_max = (f"bladder lumen closes (R = t_bar) at u = k'R = {u_hi[0]:.4g}, before braid lock-up "
+                      f"u_lock = {u_lock[0]:.4g}")
     else:
         reason_max = (f"braid lock-up: far-side fibres within {100 * (1 - LOCK_FRACTION):g}% of straight "
                       f"(u = k'R = {u_hi[0]:.4g} of u_lock = {u_lock[0]:.4g})")

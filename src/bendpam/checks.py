@@ -20,7 +20,7 @@ import numpy as np
 
 from .errors import InputError
 
-__all__ = ["UnitWarning", "number", "pressure_kpa", "MPA_SUSPECT_KPA"]
+__all__ = ["MPA_SUSPECT_KPA", "UnitWarning", "number", "pressure_kpa"]
 
 #: Below this (kPa), a set of pressures is suspected to be in MPa.
 MPA_SUSPECT_KPA = 5.0
@@ -78,7 +78,8 @@ def pressure_kpa(value: Any, name: str = "pressure_kpa", *, warn: bool = True) -
         raise InputError(f"{name} has a non-finite value {p.ravel()[i]!r} at index {i}; allowed range [0, inf) kPa")
     if p.size and np.any(p < 0.0):
         i = int(np.flatnonzero(p.ravel() < 0.0)[0])
-        raise InputError(f"{name} = {p.ravel()[i]:g} kPa at index {i} is below zero; allowed range [0, inf) kPa (gauge)")
+        raise InputError(
+            f"{name} = {p.ravel()[i]:g} kPa at index {i} is below zero; allowed range [0, inf) kPa (gauge)")
     if warn and p.size:
         nz = p[p > 0.0]
         if nz.size and float(nz.max()) < MPA_SUSPECT_KPA:

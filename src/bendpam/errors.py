@@ -19,7 +19,7 @@ it is a bug and is reported as one.
 
 from __future__ import annotations
 
-__all__ = ["BendpamError", "InputError", "FileFormatError", "ProcessingError", "NoEquilibrium", "FitError"]
+__all__ = ["BendpamError", "FileFormatError", "FitError", "InputError", "NoEquilibrium", "ProcessingError"]
 
 
 class BendpamError(Exception):

@@ -27,9 +27,10 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+
 from .errors import InputError
 
-__all__ = ["Fixture", "PAPER_FIXTURE"]
+__all__ = ["PAPER_FIXTURE", "Fixture"]
 
 
 @dataclass(frozen=True)

@@ -43,10 +43,20 @@ import math
 from dataclasses import asdict, dataclass
 
 import numpy as np
+
 from .errors import InputError
 
-__all__ = ["DahlLaw", "PrandtlIshlinskii", "LoopModel", "make_law", "LAWS", "loss_ratio", "loop_branches",
-           "predict_cycle", "Cycle"]
+__all__ = [
+    "LAWS",
+    "Cycle",
+    "DahlLaw",
+    "LoopModel",
+    "PrandtlIshlinskii",
+    "loop_branches",
+    "loss_ratio",
+    "make_law",
+    "predict_cycle",
+]
 
 LAWS = ("pi", "dahl")
 
@@ -88,7 +98,7 @@ class DahlLaw:
         z[0] = z0
         starts, ends, sgn = _segments(th)
         zs = z0
-        for a, b in zip(starts, ends):
+        for a, b in zip(starts, ends, strict=True):
             if b <= a:
                 continue
             s = sgn[a]
@@ -152,7 +162,7 @@ class PrandtlIshlinskii:
         s = float(np.clip(z0, -1.0, 1.0)) * r
         z[0] = s.sum() / norm
         starts, ends, _ = _segments(th)
-        for a, b in zip(starts, ends):
+        for a, b in zip(starts, ends, strict=True):
             if b <= a:
                 continue
             seg = th[a + 1: b + 1] - th[a]

@@ -61,14 +61,27 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import least_squares, lsq_linear
 
-from .atomic import atomic_write_text, json_safe
 from .actuator import NEUTRAL_ANGLE_DEG, Actuator
+from .atomic import atomic_write_text, json_safe
+from .errors import FileFormatError, FitError, InputError
 from .law import MomentLaw
 from .models import normalise_model
-from .errors import FileFormatError, FitError, InputError
 
-__all__ = ["PARAMETERS", "HYST_PARAMETERS", "Parameter", "FitResult", "HysteresisFit", "LossRatio", "Metrics", "fit",
-           "score", "parse_free", "developed_range", "predicted_loss_ratios", "branch_nrmse"]
+__all__ = [
+    "HYST_PARAMETERS",
+    "PARAMETERS",
+    "FitResult",
+    "HysteresisFit",
+    "LossRatio",
+    "Metrics",
+    "Parameter",
+    "branch_nrmse",
+    "developed_range",
+    "fit",
+    "parse_free",
+    "predicted_loss_ratios",
+    "score",
+]
 
 #: Identifiable parameters: short name -> (Actuator field, unit).
 PARAMETERS = {
@@ -240,8 +253,8 @@ def _data(processed, fit_range: str = "developed") -> _Data:
         raise InputError(f"fit_range = {fit_range!r}; choose 'developed' or 'all'")
     P = np.array([r.pressure_kpa for r in res], dtype=float)
     masks = [developed_range(r) if fit_range == "developed" else np.ones(r.curvature_grid.size, bool) for r in res]
-    k = [np.asarray(r.curvature_grid, float)[m] for r, m in zip(res, masks)]
-    M = [np.asarray(r.mean_curve, float)[m] for r, m in zip(res, masks)]
+    k = [np.asarray(r.curvature_grid, float)[m] for r, m in zip(res, masks, strict=True)]
+    M = [np.asarray(r.mean_curve, float)[m] for r, m in zip(res, masks, strict=True)]
     BM = np.array([r.blocked_moment[0] for r in res])
     BMse = np.array([r.blocked_moment[1] for r in res])
     K = np.array([r.free_curvature[0] for r in res])
@@ -279,7 +292,7 @@ class _Problem:
                  eq19_factor: bool, hysteresis: str | None = None):
         self.hyst = hysteresis
         if hysteresis:
-            free = list(free) + ["theta_h", "a0", "a1"]
+            free = [*free, "theta_h", "a0", "a1"]
         self._qs_cache: dict = {}
         self.base = actuator
         self.d = data
@@ -331,18 +344,19 @@ class _Problem:
             from .hysteresis import make_law
 
             z_away, z_back = make_law(self.hyst, nl["theta_h"]).steady_branches(self.d.delta, self.d.span)
+            assert self.d.branch is not None, "a hysteresis fit is built on branch-resolved data"
             z = np.where(self.d.branch < 0, z_away, z_back)  # unloading leaves the blocked state
             pa = np.maximum(self.d.Pc - self.base.P_start_kpa, 0.0)
             cols = {**cols, "a0": -z, "a1": -z * pa}
-        X = []
+        xcols = []
         for p in self.lin_names():
             if p == "S":
-                X.append(cols["C10"])
+                xcols.append(cols["C10"])
             elif p == "C01" and self.sum_param:
-                X.append(cols["C01"] - cols["C10"])
+                xcols.append(cols["C01"] - cols["C10"])
             else:
-                X.append(cols[p])
-        X = np.column_stack(X) if X else np.zeros((c0.size, 0))
+                xcols.append(cols[p])
+        X = np.column_stack(xcols) if xcols else np.zeros((c0.size, 0))
         return c0, X
 
     def _design_qs(self, nl: dict[str, float]):
@@ -368,7 +382,7 @@ class _Problem:
     def to_user(self, nl: dict[str, float], lin_int: np.ndarray) -> dict[str, float]:
         out = dict(nl)
         names = self.lin_names()
-        vals = dict(zip(names, lin_int))
+        vals = dict(zip(names, lin_int, strict=True))
         for p in self.lin:
             if p == "C10" and self.sum_param:
                 out["C10"] = vals["S"] - vals["C01"]
@@ -388,7 +402,7 @@ class _Problem:
         return w * (c0 + X @ sol.x - self.d.Mc), sol.x
 
     def residual_full(self, x_int: np.ndarray) -> np.ndarray:
-        nl = dict(zip(self.nonlin, x_int[: len(self.nonlin)]))
+        nl = dict(zip(self.nonlin, x_int[: len(self.nonlin)], strict=True))
         c0, X = self.design(nl)
         return self.d.w * (c0 + X @ x_int[len(self.nonlin):] - self.d.Mc)
 
@@ -566,7 +580,8 @@ class FitResult:
             se = "fixed" if not p.vary else (f"± {p.stderr:.3g}" if p.stderr is not None else "± n/a")
             lines.append(f"  {PARAMETERS[n][0]:>18} = {p.value:10.4g} {se:>12}  [{p.min:g}, {p.max:g}]")
         m = self.metrics
-        lines.append(f"  NRMSE cycles {100 * m.nrmse_cycles:.2f} %, blocked moment {100 * m.nrmse_blocked_moment:.2f} %, "
+        lines.append(f"  NRMSE cycles {100 * m.nrmse_cycles:.2f} %, "
+                     f"blocked moment {100 * m.nrmse_blocked_moment:.2f} %, "
                      f"free curvature {_pct(m.nrmse_free_curvature)}")
         h = self.hysteresis
         if h is not None:
@@ -588,7 +603,9 @@ def _pct(x):
     return "n/a" if x is None or not np.isfinite(x) else f"{100 * x:.2f} %"
 
 
-def score(processed, actuator: Actuator, model: str = "energy", *, order: int = 32, eq19_factor: bool = True) -> Metrics:
+def score(
+    processed, actuator: Actuator, model: str = "energy", *, order: int = 32, eq19_factor: bool = True
+) -> Metrics:
     """Metrics of eq 53-55 (and plain RMSEs) of ``actuator`` against processed data, without fitting.
 
     * eq 53: ``NRMSE_cycles = sqrt(sum_i (RMSE_i / M_max,i)^2 K_max,i / sum_i K_max,i)`` over the
@@ -605,11 +622,11 @@ def score(processed, actuator: Actuator, model: str = "energy", *, order: int = 
     pa = np.maximum(d.Pc - actuator.P_start_kpa, 0.0)
     Mm = s * (pa * A - B)
     per = []
-    rm = []
+    rm_list = []
     for i in range(d.P.size):
         sel = d.seg == i
-        rm.append(math.sqrt(float(np.mean((Mm[sel] - d.Mc[sel]) ** 2))))
-    rm = np.array(rm)
+        rm_list.append(math.sqrt(float(np.mean((Mm[sel] - d.Mc[sel]) ** 2))))
+    rm = np.array(rm_list)
     nrmse_c = math.sqrt(float(np.sum((rm / d.BM) ** 2 * d.K) / np.sum(d.K)))
     bm_model = np.abs(law.blocked_moment(d.P))
     rmse_bm = math.sqrt(float(np.mean((bm_model - d.BM) ** 2)))
@@ -725,7 +742,7 @@ def _start(prob: _Problem, bnd, grid_alpha: int, grid_r0: int):
         return best, nfev
     mesh = np.meshgrid(*grids, indexing="ij")
     for idx in np.ndindex(mesh[0].shape):
-        nl = {p: float(m[idx]) for p, m in zip(prob.nonlin, mesh)}
+        nl = {p: float(m[idx]) for p, m in zip(prob.nonlin, mesh, strict=True)}
         r, _ = prob.project(nl)
         nfev += 1
         ssr = float(r @ r)
@@ -745,14 +762,14 @@ def _search(prob: _Problem, bnd, best):
         hi = np.array([bnd[p][1] for p in prob.nonlin])
 
         def fun(x):
-            return prob.project(dict(zip(prob.nonlin, x)))[0]
+            return prob.project(dict(zip(prob.nonlin, x, strict=True)))[0]
 
         sol = least_squares(fun, x0, bounds=(lo, hi), method="trf", x_scale=np.maximum(hi - lo, 1e-9) * 0.05,
                             diff_step=1e-6, xtol=1e-12, ftol=1e-12, gtol=1e-12)
         nfev += sol.nfev * (1 + len(prob.nonlin))
         converged = bool(sol.status > 0)
         message = "converged" if converged else "the search stopped before converging (iteration limit)"
-        nl_best = dict(zip(prob.nonlin, sol.x))
+        nl_best = dict(zip(prob.nonlin, sol.x, strict=True))
     _, lin = prob.project(nl_best)
     return nl_best, lin, converged, message, nfev + 1
 

@@ -1057,7 +1057,7 @@ class StableBranch:
 def _stable_branch(law: MomentLaw, table: MomentTable, P: float, friction: float) -> StableBranch:
     pa = max(P - table.P_start_kpa, 0.0)
     kg = table.knot_curvatures
-    A, B, dA, dB = table.derivatives(kg)
+    _, _, dA, dB = table.derivatives(kg)
     dm = pa * dA - dB
     i0 = table.zero_index
     if dm[i0] >= 0.0:

@@ -13,23 +13,23 @@ import matplotlib
 if not os.environ.get("MPLBACKEND"):
     matplotlib.use("Agg")
 
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
 
-from .atomic import atomic_path  # noqa: E402
-from .braid import curvature_limits  # noqa: E402
-from .errors import InputError  # noqa: E402
-from .predict import active_pressure_kpa, free_curvature, internal_stresses, moment  # noqa: E402
+from .atomic import atomic_path
+from .braid import curvature_limits
+from .errors import InputError
+from .predict import active_pressure_kpa, free_curvature, internal_stresses, moment
 
 __all__ = [
     "curve_range",
-    "moment_curves",
-    "plot_moment_curvature",
-    "plot_internal_stresses",
-    "save_figure",
     "demo_figure",
     "figure4",
     "figure7",
+    "moment_curves",
+    "plot_internal_stresses",
+    "plot_moment_curvature",
+    "save_figure",
     "sweep_figure",
 ]
 
@@ -55,7 +55,8 @@ def curve_range(actuator, pressures_kpa, model: str = "energy", k_max: float | N
     else:
         end = float(k_max)
         if not np.isfinite(end) or end <= 0.0:
-            raise InputError(f"k_max = {k_max!r} 1/mm must be a positive number (magnitude along the bending direction)")
+            raise InputError(
+                f"k_max = {k_max!r} 1/mm must be a positive number (magnitude along the bending direction)")
         if end > abs(k_lim):
             raise InputError(
                 f"k_max = {end:g} 1/mm is beyond the braid lock-up limit |k'| = {abs(k_lim):.6g} 1/mm for this actuator"
@@ -164,7 +165,7 @@ def demo_figure(items):
     ncol = 2
     nrow = (n + 1) // 2
     fig, axes = plt.subplots(nrow, ncol, figsize=(11, 4.2 * nrow), squeeze=False)
-    for ax, (act, P, model) in zip(axes.ravel(), items):
+    for ax, (act, P, model) in zip(axes.ravel(), items, strict=False):  # spare axes are hidden below
         plot_moment_curvature(ax, act, P, model)
     for ax in axes.ravel()[n:]:
         ax.set_visible(False)
@@ -192,7 +193,7 @@ def figure4(processed, title: str = ""):
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.5))
     ax = axes[0]
     colors = plt.cm.viridis(np.linspace(0.0, 0.9, len(res)))
-    for c, r in zip(colors, res):
+    for c, r in zip(colors, res, strict=True):
         if r.series is not None:
             sel = r.series[r.series.cycle > 0]
             ax.plot(sel.curvature_per_mm, sel.moment_nmm, color=c, lw=0.7, alpha=0.8)
@@ -214,7 +215,8 @@ def figure4(processed, title: str = ""):
     if np.isfinite(a):
         xx = np.linspace(min(p0 if np.isfinite(p0) else P.min(), P.min()), P.max(), 50)
         ax.plot(xx, a * xx + b, "-", color="C1",
-                label=f"linear fit, deadband {p0:.3g} ± {se:.2g} kPa" if np.isfinite(se) else f"linear fit, deadband {p0:.3g} kPa")
+                label=(f"linear fit, deadband {p0:.3g} ± {se:.2g} kPa" if np.isfinite(se)
+                       else f"linear fit, deadband {p0:.3g} kPa"))
     ax.axhline(0, color="0.6", lw=0.8)
     ax.set_xlabel("pressure (kPa)")
     ax.set_ylabel("blocked moment (N·mm)")
@@ -246,7 +248,7 @@ def figure7(processed, fit_result, title: str = ""):
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.5))
     ax = axes[0]
     colors = plt.cm.viridis(np.linspace(0.0, 0.9, len(res)))
-    for c, r in zip(colors, res):
+    for c, r in zip(colors, res, strict=True):
         k = r.curvature_grid
         ax.plot(k, r.mean_loading, color=c, lw=0.6, alpha=0.5)
         ax.plot(k, r.mean_unloading, color=c, lw=0.6, alpha=0.5)
@@ -255,9 +257,9 @@ def figure7(processed, fit_result, title: str = ""):
         if getattr(fit_result, "loop", None) is not None:
             from .hysteresis import loop_branches
 
-            kf = float(r.free_curvature[0])
-            kk = np.linspace(0.0, kf, 160)
-            up, low = loop_branches(act, fit_result.loop, r.pressure_kpa, kf, kk, model)
+            kf_r = float(r.free_curvature[0])
+            kk = np.linspace(0.0, kf_r, 160)
+            up, low = loop_branches(act, fit_result.loop, r.pressure_kpa, kf_r, kk, model)
             ax.plot(kk, up, "-", color=c, lw=1.3)
             ax.plot(kk, low, "-", color=c, lw=1.3)
         else:

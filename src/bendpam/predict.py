@@ -30,16 +30,16 @@ from .law import FreeBending, FreeBranch, MomentLaw
 from .models import force_balance as _fb
 
 __all__ = [
-    "moment",
-    "moment_terms",
+    "active_pressure_kpa",
     "blocked_moment",
-    "tangent_stiffness",
-    "free_curvature",
     "free_branch",
+    "free_curvature",
     "internal_stresses",
     "kinematics",
-    "active_pressure_kpa",
+    "moment",
+    "moment_terms",
     "prediction_table",
+    "tangent_stiffness",
 ]
 
 

@@ -3,7 +3,8 @@
 ``be_pam(model="energy")`` and ``bc_pam(model="force_balance")`` etc. return an
 :class:`~bendpam.actuator.Actuator`.  The geometry is shared (Table 1, merged cells); each model has
 its own identified braid angle and Mooney-Rivlin constants (Table 3; the unit "kPa^-1" is read as
-kPa, docs/paper-reading.md item 8).  P_start is 68 kPa for the BE-PAM and 32 kPa for the BC-PAM (docs/paper-reading.md item 15).
+kPa, docs/paper-reading.md item 8).  P_start is 68 kPa for the BE-PAM and 32 kPa for the BC-PAM
+(docs/paper-reading.md item 15).
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ from .actuator import Actuator
 from .errors import InputError
 from .models import normalise_model
 
-__all__ = ["be_pam", "bc_pam", "get", "PRESETS", "normalise_model"]
+__all__ = ["PRESETS", "bc_pam", "be_pam", "get", "normalise_model"]
 
 MODELS = ("energy", "force_balance")
 

@@ -40,9 +40,6 @@ does not stop the report: the page shows a note in its place, and the note is re
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Any
-
 import base64
 import contextlib
 import datetime as _dt
@@ -51,16 +48,21 @@ import io
 import math
 import struct
 from collections.abc import Iterable, Iterator, Sequence
+from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .atomic import atomic_write_text
 from .actuator import Actuator
-from .fixture import PAPER_FIXTURE, Fixture
-from .presets import normalise_model
-from .lab.files import RAW_SUFFIXES, collect_raw_files
+from .atomic import atomic_write_text
 from .errors import InputError
+from .fixture import PAPER_FIXTURE, Fixture
+from .lab.files import RAW_SUFFIXES, collect_raw_files
+from .presets import normalise_model
+
+if TYPE_CHECKING:
+    from rich.progress import Progress, TaskID
 
 __all__ = [
     "RAW_SUFFIXES",
@@ -89,7 +91,7 @@ def _pressures(pressure_kpa, n_files: int) -> list[float | None]:
     values = [pressure_kpa] if isinstance(pressure_kpa, int | float | np.number) else list(pressure_kpa)
     if not values:
         return [None] * n_files
-    out = []
+    out: list[float | None] = []
     for v in values:
         try:
             fv = float(v)
@@ -311,8 +313,8 @@ class _Steps:
 
     def __init__(self, total: int, enabled: bool):
         self.total = total
-        self._progress = None
-        self._task = None
+        self._progress: Progress | None = None
+        self._task: TaskID | None = None
         if enabled:
             from rich.console import Console
 
@@ -342,10 +344,10 @@ class _Steps:
 
     @contextlib.contextmanager
     def step(self, description: str) -> Iterator[None]:
-        if self._progress is not None:
+        if self._progress is not None and self._task is not None:
             self._progress.update(self._task, description=description)
         yield
-        if self._progress is not None:
+        if self._progress is not None and self._task is not None:
             self._progress.advance(self._task)
 
 
@@ -394,7 +396,7 @@ def build_report(
     fixture: Fixture | str | None = None,
     processing_options=None,
     progress: bool = True,
-) -> dict:
+) -> Report:
     """Raw test files -> processing -> fits -> ONE self-contained HTML page at ``out_html``.
 
     Parameters
@@ -416,7 +418,7 @@ def build_report(
 
     Returns
     -------
-    dict with ``html`` (Path), ``files`` (input Paths), ``inputs`` (per file: path, dialect,
+    a :class:`Report` with ``html`` (Path), ``files`` (input Paths), ``inputs`` (per file: path, dialect,
     pressure_kpa, pressure_source, samples), ``processed`` (the ProcessedSet), ``summary``
     (``processed.summary()``), ``fits`` ({model: FitResult}), ``table2``/``table3`` (the cell
     texts, see :func:`table2_rows`, :func:`table3_rows`), ``figures`` (ids of the embedded
@@ -462,7 +464,7 @@ def build_report(
     stresses = None
     with _Steps(total, progress) as steps:
         tests = []
-        for f, p in zip(files, pressures):
+        for f, p in zip(files, pressures, strict=True):
             with steps.step(f"reading {f.name}"):
                 tests.append(read_test(f, pressure_kpa=p))
         with steps.step("processing the cycles"):
@@ -570,7 +572,7 @@ def _render(*, actuator, processed, summary, fits, figures, inputs_info, fixture
       "Energy-loss ratio: loop area / area under the cycle's mean curve (M-θ), mean over the cycles.</p>")
     body = []
     t2 = table2_rows(summary)
-    for r, txt in zip(summary["pressures"], t2):
+    for r, txt in zip(summary["pressures"], t2, strict=True):
         body.append(
             "<tr>" + _td(txt["pressure_kpa"], r["pressure_kpa"]) + _td(txt["cycles"], r["cycles"])
             + _td(txt["blocked_moment_nmm"], r["blocked_moment_nmm"], r["blocked_moment_se_nmm"], "num pm")
@@ -599,7 +601,7 @@ def _render(*, actuator, processed, summary, fits, figures, inputs_info, fixture
       "± is the standard error. NRMSE of the loading cycles, blocked moment and free-bending curvature as in "
       "eq 53-55.</p>")
     body = []
-    for (m, res), txt in zip(fits.items(), table3_rows(fits)):
+    for (m, res), txt in zip(fits.items(), table3_rows(fits), strict=True):
         cells = [f'<th scope="row">{_e(txt["model"])}</th>']
         for name, _spec, _h in _T3_PARAMS:
             p = res.parameters.get(name)
@@ -639,7 +641,7 @@ def _render(*, actuator, processed, summary, fits, figures, inputs_info, fixture
                 body.append(f'<tr><th scope="row">{_e(n)}</th>'
                             + "".join(_td(fmt_num(res.correlation[i, j], "+.3f"), res.correlation[i, j])
                                       for j in range(len(names))) + "</tr>")
-            a(_table(f"correlation-{m}", f"Correlation of the fitted parameters ({label} model)", [""] + names, body))
+            a(_table(f"correlation-{m}", f"Correlation of the fitted parameters ({label} model)", ["", *names], body))
         mt = res.metrics
         body = []
         for r in mt.per_pressure:
@@ -711,7 +713,8 @@ def _render(*, actuator, processed, summary, fits, figures, inputs_info, fixture
     settings = [
         ("fixture d, r, t (mm)", f"{fx.d_mm:g}, {fx.r_mm:g}, {fx.t_mm:g}"),
         ("L0 for k' = 2β/L0 (mm)", f"{fx.L0_mm:g}"),
-        ("low-pass cutoff (Hz)", "1 Hz (max 40 % of Nyquist)" if options.cutoff_hz is None else f"{options.cutoff_hz:g}"),
+        ("low-pass cutoff (Hz)",
+         "1 Hz (max 40 % of Nyquist)" if options.cutoff_hz is None else f"{options.cutoff_hz:g}"),
         ("filter order", f"{options.filter_order}"),
         ("reversal threshold (fraction of the stroke range)", f"{options.reversal_fraction:g}"),
         ("curvature grid points", f"{options.grid_points}"),

@@ -1,4 +1,6 @@
-"""Design sweeps (the module behind :func:`bendpam.sweep`): any actuator parameters crossed with pressures, in-process or on a Dask cluster.
+"""Design sweeps (the module behind :func:`bendpam.sweep`): actuator parameters crossed with pressures.
+
+In-process or on a Dask cluster.
 
 ``bendpam.sweep(base, pressure_kpa=[...], alpha0_deg=[...], t0_mm=[...])`` evaluates every
 combination of the swept parameters (an "actuator case") at every pressure and returns an
@@ -166,7 +168,7 @@ def _block(base, model, names, grids, P, order, eq19, idx_block):
     flat = idx_block.ravel()
     if names:
         sub = np.unravel_index(flat, shape)
-        values = {n: g[i] for n, g, i in zip(names, grids, sub)}
+        values = {n: g[i] for n, g, i in zip(names, grids, sub, strict=True)}
     else:
         values = {"alpha0_deg": np.full(flat.size, base.alpha0_deg)}
     res = evaluate_cases(base, model, values, P, order=order, eq19_factor=eq19)
@@ -174,7 +176,7 @@ def _block(base, model, names, grids, P, order, eq19, idx_block):
     for i, name in enumerate(_OUTPUTS):
         v = res[name]
         out[:, :, i] = v if v.ndim == 2 else v[:, None]
-    return out.reshape(idx_block.shape + (P.size, len(_OUTPUTS)))
+    return out.reshape((*idx_block.shape, P.size, len(_OUTPUTS)))
 
 
 def sweep(base_actuator: Actuator, pressure_kpa, model: str = "energy", *, chunk_cases: int = 256,
@@ -228,7 +230,7 @@ def sweep(base_actuator: Actuator, pressure_kpa, model: str = "energy", *, chunk
         idx = da.arange(n_cases, chunks=n_cases).reshape(shape or (1,)).rechunk(chunks or ((1,),))
         nd = idx.ndim
         arr = idx.map_blocks(fn, dtype=float, new_axis=[nd, nd + 1],
-                             chunks=idx.chunks + ((P.size,), (len(_OUTPUTS),)), meta=np.empty((0,) * (nd + 2)))
+                             chunks=(*idx.chunks, (P.size,), (len(_OUTPUTS),)), meta=np.empty((0,) * (nd + 2)))
         data = _compute(arr, scheduler, workers, show) if compute else arr
     return _dataset(data, names, grids, shape, P, base_actuator, model, order)
 
@@ -265,7 +267,7 @@ def _prevalidate(base, names, grids) -> None:
         sel = [i for i, n in enumerate(names) if n in group]
         if sel:
             mesh = np.meshgrid(*(grids[i] for i in sel), indexing="ij", sparse=True)
-            build_cases(base, {names[i]: m for i, m in zip(sel, mesh)})
+            build_cases(base, {names[i]: m for i, m in zip(sel, mesh, strict=True)})
             done.update(sel)
     for i, n in enumerate(names):
         if i not in done:
@@ -285,7 +287,7 @@ class _block_fn:
 def _loop_blocks(fn, shape, chunks, show):
     """The same blocks as the Dask path, computed in a loop (no Dask installed)."""
     flat = np.arange(int(np.prod(shape)) if shape else 1).reshape(shape or (1,))
-    bounds = [np.cumsum((0,) + c) for c in (chunks or ((1,),))]
+    bounds = [np.cumsum((0, *c)) for c in (chunks or ((1,),))]
     blocks = list(np.ndindex(*[len(c) for c in (chunks or ((1,),))]))
     if show:
         from rich.progress import track
@@ -293,7 +295,7 @@ def _loop_blocks(fn, shape, chunks, show):
         blocks = track(blocks, description="sweep", transient=True)
     out = None
     for b in blocks:
-        sl = tuple(slice(bd[i], bd[i + 1]) for bd, i in zip(bounds, b))
+        sl = tuple(slice(bd[i], bd[i + 1]) for bd, i in zip(bounds, b, strict=True))
         res = fn(flat[sl])
         if out is None:
             out = np.empty(flat.shape + res.shape[-2:])
@@ -332,10 +334,13 @@ def _compute(arr, scheduler, workers, show):
     return dask.compute(arr, scheduler="threads")[0]
 
 
+_UNIT_OF_SUFFIX = {"kpa": "kPa", "mpa": "MPa", "mm": "mm", "deg": "deg"}
+
+
 def _dataset(data, names, grids, shape, P, base, model, order) -> Any:
     import xarray as xr
 
-    dims = names + ["pressure_kpa"]
+    dims = [*names, "pressure_kpa"]
     vars_ = {}
     for i, name in enumerate(_OUTPUTS):
         if name in ("max_pressure_kpa", "branch_end"):
@@ -350,7 +355,8 @@ def _dataset(data, names, grids, shape, P, base, model, order) -> Any:
             v = v.astype(np.int8)
         unit, long_name = _UNITS[name]
         vars_[name] = xr.DataArray(v, dims=d, attrs={"units": unit, "long_name": long_name})
-    coords = {n: (n, g, {"units": n.rsplit("_", 1)[-1]}) for n, g in zip(names, grids)}
+    coords = {n: (n, g, {"units": _UNIT_OF_SUFFIX.get(n.rsplit("_", 1)[-1], n.rsplit("_", 1)[-1])})
+              for n, g in zip(names, grids, strict=True)}
     coords["pressure_kpa"] = ("pressure_kpa", P, {"units": "kPa"})
     ds = xr.Dataset(vars_, coords=coords)
     ds.attrs.update(model=model, base_actuator=base.to_toml(), quadrature_order=int(order),

@@ -10,11 +10,11 @@ from __future__ import annotations
 
 import sys
 import traceback
-from typing import Annotated, Optional
+from typing import Annotated, Any, Optional
 
 import typer
 
-__all__ = ["app", "main", "ISSUES_URL"]
+__all__ = ["ISSUES_URL", "app", "main"]
 
 ISSUES_URL = "the bendpam issue tracker (include the command line and bendpam --version)"
 
@@ -50,7 +50,8 @@ def _root(
 
 
 # Typer >= 0.20 vendors click; find its exception base class without importing click directly.
-_ClickException = next(c for c in typer.BadParameter.__mro__ if c.__name__ == "ClickException")
+# Typed as type[Any]: the class is found at run time, so its attributes (format_message) are not known statically.
+_ClickException: type[Any] = next(c for c in typer.BadParameter.__mro__ if c.__name__ == "ClickException")
 
 
 def _one_line(exc: BaseException) -> str:
@@ -93,7 +94,7 @@ def main(argv: list[str] | None = None) -> int:
         where = f": {exc.filename}" if exc.filename else ""
         typer.echo(f"bendpam: error: {exc.strerror or _one_line(exc)}{where}", err=True)
         return 2
-    except BaseException as exc:  # noqa: BLE001 - the last line of defence
+    except BaseException as exc:
         if isinstance(exc, SystemExit):
             raise
         if debug:

@@ -20,7 +20,7 @@ from typing import Annotated, Optional
 import typer
 from typer.core import TyperCommand
 
-__all__ = ["register", "MULTI_VALUE_OPTIONS"]
+__all__ = ["MULTI_VALUE_OPTIONS", "register"]
 
 #: options whose space-separated values are all collected (rewritten as repeated options)
 MULTI_VALUE_OPTIONS = ("--pressure-kpa", "--diameter-mm", "--direction-deg")
@@ -31,7 +31,7 @@ class _MultiValueCommand(TyperCommand):
 
     multi_value_options = MULTI_VALUE_OPTIONS
 
-    def parse_args(self, ctx, args):
+    def parse_args(self, ctx, args: list[str]) -> list[str]:
         out: list[str] = []
         current = None  # the multi-value option whose values are being read
         expecting = False  # its own first value comes next (it may start with '-')
@@ -90,7 +90,8 @@ def _plot_target(plot: Optional[Path]):
     if plot is None:
         return None
     if plot.suffix.lower() not in {".png", ".pdf", ".svg"}:
-        raise UserError(f"--plot {str(plot)!r}: unknown figure format {plot.suffix or '(none)'}; use .png, .pdf or .svg")
+        raise UserError(
+            f"--plot {str(plot)!r}: unknown figure format {plot.suffix or '(none)'}; use .png, .pdf or .svg")
     return plot
 
 
@@ -106,7 +107,7 @@ def _length(act, l0_mm):
 
 def register(app: typer.Typer) -> typer.Typer:
     """Add the ``finger``, ``grasp`` and ``wrist`` commands to ``app`` (once; returns ``app``)."""
-    from .options import ActuatorOpt, ModelOpt, Model, MorePressures, PresetOpt, PressureOpt
+    from .options import ActuatorOpt, Model, ModelOpt, MorePressures, PresetOpt, PressureOpt
 
     names = {c.name or (c.callback.__name__ if c.callback else None) for c in app.registered_commands}
     if {"finger", "grasp", "wrist"} <= names:
@@ -130,7 +131,8 @@ def register(app: typer.Typer) -> typer.Typer:
         tip_mass_g: Annotated[float, typer.Option("--tip-mass-g", help="Point mass at the fingertip (g).")] = 0.0,
         mass_per_length: Annotated[
             float, typer.Option("--mass-per-length-g-mm", help="Self-weight of the actuator (g/mm).")] = 0.0,
-        gravity_deg: Annotated[float, typer.Option("--gravity-deg", help="Direction of gravity (deg from +x).")] = -90.0,
+        gravity_deg: Annotated[
+            float, typer.Option("--gravity-deg", help="Direction of gravity (deg from +x).")] = -90.0,
         base_angle_deg: Annotated[
             float, typer.Option("--base-angle-deg", help="Direction of the finger at its base (deg from +x).")] = 0.0,
         bend: Annotated[str, typer.Option("--bend", help="Curl direction when inflated: ccw or cw.")] = "ccw",
@@ -143,19 +145,20 @@ def register(app: typer.Typer) -> typer.Typer:
         plot: PlotOpt = None,
     ):
         """Equilibrium shape and tip pose of a finger under tip force, tip mass and self-weight."""
-        from .options import UserError, load_actuator, model_name, pressures_kpa
         from ..design.finger import Finger, FingerLoads, blocked_tip_force, finger_sweep
+        from .options import UserError, load_actuator, model_name, pressures_kpa
 
         act = _length(load_actuator(preset, actuator, model), l0_mm)
         P = pressures_kpa(pressure_kpa, more)
         mname = model_name(model)
         plot = _plot_target(plot)
-        if bend.strip().lower() not in ("ccw", "cw"):
+        bend_key = bend.strip().lower()
+        if bend_key not in ("ccw", "cw"):
             raise UserError(f"--bend: {bend!r} is not allowed; choose ccw or cw")
         F = _pair(tip_force_n, "--tip-force-n", "N") if tip_force_n is not None else (0.0, 0.0)
         g = math.radians(gravity_deg)
-        finger = Finger(act, mname, base_angle_deg=base_angle_deg, bend=bend, fingertip_mm=fingertip_mm,
-                        fingertip_offset_mm=fingertip_offset_mm)
+        finger = Finger(act, mname, base_angle_deg=base_angle_deg, bend=1 if bend_key == "ccw" else -1,
+                        fingertip_mm=fingertip_mm, fingertip_offset_mm=fingertip_offset_mm)
         loads = FingerLoads(tip_force_n=F, tip_moment_nmm=tip_moment_nmm, tip_mass_g=tip_mass_g,
                             mass_per_length_g_per_mm=mass_per_length, gravity=(math.cos(g), math.sin(g)))
         df, shapes = finger_sweep(finger, P, loads)
@@ -168,7 +171,8 @@ def register(app: typer.Typer) -> typer.Typer:
         if as_json:
             rows = []
             for i, r in enumerate(df.itertuples()):
-                row = {"pressure_kpa": float(r.pressure_kpa), "tip_x_mm": _num(r.tip_x_mm), "tip_y_mm": _num(r.tip_y_mm),
+                row = {"pressure_kpa": float(r.pressure_kpa), "tip_x_mm": _num(r.tip_x_mm),
+                       "tip_y_mm": _num(r.tip_y_mm),
                        "tip_angle_deg": _num(r.tip_angle_deg), "equilibrium": bool(r.equilibrium),
                        "note": r.note or None, "bend_angle_deg": _num(r.bend_angle_deg),
                        "base_moment_nmm": _num(r.base_moment_nmm), "residual_nmm": _num(r.residual_nmm)}
@@ -194,7 +198,7 @@ def register(app: typer.Typer) -> typer.Typer:
                 line = (f"{r.pressure_kpa:8.4g} {_fmt(r.tip_x_mm, '10.2f')} {_fmt(r.tip_y_mm, '10.2f')} "
                         f"{_fmt(r.tip_angle_deg, '11.2f')} {_fmt(r.bend_angle_deg, '10.2f')} "
                         f"{_fmt(r.base_moment_nmm, '13.2f')} {_fmt(r.residual_nmm, '9.1e')}")
-                if blocked:
+                if bforce is not None:  # with --blocked-force
                     b = bforce[i]
                     line += f" {_fmt(b.force_n[0], '7.3f')},{_fmt(b.force_n[1], '8.3f')}" if b.equilibrium \
                         else f" {'—':>16}"
@@ -220,7 +224,8 @@ def register(app: typer.Typer) -> typer.Typer:
                                           "default 100.")] = None,
         mu: Annotated[float, typer.Option("--mu", help="Friction coefficient pad-sphere.")] = 0.5,
         fingertip_mm: Annotated[
-            Optional[float], typer.Option("--fingertip-mm", help="Rigid fingertip (pad) length (mm); default 10.")] = None,
+            Optional[float],
+            typer.Option("--fingertip-mm", help="Rigid fingertip (pad) length (mm); default 10.")] = None,
         contact_offset_mm: Annotated[
             Optional[float], typer.Option("--contact-offset-mm", help="Frame line to contact surface (mm); default "
                                           "by actuator type.")] = None,
@@ -229,8 +234,8 @@ def register(app: typer.Typer) -> typer.Typer:
         plot: PlotOpt = None,
     ):
         """Gripping (pull-out) force of an N-finger gripper on spheres against diameter and pressure."""
-        from .options import UserError, load_actuator, model_name, parse_values, pressures_kpa
         from ..design.grasp import DEFAULT_BASE_RADIUS_MM, DEFAULT_FINGERTIP_MM, Gripper, grasp_sweep
+        from .options import UserError, load_actuator, model_name, parse_values, pressures_kpa
 
         act = _length(load_actuator(preset, actuator, model), l0_mm)
         D = parse_values(diameter_mm, "--diameter-mm")
@@ -296,7 +301,8 @@ def register(app: typer.Typer) -> typer.Typer:
             Optional[list[str]],
             typer.Option("--direction-deg", help="Bending direction(s), deg: multiples of 45 (default 0 90 180 270)."),
         ] = None,
-        length_mm: Annotated[Optional[float], typer.Option("--length-mm", help="Wrist length (mm); default L0.")] = None,
+        length_mm: Annotated[
+            Optional[float], typer.Option("--length-mm", help="Wrist length (mm); default L0.")] = None,
         radius_mm: Annotated[float, typer.Option("--radius-mm", help="Mounting radius around the column (mm).")] = 20.0,
         lateral_stiffness: Annotated[
             Optional[float], typer.Option("--lateral-stiffness-nmm2", help="Out-of-plane stiffness of one actuator "
@@ -311,8 +317,8 @@ def register(app: typer.Typer) -> typer.Typer:
         plot: PlotOpt = None,
     ):
         """Bending angle of a four-actuator wrist per direction, and the load it holds horizontally."""
-        from .options import load_actuator, model_name, parse_values, pressures_kpa
         from ..design.wrist import Wrist, wrist_hold, wrist_sweep
+        from .options import load_actuator, model_name, parse_values, pressures_kpa
 
         act = load_actuator(preset, actuator, model)
         P = pressures_kpa(pressure_kpa, more)

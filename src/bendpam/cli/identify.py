@@ -29,8 +29,8 @@ ThickOpt = Annotated[Optional[float], typer.Option("--thickness-mm", help="Tensi
 
 def tension_fit(path: Path, gauge_length_mm, area_mm2, width_mm, thickness_mm):
     """Read and fit a tension test from the command-line options."""
-    from ..tension import tension_from_test
     from ..lab import read_test
+    from ..tension import tension_from_test
 
     positive("--gauge-length-mm", gauge_length_mm, "mm")
     positive("--area-mm2", area_mm2, "mm^2")

@@ -29,7 +29,8 @@ from .options import (
 FixtureOpt = Annotated[str, typer.Option("--fixture", help="Fixture geometry d,r,t in mm.")]
 ColumnsOpt = Annotated[Optional[str], typer.Option(
     "--columns", metavar="time=NAME,stroke=NAME,force=NAME",
-    help="Choose the file's channels by name (any of time, stroke, force); default: chosen and reported by the reader.")]
+    help="Choose the file's channels by name (any of time, stroke, force); "
+         "default: chosen and reported by the reader.")]
 RateOpt = Annotated[Optional[float], typer.Option(
     "--rate-hz", help="Sampling rate (Hz) for a file without a time column (default: from its metadata).")]
 RepairOpt = Annotated[bool, typer.Option(
@@ -75,7 +76,8 @@ def process(
     l0_mm: Annotated[float, typer.Option("--l0-mm", help="Active length L0 for k' = 2 beta / L0 (mm).")] = 145.0,
     fixture: FixtureOpt = "35,2.5,4",
     cutoff_hz: Annotated[
-        Optional[float], typer.Option("--cutoff-hz", help="Low-pass cutoff (Hz); default 1 Hz (max 40% of Nyquist); 0 = off.")
+        Optional[float],
+        typer.Option("--cutoff-hz", help="Low-pass cutoff (Hz); default 1 Hz (max 40% of Nyquist); 0 = off."),
     ] = None,
     tare_n: Annotated[float, typer.Option("--tare-n", help="Force tare for self-weight (N).")] = 0.0,
     reversal_fraction: Annotated[
@@ -98,7 +100,7 @@ def process(
         raise UserError("give an output folder with --out OUTDIR")
     files = collect_raw_files(inputs)
     pressures = parse_values(pressure_kpa, "--pressure-kpa") if pressure_kpa else []
-    if pressures and len(pressures) not in (1, len(files)) or (len(pressures) == 1 and len(files) > 1):
+    if (pressures and len(pressures) not in (1, len(files))) or (len(pressures) == 1 and len(files) > 1):
         raise UserError(
             f"--pressure-kpa: got {len(pressures)} pressure(s) for {len(files)} file(s); give one per file, in order"
         )
@@ -137,13 +139,15 @@ def simulate_test_cmd(
     actuator: ActuatorOpt = None,
     model: ModelOpt = Model.energy,
     pressure_kpa: PressureOpt = None,
-    out: Annotated[Optional[Path], typer.Option("--out", help="Output folder for the raw files and truth.json.")] = None,
+    out: Annotated[
+        Optional[Path], typer.Option("--out", help="Output folder for the raw files and truth.json.")] = None,
     fmt: Annotated[Format, typer.Option("--format", help="Export dialect to write.")] = Format.csv,
     noise_n: Annotated[float, typer.Option("--noise-n", help="Force noise, standard deviation (N).")] = 0.05,
     noise_stroke_mm: Annotated[float, typer.Option("--noise-stroke-mm", help="Stroke noise, standard deviation (mm).")]
     = 0.002,
     hysteresis: Annotated[
-        float, typer.Option("--hysteresis", help="Pressure part of the loop amplitude, as a fraction of the blocked moment.")
+        float,
+        typer.Option("--hysteresis", help="Pressure part of the loop amplitude, as a fraction of the blocked moment."),
     ] = 0.06,
     hysteresis_angle_deg: Annotated[
         float, typer.Option("--hysteresis-angle-deg",
@@ -158,8 +162,8 @@ def simulate_test_cmd(
     speed_mm_min: Annotated[float, typer.Option("--speed-mm-min", help="Crosshead speed (mm/min).")] = 30.0,
     rate_hz: Annotated[float, typer.Option("--rate-hz", help="Sampling rate (Hz).")] = 20.0,
     dwell_s: Annotated[float, typer.Option("--dwell-s", help="Dwell at each end of a stroke (s).")] = 0.0,
-    stroke_offset_mm: Annotated[float, typer.Option("--stroke-offset-mm", help="Machine stroke at the blocked state (mm).")]
-    = 0.0,
+    stroke_offset_mm: Annotated[
+        float, typer.Option("--stroke-offset-mm", help="Machine stroke at the blocked state (mm).")] = 0.0,
     fixture: FixtureOpt = "35,2.5,4",
     seed: Annotated[Optional[int], typer.Option("--seed", help="Random seed.")] = None,
 ):

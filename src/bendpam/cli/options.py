@@ -20,9 +20,23 @@ if TYPE_CHECKING:
     from ..actuator import Actuator
 
 __all__ = [
-    "UserError", "Model", "Preset", "Format", "PresetOpt", "ActuatorOpt", "ModelOpt", "PressureOpt", "MorePressures",
-    "parse_values", "pressures_kpa", "load_actuator", "model_name", "fmt_num", "format_prediction_table",
-    "collect_raw_files", "echo",
+    "ActuatorOpt",
+    "Format",
+    "Model",
+    "ModelOpt",
+    "MorePressures",
+    "Preset",
+    "PresetOpt",
+    "PressureOpt",
+    "UserError",
+    "collect_raw_files",
+    "echo",
+    "fmt_num",
+    "format_prediction_table",
+    "load_actuator",
+    "model_name",
+    "parse_values",
+    "pressures_kpa",
 ]
 
 #: The largest number of values one option may expand to (a range like 100:200:30000000 is refused).
@@ -132,6 +146,7 @@ def load_actuator(preset: Preset | None, actuator: Path | None, model: Model) ->
 
     if preset is not None:
         return presets.get(preset.value, model_name(model))
+    assert actuator is not None  # exactly one of preset and actuator was checked above
     return Actuator.from_toml(actuator)
 
 

@@ -134,7 +134,8 @@ def curve(
     actuator: ActuatorOpt = None,
     model: ModelOpt = Model.energy,
     pressure_kpa: PressureOpt = None,
-    out: Annotated[Optional[Path], typer.Option("--out", help="Output FILE.csv, or a figure FILE.png/.pdf/.svg.")] = None,
+    out: Annotated[
+        Optional[Path], typer.Option("--out", help="Output FILE.csv, or a figure FILE.png/.pdf/.svg.")] = None,
     k_max: Annotated[
         Optional[float],
         typer.Option("--k-max", help="End of the curvature range (1/mm, magnitude along the bending direction); "

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
-from typing import Annotated, Optional
+from typing import Annotated, Any, Optional
 
 import numpy as np
 import typer
@@ -88,8 +88,10 @@ def sweep_cmd(
     if n_points > max_points:
         raise UserError(f"the sweep has {n_points} (case, pressure) points, more than --max-points {max_points}; "
                         "raise --max-points to run it")
+    # typed Any: mypy would check the arrays against sweep()'s other keyword parameters
+    grids: dict[str, Any] = {k: np.asarray(v) for k, v in params.items()}
     ds = sweep(act, P, model_name(model), chunk_cases=chunk_cases, scheduler=scheduler, workers=workers,
-               progress=progress and sys.stderr.isatty(), **{k: np.asarray(v) for k, v in params.items()})
+               progress=progress and sys.stderr.isatty(), **grids)
     if out is not None:
         with output_file(out, [actuator]) as f:
             ds.to_netcdf(f.path)

@@ -66,9 +66,11 @@ from __future__ import annotations
 import math
 import sys
 import warnings
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
+from types import FrameType
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -78,6 +80,9 @@ from ..checks import pressure_kpa as _check_pressures
 from ..errors import InputError, NoEquilibrium
 from ..law import MomentLaw, StableBranch
 from ..models import normalise_model
+
+if TYPE_CHECKING:
+    from ..hysteresis import LoopModel
 
 __all__ = [
     "G_N_PER_G",
@@ -123,7 +128,8 @@ def _pair(name: str, value, unit: str) -> tuple[float, float]:
 
 def _user_stacklevel() -> int:
     """``stacklevel`` (for a ``warnings.warn`` in the caller) of the first frame outside bendpam.design."""
-    level, frame = 1, sys._getframe(1)
+    level = 1
+    frame: FrameType | None = sys._getframe(1)
     while frame is not None and frame.f_globals.get("__name__", "").startswith(_PACKAGE):
         frame, level = frame.f_back, level + 1
     return level
@@ -246,7 +252,7 @@ class Finger:
     fingertip_mm: float = 0.0
     fingertip_offset_mm: float = 0.0
     nodes: int = 81
-    loop: object = None
+    loop: LoopModel | None = None
     motion: str = "unloading"
 
     def __post_init__(self):
@@ -953,12 +959,15 @@ def _blocked_tip_force(finger: Finger, P: float, target, direction, given_target
     tgt = np.array(target)
     straight = np.array(_straight_tip(finger))
     P0 = min(P, finger.actuator.P_start_kpa)
-    paths = []
+    paths: list[tuple[np.ndarray, Callable[[float], Any]]] = []
     if given_target and start.equilibrium:
         # move the holder from the free tip to the target at the working pressure
         t0 = np.array(start.tip_xy)
-        paths.append((np.concatenate([start.curvature, np.zeros(nf)]),
-                      lambda t, t0=t0: make(P, *(t0 + t * (tgt - t0)))))
+
+        def toward_target(t: float, t0: np.ndarray = t0):
+            return make(P, *(t0 + t * (tgt - t0)))
+
+        paths.append((np.concatenate([start.curvature, np.zeros(nf)]), toward_target))
     # as a test rig does: hold the tip from the straight, unpressurised state while the pressure rises
     # (first move the holder to the target at P0, then raise the pressure)
     paths.append((np.zeros(n + nf),

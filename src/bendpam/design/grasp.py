@@ -173,9 +173,11 @@ class Gripper:
     def finger(self) -> Finger:
         """One finger in its radial plane: base at ``(R_b, 0)``, pointing down (tilted outward by
         ``splay_deg``), curling toward the axis (clockwise in the plane, ``bend=-1``)."""
+        offset = self.contact_offset_mm
+        assert offset is not None, "set by __post_init__ before the first call"
         return Finger(self.actuator, self.model, base_xy_mm=(self.base_radius_mm, 0.0),
                       base_angle_deg=-90.0 + self.splay_deg,
-                      bend=-1, fingertip_mm=self.fingertip_mm, fingertip_offset_mm=self.contact_offset_mm,
+                      bend=-1, fingertip_mm=self.fingertip_mm, fingertip_offset_mm=offset,
                       nodes=self.nodes)
 
     @property
@@ -428,7 +430,7 @@ class _Ctx:
 
     def __init__(self, gripper: Gripper, rod: Rod, cx, cy, R, delta, scale):
         self.gripper, self.rod, self.cx, self.cy, self.R, self.delta, self.scale = gripper, rod, cx, cy, R, delta, scale
-        self._sys = {}
+        self._sys: dict[str, _Contact] = {}
 
     def contact(self, mode) -> _Contact:
         if mode not in self._sys:
@@ -637,7 +639,9 @@ def _grasp_path(gripper: Gripper, D: float, Ps: list[float]) -> list[Grasp]:
                         "fingertip the contact moment is too small for the stable branch, so the finger snaps "
                         "through", equilibrium=False)
         out[i] = res
-    return out
+    grasps = [g for g in out if g is not None]
+    assert len(grasps) == len(Ps), "the loop fills in every pressure"
+    return grasps
 
 
 def _direct(ctx: _Ctx, gripper, D, P, depth, br_P, kind, k_c, sig0):

@@ -137,10 +137,21 @@ class Wrist:
             raise InputError(f"positions_deg = {self.positions_deg!r} must give 4 angles (deg)")
         s(self, "positions_deg", pos)
 
+    # actuator and length_mm default to None and are always set by __post_init__: typed views of them
+    @property
+    def _actuator(self) -> Actuator:
+        assert self.actuator is not None, "set by __post_init__"
+        return self.actuator
+
+    @property
+    def _length_mm(self) -> float:
+        assert self.length_mm is not None, "set by __post_init__"
+        return self.length_mm
+
     @property
     def law(self) -> MomentLaw:
         """The actuators' shared moment law under the wrist's model (:meth:`bendpam.MomentLaw.of`)."""
-        return MomentLaw.of(self.actuator, self.model)
+        return MomentLaw.of(self._actuator, self.model)
 
     @property
     def directions(self) -> np.ndarray:
@@ -200,7 +211,7 @@ def _wrist_pressures(direction_deg, P: float, positions_deg) -> tuple:
 class _WristLaw:
     def __init__(self, wrist: Wrist, pressures):
         self.w = wrist
-        self.s = wrist.actuator.bend_sign
+        self.s = wrist._actuator.bend_sign
         self.e = wrist.directions
         self.ep = np.stack([-self.e[:, 1], self.e[:, 0]], axis=1)
         self.P = tuple(float(p) for p in pressures)
@@ -307,7 +318,7 @@ def _state(wrist: Wrist, P, b, t, law, note, load_moment=(0.0, 0.0)) -> WristSta
     psi = math.degrees(math.atan2(b[1], b[0])) % 360.0 if kap > 1e-15 else math.nan
     if psi > 360.0 - 1e-6:
         psi = 0.0
-    return WristState(tuple(float(p) for p in P), kap, psi, math.degrees(kap * wrist.length_mm),
+    return WristState(tuple(float(p) for p in P), kap, psi, math.degrees(kap * wrist._length_mm),
                       tuple(float(k) for k in law.kprime(b)), tuple(load_moment), True, note)
 
 
@@ -349,7 +360,7 @@ def wrist_moment(wrist: Wrist, pressures_kpa, angle_deg, direction_deg):
     """
     _check_wrist(wrist)
     P = _four_pressures_kpa(pressures_kpa)
-    kap = math.radians(number("angle_deg", angle_deg, unit="deg")) / wrist.length_mm
+    kap = math.radians(number("angle_deg", angle_deg, unit="deg")) / wrist._length_mm
     d = math.radians(number("direction_deg", direction_deg, unit="deg"))
     with pressures_checked():
         law = _WristLaw(wrist, P)
@@ -419,7 +430,7 @@ def wrist_hold(wrist: Wrist, pressure_kpa, *, load_g: float = BOTTLE_G, lever_mm
     top = _wrist_pressures(up_deg, 1.0, wrist.positions_deg)
     if sum(p > 0 for p in top) != 1:
         raise InputError(f"up_deg = {up_deg:g} must be the direction of one actuator ({wrist.positions_deg} deg)")
-    L = wrist.length_mm
+    L = wrist._length_mm
     u = np.array([math.cos(math.radians(up_deg)), math.sin(math.radians(up_deg))])
     W1, W2 = mL * G_N_PER_G, mh * G_N_PER_G
 
@@ -438,7 +449,7 @@ def wrist_hold(wrist: Wrist, pressure_kpa, *, load_g: float = BOTTLE_G, lever_mm
     M0 = (W1 * (L / 2 + lev) + W2 * (L / 2 + levh))
     # capacity and pressure needed: at kappa = 0 only the upper actuator's blocked moment acts
     law = wrist.law
-    act = wrist.actuator
+    act = wrist._actuator
     s = act.bend_sign
     with pressures_checked():
         m_block = s * float(law.blocked_moment(P))  # the upper actuator's blocked moment magnitude

@@ -1,10 +1,11 @@
 """Finding raw test files: folders expand to their exports (known suffixes, sorted)."""
 
 from __future__ import annotations
-from ..errors import InputError
 
 import os
 from pathlib import Path
+
+from ..errors import InputError
 
 __all__ = ["RAW_SUFFIXES", "collect_raw_files"]
 

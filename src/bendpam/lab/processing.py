@@ -36,9 +36,7 @@ model sign convention (multiply by ``actuator.bend_sign`` to compare).
 
 from __future__ import annotations
 
-from ..errors import ProcessingError
-from .readers import check_cycle_count
-
+import itertools
 import math
 import warnings
 from dataclasses import dataclass, field
@@ -48,20 +46,21 @@ import pandas as pd
 import xarray as xr
 from scipy import signal
 
+from ..errors import InputError, ProcessingError
 from ..fixture import PAPER_FIXTURE, Fixture
-from ..errors import InputError
+from .readers import check_cycle_count
 
 __all__ = [
-    "ProcessingOptions",
     "PressureResult",
     "ProcessedSet",
     "ProcessingError",
+    "ProcessingOptions",
+    "deadband_fit",
+    "find_turning_points",
+    "load_processed",
     "process_series",
     "process_tests",
-    "find_turning_points",
-    "deadband_fit",
     "write_processed",
-    "load_processed",
 ]
 
 BRANCHES = ("loading", "unloading")
@@ -161,7 +160,7 @@ class PressureResult:
         if k[0] <= 0.0:
             return float(m[0])
         n = max(3, k.size // 20)
-        slope, icept = np.polyfit(k[:n], m[:n], 1)
+        _slope, icept = np.polyfit(k[:n], m[:n], 1)
         return float(icept)
 
     def summary(self) -> dict:
@@ -204,7 +203,7 @@ def _segment_lowpass(x: np.ndarray, tp: np.ndarray, fs: float, cutoff: float, or
     acc = np.zeros(x.size)
     cnt = np.zeros(x.size)
     need = 3 * (2 * sos.shape[0] + 1)
-    for a, b in zip(edges[:-1], edges[1:]):
+    for a, b in itertools.pairwise(edges):
         seg = x[a: b + 1]
         if seg.size <= need:
             continue
@@ -365,7 +364,7 @@ def process_series(
     kf = np.empty(n)
     loss = np.empty(n)
     stored = np.empty(n)
-    for ci, ((a, b, c), pair) in enumerate(zip(cycles, seg)):
+    for ci, ((a, b, c), pair) in enumerate(zip(cycles, seg, strict=True)):
         for bi, (i0, i1) in enumerate(pair):
             kk, mm = k[i0:i1 + 1], M[i0:i1 + 1]
             order = np.argsort(kk, kind="stable")
@@ -495,15 +494,20 @@ class ProcessedSet:
                                {"units": "N*mm", "long_name": "branch moment on the common curvature grid"}),
                 "mean_loading_nmm": (("pressure_kpa", "point"), np.nanmean(br[:, :, 0], axis=1),
                                      {"units": "N*mm", "long_name": "loading branch (free -> blocked), cycle mean"}),
-                "mean_unloading_nmm": (("pressure_kpa", "point"), np.nanmean(br[:, :, 1], axis=1),
-                                       {"units": "N*mm", "long_name": "unloading branch (blocked -> free), cycle mean"}),
+                "mean_unloading_nmm": (
+                    ("pressure_kpa", "point"), np.nanmean(br[:, :, 1], axis=1),
+                    {"units": "N*mm", "long_name": "unloading branch (blocked -> free), cycle mean"}),
                 "blocked_moment_cycle_nmm": (("pressure_kpa", "cycle"), bmc, {"units": "N*mm"}),
                 "free_curvature_cycle_per_mm": (("pressure_kpa", "cycle"), kfc, {"units": "1/mm"}),
                 "energy_loss_ratio_cycle": (("pressure_kpa", "cycle"), elc, {"units": "1"}),
-                "blocked_moment_nmm": ("pressure_kpa", [r.blocked_moment[0] for r in self.results], {"units": "N*mm"}),
-                "blocked_moment_se_nmm": ("pressure_kpa", [r.blocked_moment[1] for r in self.results], {"units": "N*mm"}),
-                "free_curvature_per_mm": ("pressure_kpa", [r.free_curvature[0] for r in self.results], {"units": "1/mm"}),
-                "free_curvature_se_per_mm": ("pressure_kpa", [r.free_curvature[1] for r in self.results], {"units": "1/mm"}),
+                "blocked_moment_nmm": (
+                    "pressure_kpa", [r.blocked_moment[0] for r in self.results], {"units": "N*mm"}),
+                "blocked_moment_se_nmm": (
+                    "pressure_kpa", [r.blocked_moment[1] for r in self.results], {"units": "N*mm"}),
+                "free_curvature_per_mm": (
+                    "pressure_kpa", [r.free_curvature[0] for r in self.results], {"units": "1/mm"}),
+                "free_curvature_se_per_mm": (
+                    "pressure_kpa", [r.free_curvature[1] for r in self.results], {"units": "1/mm"}),
                 "energy_loss_ratio": ("pressure_kpa", [r.energy_loss_ratio for r in self.results], {"units": "1"}),
             },
             coords={
@@ -638,7 +642,7 @@ def load_processed(path) -> ProcessedSet:
     try:
         with xr.open_dataset(nc) as ds:
             ds = ds.load()
-    except Exception as exc:  # noqa: BLE001 - any backend failure becomes one clear line
+    except Exception as exc:
         raise ProcessingError(f"{nc}: cannot read as a bendpam processed-curves file ({type(exc).__name__})") from None
     need = {"moment_nmm", "blocked_moment_cycle_nmm", "free_curvature_cycle_per_mm", "energy_loss_ratio_cycle"}
     if not need <= set(ds.data_vars):

@@ -33,15 +33,15 @@ import pandas as pd
 from scipy.optimize import brentq
 
 from ..atomic import atomic_write_text
-from ..fixture import PAPER_FIXTURE, Fixture
-from ..hysteresis import LAWS, make_law
 from ..braid import curvature_limits
-from ..predict import blocked_moment, free_curvature, moment
 from ..checks import number
 from ..errors import InputError, NoEquilibrium
+from ..fixture import PAPER_FIXTURE, Fixture
+from ..hysteresis import LAWS, make_law
 from ..models import normalise_model
+from ..predict import blocked_moment, free_curvature, moment
 
-__all__ = ["SimulationSettings", "simulate_test", "simulate_tests", "DIALECT_SUFFIX"]
+__all__ = ["DIALECT_SUFFIX", "SimulationSettings", "simulate_test", "simulate_tests"]
 
 #: The fixture's plates cannot pitch beyond this (deg); the free state must be found before it.
 MAX_BETA_DEG = 80.0
@@ -152,7 +152,7 @@ def simulate_test(actuator, pressure_kpa: float, model: str = "energy", *, fixtu
     for _ in range(st.cycles):
         legs += [("ramp", 0.0, s_f), ("dwell", s_f, s_f), ("ramp", s_f, 0.0), ("dwell", 0.0, 0.0)]
     knots_t, knots_s = [0.0], [0.0]
-    for kind, a, b in legs:
+    for kind, _a, b in legs:
         dur = t_ramp if kind == "ramp" else st.dwell_s
         if dur <= 0:
             continue
@@ -161,7 +161,7 @@ def simulate_test(actuator, pressure_kpa: float, model: str = "energy", *, fixtu
     T = knots_t[-1]
     t = np.arange(0.0, T + 0.5 / st.rate_hz, 1.0 / st.rate_hz)
     s = np.interp(t, knots_t, knots_s)
-    force, M, k = _machine(actuator, P, model, fixture, law, A, s, m_qs)
+    force, _M, _k = _machine(actuator, P, model, fixture, law, A, s, m_qs)
     truth_cycles = _truth(actuator, P, model, fixture, law, A, s_f, st.cycles, m_qs)
     data = pd.DataFrame({
         "time_s": t,

@@ -136,8 +136,8 @@ def write_test(
         )
     arr = data[list(COLUMNS)].to_numpy(dtype=np.float64, copy=True)
     if not np.isfinite(arr).all():
-        row = int(np.argwhere(~np.isfinite(arr))[0][0])
-        raise ValueError(f"data row {row} has a non-finite value; a readable export needs numbers")
+        bad_row = int(np.argwhere(~np.isfinite(arr))[0][0])
+        raise ValueError(f"data row {bad_row} has a non-finite value; a readable export needs numbers")
     arr[:, 2] /= FORCE_UNITS[fkey]
     if pressure_kpa is not None:
         pressure_kpa = float(pressure_kpa)

@@ -139,7 +139,7 @@ def bladder_energy(params, curvature, *, order: int = DEFAULT_ORDER):
     :func:`terms` against a finite difference of this function.
     """
     k = np.asarray(curvature, dtype=float)
-    u, R, dR, omc, wbar, lam1 = _state(params, k, order)
+    _u, R, _dR, _omc, wbar, lam1 = _state(params, k, order)
     eta = (R / params.R0_start)[..., None]
     return params.bladder_area * (MooneyRivlin(params.C10, params.C01).energy(lam1, eta) @ wbar)
 

@@ -46,7 +46,7 @@ __all__ = ["basis", "coefficients", "stress_state", "terms"]
 
 def _state(params, k, order):
     R0 = params.R0_start
-    u, R, dR = radius_terms(k, params.alpha0, R0, order)
+    u, R, _dR = radius_terms(k, params.alpha0, R0, order)
     phi, wbar = gauss_nodes(order)
     omc = 1.0 - np.cos(phi)
     lam1 = 1.0 + u[..., None] * omc
@@ -61,7 +61,8 @@ def _state(params, k, order):
     # elastic (pressure-free) parts of eq 43 and eq 44
     const1 = -2.0 * C1 / le2 + 2.0 * C2 * le2  # Phi-independent part of sigma_bl,1^el
     sig2e = 2.0 * C1 * (eta * eta - 1.0 / le2) - 2.0 * C2 * (1.0 / (eta * eta) - le2)
-    varpart = 2.0 * np.pi * (((2.0 * case_column(C1) * lam1 * lam1 - 2.0 * case_column(C2) / (lam1 * lam1)) * omc) @ wbar)
+    varpart = 2.0 * np.pi * (((2.0 * case_column(C1) * lam1 * lam1 - 2.0 * case_column(C2) / (lam1 * lam1)) * omc)
+                             @ wbar)
     m_bl = tbar * R * R * (varpart + 2.0 * np.pi * const1)
     return dict(u=u, R=R, lam1=lam1, c=c, lbar=lbar, eta=eta, tbar=tbar, J=J, sig2e=sig2e, const1=const1, m_bl=m_bl,
                 omc=omc, wbar=wbar)
