@@ -2,8 +2,9 @@ import math
 
 import pytest
 
-from bendpam import Actuator, presets
+from bendpam import Actuator, ModelParams, presets
 from bendpam.actuator import NEUTRAL_ANGLE_DEG
+from bendpam.errors import InputError
 
 
 def base(**kw):
@@ -28,18 +29,31 @@ def test_presets_table1_and_table3():
 def test_eq52_prestrain_by_hand():
     a = presets.be_pam()
     # area pi (8.5^2 - 6^2) = pi 36.25; t0s = 10.1 - sqrt(10.1^2 - 36.25)
-    assert a.t0_start == pytest.approx(10.1 - math.sqrt(102.01 - 36.25))
+    assert a.t0_start_mm == pytest.approx(10.1 - math.sqrt(102.01 - 36.25))
     # eq 51: the wall area is unchanged
-    assert math.pi * (a.R0_start**2 - (a.R0_start - a.t0_start) ** 2) == pytest.approx(a.bladder_area)
-    assert a.bladder_area == pytest.approx(math.pi * 36.25)
-    assert base().t0_start == pytest.approx(2.5)  # no prestrain by default
+    assert math.pi * (a.R0_start_mm**2 - (a.R0_start_mm - a.t0_start_mm) ** 2) == pytest.approx(a.bladder_area_mm2)
+    assert a.bladder_area_mm2 == pytest.approx(math.pi * 36.25)
+    assert base().t0_start_mm == pytest.approx(2.5)  # no prestrain by default
+    # the numerics' view carries the same derived values (mm)
+    assert a.params.t0_start == pytest.approx(a.t0_start_mm)
+    assert a.params.bladder_area == pytest.approx(a.bladder_area_mm2)
+    assert a.params.R0_start == a.R0_start_mm
 
 
 def test_internal_units():
+    """``actuator.params`` is the numerics' view in mm / MPa / rad; the actuator itself has unit-named fields."""
     a = base(P_start_kpa=68.0)
-    assert a.alpha0 == pytest.approx(math.radians(68.0))
-    assert a.C10 == pytest.approx(0.114) and a.C01 == pytest.approx(0.3) and a.P_start == pytest.approx(0.068)
-    assert a.frame_stiffness == pytest.approx(6796.0 * 5.0 * 0.125 / 12.0)
+    p = a.params
+    assert isinstance(p, ModelParams) and p.shape == ()
+    assert p.alpha0 == pytest.approx(math.radians(68.0))
+    assert p.C10 == pytest.approx(0.114) and p.C01 == pytest.approx(0.3) and p.P_start == pytest.approx(0.068)
+    assert p.frame_stiffness == pytest.approx(6796.0 * 5.0 * 0.125 / 12.0)
+    assert a.frame_stiffness_nmm2 == pytest.approx(6796.0 * 5.0 * 0.125 / 12.0)
+    assert a.frame_inertia_mm4 == pytest.approx(5.0 * 0.125 / 12.0)
+    # the internal-unit properties are gone from the Actuator (issue 10)
+    for gone in ("alpha0", "C10", "C01", "P_start", "R0", "t0", "L0", "R0_start", "t0_start", "bladder_area",
+                 "frame_inertia", "frame_stiffness"):
+        assert not hasattr(a, gone), gone
 
 
 @pytest.mark.parametrize(
@@ -58,10 +72,12 @@ def test_internal_units():
         (dict(P_start_kpa=-1.0), ["P_start_kpa", "[0, inf)"]),
         (dict(R0_start_mm=8.0), ["R0_start_mm", "8.5"]),
         (dict(alpha0_deg="abc"), ["alpha0_deg", "not a number"]),
+        (dict(alpha0_deg="70"), ["alpha0_deg", "not a number"]),  # a string is not a number
+        (dict(alpha0_deg=True), ["alpha0_deg", "not a number"]),  # nor is a bool
     ],
 )
 def test_bad_values_name_parameter_value_and_range(kw, words):
-    with pytest.raises(ValueError) as exc:
+    with pytest.raises(InputError) as exc:
         base(**kw)
     msg = str(exc.value)
     assert "\n" not in msg
@@ -103,19 +119,24 @@ def test_toml_round_trip(tmp_path):
     "text,words",
     [
         ("[actuator]\nalpha0_deg = 70\n", ["missing actuator parameter"]),
-        ("[actuator]\nalpha0 = 70\n", ["unknown actuator parameter", "alpha0"]),
+        ("[actuator]\nalpha0 = 70\n", ["unknown actuator parameter", "alpha0", "did you mean 'alpha0_deg'"]),
         ("alpha0_deg = = 3\n", ["invalid TOML", "line 1"]),
         (
             "[actuator]\nalpha0_deg=95\nR0_mm=8.5\nt0_mm=2.5\nL0_mm=145\nframe_thickness_mm=0.5\nframe_width_mm=5\n"
             "frame_modulus_mpa=6796\nC10_kpa=100\nC01_kpa=100\n",
             ["alpha0_deg", "95"],
         ),
+        (
+            "[actuator]\nalpha0_deg=true\nR0_mm=8.5\nt0_mm=2.5\nL0_mm=145\nframe_thickness_mm=0.5\nframe_width_mm=5\n"
+            "frame_modulus_mpa=6796\nC10_kpa=100\nC01_kpa=100\n",
+            ["alpha0_deg", "True", "not a number"],
+        ),
     ],
 )
 def test_bad_toml(tmp_path, text, words):
     p = tmp_path / "a.toml"
     p.write_text(text)
-    with pytest.raises(ValueError) as exc:
+    with pytest.raises(InputError) as exc:
         Actuator.from_toml(p)
     msg = str(exc.value)
     assert str(p) in msg and "\n" not in msg

@@ -27,8 +27,8 @@ def test_golden_values_by_hand():
 def test_stroke_to_beta_is_the_bracketed_root_of_eq6():
     for f in (PAPER_FIXTURE, Fixture(20.0, 3.0, 6.0, 100.0), Fixture(10.0, 0.0, 0.0, 145.0), Fixture(5.0, 4.0, 2.0)):
         s = np.array([1e-6, 0.3, 3.0, 20.0, 60.0, 150.0])
-        ref = [brentq(lambda b: f.d_mm * math.tan(b) + (1 / math.cos(b) - 1) * f.c - x, 0.0, math.pi / 2 - 1e-12,
-                      xtol=1e-15) for x in s]
+        ref = [brentq(lambda b, f=f, x=x: f.d_mm * math.tan(b) + (1 / math.cos(b) - 1) * f.c - x,
+                      0.0, math.pi / 2 - 1e-12, xtol=1e-15) for x in s]
         assert_allclose(f.stroke_to_beta(s), ref, rtol=1e-12, atol=1e-15)
 
 

@@ -80,10 +80,11 @@ def test_rate_independence_of_the_laws():
 
 def test_zero_amplitude_gives_zero_loss():
     a = presets.be_pam()
-    c = predict_cycle(a, LoopModel(a0_nmm=0.0, a1_nmm_per_mpa=0.0), 150.0)
+    c = predict_cycle(a, LoopModel(a0_nmm=0.0, a1_nmm_per_kpa=0.0), 150.0)
     assert c.energy_loss_ratio == pytest.approx(0.0, abs=1e-12)
     assert_allclose(c.loading_nmm, c.unloading_nmm)
-    assert c.free_curvature_per_mm == pytest.approx(float(bendpam.free_curvature(a, 0.15).curvature), rel=1e-3)
+    assert c.free_curvature_per_mm == pytest.approx(float(bendpam.free_curvature(a, 150.0).curvature_per_mm),
+                                                    rel=1e-3)
     d, tr = simulate_test(a, 150, settings=SimulationSettings(hysteresis=0.0, noise_n=0.0, noise_stroke_mm=0.0))
     assert tr["energy_loss_ratio"] == pytest.approx(0.0, abs=1e-12)
     r = process_series(d.time_s, d.stroke_mm, d.force_n, 150)
@@ -92,10 +93,11 @@ def test_zero_amplitude_gives_zero_loss():
 
 def test_loss_grows_with_amplitude_and_is_higher_near_threshold_with_a_constant_part():
     a = presets.be_pam()
-    small = predict_cycle(a, LoopModel(a0_nmm=1.0, a1_nmm_per_mpa=60.0), 150.0).energy_loss_ratio
-    large = predict_cycle(a, LoopModel(a0_nmm=1.0, a1_nmm_per_mpa=120.0), 150.0).energy_loss_ratio
+    # a1 in N*mm per kPa of active pressure (60 N*mm/MPa = 0.06 N*mm/kPa)
+    small = predict_cycle(a, LoopModel(a0_nmm=1.0, a1_nmm_per_kpa=0.060), 150.0).energy_loss_ratio
+    large = predict_cycle(a, LoopModel(a0_nmm=1.0, a1_nmm_per_kpa=0.120), 150.0).energy_loss_ratio
     assert 0 < small < large
-    loop = LoopModel(a0_nmm=5.0, a1_nmm_per_mpa=100.0)
+    loop = LoopModel(a0_nmm=5.0, a1_nmm_per_kpa=0.100)
     near = predict_cycle(a, loop, 90.0).energy_loss_ratio
     far = predict_cycle(a, loop, 200.0).energy_loss_ratio
     assert near > far  # the residual fabric friction dominates near P_start (Table 2's trend)
@@ -103,11 +105,13 @@ def test_loss_grows_with_amplitude_and_is_higher_near_threshold_with_a_constant_
 
 def test_interfacial_amplitude_equals_linear_when_straight():
     a = presets.bc_pam("force_balance")
-    lin = LoopModel(a0_nmm=2.0, a1_nmm_per_mpa=150.0)
-    inter = LoopModel(a0_nmm=2.0, a1_nmm_per_mpa=150.0, amplitude="interfacial")
-    assert inter.amplitude_nmm(a, 0.1, 0.0) == pytest.approx(float(lin.amplitude_nmm(a, 0.1, 0.0)))
+    lin = LoopModel(a0_nmm=2.0, a1_nmm_per_kpa=0.150)
+    inter = LoopModel(a0_nmm=2.0, a1_nmm_per_kpa=0.150, amplitude="interfacial")
+    assert inter.amplitude_nmm(a, 100.0, 0.0) == pytest.approx(float(lin.amplitude_nmm(a, 100.0, 0.0)))
+    # by hand: a0 + a1 (P - P_start) = 2 + 0.15 (100 - 32) N*mm
+    assert float(lin.amplitude_nmm(a, 100.0, 0.0)) == pytest.approx(2.0 + 0.15 * 68.0)
     # away from straight the interfacial pressure changes (eq 45)
-    assert inter.amplitude_nmm(a, 0.1, -0.006) != pytest.approx(float(lin.amplitude_nmm(a, 0.1, -0.006)))
+    assert inter.amplitude_nmm(a, 100.0, -0.006) != pytest.approx(float(lin.amplitude_nmm(a, 100.0, -0.006)))
     c = predict_cycle(a, inter, 100.0, "force_balance")
     assert 0 < c.energy_loss_ratio < 1
 
@@ -139,15 +143,16 @@ def test_round_trip_recovers_the_loop(name, model, P):
     ps, trs = simulate_processed(truth, P, model, st)
     r = fit(ps, base, model, hysteresis="pi")
     assert r.converged
-    hp = r.hysteresis["parameters"]
-    true = {"a0_nmm": 3.0, "a1_nmm_per_mpa": trs[0]["loop"]["a1_nmm_per_mpa"], "theta_h_deg": 12.0}
+    hp = {p.field: p for p in r.hysteresis.parameters.values()}
+    assert hp["a1_nmm_per_kpa"].unit == "N*mm/kPa"
+    true = {"a0_nmm": 3.0, "a1_nmm_per_kpa": trs[0]["loop"]["a1_nmm_per_kpa"], "theta_h_deg": 12.0}
     for k, v in true.items():
-        est, se = hp[k]["value"], hp[k]["stderr"]
+        est, se = hp[k].value, hp[k].stderr
         assert se is not None and se > 0
         assert abs(est - v) <= 3 * se + 1e-3 * abs(v), (k, est, se, v)
-    for e in r.hysteresis["energy_loss_ratio"]:
-        assert abs(e["predicted"] - e["measured"]) < 0.02  # within 2 percentage points
-    assert r.hysteresis["nrmse_branches"] < 0.02
+    for e in r.hysteresis.energy_loss_ratio:
+        assert abs(e.predicted - e.measured) < 0.02  # within 2 percentage points
+    assert r.hysteresis.nrmse_branches < 0.02
     assert abs(r.parameters["alpha0"].value - truth.alpha0_deg) < 0.1
     # the predicted loop at each pressure: unloading below loading everywhere inside
     kf = ps.results[-1].free_curvature[0]
@@ -171,7 +176,8 @@ def test_cli_fit_hysteresis_and_predict_cycle(tmp_path, capsys):
     out, err = capsys.readouterr()
     assert code == 0, err
     h = json.loads(out)["hysteresis"]
-    assert h["law"] == "pi" and set(h["parameters"]) == {"a0_nmm", "a1_nmm_per_mpa", "theta_h_deg"}
+    assert h["law"] == "pi" and set(h["parameters"]) == {"a0_nmm", "a1_nmm_per_kpa", "theta_h_deg"}
+    assert h["parameters"]["a1_nmm_per_kpa"]["unit"] == "N*mm/kPa"
     assert {"pressure_kpa", "measured", "predicted"} <= set(h["energy_loss_ratio"][0])
     assert h["nrmse_branches"] < 0.02
     assert "[hysteresis]" in (tmp_path / "f" / "fitted_actuator.toml").read_text()
@@ -180,7 +186,7 @@ def test_cli_fit_hysteresis_and_predict_cycle(tmp_path, capsys):
     out, err = capsys.readouterr()
     assert code == 0, err
     cyc = json.loads(out)["results"][0]["cycle"]
-    measured = [e["measured"] for e in h["energy_loss_ratio"] if e["pressure_kpa"] == 150.0][0]
+    measured = next(e["measured"] for e in h["energy_loss_ratio"] if e["pressure_kpa"] == 150.0)
     assert cyc["energy_loss_ratio"] == pytest.approx(measured, abs=0.02)
     assert main(["predict", "--preset", "be-pam", "--pressure-kpa", "150", "--cycle"]) == 2
     assert main(["simulate-test", "--preset", "be-pam", "--pressure-kpa", "150", "--out", str(tmp_path / "d"),
@@ -210,15 +216,15 @@ def test_finger_loading_and_unloading_shapes_differ():
     from bendpam.design import Finger, FingerLoads, solve_finger
 
     a = presets.be_pam()
-    loop = LoopModel(a0_nmm=3.0, a1_nmm_per_mpa=120.0, theta_h_deg=10.0)
+    loop = LoopModel(a0_nmm=3.0, a1_nmm_per_kpa=0.120, theta_h_deg=10.0)
     loads = FingerLoads(tip_force_n=(0.0, -0.3))
-    plain = solve_finger(Finger(a), 0.15, loads)
-    opening = solve_finger(Finger(a, loop=loop, motion="unloading"), 0.15, loads)
-    closing = solve_finger(Finger(a, loop=loop, motion="loading"), 0.15, loads)
+    plain = solve_finger(Finger(a), 150.0, loads)
+    opening = solve_finger(Finger(a, loop=loop, motion="unloading"), 150.0, loads)
+    closing = solve_finger(Finger(a, loop=loop, motion="loading"), 150.0, loads)
     assert plain.equilibrium and opening.equilibrium and closing.equilibrium
     # friction holds the finger back while it opens and while it is pushed back: the loading shape
     # bends further than the quasi-static one, the unloading shape less
     assert opening.tip_angle_deg < plain.tip_angle_deg < closing.tip_angle_deg
     # with zero amplitude the loop changes nothing
-    zero = solve_finger(Finger(a, loop=LoopModel(), motion="loading"), 0.15, loads)
+    zero = solve_finger(Finger(a, loop=LoopModel(), motion="loading"), 150.0, loads)
     assert zero.tip_angle_deg == pytest.approx(plain.tip_angle_deg, abs=1e-9)

@@ -11,8 +11,7 @@ import bendpam
 from bendpam import presets
 from bendpam.cli import main
 from bendpam.fixture import PAPER_FIXTURE
-from bendpam.identify import fit, fit_tension, parse_free, score, tension_from_test
-from bendpam.material import MooneyRivlin
+from bendpam.identify import fit, parse_free, score
 from bendpam.lab import read_test, write_test
 from bendpam.lab.processing import (
     PressureResult,
@@ -22,6 +21,8 @@ from bendpam.lab.processing import (
     write_processed,
 )
 from bendpam.lab.simulate import SimulationSettings, simulate_test
+from bendpam.material import MooneyRivlin
+from bendpam.tension import fit_tension, tension_from_test
 
 CASES = {"be-pam": [100, 125, 150, 175, 200], "bc-pam": [40, 60, 80, 100, 120]}
 # known parameters different from the presets (kept away from the BC-PAM fold)
@@ -50,7 +51,7 @@ def true_curve_nrmse(processed, truth, fitted, model):
     s = truth.bend_sign
     num = den = 0.0
     for r in processed.results:
-        k, p = r.curvature_grid, r.pressure_kpa * 1e-3
+        k, p = r.curvature_grid, r.pressure_kpa
         mt = s * bendpam.moment(truth, p, s * k, model)
         mf = s * bendpam.moment(fitted, p, s * k, model)
         Kmax = r.free_curvature[0]
@@ -59,17 +60,17 @@ def true_curve_nrmse(processed, truth, fitted, model):
     return math.sqrt(num / den)
 
 
-def fake_set(actuator, model, offsets, bm_offsets, kf_offsets, pressures=(0.15, 0.2)):
-    """Processed 'data' = model curves + known constant offsets (for hand-computed metrics)."""
+def fake_set(actuator, model, offsets, bm_offsets, kf_offsets, pressures=(150.0, 200.0)):
+    """Processed 'data' = model curves + known constant offsets (for hand-computed metrics); pressures in kPa."""
     s = actuator.bend_sign
     res = []
     for p, c, dbm, dk in zip(pressures, offsets, bm_offsets, kf_offsets):
-        kf = abs(float(bendpam.free_curvature(actuator, p, model).curvature))
+        kf = abs(float(bendpam.free_curvature(actuator, p, model).curvature_per_mm))
         grid = np.linspace(0.0, kf, 11)
         M = s * bendpam.moment(actuator, p, s * grid, model) + c
         bm = abs(float(bendpam.blocked_moment(actuator, p, model))) + dbm
         br = np.stack([np.stack([M, M])])
-        res.append(PressureResult(p * 1e3, "fake", 1, grid, br, np.array([bm]), np.array([kf + dk]), np.array([0.2]),
+        res.append(PressureResult(p, "fake", 1, grid, br, np.array([bm]), np.array([kf + dk]), np.array([0.2]),
                                   np.array([1.0]), np.array([5.0]), 20.0, 1.0))
     return ProcessedSet(res, PAPER_FIXTURE, ProcessingOptions())
 
@@ -94,7 +95,7 @@ def test_metrics_match_hand_computation():
 
 def test_score_of_the_truth_is_zero():
     a = presets.bc_pam("force_balance")
-    m = score(fake_set(a, "force_balance", [0, 0], [0, 0], [0, 0], pressures=(0.08, 0.12)), a, "force_balance")
+    m = score(fake_set(a, "force_balance", [0, 0], [0, 0], [0, 0], pressures=(80.0, 120.0)), a, "force_balance")
     assert m.nrmse_cycles < 1e-12 and m.nrmse_blocked_moment < 1e-12 and m.nrmse_free_curvature < 1e-10
 
 
@@ -123,6 +124,7 @@ def test_round_trip_with_noise_and_hysteresis(name, model):
     assert "fitted" in r.actuator.name
 
 
+@pytest.mark.slow  # 20 fits, about 9 s
 def test_standard_errors_cover_the_truth():
     base, truth = true_actuator("be-pam", "energy")
     z = []
@@ -183,10 +185,10 @@ def test_bad_free(free):
 
 
 def test_tension_fit_golden_and_from_file(tmp_path):
-    mat = MooneyRivlin(0.114, 0.300)
+    mat = MooneyRivlin(0.114, 0.300)  # MPa: the material law works in the numerics' units
     lam = np.linspace(1.0, 2.5, 60)
-    stress = mat.uniaxial_nominal_stress(lam)
-    t = fit_tension(lam, stress)
+    stress = mat.uniaxial_nominal_stress(lam)  # MPa = N/mm^2
+    t = fit_tension(lam, stress * 1e3)  # kPa at the public edge
     assert t.C10_kpa == pytest.approx(114.0, rel=1e-9) and t.C01_kpa == pytest.approx(300.0, rel=1e-9)
     # through a raw export: gauge 20 mm, 2 x 1 mm strip, loading then unloading
     ext = np.concatenate([(lam - 1) * 20.0, (lam[::-1] - 1) * 20.0])
@@ -224,6 +226,7 @@ def test_cli_fit_end_to_end(tmp_path, capsys):
     assert json.loads(out)["actuator"]["alpha0_deg"] == pytest.approx(obj["parameters"]["alpha0_deg"]["value"])
     # errors: not a processed folder, unknown parameter
     assert main(["fit", str(tmp_path), "--preset", "bc-pam", "--out", str(tmp_path / "x")]) == 2
-    assert main(["fit", str(tmp_path / "proc"), "--preset", "bc-pam", "--free", "zeta", "--out", str(tmp_path / "x")]) == 2
+    assert main(["fit", str(tmp_path / "proc"), "--preset", "bc-pam", "--free", "zeta",
+                 "--out", str(tmp_path / "x")]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 2 and "zeta" in err

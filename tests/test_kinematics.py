@@ -8,8 +8,9 @@ from numpy.testing import assert_allclose
 from scipy.integrate import quad
 
 import bendpam
-from strategies import actuators as actuator_strategy
 from bendpam.braid import LOCK_FRACTION, gauss_nodes
+from bendpam.errors import InputError
+from strategies import actuators as actuator_strategy
 
 
 def eq5_quad(u, alpha0):
@@ -24,7 +25,7 @@ def test_eta_at_zero_is_one_exactly(preset_model):
     a, _ = preset_model
     kin = bendpam.kinematics(a, 0.0)
     assert kin.eta == 1.0
-    assert kin.radius == a.R0_start
+    assert kin.radius == a.R0_start_mm
     assert kin.u == 0.0
 
 
@@ -32,14 +33,14 @@ def test_dR_at_zero_golden(preset_model):
     # by hand: dxi/du(0) = -cot^2 a0 and du/dk' = R0, so dR/dk'(0) = -R0^2 cot^2 a0
     a, _ = preset_model
     kin = bendpam.kinematics(a, 0.0)
-    assert kin.dradius == pytest.approx(-a.R0_start**2 / math.tan(a.alpha0) ** 2, rel=1e-12)
+    assert kin.dradius == pytest.approx(-a.R0_start_mm**2 / math.tan(math.radians(a.alpha0_deg)) ** 2, rel=1e-12)
 
 
 def test_eq5_against_adaptive_quadrature(preset_model, span):
     a, _ = preset_model
     k = span(a, 0.97, 15)
     kin = bendpam.kinematics(a, k)
-    ref = np.array([eq5_quad(u, a.alpha0) for u in kin.u])
+    ref = np.array([eq5_quad(u, math.radians(a.alpha0_deg)) for u in kin.u])
     assert_allclose(kin.eta, ref, rtol=1e-11)
     assert_allclose(kin.u, k * kin.radius, rtol=1e-12, atol=1e-16)
 
@@ -54,11 +55,12 @@ def test_dR_against_finite_differences(preset_model, span):
 
 def test_braid_constraint_and_angles(be):
     kin = bendpam.kinematics(be, np.array([-0.03, 0.0, 0.01, 0.1]))
-    c, s = math.cos(be.alpha0), math.sin(be.alpha0)
+    a0 = math.radians(be.alpha0_deg)
+    c, s = math.cos(a0), math.sin(a0)
     assert_allclose(c**2 * kin.lambda1**2 + s**2 * kin.lambda2_braid**2, 1.0, atol=1e-14)  # eq 2
     assert_allclose(np.cos(kin.braid_angle), c * kin.lambda1, atol=1e-14)  # eq 4
     assert_allclose(kin.axis_curvature, kin.curvature / (1 + kin.curvature * kin.radius))  # eq 1
-    assert_allclose(kin.angle, kin.curvature * be.L0)
+    assert_allclose(kin.angle, kin.curvature * be.L0_mm)
     # R0/R is the circle mean of 1/lambda2_braid (eq 35)
     assert_allclose(1.0 / kin.eta, (1.0 / kin.lambda2_braid) @ kin.weights, rtol=1e-13)
 
@@ -68,7 +70,7 @@ def test_radius_falls_with_curvature(be, bc, span):
         k = span(a, 0.9, 31)
         R = bendpam.kinematics(a, k).radius
         assert np.all(np.diff(R) < 0)  # R falls monotonically as k' increases, on both sides
-        assert R[0] > a.R0_start > R[-1]
+        assert R[0] > a.R0_start_mm > R[-1]
 
 
 @pytest.mark.parametrize("frac", [0.5, 0.9, 0.99])
@@ -76,7 +78,7 @@ def test_quadrature_convergence(preset_model, frac, span):
     a, model = preset_model
     k = span(a, frac, 9)
     R = {n: bendpam.kinematics(a, k, order=n).radius for n in (8, 16, 32, 128)}
-    M = {n: bendpam.moment(a, 0.15, k, model, order=n) for n in (8, 16, 32, 128)}
+    M = {n: bendpam.moment(a, 150.0, k, model, order=n) for n in (8, 16, 32, 128)}
     err = {n: np.max(np.abs(R[n] - R[128]) / R[128]) for n in (8, 16, 32)}
     merr = {n: np.max(np.abs(M[n] - M[128])) / np.max(np.abs(M[128])) for n in (8, 16, 32)}
     assert err[32] < 1e-9 and merr[32] < 1e-7
@@ -88,7 +90,7 @@ def test_full_circle_equals_half_range_by_symmetry(be):
     kin = bendpam.kinematics(be, 0.05)
     x, w = np.polynomial.legendre.leggauss(64)
     phi_full = (x + 1) * np.pi
-    c = math.cos(be.alpha0)
+    c = math.cos(math.radians(be.alpha0_deg))
     f = lambda p: 1.0 / np.sqrt(1 - (c * (1 + kin.u * (1 - np.cos(p)))) ** 2)
     full = np.sum(w * np.pi * f(phi_full)) / (2 * np.pi)
     phi, wbar = gauss_nodes(32)
@@ -100,14 +102,16 @@ def test_lock_up_limits(be, bc):
     for a in (be, bc):
         lim = bendpam.curvature_limits(a)
         assert lim.k_min < 0 < lim.k_max
-        u_lock = (1 / math.cos(a.alpha0) - 1) / 2
+        u_lock = (1 / math.cos(math.radians(a.alpha0_deg)) - 1) / 2
         assert lim.u_max <= LOCK_FRACTION * u_lock + 1e-15
         # far side stretch at the lower limit is 1 + 2 u_min >= 0
         assert 1 + 2 * lim.u_min >= 0.0
-        with pytest.raises(ValueError, match="lock-up"):
+        with pytest.raises(InputError, match="lock-up"):
             bendpam.kinematics(a, lim.k_max * 1.01)
-        with pytest.raises(ValueError, match="lock-up"):
-            bendpam.moment(a, 0.1, lim.k_min * 1.01)
+        with pytest.raises(InputError, match="lock-up"):
+            lim.check(lim.k_max * 1.01)
+        with pytest.raises(InputError, match="lock-up"):
+            bendpam.moment(a, 100.0, lim.k_min * 1.01)
         bendpam.kinematics(a, [lim.k_min, lim.k_max])  # the limits themselves are admissible
     # BC-PAM: the lumen closes (R = t_bar) before the braid locks
     lim = bendpam.curvature_limits(bc)

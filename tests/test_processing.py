@@ -159,11 +159,11 @@ def test_simulate_process_round_trip(simulated, name, fmt):
         assert abs(r.energy_loss_ratio - tr["energy_loss_ratio"]) < 0.02  # 2 percentage points
         # the hysteresis-free mean curve recovers the quasi-static model away from the reversals,
         # where the Dahl loop is saturated (free angle > 3 theta_c)
-        if tr["free_curvature_per_mm"] * a.L0 < 3 * np.radians(5.0):
+        if tr["free_curvature_per_mm"] * a.L0_mm < 3 * np.radians(5.0):
             continue
         g = r.curvature_grid
         mid = (g > 0.3 * g[-1]) & (g < 0.7 * g[-1])
-        model = sign * bendpam.moment(a, r.pressure_kpa * 1e-3, sign * g[mid])
+        model = sign * bendpam.moment(a, r.pressure_kpa, sign * g[mid])
         assert_allclose(r.mean_curve[mid], model, atol=0.02 * tr["model_blocked_moment_nmm"])
     p0, se = ps.deadband()
     assert p0 == pytest.approx(truth["deadband_kpa"], abs=2.0)
@@ -240,7 +240,8 @@ def test_cli_simulate_and_process(capsys, tmp_path):
         (["process", "raw"], ["--out"]),
         (["process", "raw", "--out", "o", "--cutoff-hz", "100"], ["Nyquist"]),
         (["simulate-test", "--preset", "bc-pam", "--pressure-kpa", "10", "--out", "s"], ["P_start"]),
-        (["simulate-test", "--preset", "be-pam", "--pressure-kpa", "100", "--out", "s", "--rate-hz", "-1"], ["rate_hz"]),
+        (["simulate-test", "--preset", "be-pam", "--pressure-kpa", "100", "--out", "s", "--rate-hz", "-1"],
+         ["rate_hz"]),
         (["simulate-test", "--preset", "be-pam", "--pressure-kpa", "100", "--out", "s", "--format", "xls"], ["xls"]),
     ],
 )

@@ -5,9 +5,9 @@ package (its own browser download is not used); it is skipped with a reason when
 """
 
 import contextlib
-import os
 import html
 import io
+import os
 import re
 from html.parser import HTMLParser
 from pathlib import Path
@@ -19,10 +19,10 @@ import bendpam
 import bendpam.cli
 from bendpam import presets
 from bendpam.identify import fit
-from bendpam.report import build_report, fmt_num, fmt_pct, fmt_pm, fmt_se, table2_rows, table3_rows
 from bendpam.lab import read_test
 from bendpam.lab.processing import process_tests
 from bendpam.lab.simulate import SimulationSettings, simulate_tests
+from bendpam.report import Report, build_report, fmt_num, fmt_pct, fmt_pm, fmt_se, table2_rows, table3_rows
 
 CHROMIUM = Path("/usr/bin/chromium")
 CHROMIUM_ARGS = ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
@@ -169,7 +169,7 @@ def test_tables_hold_the_numbers(built, expected):
     # Table 3 against an independent fit
     rows = scan.tables["table3"]
     assert [r[0] for r in rows] == ["energy model", "force-balance model"]
-    for row, (m, res) in zip(rows, fits.items()):
+    for row, res in zip(rows, fits.values()):
         p = res.parameters
         assert row[1] == f"{p['alpha0'].value:.2f} ± {fmt_se(p['alpha0'].stderr)}"
         assert row[2] == fmt_pm(p["C10"].value, p["C10"].stderr, ".1f")
@@ -187,7 +187,7 @@ def test_tables_hold_the_numbers(built, expected):
     # deadband and fit notes
     dead = next(a for tag, a in scan.tags if a.get("id") == "deadband")
     assert float(dead["data-value"]) == pytest.approx(summ["deadband_kpa"], rel=1e-9)
-    for m, res in fits.items():
+    for m in fits:
         assert any(a.get("id") == f"flags-{m}" for _, a in scan.tags)
     text = html_path.read_text(encoding="utf-8")
     flags = [f for res in fits.values() for f in res.flags]
@@ -273,21 +273,22 @@ def test_build_report_bc_pam(tmp_path, monkeypatch, capsys):
     monkeypatch.delenv("TTY_COMPATIBLE", raising=False)
     res = build_report(raw, act, tmp_path / "bc.html", models=("force-balance",), progress=True)
     err = capsys.readouterr().err
-    assert res["progress_shown"] and "bendpam report" in err
-    assert res["html"].exists() and res["figures"] == ["fig-figure4", "fig-figure7-force_balance", "fig-stresses"]
-    assert [i["dialect"] for i in res["inputs"]] == ["testxpert", "testxpert"]
-    assert list(res["fits"]) == ["force_balance"] and res["notes"] == []
-    top = res["processed"].results[-1]
-    assert res["stresses"]["pressure_kpa"] == 100.0
-    assert res["stresses"]["curvature_per_mm"] == pytest.approx(-0.5 * top.free_curvature[0])  # BC-PAM: k' < 0
-    assert res["summary"]["deadband_kpa"] == pytest.approx(res["processed"].summary()["deadband_kpa"])
-    text = res["html"].read_text(encoding="utf-8")
+    assert isinstance(res, Report)  # build_report returns a Report value (it returned a dict)
+    assert res.progress_shown and "bendpam report" in err
+    assert res.html.exists() and res.figures == ["fig-figure4", "fig-figure7-force_balance", "fig-stresses"]
+    assert [i["dialect"] for i in res.inputs] == ["testxpert", "testxpert"]
+    assert list(res.fits) == ["force_balance"] and res.notes == []
+    top = res.processed.results[-1]
+    assert res.stresses["pressure_kpa"] == 100.0
+    assert res.stresses["curvature_per_mm"] == pytest.approx(-0.5 * top.free_curvature[0])  # BC-PAM: k' < 0
+    assert res.summary["deadband_kpa"] == pytest.approx(res.processed.summary()["deadband_kpa"])
+    text = res.html.read_text(encoding="utf-8")
     assert 'id="table3"' in text and "energy model" not in text
     # without a terminal: no bar
     monkeypatch.delenv("FORCE_COLOR")
     monkeypatch.setenv("TTY_COMPATIBLE", "0")
     res = build_report(raw, act, tmp_path / "bc2.html", models=("energy",), progress=True)
-    assert not res["progress_shown"] and capsys.readouterr().err == ""
+    assert not res.progress_shown and capsys.readouterr().err == ""
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bc.html", "bc2.html", "raw"]
 
 
@@ -322,7 +323,6 @@ def test_bad_inputs(tmp_path, raw_dir, capsys, monkeypatch):
         ((raw_dir, "--preset", "be-pam", "--out", out, "--pressure-kpa", "100,150"), "one per file"),
         ((raw_dir, "--preset", "be-pam", "--out", out, "--free", "alpha0,bogus"), "bogus"),
         ((raw_dir, "--preset", "be-pam", "--out", out, "--fixture", "35,2.5"), "--fixture"),
-        ((raw_dir, "--preset", "be-pam", "--out", tmp_path / "nodir" / "r.html"), "does not exist"),
         ((raw_dir, "--preset", "be-pam", "--out", out, "--model", "springs"), "springs"),
     ]
     for args, needle in cases:
@@ -333,3 +333,11 @@ def test_bad_inputs(tmp_path, raw_dir, capsys, monkeypatch):
         assert "Traceback" not in err
     assert not out.exists()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["empty", "garbage_100kPa.csv", "nopress"]
+
+
+def test_missing_output_folder_is_refused(tmp_path, raw_dir, capsys, monkeypatch):
+    code, stdout, err = _run_bad(capsys, monkeypatch, raw_dir, "--preset", "be-pam", "--out",
+                                 tmp_path / "nodir" / "r.html")
+    assert code == 2, (stdout, err)
+    assert err.count("\n") == 1 and err.startswith("bendpam: error: ") and "does not exist" in err, err
+    assert not (tmp_path / "nodir").exists()

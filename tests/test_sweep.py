@@ -12,12 +12,13 @@ from numpy.testing import assert_allclose
 import bendpam
 from bendpam import presets
 from bendpam.cli import main
-from bendpam.sweeps import SWEEP_PARAMETERS, evaluate_cases
+from bendpam.errors import InputError
+from bendpam.sweeps import SWEEP_PARAMETERS, build_cases, evaluate_cases
 
 
 def direct(base, model, P_kpa, **changes):
     a = base.replace(**changes)
-    fb = bendpam.free_curvature(a, np.asarray(P_kpa) * 1e-3, model)
+    fb = bendpam.free_curvature(a, np.asarray(P_kpa), model)
     return a, fb
 
 
@@ -34,16 +35,16 @@ def test_sweep_equals_direct_evaluation(name, model):
         for j, c in enumerate(C01):
             act, fb = direct(base, model, P, alpha0_deg=a, C01_kpa=c)
             k = ds.free_curvature_per_mm.values[i, j]
-            assert np.array_equal(np.isnan(k), np.isnan(fb.curvature))
+            assert np.array_equal(np.isnan(k), np.isnan(fb.curvature_per_mm))
             ok = np.isfinite(k)
-            assert_allclose(k[ok], fb.curvature[ok], rtol=1e-10, atol=1e-15)
+            assert_allclose(k[ok], fb.curvature_per_mm[ok], rtol=1e-10, atol=1e-15)
             assert_allclose(ds.free_angle_deg.values[i, j][ok], fb.angle_deg[ok], rtol=1e-10, atol=1e-12)
-            assert_allclose(ds.blocked_moment_nmm.values[i, j], bendpam.blocked_moment(act, P * 1e-3, model),
+            assert_allclose(ds.blocked_moment_nmm.values[i, j], bendpam.blocked_moment(act, P, model),
                             rtol=1e-12, atol=1e-9)
-            br = bendpam.branch_info(act, model)
+            br = bendpam.free_branch(act, model)
             mp = float(ds.max_pressure_kpa.values[i, j])
-            if np.isfinite(br.max_pressure):
-                assert mp == pytest.approx(br.max_pressure * 1e3, rel=1e-9)
+            if np.isfinite(br.max_pressure_kpa):
+                assert mp == pytest.approx(br.max_pressure_kpa, rel=1e-9)
             else:
                 assert mp == np.inf
             lim = bendpam.curvature_limits(act)
@@ -63,9 +64,29 @@ def test_every_parameter_can_be_swept():
         ds = bendpam.sweep(base, [150.0], **{name: vals})
         for i, val in enumerate(vals):
             act = base.replace(**{name: val}) if name != "R0_mm" else base.replace(
-                R0_mm=val, R0_start_mm=val * base.R0_start / base.R0_mm)
-            ref = bendpam.free_curvature(act, 0.15).curvature
+                R0_mm=val, R0_start_mm=val * base.R0_start_mm / base.R0_mm)
+            ref = bendpam.free_curvature(act, 150.0).curvature_per_mm
             assert float(ds.free_curvature_per_mm.values[i, 0]) == pytest.approx(float(ref), rel=1e-10), name
+
+
+def test_build_cases_is_a_block_of_model_params():
+    """``build_cases`` (which replaced ``CaseArrays``) gives the numerics' view of every case at once."""
+    base = presets.be_pam()
+    a0 = np.array([62.0, 68.0, 74.0])
+    cs = build_cases(base, {"alpha0_deg": a0})
+    assert isinstance(cs, bendpam.ModelParams) and cs.shape == (3,)
+    assert_allclose(cs.alpha0, np.radians(a0), rtol=1e-15)
+    for i, a in enumerate(a0):
+        one = base.replace(alpha0_deg=a).params
+        for f in ("alpha0", "R0_start", "t0_start", "bladder_area", "frame_stiffness", "C10", "C01", "P_start", "L0"):
+            assert float(np.asarray(getattr(cs, f))[i]) == pytest.approx(float(getattr(one, f)), rel=1e-15), f
+    # R0_mm swept alone: R0_start keeps the base ratio, t0_start follows eq 52
+    cs = build_cases(base, {"R0_mm": np.array([8.0, 9.0])})
+    assert_allclose(cs.R0_start, np.array([8.0, 9.0]) * base.R0_start_mm / base.R0_mm, rtol=1e-15)
+    ref = base.replace(R0_mm=9.0, R0_start_mm=9.0 * base.R0_start_mm / base.R0_mm)
+    assert float(cs.t0_start[1]) == pytest.approx(ref.t0_start_mm, rel=1e-14)
+    with pytest.raises(InputError, match="alpha0_deg"):
+        build_cases(base, {"alpha0_deg": np.array([60.0, 95.0])})
 
 
 def test_bad_sweeps():
@@ -114,6 +135,7 @@ def test_local_cluster_equals_in_process_bit_for_bit():
         assert np.array_equal(a[k], b[k]), k
 
 
+@pytest.mark.slow  # a LocalCluster with a killed worker, about 5 s
 def test_killed_worker_loses_no_results():
     distributed = pytest.importorskip("distributed")
     base = presets.be_pam()

@@ -28,12 +28,12 @@ Laws for ``z`` (both rate-independent: they depend on the path, not on its speed
 Amplitude (:class:`LoopModel`)
     * ``"linear"`` (default): ``A = a0 + a1 P_active`` with ``a0`` (N*mm) the residual friction of
       the fabric's inherent tension, which makes the loss ratio rise near P_start, and ``a1``
-      (N*mm/MPa) the pressure-driven part;
+      (N*mm/kPa) the pressure-driven part;
     * ``"interfacial"``: ``A = a0 + a1 P_e(P, k')`` with the interfacial pressure ``P_e`` between
       bladder and braid of the force-balance model (eq 45): friction in proportion to the normal
       pressure where the sleeve slides on the bladder.
 
-Units: ``a0_nmm`` in N*mm, ``a1_nmm_per_kpa`` in N*mm/MPa, ``theta_h_deg`` (saturation angle of
+Units: ``a0_nmm`` in N*mm, ``a1_nmm_per_kpa`` in N*mm/kPa, ``theta_h_deg`` (saturation angle of
 the Prandtl-Ishlinskii law, or Dahl's ``theta_c``) in degrees.
 """
 

@@ -61,6 +61,8 @@ __all__ = [
 _PER_KPA = 1e-3  # MPa per kPa: the models' A is per MPa
 _CHUNK = 1 << 13  # curvatures per block: keeps the (points x nodes) temporaries in cache
 BRANCH_SAMPLES = 1200
+#: Active pressures (kPa) below this have the straight free state (k' = 0) without a solve.
+TINY_ACTIVE_KPA = 1e-9
 #: Interpolation tolerance of the table behind :meth:`MomentLaw.stable_branch` (finger statics).
 STABLE_BRANCH_TOL = 1e-8
 #: Codes of the end of a free-bending branch (as stored in sweeps).
@@ -101,9 +103,9 @@ class MomentLaw:
     >>> import numpy as np, bendpam
     >>> law = bendpam.MomentLaw.of(bendpam.presets.bc_pam(), "energy")
     >>> law.moment([40.0, 80.0], 0.0).round(2).tolist()
-    [-22.91, -137.45]
+    [-42.11, -252.65]
     >>> round(law.free_branch().max_pressure_kpa, 1)
-    133.9
+    134.2
     """
 
     def __init__(self, actuator: Actuator | ModelParams, model: str = "energy", *, eq19_factor: bool = True,
@@ -395,6 +397,47 @@ class _ExactPath:
         return x
 
 
+class _ExactUPath:
+    """The branch parameter is ``u = k'R``, with the section means computed exactly (no eq 5 solve).
+
+    Sampling and solving the free-bending branch in ``u`` needs one pass of the quadrature per
+    point, where a curvature needs the Newton solve of eq 5 first (four to six passes).
+    """
+
+    def __init__(self, law: MomentLaw):
+        self.law = law
+        self.cs = _flat_params(law)
+        self.scalar = not law.is_cases
+        lim = curvature_limits(law.params if self.scalar else self.cs, law.order)
+        n = self.cs.alpha0.size
+        self.k_min = np.broadcast_to(np.asarray(lim.k_min, dtype=float), (n,)).copy()
+        self.k_max = np.broadcast_to(np.asarray(lim.k_max, dtype=float), (n,)).copy()
+        self.x_min = np.broadcast_to(np.asarray(lim.u_min, dtype=float), (n,)).copy()
+        self.x_max = np.broadcast_to(np.asarray(lim.u_max, dtype=float), (n,)).copy()
+
+    def _state(self, u, rows):
+        sub = self.law.params if self.scalar else self.cs.take(rows)
+        m = self.law._mod.section_means(u, sub.alpha0, self.law.order)
+        R, dR, k = radius_from_u(u, m["ib"], m["dib"], sub.alpha0, sub.R0_start)
+        return sub, m, R, dR, k
+
+    def coef(self, u, rows):
+        sub, m, R, dR, k = self._state(np.asarray(u, dtype=float), rows)
+        return _assembled(self.law, sub, k, u, R, dR, m)
+
+    def to_k(self, u, rows):
+        return self._state(np.asarray(u, dtype=float), rows)[4]
+
+
+def _assembled(law: MomentLaw, sub, k, u, R, dR, m):
+    """``(A per kPa, B)`` of the law's model from kinematics and section means."""
+    if law.model == "energy":
+        A, b10, b01 = law._mod.assemble(sub, k, u, R, dR, m, eq19_factor=law.eq19_factor)
+    else:
+        A, b10, b01 = law._mod.assemble(sub, k, u, R, dR, m)
+    return A * _PER_KPA, sub.C10 * b10 + sub.C01 * b01 + sub.frame_stiffness * k
+
+
 class SectionTables:
     """Spline tables of a model's section means over ``u = k'R``, one per distinct braid angle.
 
@@ -497,12 +540,7 @@ class _TablePath:
 
     def coef(self, u, rows):
         sub, m, R, dR, k = self._state(u, rows)
-        law = self.law
-        if law.model == "energy":
-            A, b10, b01 = law._mod.assemble(sub, k, u, R, dR, m, eq19_factor=law.eq19_factor)
-        else:
-            A, b10, b01 = law._mod.assemble(sub, k, u, R, dR, m)
-        return A * _PER_KPA, sub.C10 * b10 + sub.C01 * b01 + sub.frame_stiffness * k
+        return _assembled(self.law, sub, k, u, R, dR, m)
 
     def to_k(self, u, rows):
         m = self.tables.means(self.ia[rows], u)
@@ -541,13 +579,13 @@ TABLE_MIN_CASES_PER_ANGLE = 8
 
 
 def _path(law: MomentLaw):
-    """The exact path, or the shared-table path for blocks of cases with few distinct braid angles."""
+    """The exact path (in u), or the shared-table path for blocks of cases with few distinct braid angles."""
     if law.is_cases:
         cs = _flat_params(law)
         uniq, inverse = np.unique(cs.alpha0, return_inverse=True)
         if cs.alpha0.size >= TABLE_MIN_CASES_PER_ANGLE * uniq.size:
             return _TablePath(law, cs, uniq, inverse.reshape(-1))
-    return _ExactPath(law)
+    return _ExactUPath(law)
 
 
 def _branch_table(law: MomentLaw, samples: int) -> BranchTable:
@@ -680,23 +718,28 @@ def _solve_free(law: MomentLaw, tab: BranchTable, pa: np.ndarray, xtol: float) -
     """Roots of ``M = 0`` at active pressures ``pa`` (cases, pressures) (kPa); NaN above the branch end."""
     k = np.zeros(pa.shape)
     above = pa > tab.p_end[:, None]
-    solve = (pa > 0.0) & ~above & (tab.sgn[:, None] != 0)
+    # below 1e-9 kPa of active pressure the root is straight to rounding (B(0) = 0 is itself only
+    # zero to rounding there, which would spoil the first bracket)
+    solve = (pa > TINY_ACTIVE_KPA) & ~above & (tab.sgn[:, None] != 0)
     k[above] = np.nan
     if not np.any(solve):
         return k
     case, col = np.nonzero(solve)
     q = pa[case, col]
-    xt, pt = tab.xt[case], tab.pt[case]
     # bracket: first table index with p >= q (the table is increasing up to its end, then inf)
-    j = np.clip((pt < q[:, None]).sum(-1), 1, xt.shape[-1] - 1)
-    a = np.take_along_axis(xt, (j - 1)[:, None], -1)[:, 0]
-    b = np.take_along_axis(xt, j[:, None], -1)[:, 0]
+    if tab.pt.shape[0] == 1:
+        jall = np.searchsorted(tab.pt[0], pa[0], side="left")[None, :]
+    else:
+        jall = (tab.pt[:, None, :] < pa[:, :, None]).sum(-1)  # (cases, pressures): no per-point copies
+    j = np.clip(jall[case, col], 1, tab.xt.shape[-1] - 1)
+    a = tab.xt[case, j - 1]
+    b = tab.xt[case, j]
     last = tab.last[case]
     beyond = j > last
     fold_end = (tab.kind[case] == BRANCH_END["fold"]) & tab.use_ref[case] & beyond
     unb = (tab.kind[case] == BRANCH_END["unbounded"]) & beyond
     b = np.where(fold_end, tab.x_fold[case], np.where(unb, tab.x_end[case], b))
-    a = np.where(fold_end | unb, np.take_along_axis(xt, last[:, None], -1)[:, 0], a)
+    a = np.where(fold_end | unb, tab.xt[case, last], a)
     sgn = tab.sgn[case]
     ev = tab.path
 

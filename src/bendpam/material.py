@@ -276,21 +276,21 @@ class MooneyRivlin:
         lo = max(lim.lower for lim in limits)
         hi = min(lim.upper for lim in limits)
         beta = self.shape
-        if _within(beta, lo, hi):
+        if within(beta, lo, hi):
             return None
         tail = (
             f"admissible shapes beta = C01/(C10 + C01) on stretches [{a:g}, {b:g}] "
             f"are [{lo:.4g}, {hi:.4g}], this material has beta = {beta:.4g}"
         )
         energy, uniaxial, be = limits
-        if not _within(beta, energy.lower, energy.upper):
+        if not within(beta, energy.lower, energy.upper):
             l1, l2, w = _worst_energy(self, a, b)
             return (
                 f"{self._label()} has negative strain energy W = {w * 1e3:.4g} kPa at "
                 f"principal stretches ({l1:.4g}, {l2:.4g}, {1.0 / (l1 * l2):.4g}); "
                 f"{tail}"
             )
-        if not _within(beta, uniaxial.lower, uniaxial.upper):
+        if not within(beta, uniaxial.lower, uniaxial.upper):
             lam = _uniaxial_turning_point(beta, a, b)
             if lam > 1.0:
                 where = f"peaks at stretch {lam:.4g} and falls from there to {b:g}"
@@ -407,7 +407,7 @@ def _span(stretch_min: Any, stretch_max: Any) -> tuple[float, float]:
     return min(a, 1.0), max(b, 1.0)
 
 
-def _within(beta: float, lo: float, hi: float) -> bool:
+def within(beta: float, lo: float, hi: float) -> bool:
     lo_ok = lo - _BOUND_TOL * max(1.0, abs(lo)) <= beta
     return lo_ok and beta <= hi + _BOUND_TOL * max(1.0, abs(hi))
 

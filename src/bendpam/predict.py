@@ -94,7 +94,7 @@ def moment(actuator: Actuator, pressure_kpa, curvature_per_mm, model: str = "ene
     >>> import numpy as np, bendpam
     >>> be = bendpam.presets.be_pam()
     >>> bendpam.moment(be, [[100.0], [200.0]], [0.0, 0.01]).round(1).tolist()
-    [[75.2, -20.3], [310.3, 148.4]]
+    [[75.2, -130.1], [310.3, 63.2]]
     """
     return _law(actuator, model, eq19_factor, order).moment(pressure_kpa, curvature_per_mm)
 
@@ -146,7 +146,7 @@ def free_branch(actuator: Actuator, model: str = "energy", *, eq19_factor: bool 
     >>> import bendpam
     >>> br = bendpam.free_branch(bendpam.presets.bc_pam())
     >>> br.kind, round(br.max_pressure_kpa, 1)
-    ('fold', 133.9)
+    ('fold', 134.2)
     """
     return _law(actuator, model, eq19_factor, order).free_branch()
 
@@ -164,7 +164,7 @@ def free_curvature(actuator: Actuator, pressure_kpa, model: str = "energy", *, e
     >>> import bendpam
     >>> fb = bendpam.free_curvature(bendpam.presets.bc_pam(), [100.0, 150.0])
     >>> fb.status.tolist(), round(fb.max_pressure_kpa, 1)
-    (['ok', 'no-equilibrium'], 133.9)
+    (['ok', 'no-equilibrium'], 134.2)
     """
     return _law(actuator, model, eq19_factor, order).free_curvature(pressure_kpa, xtol=xtol)
 

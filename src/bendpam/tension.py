@@ -45,7 +45,7 @@ from numpy.typing import ArrayLike
 from .atomic import json_safe
 from .checks import number
 from .errors import FitError, InputError, ProcessingError
-from .material import MooneyRivlin, _within, admissible_shape_range
+from .material import MooneyRivlin, admissible_shape_range, within
 
 __all__ = [
     "DEFAULT_ADMISSIBLE_RANGE",
@@ -316,7 +316,7 @@ def _cone_lstsq(
     """
     X = np.column_stack([g1, g2])
     x_free = np.linalg.lstsq(X, p, rcond=None)[0]
-    if x_free[0] > 0.0 and _within(float(x_free[1] / x_free[0]), b_lo, b_hi):
+    if x_free[0] > 0.0 and within(float(x_free[1] / x_free[0]), b_lo, b_hi):
         return x_free, False, x_free
     best = np.zeros(2)
     best_rss = float(p @ p)  # the apex x = 0

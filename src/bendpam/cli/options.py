@@ -114,18 +114,23 @@ def parse_values(tokens: list[str] | None, name: str, *, max_values: int = MAX_V
     return out
 
 
-def pressures_kpa(first: list[str] | None, more: list[str] | None = None) -> list[float]:
+def pressure_kpa(value: float, name: str = "--pressure-kpa") -> float:
+    """One pressure option in kPa, with the same checks as :func:`pressures_kpa`."""
+    return pressures_kpa([repr(float(value))], None, name)[0]
+
+
+def pressures_kpa(first: list[str] | None, more: list[str] | None = None, name: str = "--pressure-kpa") -> list[float]:
     if more and not first:
         raise UserError(f"unexpected argument(s) {' '.join(more)!r}; pressures go after --pressure-kpa")
-    values = parse_values((first or []) + (more or []), "--pressure-kpa")
+    values = parse_values((first or []) + (more or []), name)
     if not values:
-        raise UserError("give at least one pressure with --pressure-kpa (kPa), e.g. --pressure-kpa 100 150 200")
+        raise UserError(f"give at least one pressure with {name} (kPa), e.g. {name} 100 150 200")
     for v in values:
         if v < 0:
-            raise UserError(f"--pressure-kpa: {v:g} kPa is below zero; pressures are gauge pressures >= 0 kPa")
+            raise UserError(f"{name}: {v:g} kPa is below zero; pressures are gauge pressures >= 0 kPa")
     nz = [v for v in values if v > 0]
     if nz and max(nz) < 5.0:
-        raise UserError(f"--pressure-kpa: every pressure is below 5 kPa (largest {max(nz):g}); pressures are in kPa "
+        raise UserError(f"{name}: every pressure is below 5 kPa (largest {max(nz):g}); pressures are in kPa "
                         "(0.2 MPa = 200 kPa)")
     return values
 
@@ -195,7 +200,8 @@ def output_file(out: Path, inputs=()):
     """An :class:`~bendpam.outputs.OutputFile` for a command's single output file."""
     from ..outputs import OutputFile
 
-    out.parent.mkdir(parents=True, exist_ok=True)
+    if not out.parent.is_dir():
+        raise UserError(f"--out {str(out)!r}: the folder {str(out.parent)!r} does not exist")
     return OutputFile(out, inputs=[p for p in inputs if p is not None], command=command_line())
 
 

@@ -27,6 +27,7 @@ from .options import (
     output_file,
     pressures_kpa,
 )
+from .options import pressure_kpa as checked_pressure
 
 FIGURE_SUFFIXES = {".png", ".pdf", ".svg"}
 
@@ -185,8 +186,7 @@ def stresses(
     from ..predict import internal_stresses
 
     act = load_actuator(preset, actuator, Model.force_balance)
-    if pressure_kpa < 0:
-        raise UserError(f"--pressure-kpa: {pressure_kpa:g} kPa is below zero")
+    pressure_kpa = checked_pressure(pressure_kpa)
     if out is None:
         raise UserError("give an output file with --out FILE.png (figure), FILE.nc or FILE.csv (data)")
     suffix = out.suffix.lower()
@@ -252,6 +252,7 @@ def demo(
             if br.kind == "fold":
                 typer.echo(f"fold: no free-bending equilibrium above {br.max_pressure_kpa:.4g} kPa")
             items.append((act, np.asarray(P, dtype=float), mname))
+    out.parent.mkdir(parents=True, exist_ok=True)
     with output_file(out) as f:
         save_figure(demo_figure(items), f.path)
     typer.echo(f"\nwrote {out}  ({time.perf_counter() - t0:.1f} s)")

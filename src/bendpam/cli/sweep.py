@@ -21,6 +21,7 @@ from .options import (
     model_name,
     output_file,
     parse_values,
+    pressures_kpa,
 )
 
 
@@ -81,9 +82,9 @@ def sweep_cmd(
     for name in params:
         if name not in SWEEP_PARAMETERS:
             raise UserError(f"--param {name}: cannot sweep it; choose from {', '.join(SWEEP_PARAMETERS)}")
-    P = parse_values(pressure_kpa, "--pressure-kpa")
-    if not P:
+    if not pressure_kpa:
         raise UserError("give the pressures with --pressure-kpa, e.g. 100:250:16")
+    P = pressures_kpa(pressure_kpa)
     n_points = len(P) * int(np.prod([len(v) for v in params.values()] or [1]))
     if n_points > max_points:
         raise UserError(f"the sweep has {n_points} (case, pressure) points, more than --max-points {max_points}; "

@@ -72,13 +72,23 @@ def section_means(u, alpha0, order: int = DEFAULT_ORDER, ib=None, dib=None) -> d
     if ib is None or dib is None:
         ib, dib = ibar(u, c, omc, wbar)
     xi = np.where(u == 0.0, 1.0, 1.0 / (s * ib))
-    lam1 = 1.0 + u[..., None] * omc
-    eta = xi[..., None]
-    out = {"ib": ib, "dib": dib}
-    for key, mat in (("10", _UNIT10), ("01", _UNIT01)):
-        out["d1_" + key] = (mat.dW_dl1(lam1, eta) * omc) @ wbar
-        out["d2_" + key] = mat.dW_dl2(lam1, eta) @ wbar
-    return out
+    # With lambda2 = xi uniform, the Mooney-Rivlin derivatives (MooneyRivlin.dW_dl1, dW_dl2) reduce to
+    # four circle means of powers of lambda1 = 1 + u (1 - cos Phi): two are polynomials in u
+    # (mean(1 - cos) = 1, mean((1 - cos)^2) = 3/2), two need the quadrature.
+    inv = 1.0 / (1.0 + u[..., None] * omc)
+    inv2 = inv * inv
+    m_im2 = inv2 @ wbar  # mean(lambda1^-2)
+    m_oim3 = (omc * inv2 * inv) @ wbar  # mean((1 - cos) lambda1^-3)
+    m_lo = 1.0 + 1.5 * u  # mean(lambda1 (1 - cos))
+    m_l2 = 1.0 + u * (2.0 + 1.5 * u)  # mean(lambda1^2)
+    x2 = xi * xi
+    return {
+        "ib": ib, "dib": dib,
+        "d1_10": 2.0 * (m_lo - m_oim3 / x2),
+        "d2_10": 2.0 * (xi - m_im2 / (x2 * xi)),
+        "d1_01": 2.0 * (x2 * m_lo - m_oim3),
+        "d2_01": 2.0 * (xi * m_l2 - 1.0 / (x2 * xi)),
+    }
 
 
 def assemble(params, k, u, R, dR, means, *, eq19_factor: bool = True):

@@ -86,10 +86,11 @@ def section_means(u, alpha0, order: int = DEFAULT_ORDER, ib=None, dib=None) -> d
     if ib is None or dib is None:
         ib, dib = ibar(u, c, omc, wbar)
     lam1 = 1.0 + u[..., None] * omc
-    l2 = lam1 * lam1
-    cl2 = case_column(c * c) * l2
-    return {"ib": ib, "dib": dib, "J": 2.0 * np.pi * ((l2 * omc / (1.0 - cl2)) @ wbar),
-            "L2": (l2 * omc) @ wbar, "Lm2": (omc / l2) @ wbar}
+    l2o = lam1 * lam1 * omc
+    J = 2.0 * np.pi * ((l2o / (1.0 - case_column(c * c) * (lam1 * lam1))) @ wbar)
+    Lm2 = ((omc / lam1) / lam1) @ wbar
+    # mean(lambda1^2 (1 - cos)) is a polynomial in u: mean((1 - cos)^n) = 1, 3/2, 5/2 for n = 1, 2, 3
+    return {"ib": ib, "dib": dib, "J": J, "L2": 1.0 + u * (3.0 + 2.5 * u), "Lm2": Lm2}
 
 
 def assemble(params, k, u, R, dR, means):

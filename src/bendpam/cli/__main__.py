@@ -1,0 +1,7 @@
+"""``python -m bendpam.cli``: the same as the ``bendpam`` command."""
+
+import sys
+
+from .app import main
+
+sys.exit(main())

@@ -1,0 +1,334 @@
+"""The package's structure (issue 10): no import cycles, no private names across modules, a light
+``import bendpam``, a working command line, and one sampler of the moment law.
+
+The sources are read with :mod:`pathlib` and parsed with :mod:`ast`; nothing here imports the
+modules it checks except through a fresh interpreter.
+"""
+
+import ast
+import json
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import bendpam
+
+SRC = Path(bendpam.__file__).resolve().parent  # src/bendpam
+ROOT = SRC.parent  # src
+
+
+def module_name(path: Path) -> str:
+    parts = list(path.relative_to(ROOT).with_suffix("").parts)
+    if parts[-1] == "__init__":
+        parts = parts[:-1]
+    return ".".join(parts)
+
+
+MODULES = {module_name(p): p for p in sorted(SRC.rglob("*.py"))}
+
+
+def parse(path: Path) -> ast.Module:
+    return ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+
+
+def _is_type_checking(test: ast.expr) -> bool:
+    return "TYPE_CHECKING" in ast.unparse(test)
+
+
+def module_level_imports(tree: ast.Module) -> list:
+    """Import statements executed when the module is imported.
+
+    Everything outside function bodies counts (class bodies, ``if``/``try`` blocks, ``with``);
+    imports inside functions (deferred on purpose) and under ``if TYPE_CHECKING:`` do not.
+    """
+    out = []
+
+    def visit(stmts):
+        for node in stmts:
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                continue
+            if isinstance(node, (ast.Import, ast.ImportFrom)):
+                out.append(node)
+            elif isinstance(node, ast.If) and _is_type_checking(node.test):
+                visit(node.orelse)
+            else:
+                for name in ("body", "orelse", "finalbody"):
+                    visit(getattr(node, name, None) or [])
+                for handler in getattr(node, "handlers", None) or []:
+                    visit(handler.body)
+                for case in getattr(node, "cases", None) or []:
+                    visit(case.body)
+
+    visit(tree.body)
+    return out
+
+
+def resolve(name: str, path: Path, node) -> list[tuple[str, str | None]]:
+    """The bendpam modules an import statement of module ``name`` binds: (module, imported name)."""
+    if isinstance(node, ast.Import):
+        return [(a.name, None) for a in node.names if a.name == "bendpam" or a.name.startswith("bendpam.")]
+    if node.level:
+        package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+        base = package.split(".")
+        base = base[: len(base) - (node.level - 1)]
+        mod = ".".join(base + ([node.module] if node.module else []))
+    else:
+        mod = node.module or ""
+        if not (mod == "bendpam" or mod.startswith("bendpam.")):
+            return []
+    out = []
+    for a in node.names:
+        sub = f"{mod}.{a.name}"
+        out.append((sub, None) if sub in MODULES else (mod, a.name))  # a submodule, or a name from mod
+    return out
+
+
+def import_graph() -> dict[str, set[str]]:
+    graph = {}
+    for name, path in MODULES.items():
+        edges = set()
+        for node in module_level_imports(parse(path)):
+            for target, _ in resolve(name, path, node):
+                if target != name:
+                    edges.add(target)
+        graph[name] = edges
+    return graph
+
+
+def find_cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """Every back edge of a depth-first search, as the cycle it closes (empty: acyclic)."""
+    state, stack, cycles = {}, [], []
+
+    def dfs(u):
+        state[u] = "open"
+        stack.append(u)
+        for v in sorted(graph.get(u, ())):
+            if state.get(v) == "open":
+                cycles.append([*stack[stack.index(v):], v])
+            elif v not in state:
+                dfs(v)
+        stack.pop()
+        state[u] = "done"
+
+    for u in sorted(graph):
+        if u not in state:
+            dfs(u)
+    return cycles
+
+
+# ------------------------------------------------------------------------------------------------
+# import cycles
+# ------------------------------------------------------------------------------------------------
+def test_the_checker_sees_imports_and_cycles():
+    # the parser finds the imports it must (absolute and relative, from a package and from a module)
+    graph = import_graph()
+    assert len(MODULES) > 20 and "bendpam.law" in MODULES and "bendpam.cli.app" in MODULES
+    assert {"bendpam.actuator", "bendpam.braid", "bendpam.models"} <= graph["bendpam.law"]
+    assert "bendpam.law" in graph["bendpam"] and "bendpam.cli.app" in graph["bendpam.cli.predict"]
+    tree = ast.parse("import bendpam.law\nfrom bendpam import braid\nfrom ..models import energy\n"
+                     "def f():\n    from . import plots\n"
+                     "from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from ..sweeps import sweep\n"
+                     "try:\n    from ..fast import moment_table\nexcept ImportError:\n    pass\n")
+    got = {t for n in module_level_imports(tree) for t, _ in resolve("bendpam.lab.simulate", SRC / "lab" / "x.py", n)}
+    assert got == {"bendpam.law", "bendpam.braid", "bendpam.models.energy", "bendpam.fast"}
+    # and the cycle finder finds a cycle
+    assert find_cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c", "a"]]
+    assert find_cycles({"a": {"b"}, "b": set(), "c": {"a", "b"}}) == []
+
+
+def test_no_import_cycle_among_bendpam_modules():
+    cycles = find_cycles(import_graph())
+    assert cycles == [], "module-level import cycles: " + "; ".join(" -> ".join(c) for c in cycles)
+
+
+# ------------------------------------------------------------------------------------------------
+# private names
+# ------------------------------------------------------------------------------------------------
+def private_imports() -> list[str]:
+    """``path: from module import _name`` for every private name imported from another bendpam module."""
+    bad = []
+    for name, path in MODULES.items():
+        for node in ast.walk(parse(path)):  # anywhere, also inside functions
+            if not isinstance(node, ast.ImportFrom):
+                continue
+            for target, imported in resolve(name, path, node):
+                if imported is not None and imported.startswith("_") and imported != "__version__":
+                    bad.append(f"{path.relative_to(ROOT).as_posix()}: from {target} import {imported}")
+    return bad
+
+
+#: Violations present when this test was written (reported as src bugs); new ones fail at once.
+KNOWN_PRIVATE_IMPORTS: set[str] = set()  # none left
+
+
+def test_no_private_name_is_imported_from_another_bendpam_module():
+    # (importing a public name under a private alias, ``from .x import y as _y``, is fine)
+    bad = [b for b in private_imports() if b not in KNOWN_PRIVATE_IMPORTS]
+    assert bad == [], "private names imported across modules:\n" + "\n".join(bad)
+
+
+def test_known_private_imports_are_gone():
+    assert not KNOWN_PRIVATE_IMPORTS & set(private_imports())
+
+
+def test_the_private_import_check_sees_them():
+    tree = ast.parse("from ..material import MooneyRivlin, _within\nfrom .. import __version__\n"
+                     "from ..checks import pressure_kpa as _p\ndef f():\n    from ..law import _branch_table\n")
+    found = sorted((t, i) for n in ast.walk(tree) if isinstance(n, ast.ImportFrom)
+                   for t, i in resolve("bendpam.lab.x", SRC / "lab" / "x.py", n)
+                   if i is not None and i.startswith("_") and i != "__version__")
+    assert found == [("bendpam.law", "_branch_table"), ("bendpam.material", "_within")]
+
+
+# ------------------------------------------------------------------------------------------------
+# a light import
+# ------------------------------------------------------------------------------------------------
+HEAVY = ["matplotlib", "xarray", "pandas", "dask", "scipy.stats", "scipy.optimize"]
+
+
+@pytest.fixture(scope="module")
+def modules_after_import():
+    code = "import json, sys, bendpam; print(json.dumps(sorted(sys.modules)))"
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    return set(json.loads(r.stdout))
+
+
+@pytest.mark.parametrize("heavy", HEAVY)
+def test_import_bendpam_is_light(modules_after_import, heavy):
+    assert "bendpam" in modules_after_import and "bendpam.law" in modules_after_import
+    loaded = sorted(m for m in modules_after_import if m == heavy or m.startswith(heavy + "."))
+    assert loaded == [], f"`import bendpam` imports {heavy}: {loaded[:5]}"
+
+
+# ------------------------------------------------------------------------------------------------
+# the command line starts
+# ------------------------------------------------------------------------------------------------
+def _bendpam_command() -> list[str]:
+    exe = Path(sys.executable).with_name("bendpam")
+    if exe.exists():
+        return [str(exe)]
+    return [sys.executable, "-c", "import sys; from bendpam.cli import main; sys.exit(main())"]
+
+
+@pytest.mark.parametrize("flag", ["--help", "--version"])
+def test_bendpam_help_and_version_exit_0(flag, tmp_path):
+    r = subprocess.run([*_bendpam_command(), flag], capture_output=True, text=True, cwd=tmp_path, timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert r.stderr == ""
+    if flag == "--version":
+        assert r.stdout.startswith("bendpam ") and r.stdout.count("\n") == 1
+    else:
+        for command in ("predict", "curve", "stresses", "actuator", "sweep", "fit", "process", "report"):
+            assert command in r.stdout, command
+        assert "kPa" in r.stdout  # the unit rule is stated up front
+
+
+# ------------------------------------------------------------------------------------------------
+# the law is the only sampler of the models
+# ------------------------------------------------------------------------------------------------
+MODELS_PACKAGE = "bendpam.models"
+SAMPLERS = {"coefficients", "basis"}
+ALLOWED = {"bendpam.law", "bendpam.braid"}
+
+
+def _is_models(target: str) -> bool:
+    return target == MODELS_PACKAGE or target.startswith(MODELS_PACKAGE + ".")
+
+
+def direct_sampling_calls(name: str, path: Path, tree: ast.Module) -> list[str]:
+    """Calls of the models' ``coefficients``/``basis`` in one module (imports anywhere count).
+
+    A *model expression* is a name bound to :mod:`bendpam.models`, ``bendpam.models.energy`` or
+    ``bendpam.models.force_balance`` (by import or by assignment from a model expression,
+    ``self._mod = energy``), a call of ``get_model``, or a conditional, ``or`` or dictionary
+    look-up of those.  A call ``<model expression>.coefficients(...)`` or ``.basis(...)``, or of
+    ``coefficients``/``basis`` imported from a model module, is a direct sampling call.
+    """
+    modules: set[str] = set()  # names (or dotted attributes) bound to model modules
+    factories: set[str] = set()  # names bound to get_model
+    functions: set[str] = set()  # names bound to the models' coefficients / basis
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            for a in node.names:
+                if _is_models(a.name):
+                    modules.add(a.asname or a.name)
+        elif isinstance(node, ast.ImportFrom):
+            resolved = resolve(name, path, node)  # one entry per name, or none (not a bendpam import)
+            for a, (target, imported) in zip(node.names, resolved or [("", None)] * len(node.names), strict=True):
+                if not _is_models(target):
+                    continue
+                bound = a.asname or a.name
+                if imported is None:
+                    modules.add(bound)  # a model module (or the package)
+                elif imported == "get_model":
+                    factories.add(bound)
+                elif imported in SAMPLERS:
+                    functions.add(bound)
+
+    def is_model(expr) -> bool:
+        if isinstance(expr, (ast.Name, ast.Attribute)):
+            return ast.unparse(expr) in modules
+        if isinstance(expr, ast.Call):
+            return isinstance(expr.func, ast.Name) and expr.func.id in factories
+        if isinstance(expr, ast.IfExp):
+            return is_model(expr.body) or is_model(expr.orelse)
+        if isinstance(expr, ast.BoolOp):
+            return any(is_model(v) for v in expr.values)
+        if isinstance(expr, ast.Subscript):
+            return is_model(expr.value)
+        if isinstance(expr, ast.Dict):
+            return any(v is not None and is_model(v) for v in expr.values)
+        return False
+
+    changed = True
+    while changed:  # follow assignments until nothing changes
+        changed = False
+        for node in ast.walk(tree):
+            if isinstance(node, (ast.Assign, ast.AnnAssign)) and node.value is not None and is_model(node.value):
+                for t in (node.targets if isinstance(node, ast.Assign) else [node.target]):
+                    if isinstance(t, (ast.Name, ast.Attribute)) and ast.unparse(t) not in modules:
+                        modules.add(ast.unparse(t))
+                        changed = True
+    found = []
+    for node in ast.walk(tree):
+        if not isinstance(node, ast.Call):
+            continue
+        f = node.func
+        if (isinstance(f, ast.Attribute) and f.attr in SAMPLERS and is_model(f.value)) or \
+                (isinstance(f, ast.Name) and f.id in functions):
+            found.append(f"{path.relative_to(ROOT)}:{node.lineno}: {ast.unparse(f)}(...)")
+    return sorted(found, key=lambda s: int(s.split(":")[1]))
+
+
+def test_the_sampler_check_finds_direct_calls():
+    snippet = ("from .models import get_model, normalise_model, energy as en\nfrom .models.force_balance import basis\n"
+               "class X:\n    def __init__(self, m):\n        self._mod = get_model(m)\n"
+               "    def a(self, p, k):\n        return self._mod.coefficients(p, k)\n"
+               "def b(p, k):\n    return get_model('energy').coefficients(p, k)\n"
+               "def c(p, k):\n    m = en\n    return m.basis(p, k)\n"
+               "def d(p, k):\n    return basis(p, k)\n"
+               "def e(law, model, k):\n    model = normalise_model(model)\n"
+               "    return MomentLaw.of(law, model).coefficients(k)\n"
+               "def g(p):\n    mod = {'energy': en}[p]\n    return mod.basis(p, 0.0)\n")
+    found = direct_sampling_calls("bendpam.somewhere", SRC / "somewhere.py", ast.parse(snippet))
+    assert [f.split(": ")[1] for f in found] == ["self._mod.coefficients(...)", "get_model('energy').coefficients(...)",
+                                                "m.basis(...)", "basis(...)", "mod.basis(...)"]
+    # the law itself samples the models (it is the one allowed to)
+    assert direct_sampling_calls("bendpam.law", MODULES["bendpam.law"], parse(MODULES["bendpam.law"]))
+
+
+def test_the_law_is_the_only_sampler():
+    found = []
+    grep = re.compile(r"get_model\([^()]*\)\s*\.\s*(coefficients|basis)\s*\(")
+    for name, path in MODULES.items():
+        if name in ALLOWED or _is_models(name):
+            continue
+        found += direct_sampling_calls(name, path, parse(path))
+        text = path.read_text(encoding="utf-8")  # and a plain grep, whatever the names
+        found += [f"{path.relative_to(ROOT)}: {m.group(0)}" for m in grep.finditer(text)]
+    assert found == [], ("only bendpam.law (and bendpam.models, bendpam.braid) may call the models' "
+                         "coefficients/basis; use bendpam.MomentLaw:\n" + "\n".join(found))
