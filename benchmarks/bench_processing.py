@@ -1,49 +1,73 @@
-"""Benchmark: raw samples processed per second (issue 3 target: >= 1e6 samples/s on one core).
+"""Processing benchmark: raw samples per second for ``process_series`` and for read + process.
 
-Builds a long simulated cyclic test (BE-PAM at 200 kPa, many cycles at a high sampling rate),
-writes it as plain CSV and testXpert, and times reading and processing separately, with the
-peak memory of each stage (tracemalloc).  Run:  python benchmarks/bench_processing.py
+A long simulated cyclic test (BE-PAM at 200 kPa, 10 cycles at a high sampling rate) is processed
+in memory, then written as plain CSV and as a testXpert export and read back and processed.  All
+candidates run side by side (interleaved repeats, median); peak traced memory of one extra run.
+
+Run: ``python benchmarks/bench_processing.py [--quick]``.
 """
 
 from __future__ import annotations
 
-import argparse
 import sys
 import tempfile
 from pathlib import Path
 
-from bendpam import presets
-from bendpam.lab import read_test, write_test
-from bendpam.lab.processing import process_series
-from bendpam.lab.simulate import SimulationSettings, simulate_test
-
 sys.path.insert(0, str(Path(__file__).parent))
-from _timing import measure  # noqa: E402
+from _timing import Recorder, compare, header, peak_mib, standalone
+
+TARGET = 1e6  # samples/s on one core (issue 3)
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--samples", type=float, default=1e6, help="approximate number of raw samples")
-    args = ap.parse_args()
+def simulated_test(samples: float, pressure_kpa: float = 200.0):
+    """A BE-PAM test at ``pressure_kpa`` with about ``samples`` raw samples (10 cycles)."""
+    from bendpam import presets
+    from bendpam.lab.simulate import SimulationSettings, simulate_test
+
     a = presets.be_pam()
-    # one cycle at 200 kPa and 30 mm/min is ~236 s; choose the rate to reach the sample count in 10 cycles
-    rate = args.samples / (10 * 236.0)
-    data, _ = simulate_test(a, 200, settings=SimulationSettings(cycles=10, rate_hz=rate, seed=0))
+    _, truth = simulate_test(a, pressure_kpa, settings=SimulationSettings(cycles=10, rate_hz=0.5, seed=0))
+    rate = samples / truth["duration_s"]
+    data, _ = simulate_test(a, pressure_kpa, settings=SimulationSettings(cycles=10, rate_hz=rate, seed=0))
+    return data
+
+
+def process(data, pressure_kpa: float = 200.0):
+    from bendpam.lab.processing import process_series
+
+    return process_series(data.time_s.to_numpy(), data.stroke_mm.to_numpy(), data.force_n.to_numpy(), pressure_kpa,
+                          keep_series=False)
+
+
+def run(rec: Recorder, quick: bool) -> None:
+    from bendpam.lab import read_test, write_test
+
+    data = simulated_test(2e5 if quick else 1e6)
     n = len(data)
-    print(f"raw samples: {n:,} (10 cycles at {rate:.0f} Hz)")
-    _, t_proc, mem = measure(lambda: process_series(data.time_s.to_numpy(), data.stroke_mm.to_numpy(),
-                                                  data.force_n.to_numpy(), 200.0, keep_series=False))
-    print(f"process_series: {t_proc:.3f} s  -> {n / t_proc:,.0f} samples/s   peak {mem:.0f} MiB   (target >= 1,000,000)")
+    header(f"Processing: {n:,} raw samples (BE-PAM, 200 kPa, 10 cycles); samples/s, median of interleaved runs")
     with tempfile.TemporaryDirectory() as d:
+        files = {}
         for dialect in ("csv", "testxpert"):
             p = Path(d) / f"t_200kPa.{dialect}.txt"
             write_test(p, data, dialect, pressure_kpa=200)
-            rt, t_read, mem = measure(lambda: read_test(p))
-            print(f"read_test[{dialect}]: {t_read:.3f} s  -> {n / t_read:,.0f} samples/s   peak {mem:.0f} MiB")
-            _, t_all, _ = measure(lambda: process_series(rt.data.time_s.to_numpy(), rt.data.stroke_mm.to_numpy(),
-                                                       rt.data.force_n.to_numpy(), 200.0, keep_series=False), 1)
-            print(f"read + process [{dialect}]: {t_read + t_all:.3f} s -> {n / (t_read + t_all):,.0f} samples/s")
+            files[dialect] = p
+        cands = {"process_series": (lambda: process(data), n)}
+        for dialect, p in files.items():
+            cands[f"read {dialect}"] = (lambda p=p: read_test(p), n)
+            cands[f"read+process {dialect}"] = (lambda p=p: process(read_test(p).data), n)
+        st = compare(cands, repeats=3 if quick else 5)
+        mem = {k: peak_mib(v[0]) for k, v in cands.items() if k.startswith(("process", "read+"))}
+    for k, s in st.items():
+        m = f", peak {mem[k]:.0f} MiB" if k in mem else ""
+        print(f"  {k:24} {s}  -> {s.rate:12,.0f} samples/s{m}")
+    rec.record("processing", "samples", n)
+    rec.record("processing", "timing", st)
+    rec.record("processing", "peak_mib", mem)
+    rec.row("process_series samples/s", st["process_series"].rate, "/s", ">= 1e6", st["process_series"].rate >= TARGET,
+            "issue 3 target")
+    for dialect in ("csv", "testxpert"):
+        r = st[f"read+process {dialect}"].rate
+        rec.row(f"read+process {dialect} samples/s", r, "/s", "", None)
 
 
 if __name__ == "__main__":
-    main()
+    standalone(run, "processing")
