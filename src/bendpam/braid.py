@@ -145,8 +145,8 @@ def solve_u(q_target, alpha0: float, order: int = DEFAULT_ORDER, u_bounds: tuple
     eps = 1e-9 * (hi - lo)
     if np.ndim(alpha0) == 0:
         # start from a monotone interpolation of the inverse q -> u (tabulated once per alpha0)
-        qt, ut = _inverse_table(float(alpha0), int(order))
-        u0 = np.interp(q, qt, ut)
+        qt, ut, dt = _inverse_table(float(alpha0), int(order))
+        u0 = _hermite_start(q, qt, ut, dt)
     else:
         # per-point braid angles (sweeps): interpolate a table of q over (alpha0, normalised u)
         u0 = _universal_start(q, np.broadcast_to(alpha0, q.shape), int(order))
@@ -161,7 +161,8 @@ def solve_u(q_target, alpha0: float, order: int = DEFAULT_ORDER, u_bounds: tuple
         un = u - step
         outside = ~((un >= lo) & (un <= hi))
         un = np.where(outside, 0.5 * (lo + hi), un)
-        done = (np.abs(un - u) <= 1e-14 * np.abs(u)) | (f == 0.0)
+        # Newton converges quadratically: a step below 1e-8 |u| leaves an error near 1e-16 |u|
+        done = ((np.abs(un - u) <= 1e-8 * np.abs(u)) & ~outside) | (f == 0.0)
         u = np.where(f == 0.0, u, un)
         if np.all(done):
             break
@@ -214,18 +215,32 @@ def _universal_start(q, alpha0, order: int):
 
 
 @lru_cache(maxsize=64)
-def _inverse_table(alpha0: float, order: int) -> tuple[np.ndarray, np.ndarray]:
-    """Table ``(q(u), u)`` on (-1/2, u_lock), increasing, for Newton starting values."""
+def _inverse_table(alpha0: float, order: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Table ``(q(u), u, du/dq)`` on (-1/2, u_lock), increasing, for Newton starting values."""
     c, s = math.cos(alpha0), math.sin(alpha0)
     u_lock = (1.0 / c - 1.0) / 2.0
-    t = np.linspace(0.0, 1.0, 257)
+    t = np.linspace(0.0, 1.0, 513)
     u = np.concatenate([-0.5 * (1.0 - (1.0 - t[::-1]) ** 2)[:-1] * 0.9999, u_lock * (1.0 - (1.0 - t) ** 2) * 0.9999])
     phi, wbar = gauss_nodes(order)
-    ib, _ = ibar(u, c, 1.0 - np.cos(phi), wbar)
+    ib, dib = ibar(u, c, 1.0 - np.cos(phi), wbar)
     q = s * u * ib
-    q.setflags(write=False)
-    u.setflags(write=False)
-    return q, u
+    dudq = 1.0 / (s * (ib + u * dib))
+    for a in (q, u, dudq):
+        a.setflags(write=False)
+    return q, u, dudq
+
+
+def _hermite_start(q, qt, ut, dt):
+    """Cubic Hermite interpolation of the inverse ``u(q)`` from the table (values and slopes)."""
+    j = np.clip(np.searchsorted(qt, q) - 1, 0, qt.size - 2)
+    h = qt[j + 1] - qt[j]
+    x = np.clip((q - qt[j]) / h, 0.0, 1.0)
+    x2 = x * x
+    h00 = (1.0 + 2.0 * x) * (1.0 - x) ** 2
+    h10 = x * (1.0 - x) ** 2
+    h01 = x2 * (3.0 - 2.0 * x)
+    h11 = x2 * (x - 1.0)
+    return h00 * ut[j] + h10 * h * dt[j] + h01 * ut[j + 1] + h11 * h * dt[j + 1]
 
 
 @dataclass(frozen=True)

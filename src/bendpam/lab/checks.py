@@ -11,7 +11,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import ndimage
 
 __all__ = ["GAP_FACTOR", "GAP_MIN_S", "SPIKE_FACTOR", "TimeProblems", "find_spikes", "time_problems"]
 
@@ -53,6 +52,8 @@ def find_spikes(x: np.ndarray) -> np.ndarray:
     mag = float(np.median(np.abs(x)))
     floor = max(1e-9 * max(mag, 1.0), 1e-12)
     scale = max(scale, floor)
+    from scipy import ndimage
+
     dev = ndimage.median_filter(x, size=5, mode="nearest")
     np.subtract(x, dev, out=dev)
     np.abs(dev, out=dev)

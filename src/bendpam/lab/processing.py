@@ -44,7 +44,6 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 import xarray as xr
-from scipy import signal
 
 from ..errors import InputError, ProcessingError
 from ..fixture import PAPER_FIXTURE, Fixture
@@ -184,6 +183,8 @@ class PressureResult:
 def _lowpass(x: np.ndarray, fs: float, cutoff: float, order: int) -> np.ndarray:
     if cutoff <= 0.0:
         return x.copy()
+    from scipy import signal
+
     sos = signal.butter(order, cutoff, btype="low", fs=fs, output="sos")
     padlen = min(3 * (2 * sos.shape[0] + 1), x.size - 1)
     return signal.sosfiltfilt(sos, x, padlen=padlen)
@@ -197,6 +198,8 @@ def _segment_lowpass(x: np.ndarray, tp: np.ndarray, fs: float, cutoff: float, or
     """
     if cutoff <= 0.0:
         return x.copy()
+    from scipy import signal
+
     sos = signal.butter(order, cutoff, btype="low", fs=fs, output="sos")
     edges = np.unique(np.concatenate([tp, [x.size - 1]]))
     out = fallback.copy()
