@@ -71,7 +71,9 @@ def main(argv: list[str] | None = None) -> int:
 
     try:
         with interrupts():
-            app(args=args, prog_name="bendpam", standalone_mode=False)
+            rv = app(args=args, prog_name="bendpam", standalone_mode=False)
+        if isinstance(rv, int) and not isinstance(rv, bool):  # typer.Exit(code) inside a command
+            return rv
     except Interrupted as exc:
         typer.echo("bendpam: interrupted; no outputs were changed", err=True)
         return exc.exit_code
