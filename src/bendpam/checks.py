@@ -20,7 +20,7 @@ import numpy as np
 
 from .errors import InputError
 
-__all__ = ["MPA_SUSPECT_KPA", "UnitWarning", "number", "pressure_kpa"]
+__all__ = ["MPA_SUSPECT_KPA", "UnitWarning", "float_array", "number", "pressure_kpa"]
 
 #: Below this (kPa), a set of pressures is suspected to be in MPa.
 MPA_SUSPECT_KPA = 5.0
@@ -59,6 +59,16 @@ def number(name: str, value: Any, lo: float | None = None, hi: float | None = No
     return v
 
 
+def float_array(name: str, value: Any, unit: str) -> np.ndarray:
+    """``value`` as a float array, or a one-line :class:`InputError` (a bool or a string is not a number)."""
+    if isinstance(value, bool | str | bytes):
+        raise InputError(f"{name} = {value!r} is not a number ({unit} expected)")
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} = {value!r} is not numeric ({unit} expected)") from None
+
+
 def pressure_kpa(value: Any, name: str = "pressure_kpa", *, warn: bool = True) -> np.ndarray:
     """Gauge pressures in kPa as a float array: finite and >= 0, else a one-line :class:`InputError`.
 
@@ -67,12 +77,7 @@ def pressure_kpa(value: Any, name: str = "pressure_kpa", *, warn: bool = True) -
     >>> pressure_kpa([100, 150]).tolist()
     [100.0, 150.0]
     """
-    if isinstance(value, bool | str | bytes):
-        raise InputError(f"{name} = {value!r} is not a number (kPa expected)")
-    try:
-        p = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise InputError(f"{name} = {value!r} is not numeric (kPa expected)") from None
+    p = float_array(name, value, "kPa")
     if p.size and not np.all(np.isfinite(p)):
         i = int(np.flatnonzero(~np.isfinite(p.ravel()))[0])
         raise InputError(f"{name} has a non-finite value {p.ravel()[i]!r} at index {i}; allowed range [0, inf) kPa")

@@ -43,6 +43,7 @@ import numpy as np
 
 from .actuator import NEUTRAL_ANGLE_DEG, Actuator, ModelParams
 from .braid import DEFAULT_ORDER, LOCK_FRACTION, MIN_FAR_STRETCH, CurvatureLimits, curvature_limits, radius_from_u
+from .checks import float_array
 from .checks import pressure_kpa as _check_pressure
 from .errors import InputError, NoEquilibrium
 from .models import energy, force_balance, normalise_model
@@ -187,12 +188,7 @@ class MomentLaw:
     # ---- validated evaluation -----------------------------------------------------------------
     def check_curvature(self, curvature_per_mm) -> np.ndarray:
         """``curvature_per_mm`` as a float array inside the lock-up limits, else a one-line InputError."""
-        if isinstance(curvature_per_mm, bool | str | bytes):
-            raise InputError(f"curvature_per_mm = {curvature_per_mm!r} is not a number (1/mm expected)")
-        try:
-            k = np.asarray(curvature_per_mm, dtype=float)
-        except (TypeError, ValueError):
-            raise InputError(f"curvature_per_mm = {curvature_per_mm!r} is not numeric (1/mm expected)") from None
+        k = float_array("curvature_per_mm", curvature_per_mm, "1/mm")
         self.limits.check(k)
         return k
 
