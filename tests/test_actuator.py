@@ -165,3 +165,21 @@ def test_outputs_have_ordinary_permissions(tmp_path):
     umask = os.umask(0)
     os.umask(umask)
     assert stat.S_IMODE(p.stat().st_mode) == 0o666 & ~umask
+
+
+def test_actuator_files_know_their_model(tmp_path, capsys):
+    from bendpam.cli import main
+
+    assert presets.be_pam("force_balance").model == "force_balance"
+    f = tmp_path / "be.toml"
+    assert main(["actuator", "--preset", "be-pam", "--model", "force-balance", "--out", str(f)]) == 0
+    a = Actuator.from_toml(f)
+    assert a.model == "force_balance" and a.C10_kpa == presets.be_pam("force_balance").C10_kpa
+    capsys.readouterr()
+    assert main(["predict", "--actuator", str(f), "--model", "force-balance", "--pressure-kpa", "150"]) == 0
+    assert "warning" not in capsys.readouterr().err
+    assert main(["predict", "--actuator", str(f), "--model", "energy", "--pressure-kpa", "150"]) == 0
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "force-balance model" in err and "warning" in err
+    with pytest.raises(InputError, match="model"):
+        a.replace(model="elastic")

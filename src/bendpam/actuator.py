@@ -166,6 +166,10 @@ class Actuator:
         only to turn the braid line tension into the nominal stress sigma_br (eq 31, 48).
     name : str
         A label for tables and figures.
+    model : str
+        The model whose identification gave these constants (``"energy"``, ``"force_balance"``) or
+        ``""`` (unknown).  Table 3 gives different constants for each model; the command line warns
+        when an actuator is used with the other model.
     """
 
     alpha0_deg: float
@@ -181,6 +185,7 @@ class Actuator:
     R0_start_mm: float | None = None
     braid_thickness_mm: float = 0.3
     name: str = ""
+    model: str = ""
 
     # derived, filled in __post_init__
     _material: MooneyRivlin = field(init=False, repr=False, compare=False, hash=False)
@@ -213,10 +218,14 @@ class Actuator:
                 _check("R0_start_mm", self.R0_start_mm, self.R0_mm, None, lo_open=False, unit="mm"),
             )
         s(self, "braid_thickness_mm", _check("braid_thickness_mm", self.braid_thickness_mm, 0.0, None, unit="mm"))
+        if self.model not in ("", "energy", "force_balance"):
+            raise InputError(f"model = {self.model!r}: the model the constants were identified with must be "
+                             "'energy', 'force_balance' or '' (unknown)")
         if not isinstance(self.name, str):
             raise InputError(f"name = {self.name!r} must be a string")
         s(self, "_material", MooneyRivlin(self.C10_kpa * 1e-3, self.C01_kpa * 1e-3))
-        s(self, "_params", ModelParams.build(**{f: getattr(self, f) for f in self.field_names() if f != "name"}))
+        s(self, "_params", ModelParams.build(**{f: getattr(self, f) for f in self.field_names()
+                                                     if f not in ("name", "model")}))
 
     # ---- derived values (units in the names) ---------------------------------------------------
     @property

@@ -855,7 +855,8 @@ def _result(processed, actuator, model, prob, bnd, unc: _Uncertainty, tension, h
     """Stage 5: the fitted actuator, its parameters, the metrics and the loop."""
     flags = list(unc.flags)
     fitted = prob.actuator(unc.values)
-    fitted = fitted.replace(name=f"{actuator.name or actuator.kind} [fitted, {model.replace('_', '-')} model]")
+    fitted = fitted.replace(name=f"{actuator.name or actuator.kind} [fitted, {model.replace('_', '-')} model]",
+                            model=model)
     params = {}
     for n in _ORDER:
         field_, unit = PARAMETERS[n]

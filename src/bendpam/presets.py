@@ -46,6 +46,7 @@ def _make(which: str, model: str) -> Actuator:
         C10_kpa=c10,
         C01_kpa=c01,
         name=f"{label} (paper, {m.replace('_', '-')} constants)",
+        model=m,
         **_TABLE1,
         **_START[which],
     )

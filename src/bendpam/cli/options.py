@@ -152,7 +152,11 @@ def load_actuator(preset: Preset | None, actuator: Path | None, model: Model) ->
     if preset is not None:
         return presets.get(preset.value, model_name(model))
     assert actuator is not None  # exactly one of preset and actuator was checked above
-    return Actuator.from_toml(actuator)
+    act = Actuator.from_toml(actuator)
+    if act.model and act.model != model_name(model):
+        echo(f"bendpam: warning: {actuator}: its constants were identified with the {act.model.replace('_', '-')} "
+             f"model; using them with the {model.value} model", err=True)
+    return act
 
 
 def fmt_num(x, fmt: str) -> str:
