@@ -259,6 +259,9 @@ class LoopModel:
     @classmethod
     def from_dict(cls, d: dict, *, source: str = "hysteresis") -> LoopModel:
         known = set(cls.__dataclass_fields__)
+        if not isinstance(d, dict):
+            raise InputError(f"{source}: expected a table of loop parameters ({', '.join(sorted(known))}), "
+                             f"got {type(d).__name__} {d!r}")
         unknown = [k for k in d if k not in known]
         if unknown:
             raise InputError(f"{source}: unknown hysteresis parameter(s) {unknown}; known: {', '.join(sorted(known))}")

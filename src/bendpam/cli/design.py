@@ -95,6 +95,18 @@ def _plot_target(plot: Optional[Path]):
     return plot
 
 
+#: The most equilibrium solutions one design command may compute (each takes about 10 ms).
+MAX_DESIGN_POINTS = 10_000
+
+
+def _budget(n: int, what: str) -> None:
+    """Refuse a design grid of more than :data:`MAX_DESIGN_POINTS` points before computing it."""
+    from .options import UserError
+
+    if n > MAX_DESIGN_POINTS:
+        raise UserError(f"{what} = {n} points; at most {MAX_DESIGN_POINTS} (about 10 ms each): give fewer values")
+
+
 def _length(act, l0_mm):
     from .options import UserError
 
@@ -150,6 +162,7 @@ def register(app: typer.Typer) -> typer.Typer:
 
         act = _length(load_actuator(preset, actuator, model), l0_mm)
         P = pressures_kpa(pressure_kpa, more)
+        _budget(len(P), "--pressure-kpa")
         mname = model_name(model)
         plot = _plot_target(plot)
         bend_key = bend.strip().lower()
@@ -245,6 +258,7 @@ def register(app: typer.Typer) -> typer.Typer:
             if d <= 0:
                 raise UserError(f"--diameter-mm: {d:g} mm is not a positive diameter")
         P = pressures_kpa(pressure_kpa, None)
+        _budget(len(P) * len(D), "--pressure-kpa x --diameter-mm")
         mname = model_name(model)
         plot = _plot_target(plot)
         gr = Gripper(act, mname, fingers=fingers,
@@ -323,6 +337,7 @@ def register(app: typer.Typer) -> typer.Typer:
         act = load_actuator(preset, actuator, model)
         P = pressures_kpa(pressure_kpa, more)
         dirs = parse_values(direction_deg, "--direction-deg") if direction_deg else [0.0, 90.0, 180.0, 270.0]
+        _budget(len(P) * len(dirs), "--pressure-kpa x --direction-deg")
         mname = model_name(model)
         plot = _plot_target(plot)
         w = Wrist(act, mname, radius_mm=radius_mm, length_mm=length_mm, lateral_stiffness_nmm2=lateral_stiffness,

@@ -24,6 +24,18 @@ from .options import (
     pressures_kpa,
 )
 
+#: The most (case, pressure) points one block may hold: the model's working arrays take about 2 kB per point.
+MAX_BLOCK_POINTS = 1_000_000
+#: The largest value of --max-points (the result alone takes 40 bytes per point).
+MAX_POINTS_LIMIT = 1_000_000_000
+
+
+def max_local_workers() -> int:
+    """The most processes ``--workers`` may start: four per CPU."""
+    import os
+
+    return 4 * (os.cpu_count() or 1)
+
 
 def parse_param(text: str) -> tuple[str, list[float]]:
     """``NAME=start:stop:count`` or ``NAME=v1,v2,...`` -> (name, values)."""
@@ -54,8 +66,9 @@ def sweep_cmd(
     = None,
     chunk_cases: Annotated[int, typer.Option("--chunk-cases", min=1, max=1_000_000,
                                              help="Actuator cases per block (memory bound).")] = 256,
-    max_points: Annotated[int, typer.Option("--max-points", min=1, help="Refuse sweeps larger than this many "
-                                            "(case, pressure) points.")] = 100_000_000,
+    max_points: Annotated[int, typer.Option("--max-points", min=1, max=MAX_POINTS_LIMIT,
+                                            help="Refuse sweeps larger than this many (case, pressure) points.")]
+    = 100_000_000,
     out: Annotated[Optional[Path], typer.Option("--out", help="Output NetCDF file (.nc).")] = None,
     plot: Annotated[Optional[Path], typer.Option("--plot", help="Quick figure (.png) of one output.")] = None,
     plot_var: Annotated[str, typer.Option("--plot-var", help="Output to plot.")] = "free_angle_deg",
@@ -77,6 +90,9 @@ def sweep_cmd(
         raise UserError("give either --scheduler or --workers, not both")
     if workers is not None and workers < 1:
         raise UserError(f"--workers {workers}: give at least 1 worker process")
+    if workers is not None and workers > max_local_workers():
+        raise UserError(f"--workers {workers}: at most {max_local_workers()} local processes (4 per CPU); "
+                        "use --scheduler for a larger cluster")
     act = load_actuator(preset, actuator, model)
     params = dict(parse_param(p) for p in (param or []))
     for name in params:
@@ -89,6 +105,12 @@ def sweep_cmd(
     if n_points > max_points:
         raise UserError(f"the sweep has {n_points} (case, pressure) points, more than --max-points {max_points}; "
                         "raise --max-points to run it")
+    n_cases = n_points // len(P)
+    block = min(chunk_cases, n_cases) * len(P)
+    if block > MAX_BLOCK_POINTS:
+        raise UserError(f"--chunk-cases {chunk_cases} with {len(P)} pressures gives {block} (case, pressure) points "
+                        f"per block, more than {MAX_BLOCK_POINTS} (about 2 kB of memory each); use --chunk-cases "
+                        f"{max(MAX_BLOCK_POINTS // len(P), 1)} or fewer, or fewer pressures")
     # typed Any: mypy would check the arrays against sweep()'s other keyword parameters
     grids: dict[str, Any] = {k: np.asarray(v) for k, v in params.items()}
     ds = sweep(act, P, model_name(model), chunk_cases=chunk_cases, scheduler=scheduler, workers=workers,

@@ -659,6 +659,12 @@ def load_processed(path) -> ProcessedSet:
     for i, P in enumerate(ds["pressure_kpa"].values):
         bmc = ds["blocked_moment_cycle_nmm"].values[i]
         n = int(np.sum(np.isfinite(bmc)))
+        if not np.isfinite(P):
+            raise ProcessingError(f"{nc}: pressure {i + 1} is not a finite number ({P!r})")
+        if n == 0 or not np.isfinite(ds["curvature_per_mm"].values[i]).any() \
+                or not np.isfinite(ds["moment_nmm"].values[i, :n]).any():
+            raise ProcessingError(f"{nc}: no finite cycle at {float(P):g} kPa (blocked moments, curvatures or "
+                                  "moments are all missing); process the raw files again")
         results.append(PressureResult(
             pressure_kpa=float(P), source=sources[i] if i < len(sources) else str(nc), n_cycles=n,
             curvature_grid=ds["curvature_per_mm"].values[i], branches=ds["moment_nmm"].values[i, :n],

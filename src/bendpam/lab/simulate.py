@@ -48,6 +48,10 @@ MAX_BETA_DEG = 80.0
 
 DIALECT_SUFFIX = {"csv": ".csv", "testxpert": ".txt", "bluehill": ".csv", "mts": ".txt"}
 
+#: The most samples one simulated test may record (rate x duration); a larger test is refused before any
+#: allocation (10^7 samples are a few hundred MB of working arrays).
+MAX_SAMPLES = 10_000_000
+
 
 @dataclass(frozen=True)
 class SimulationSettings:
@@ -88,6 +92,9 @@ class SimulationSettings:
                 raise InputError(f"{name} = {v!r} is not a number") from None
             if not (math.isfinite(fv) and lo <= fv <= hi):
                 raise InputError(f"{name} = {v!r} is outside the allowed range [{lo:g}, {hi:g}]")
+        if self.seed is not None and (isinstance(self.seed, bool) or not isinstance(self.seed, int | np.integer)
+                                      or not 0 <= int(self.seed) < 2**128):
+            raise InputError(f"seed = {self.seed!r} must be an integer in [0, 2^128)")
         if self.hysteresis_law not in LAWS:
             raise InputError(f"hysteresis_law = {self.hysteresis_law!r}; choose one of {', '.join(LAWS)}")
 
@@ -159,6 +166,13 @@ def simulate_test(actuator, pressure_kpa: float, model: str = "energy", *, fixtu
         knots_t.append(knots_t[-1] + dur)
         knots_s.append(b)
     T = knots_t[-1]
+    n_samples = math.floor(T * st.rate_hz + 0.5) + 1
+    if n_samples > MAX_SAMPLES:
+        raise InputError(
+            f"at {pressure_kpa:g} kPa the test would record {n_samples:,} samples ({st.rate_hz:g} Hz x {T:.4g} s), "
+            f"more than the limit of {MAX_SAMPLES:,} per test; use a lower --rate-hz, fewer --cycles, a shorter "
+            "--dwell-s or a higher --speed-mm-min"
+        )
     t = np.arange(0.0, T + 0.5 / st.rate_hz, 1.0 / st.rate_hz)
     s = np.interp(t, knots_t, knots_s)
     force, _M, _k = _machine(actuator, P, model, fixture, law, A, s, m_qs)

@@ -1,0 +1,151 @@
+"""Fault injection of the real ``bendpam`` commands (issue 12).
+
+The commands run as subprocesses.  Every outcome must be exit 0 (with strict JSON on stdout for
+``--json``), ONE line ``bendpam: error: ...`` with exit 2, or the interrupt line with 130/143 --
+never a traceback, an exit-1 internal error, a hang or a mixed output set.  The harness is
+``tools/fault_injection.py`` (its longer run: ``python tools/fault_injection.py``).
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import signal
+import sys
+from pathlib import Path
+
+import pytest
+
+_TOOL = Path(__file__).resolve().parents[1] / "tools" / "fault_injection.py"
+_spec = importlib.util.spec_from_file_location("bendpam_fault_injection", _TOOL)
+assert _spec is not None and _spec.loader is not None
+fi = importlib.util.module_from_spec(_spec)
+sys.modules[_spec.name] = fi
+_spec.loader.exec_module(fi)
+
+pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals and flock")
+
+TIMEOUT = 90.0
+
+
+@pytest.fixture(scope="module")
+def inputs(tmp_path_factory):
+    return fi.build_inputs(tmp_path_factory.mktemp("fault_inputs"))
+
+
+def _assert_clean(tally) -> None:
+    assert tally.ok, "\n".join(tally.failures)
+
+
+# ---- the harness itself -----------------------------------------------------------------------
+def test_strict_json_refuses_nan():
+    with pytest.raises(ValueError):
+        fi.strict_json('{"a": NaN}')
+    with pytest.raises(ValueError):
+        fi.strict_json("[Infinity]")
+    assert fi.strict_json('{"a": null}') == {"a": None}
+
+
+def test_classify_outcomes():
+    ok = fi.Run(["x"], 0, "", "", 0.1)
+    assert fi.classify(ok)[0] == "ok"
+    assert fi.classify(fi.Run(["x"], 2, "", "bendpam: error: bad\n", 0.1))[0] == "error"
+    assert fi.classify(fi.Run(["x"], 2, "", "noise\nbendpam: error: bad\n", 0.1))[0] == "bad-error"
+    assert fi.classify(fi.Run(["x"], 1, "", "bendpam: internal error (X)", 0.1))[0] == "internal"
+    assert fi.classify(fi.Run(["x"], 1, "", "Traceback (most recent call last):\n", 0.1))[0] == "traceback"
+    assert fi.classify(fi.Run(["x"], 130, "", fi.INTERRUPT_LINE + "\n", 0.1))[0] == "interrupt"
+    assert fi.classify(fi.Run(["--json"], 0, '{"a": NaN}', "", 0.1))[0] == "bad-json"
+    assert fi.classify(fi.Run(["x"], None, "", "", 9.0, hung=True))[0] == "hang"
+
+
+def test_set_problem_detects_a_mixture(tmp_path):
+    import json
+
+    d = tmp_path / "set"
+    d.mkdir()
+    (d / "a.txt").write_text("a")
+    entry = {"path": "a.txt", "size": 1, "sha256": fi.sha256(d / "a.txt")}
+    (d / "manifest.json").write_text(json.dumps({"files": [entry]}))
+    before = fi.snapshot(d)
+    assert fi.set_problem(d, before) is None
+    assert fi.set_problem(d, None) is None  # complete set
+    (d / "b.txt").write_text("b")  # a file the manifest does not list
+    assert fi.set_problem(d, before) is not None
+
+
+# ---- bad command lines and mutated inputs ------------------------------------------------------
+def test_bad_command_lines(inputs):
+    tally = fi.Tally()
+    cases = fi.bad_command_lines(inputs)[::2]  # the tool runs them all
+    assert len(cases) >= 40
+    results = fi.run_cases(tally, cases, inputs["work"], jobs=3, timeout=TIMEOUT)
+    _assert_clean(tally)
+    # the absurd sizes are refused, not attempted
+    refused = {" ".join(a): d for a, k, d in results if k == "error"}
+    assert any("--workers 0" in a for a in refused)
+    assert any("30000000" in a for a in refused)
+
+
+def test_simulate_rate_is_bounded_before_allocation(inputs):
+    r = fi.run(["simulate-test", "--preset", "be-pam", "--pressure-kpa", "150", "--rate-hz", "1e6",
+                "--out", "sim_big"], inputs["work"], timeout=30)
+    kind, line = fi.classify(r)
+    assert kind == "error", r.stderr
+    assert "samples" in line and "--rate-hz" in line and "--cycles" in line
+    assert r.seconds < 20
+    assert not (inputs["work"] / "sim_big").exists()
+    assert fi.temporaries(inputs["work"] / "sim_big") == []
+
+
+def test_mutated_inputs(inputs, tmp_path):
+    tally = fi.Tally()
+    cases = fi.mutated_cases(inputs, tmp_path, seed=3, small=True)
+    assert len(cases) >= 20
+    fi.run_cases(tally, cases, inputs["work"], jobs=3, timeout=TIMEOUT)
+    _assert_clean(tally)
+
+
+def test_toml_scalar_hysteresis_is_one_line(inputs, tmp_path):
+    t = tmp_path / "act.toml"
+    t.write_text("hysteresis = 5\n" + inputs["toml"].read_text())
+    r = fi.run(["predict", "--actuator", t, "--pressure-kpa", "150", "--cycle"], inputs["work"], timeout=TIMEOUT)
+    kind, line = fi.classify(r)
+    assert kind == "error" and "hysteresis" in line, r.stderr
+
+
+# ---- signals and concurrency ---------------------------------------------------------------------
+@pytest.mark.parametrize("sig, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_signal_gives_exit_code_and_one_line(inputs, tmp_path, sig, code):
+    tally = fi.Tally()
+    fi.kill_case(tally, "report", inputs, tmp_path, sig, 1.5)
+    _assert_clean(tally)
+    assert tally.counts["interrupt"] == 1
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("command", list(fi.KILL_COMMANDS))
+def test_random_kills_keep_output_sets_whole(inputs, tmp_path, command):
+    tally = fi.Tally()
+    max_delay = {"process": 2.5, "fit": 3.0, "report": 4.0, "sweep": 2.5}[command]
+    fi.kill_series(tally, command, inputs, tmp_path, n=3, seed=sorted(fi.KILL_COMMANDS).index(command),
+                   max_delay=max_delay, startup_fraction=0.0)
+    _assert_clean(tally)
+
+
+def test_sigint_during_startup_is_one_line(inputs):
+    import subprocess
+    import time
+
+    p = subprocess.Popen(fi.cli("predict", "--preset", "be-pam", "--pressure-kpa", "150"), cwd=inputs["work"],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(0.08)
+    p.send_signal(signal.SIGINT)
+    out, err = p.communicate(timeout=TIMEOUT)
+    assert p.returncode == 130 and err.strip() == fi.INTERRUPT_LINE
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("command", ["process", "sweep"])
+def test_concurrent_runs_never_mix(inputs, tmp_path, command):
+    tally = fi.Tally()
+    fi.concurrent_case(tally, command, inputs, tmp_path, stagger=0.0)
+    _assert_clean(tally)
