@@ -18,42 +18,10 @@ from pathlib import Path
 from typing import Annotated, Optional
 
 import typer
-from typer.core import TyperCommand
 
-__all__ = ["MULTI_VALUE_OPTIONS", "register"]
+__all__ = ["register"]
 
 #: options whose space-separated values are all collected (rewritten as repeated options)
-MULTI_VALUE_OPTIONS = ("--pressure-kpa", "--diameter-mm", "--direction-deg")
-
-
-class _MultiValueCommand(TyperCommand):
-    """A command in which ``--opt a b c`` means ``--opt a --opt b --opt c`` for the options above."""
-
-    multi_value_options = MULTI_VALUE_OPTIONS
-
-    def parse_args(self, ctx, args: list[str]) -> list[str]:
-        out: list[str] = []
-        current = None  # the multi-value option whose values are being read
-        expecting = False  # its own first value comes next (it may start with '-')
-        for i, tok in enumerate(args):
-            if tok == "--":
-                out.extend(args[i:])
-                break
-            if expecting:
-                out.append(tok)
-                expecting = False
-            elif tok.startswith("-"):
-                name = tok.split("=", 1)[0]
-                current = name if name in self.multi_value_options else None
-                expecting = current is not None and "=" not in tok
-                out.append(tok)
-            elif current is not None:
-                out.extend([current, tok])
-            else:
-                out.append(tok)
-        return super().parse_args(ctx, out)
-
-
 def _fmt(x, spec: str) -> str:
     width = spec.split(".")[0]
     try:
@@ -119,7 +87,7 @@ def _length(act, l0_mm):
 
 def register(app: typer.Typer) -> typer.Typer:
     """Add the ``finger``, ``grasp`` and ``wrist`` commands to ``app`` (once; returns ``app``)."""
-    from .options import ActuatorOpt, Model, ModelOpt, MorePressures, PresetOpt, PressureOpt
+    from .options import ActuatorOpt, Model, ModelOpt, MultiValueCommand, PresetOpt, PressureOpt
 
     names = {c.name or (c.callback.__name__ if c.callback else None) for c in app.registered_commands}
     if {"finger", "grasp", "wrist"} <= names:
@@ -130,9 +98,8 @@ def register(app: typer.Typer) -> typer.Typer:
     L0Opt = Annotated[Optional[float], typer.Option("--l0-mm", help="Active length L0 (mm); default: the actuator's.")]
 
     # ---- finger -------------------------------------------------------------------------------
-    @app.command("finger", cls=_MultiValueCommand)
+    @app.command("finger", cls=MultiValueCommand)
     def finger_cmd(
-        more: MorePressures = None,
         preset: PresetOpt = None,
         actuator: ActuatorOpt = None,
         model: ModelOpt = Model.energy,
@@ -161,7 +128,7 @@ def register(app: typer.Typer) -> typer.Typer:
         from .options import UserError, load_actuator, model_name, pressures_kpa
 
         act = _length(load_actuator(preset, actuator, model), l0_mm)
-        P = pressures_kpa(pressure_kpa, more)
+        P = pressures_kpa(pressure_kpa)
         _budget(len(P), "--pressure-kpa")
         mname = model_name(model)
         plot = _plot_target(plot)
@@ -220,7 +187,7 @@ def register(app: typer.Typer) -> typer.Typer:
             typer.echo(f"wrote {plot}")
 
     # ---- grasp --------------------------------------------------------------------------------
-    @app.command("grasp", cls=_MultiValueCommand)
+    @app.command("grasp", cls=MultiValueCommand)
     def grasp_cmd(
         preset: PresetOpt = None,
         actuator: ActuatorOpt = None,
@@ -304,9 +271,8 @@ def register(app: typer.Typer) -> typer.Typer:
             typer.echo(f"wrote {plot}")
 
     # ---- wrist --------------------------------------------------------------------------------
-    @app.command("wrist", cls=_MultiValueCommand)
+    @app.command("wrist", cls=MultiValueCommand)
     def wrist_cmd(
-        more: MorePressures = None,
         preset: PresetOpt = None,
         actuator: ActuatorOpt = None,
         model: ModelOpt = Model.energy,
@@ -335,7 +301,7 @@ def register(app: typer.Typer) -> typer.Typer:
         from .options import load_actuator, model_name, parse_values, pressures_kpa
 
         act = load_actuator(preset, actuator, model)
-        P = pressures_kpa(pressure_kpa, more)
+        P = pressures_kpa(pressure_kpa)
         dirs = parse_values(direction_deg, "--direction-deg") if direction_deg else [0.0, 90.0, 180.0, 270.0]
         _budget(len(P) * len(dirs), "--pressure-kpa x --direction-deg")
         mname = model_name(model)

@@ -13,7 +13,7 @@ from .options import (
     Format,
     Model,
     ModelOpt,
-    MorePressures,
+    MultiValueCommand,
     PresetOpt,
     PressureOpt,
     UserError,
@@ -132,9 +132,8 @@ def process(
     typer.echo(f"wrote {out}/ (curves.nc, curves.csv, summary.json{', figure4.png' if figure else ''})")
 
 
-@app.command("simulate-test")
+@app.command("simulate-test", cls=MultiValueCommand)
 def simulate_test_cmd(
-    more: MorePressures = None,
     preset: PresetOpt = None,
     actuator: ActuatorOpt = None,
     model: ModelOpt = Model.energy,
@@ -174,7 +173,7 @@ def simulate_test_cmd(
     if out is None:
         raise UserError("give an output folder with --out DIR")
     act = load_actuator(preset, actuator, model)
-    P = pressures_kpa(pressure_kpa, more)
+    P = pressures_kpa(pressure_kpa)
     st = SimulationSettings(cycles=cycles, speed_mm_min=speed_mm_min, rate_hz=rate_hz, noise_n=noise_n,
                             noise_stroke_mm=noise_stroke_mm, hysteresis=hysteresis,
                             hysteresis_angle_deg=hysteresis_angle_deg, hysteresis_law=hysteresis_law,

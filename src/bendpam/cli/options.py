@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Optional
 
 import typer
+from typer.core import TyperCommand
 
 from ..errors import InputError
 
@@ -20,11 +21,12 @@ if TYPE_CHECKING:
     from ..actuator import Actuator
 
 __all__ = [
+    "MULTI_VALUE_OPTIONS",
     "ActuatorOpt",
     "Format",
     "Model",
     "ModelOpt",
-    "MorePressures",
+    "MultiValueCommand",
     "Preset",
     "PresetOpt",
     "PressureOpt",
@@ -74,7 +76,38 @@ PressureOpt = Annotated[
     Optional[list[str]],
     typer.Option("--pressure-kpa", metavar="KPA...", help=f"Gauge pressure(s) in kPa: {RANGE_HELP}."),
 ]
-MorePressures = Annotated[Optional[list[str]], typer.Argument(hidden=True, metavar="")]
+#: options whose space-separated values are all collected (rewritten as repeated options)
+MULTI_VALUE_OPTIONS = ("--pressure-kpa", "--diameter-mm", "--direction-deg")
+
+
+class MultiValueCommand(TyperCommand):
+    """A command in which ``--opt a b c`` means ``--opt a --opt b --opt c`` for the options above."""
+
+    multi_value_options = MULTI_VALUE_OPTIONS
+
+    def parse_args(self, ctx, args: list[str]) -> list[str]:
+        out: list[str] = []
+        current = None  # the multi-value option whose values are being read
+        expecting = False  # its own first value comes next (it may start with '-')
+        for i, tok in enumerate(args):
+            if tok == "--":
+                out.extend(args[i:])
+                break
+            if expecting:
+                out.append(tok)
+                expecting = False
+            elif tok.startswith("-"):
+                name = tok.split("=", 1)[0]
+                current = name if name in self.multi_value_options else None
+                expecting = current is not None and "=" not in tok
+                out.append(tok)
+            elif current is not None:
+                out.extend([current, tok])
+            else:
+                out.append(tok)
+        return super().parse_args(ctx, out)
+
+
 
 
 def echo(text: str = "", err: bool = False) -> None:
@@ -120,8 +153,7 @@ def pressure_kpa(value: float, name: str = "--pressure-kpa") -> float:
 
 
 def pressures_kpa(first: list[str] | None, more: list[str] | None = None, name: str = "--pressure-kpa") -> list[float]:
-    if more and not first:
-        raise UserError(f"unexpected argument(s) {' '.join(more)!r}; pressures go after --pressure-kpa")
+    """Pressures (kPa) from the option's values (``more``: values that followed it, if any)."""
     values = parse_values((first or []) + (more or []), name)
     if not values:
         raise UserError(f"give at least one pressure with {name} (kPa), e.g. {name} 100 150 200")

@@ -16,7 +16,7 @@ from .options import (
     ActuatorOpt,
     Model,
     ModelOpt,
-    MorePressures,
+    MultiValueCommand,
     PresetOpt,
     PressureOpt,
     UserError,
@@ -32,9 +32,8 @@ from .options import pressure_kpa as checked_pressure
 FIGURE_SUFFIXES = {".png", ".pdf", ".svg"}
 
 
-@app.command()
+@app.command(cls=MultiValueCommand)
 def predict(
-    more: MorePressures = None,
     preset: PresetOpt = None,
     actuator: ActuatorOpt = None,
     model: ModelOpt = Model.energy,
@@ -58,7 +57,7 @@ def predict(
     from ..predict import prediction_table
 
     act = load_actuator(preset, actuator, model)
-    P = pressures_kpa(pressure_kpa, more)
+    P = pressures_kpa(pressure_kpa)
     mname = model_name(model)
     df = prediction_table(act, P, mname)
     br = MomentLaw.of(act, mname).free_branch()
@@ -128,9 +127,8 @@ def _cycle_json(c) -> dict:
     }
 
 
-@app.command()
+@app.command(cls=MultiValueCommand)
 def curve(
-    more: MorePressures = None,
     preset: PresetOpt = None,
     actuator: ActuatorOpt = None,
     model: ModelOpt = Model.energy,
@@ -151,7 +149,7 @@ def curve(
     if suffix not in {".csv"} | FIGURE_SUFFIXES:
         raise UserError(f"--out {str(out)!r}: unknown format {suffix or '(none)'}; use .csv, .png, .pdf or .svg")
     act = load_actuator(preset, actuator, model)
-    P = np.asarray(pressures_kpa(pressure_kpa, more))
+    P = np.asarray(pressures_kpa(pressure_kpa))
     if P.size * points > 10_000_000:
         raise UserError(f"--pressure-kpa x --points = {P.size * points} curve points; at most 10000000")
     mname = model_name(model)
