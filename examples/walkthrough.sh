@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# The README's story, in order, in one empty folder: predict -> simulate a test -> inspect and
+# process -> fit -> report -> a finger -> a sweep.  Run it as `bash examples/walkthrough.sh` from an
+# empty folder; tests/test_walkthrough.py runs it and checks what it writes.
+set -euo pipefail
+
+# 1. Predict the paper's BE-PAM, and save it as an editable actuator file
+bendpam predict --preset be-pam --pressure-kpa 100 150 200
+bendpam actuator --preset be-pam --out be.toml
+
+# 2. A virtual cyclic test (four-point bending, 5 pressures) written as Zwick testXpert exports
+bendpam simulate-test --actuator be.toml --pressure-kpa 100:200:5 --out raw-be --format testxpert --seed 1
+
+# 3. What the reader understands of the files, then Table 2 quantities and Figure 4
+bendpam inspect raw-be
+bendpam process raw-be --out processed-be
+
+# 4. Identify alpha0, C10, C01 (Table 3) and predict with the fitted actuator
+bendpam fit processed-be --actuator be.toml --out fit-be
+bendpam predict --actuator fit-be/fitted_actuator.toml --pressure-kpa 100 150 200
+
+# 5. A test with a pronounced friction loop, fitted with both branches, and the predicted cycle
+bendpam simulate-test --preset be-pam --pressure-kpa 100:200:5 --out raw-loop --hysteresis 0.05 \
+    --hysteresis-law pi --hysteresis-angle-deg 12 --seed 2
+bendpam process raw-loop --out processed-loop
+bendpam fit processed-loop --preset be-pam --hysteresis --out fit-loop
+bendpam predict --actuator fit-loop/fitted_actuator.toml --pressure-kpa 150 --cycle
+
+# 6. One HTML page from the raw files: Table 2, Table 3 for both models, Figures 4 and 7
+bendpam report raw-be --actuator be.toml --out report-be.html
+
+# 7. A finger made of the fitted actuator, loaded at its tip
+bendpam finger --actuator fit-be/fitted_actuator.toml --pressure-kpa 100 150 200 --tip-force-n 0,-0.5 \
+    --plot finger.png
+
+# 8. A design sweep over the braid angle and the bladder wall
+bendpam sweep --preset be-pam --param alpha0_deg=60:80:21 --param t0_mm=1.5:3:4 --pressure-kpa 100:250:16 \
+    --out sweep.nc --plot sweep.png
