@@ -537,6 +537,31 @@ class _Output:
                 f"output {self._kind} {str(self._given)!r} is the file-system root"
             )
 
+    def _prepare(self) -> None:
+        """Checks before the lock (inputs, target)."""
+        raise NotImplementedError
+
+    def _open(self) -> None:
+        """Setup under the lock (stale temporaries, the staging place)."""
+        raise NotImplementedError
+
+    def _abort(self, exc: BaseException | None) -> None:
+        """Remove what was staged and release the lock."""
+        raise NotImplementedError
+
+    def _enter(self) -> Any:
+        if self._state != "new":
+            raise RuntimeError(f"an {type(self).__name__} can be entered only once")
+        self._prepare()
+        try:
+            self._lock.acquire(self.lock_timeout_s)
+            self._open()
+        except BaseException as exc:
+            self._abort(exc)
+            raise
+        self._state = "open"
+        return self
+
     def _require_open(self) -> None:
         if self._state != "open":
             raise RuntimeError(
@@ -696,9 +721,7 @@ class OutputSet(_Output):
             else:
                 _remove(path)
 
-    def __enter__(self) -> OutputSet:
-        if self._state != "new":
-            raise RuntimeError("an OutputSet can be entered only once")
+    def _prepare(self) -> None:
         self._started = _now()
         self._inputs_resolved = self._check_inputs()
         self._check_target()
@@ -709,23 +732,21 @@ class OutputSet(_Output):
                 f"cannot create the folder {str(self.target.parent)!r}: "
                 f"{exc.strerror or exc}"
             ) from exc
-        try:
-            self._lock.acquire(self.lock_timeout_s)
-            self._clean_stale()
-            self._check_target()  # again, under the lock
-            self._check_replaceable()
-            with _HeldSignals():
-                self._staging = Path(
-                    tempfile.mkdtemp(
-                        prefix=f".{self.target.name}.bendpam-tmp-{os.getpid()}-",
-                        dir=self.target.parent,
-                    )
+
+    def _open(self) -> None:
+        self._clean_stale()
+        self._check_target()  # again, under the lock
+        self._check_replaceable()
+        with _HeldSignals():
+            self._staging = Path(
+                tempfile.mkdtemp(
+                    prefix=f".{self.target.name}.bendpam-tmp-{os.getpid()}-",
+                    dir=self.target.parent,
                 )
-        except BaseException as exc:
-            self._abort(exc)
-            raise
-        self._state = "open"
-        return self
+            )
+
+    def __enter__(self) -> OutputSet:
+        return self._enter()
 
     # -- writing -----------------------------------------------------------------------
     @property
@@ -1006,22 +1027,16 @@ class OutputFile(_Output):
                 f"(for {shown!r})"
             )
 
-    def __enter__(self) -> OutputFile:
-        if self._state != "new":
-            raise RuntimeError("an OutputFile can be entered only once")
+    def _prepare(self) -> None:
         self._check_target(self._check_inputs())
-        try:
-            self._lock.acquire(self.lock_timeout_s)
-            for _, stale in _stale_temporaries(self.target.parent, self.target.name):
-                _remove(stale)
-            self._tmp = self.target.parent / _temp_name(
-                self.target.name, "tmp", self.target.suffix
-            )
-        except BaseException as exc:
-            self._abort(exc)
-            raise
-        self._state = "open"
-        return self
+
+    def _open(self) -> None:
+        for _, stale in _stale_temporaries(self.target.parent, self.target.name):
+            _remove(stale)
+        self._tmp = self.target.parent / _temp_name(self.target.name, "tmp", self.target.suffix)
+
+    def __enter__(self) -> OutputFile:
+        return self._enter()
 
     @property
     def path(self) -> Path:
