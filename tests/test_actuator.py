@@ -183,3 +183,12 @@ def test_actuator_files_know_their_model(tmp_path, capsys):
     assert err.count("\n") == 1 and "force-balance model" in err and "warning" in err
     with pytest.raises(InputError, match="model"):
         a.replace(model="elastic")
+
+
+def test_unknown_toml_table_is_named(tmp_path):
+    f = tmp_path / "a.toml"
+    f.write_text(presets.be_pam().to_toml() + "\n[bogus]\nx = 1\n")
+    with pytest.raises(InputError, match="bogus"):
+        Actuator.from_toml(f)
+    f.write_text(presets.be_pam().to_toml() + "\n[hysteresis]\na0_nmm = 1.0\n")
+    assert Actuator.from_toml(f) == presets.be_pam()

@@ -343,8 +343,12 @@ class Actuator:
             raise FileFormatError(f"{p}: not UTF-8 text (byte {exc.start})") from None
         except tomllib.TOMLDecodeError as exc:
             raise FileFormatError(f"{p}: invalid TOML: {exc}") from None
-        table = data.get("actuator", data)
-        return cls.from_dict(table, source=str(p))
+        if "actuator" in data:
+            extra = [k for k in data if k not in ("actuator", "hysteresis")]
+            if extra:
+                raise InputError(f"{p}: unknown table or key {_suggest(extra[0], ('actuator', 'hysteresis'))}")
+            return cls.from_dict(data["actuator"], source=str(p))
+        return cls.from_dict({k: v for k, v in data.items() if k != "hysteresis"}, source=str(p))
 
     def summary(self) -> str:
         """A short human-readable description."""
