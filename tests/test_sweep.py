@@ -196,3 +196,30 @@ def test_cli_sweep(tmp_path, capsys):
         code = main(base_args + args)
         err = capsys.readouterr().err
         assert code == 2 and word in err and err.count("\n") == 1, err
+
+
+def test_sweep_plot_single_pressure_and_at(tmp_path, capsys):
+    from bendpam.cli import main
+
+    assert main(["sweep", "--preset", "be-pam", "--param", "alpha0_deg=60:80:5", "--pressure-kpa", "150",
+                 "--plot", str(tmp_path / "one.png")]) == 0
+    assert (tmp_path / "one.png").stat().st_size > 1000
+    assert main(["sweep", "--preset", "be-pam", "--param", "alpha0_deg=60:80:5", "--param", "t0_mm=2,2.5",
+                 "--pressure-kpa", "100:200:3", "--plot", str(tmp_path / "at.png"), "--at", "pressure_kpa=150"]) == 0
+    capsys.readouterr()
+    assert main(["sweep", "--preset", "be-pam", "--param", "alpha0_deg=60:80:5", "--pressure-kpa", "150",
+                 "--plot", str(tmp_path / "x.png"), "--at", "nope=1"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "nope" in err
+
+
+def test_sweep_figure_fixes_the_requested_slice():
+    import numpy as np
+
+    import bendpam
+    from bendpam.plots import sweep_figure
+
+    ds = bendpam.sweep(bendpam.presets.be_pam(), [100.0, 150.0, 200.0], alpha0_deg=np.linspace(60, 80, 4),
+                       t0_mm=[2.0, 2.5])
+    fig = sweep_figure(ds, at={"pressure_kpa": 151.0})
+    assert "pressure_kpa = 150" in fig.axes[0].get_title()

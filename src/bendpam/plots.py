@@ -300,36 +300,49 @@ def figure7(processed, fit_result, title: str = ""):
     return fig
 
 
-def sweep_figure(ds, var: str = "free_angle_deg", x: str | None = None, y: str | None = None):
-    """Colour map of one sweep output against two of its dimensions.
+def sweep_figure(ds, var: str = "free_angle_deg", x: str | None = None, y: str | None = None,
+                 at: dict[str, float] | None = None):
+    """Colour map (or line) of one sweep output against one or two of its dimensions.
 
-    Other dimensions are fixed at their middle value (named in the title).  ``x`` and ``y``
-    default to the first two dimensions of ``var``.
+    ``x`` and ``y`` default to the first two dimensions of ``var`` with more than one value (a
+    single pressure is not an axis).  The other dimensions are fixed at ``at`` (``{dim: value}``,
+    the nearest value is taken) or else at their middle value; the title names them.
     """
     if var not in ds.data_vars:
         raise InputError(f"variable {var!r} is not a sweep output; choose from {', '.join(ds.data_vars)}")
     da_ = ds[var]
     dims = list(da_.dims)
-    x = x or dims[0]
-    y = y or (dims[1] if len(dims) > 1 else None)
-    for d in (x, y):
-        if d is not None and d not in dims:
-            raise InputError(f"{d!r} is not a dimension of {var}; choose from {', '.join(dims)}")
-    fixed = {d: da_[d].values[da_[d].size // 2] for d in dims if d not in (x, y)}
-    sel = da_.isel({d: da_[d].size // 2 for d in fixed}) if fixed else da_
+    at = dict(at or {})
+    for d in at:
+        if d not in dims:
+            raise InputError(f"--at {d}: not a dimension of {var}; choose from {', '.join(dims)}")
+    free = [str(d) for d in dims if da_[d].size > 1 and d not in at]
+    xd: str = x or (free[0] if free else str(dims[0]))
+    yd: str | None = y or next((d for d in free if d != xd), None)
+    for dim in (xd, yd):
+        if dim is not None and dim not in dims:
+            raise InputError(f"{dim!r} is not a dimension of {var}; choose from {', '.join(dims)}")
+    index = {}
+    for d in dims:
+        if d in (xd, yd):
+            continue
+        vals = np.asarray(da_[d].values, dtype=float)
+        index[d] = int(np.argmin(np.abs(vals - float(at[d])))) if d in at else vals.size // 2
+    fixed = {d: float(da_[d].values[i]) for d, i in index.items()}
+    sel = da_.isel(index) if index else da_
     fig, ax = plt.subplots(figsize=(6.5, 4.8))
-    if y is None:
-        ax.plot(sel[x].values, np.asarray(sel.values, dtype=float), "-o", ms=3)
+    if yd is None:
+        ax.plot(sel[xd].values, np.asarray(sel.values, dtype=float), "-o", ms=3)
         ax.set_ylabel(f"{var} ({da_.attrs.get('units', '')})")
     else:
-        z = np.asarray(sel.transpose(y, x).values, dtype=float)
-        m = ax.pcolormesh(sel[x].values, sel[y].values, np.ma.masked_invalid(z), shading="auto", cmap="viridis")
+        z = np.asarray(sel.transpose(yd, xd).values, dtype=float)
+        m = ax.pcolormesh(sel[xd].values, sel[yd].values, np.ma.masked_invalid(z), shading="auto", cmap="viridis")
         fig.colorbar(m, ax=ax, label=f"{var} ({da_.attrs.get('units', '')})")
         if np.any(~np.isfinite(z)):
-            ax.contour(sel[x].values, sel[y].values, np.isfinite(z).astype(float), levels=[0.5], colors="crimson",
+            ax.contour(sel[xd].values, sel[yd].values, np.isfinite(z).astype(float), levels=[0.5], colors="crimson",
                        linewidths=1.0)
-        ax.set_ylabel(y)
-    ax.set_xlabel(x)
+        ax.set_ylabel(yd)
+    ax.set_xlabel(xd)
     title = da_.attrs.get("long_name", var)
     if fixed:
         title += "\n" + ", ".join(f"{d} = {v:g}" for d, v in fixed.items())

@@ -77,6 +77,11 @@ def sweep_cmd(
     plot_y: Annotated[
         Optional[str], typer.Option("--plot-y", help="Parameter or 'pressure_kpa' on the y axis (default: second).")
     ] = None,
+    at: Annotated[
+        Optional[list[str]],
+        typer.Option("--at", metavar="NAME=VALUE", help="Fix a dimension of the plot, e.g. pressure_kpa=150 "
+                     "(repeat for more; default: the middle value)."),
+    ] = None,
     progress: Annotated[bool, typer.Option("--progress/--no-progress", help="Progress bar.")] = True,
 ):
     """Design sweep: actuator parameters crossed with pressures (in-process or on Dask)."""
@@ -84,6 +89,13 @@ def sweep_cmd(
 
     if out is None and plot is None:
         raise UserError("give --out FILE.nc and/or --plot FILE.png")
+    fixed_at = {}
+    for item in at or []:
+        name, sep, value = item.partition("=")
+        vals = parse_values([value], f"--at {name}") if sep else []
+        if len(vals) != 1:
+            raise UserError(f"--at {item!r}: expected NAME=VALUE, e.g. pressure_kpa=150")
+        fixed_at[name.strip()] = vals[0]
     if out is not None and out.suffix.lower() != ".nc":
         raise UserError(f"--out {str(out)!r}: the sweep is written as NetCDF; use a .nc file")
     if scheduler and workers:
@@ -123,5 +135,5 @@ def sweep_cmd(
         from ..plots import save_figure, sweep_figure
 
         with output_file(plot, [actuator]) as f:
-            save_figure(sweep_figure(ds, plot_var, plot_x, plot_y), f.path)
+            save_figure(sweep_figure(ds, plot_var, plot_x, plot_y, at=fixed_at), f.path)
         typer.echo(f"wrote {plot}")
