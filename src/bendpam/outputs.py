@@ -562,6 +562,24 @@ class _Output:
         self._state = "open"
         return self
 
+    def _commit(self) -> None:
+        """Move the written output into place."""
+        raise NotImplementedError
+
+    def _exit(self, exc: BaseException | None) -> Literal[False]:
+        """Commit on success, else clean up; never swallows an exception."""
+        if self._state != "open":
+            return False
+        if exc is not None:
+            self._abort(exc)
+            return False
+        try:
+            self._commit()
+        except BaseException as err:
+            self._abort(err)
+            raise
+        return False
+
     def _require_open(self) -> None:
         if self._state != "open":
             raise RuntimeError(
@@ -834,17 +852,7 @@ class OutputSet(_Output):
         there the next run restores the old set.  In neither case can a reader see a
         mixture.
         """
-        if self._state != "open":
-            return False
-        if exc is not None:
-            self._abort(exc)
-            return False
-        try:
-            self._commit()
-        except BaseException as err:
-            self._abort(err)
-            raise
-        return False
+        return self._exit(exc)
 
     def _abort(self, exc: BaseException | None) -> None:
         with _HeldSignals(drop=_is_interruption(exc)):
@@ -1066,17 +1074,7 @@ class OutputFile(_Output):
         tb: TracebackType | None,
     ) -> Literal[False]:
         """Rename the temporary file onto the target on success; otherwise remove it."""
-        if self._state != "open":
-            return False
-        if exc is not None:
-            self._abort(exc)
-            return False
-        try:
-            self._commit()
-        except BaseException as err:
-            self._abort(err)
-            raise
-        return False
+        return self._exit(exc)
 
     def _commit(self) -> None:
         tmp = self.path
