@@ -347,8 +347,8 @@ class BranchTable:
     pressure (kPa) at the end (``inf`` when unbounded or neutral); ``k_end`` the curvature there;
     ``k_lim`` the lock-up limit in the bending direction; ``last`` the last table index on the
     branch; ``k_fold``/``use_ref`` the refined fold where it lies between samples.  ``xt``,
-    ``x_end``, ``x_fold`` are the same in the path's branch parameter (k' on the exact path, u = k'R
-    on the shared-table path) and ``path`` evaluates the law in it.
+    ``x_end``, ``x_fold`` are the same in the branch parameter u = k'R (with the section means computed
+    exactly, or interpolated from the shared tables) and ``path`` evaluates the law in it.
     """
 
     sgn: np.ndarray
@@ -371,26 +371,6 @@ def _flat_params(law: MomentLaw) -> ModelParams:
     """The law's parameters as 1-D arrays over the cases (one case for one actuator)."""
     p = law.params.broadcast()
     return ModelParams(**{k: np.asarray(v).reshape(-1) for k, v in p.__dict__.items()})
-
-
-class _ExactPath:
-    """The branch parameter is the curvature k' itself; every value is computed exactly (eq 5 solved)."""
-
-    def __init__(self, law: MomentLaw):
-        self.law = law
-        self.cs = _flat_params(law)
-        self.scalar = not law.is_cases
-        lim = curvature_limits(law.params if self.scalar else self.cs, law.order)
-        self.k_min = np.atleast_1d(np.asarray(lim.k_min, dtype=float))
-        self.k_max = np.atleast_1d(np.asarray(lim.k_max, dtype=float))
-        self.x_min, self.x_max = self.k_min, self.k_max
-
-    def coef(self, x, rows):
-        """``(A per kPa, B)`` at branch parameters ``x`` of the cases ``rows`` (broadcasting)."""
-        return self.law.coefficients(x, None if self.scalar else self.cs.take(rows))
-
-    def to_k(self, x, rows):
-        return x
 
 
 class _ExactUPath:
@@ -587,7 +567,7 @@ def _path(law: MomentLaw):
 def _branch_table(law: MomentLaw, samples: int) -> BranchTable:
     """Sample ``P_a(x) = B/A`` along each case's bending direction; find its end (fold, lock-up).
 
-    ``x`` is the branch parameter of the path (:func:`_path`): k' (exact) or u = k'R (tables).
+    ``x`` is the branch parameter u = k'R, evaluated exactly or on shared tables (:func:`_path`).
     """
     ev = _path(law)
     cs = ev.cs
