@@ -19,17 +19,9 @@ from typing import Annotated, Optional
 
 import typer
 
+from .options import fmt_num as _fmt
+
 __all__ = ["register"]
-
-#: options whose space-separated values are all collected (rewritten as repeated options)
-def _fmt(x, spec: str) -> str:
-    width = spec.split(".")[0]
-    try:
-        ok = x is not None and math.isfinite(float(x))
-    except (TypeError, ValueError):
-        ok = False
-    return format(float(x), spec) if ok else "—".rjust(int(width) if width else 1)
-
 
 def _num(x):
     try:
