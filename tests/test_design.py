@@ -373,7 +373,7 @@ def test_design_results_are_in_kpa():
     low = solve_grasp(Gripper(a), 80.0, 130.0)
     assert low.pressure_kpa == 130.0 and " kPa" in low.note
     onset = float(low.note.split("contact from ")[1].split(" kPa")[0])
-    assert 130.0 < onset < 160.0
+    assert 130.0 < onset < 200.0  # about 178 kPa with the default (15 deg splayed) gripper
 
 
 def test_no_equilibrium_is_its_own_error():
@@ -385,114 +385,8 @@ def test_no_equilibrium_is_its_own_error():
 
 
 # ------------------------------------------------------------------------------------------------
-# grasp
+# grasp: see tests/test_grasp.py (grasp, pull-out, figure and the grasp command)
 # ------------------------------------------------------------------------------------------------
-PRESSURES = np.array([130.0, 160.0, 190.0, 220.0, 250.0])  # kPa
-DIAMETERS = [80.0, 120.0, 160.0, 200.0, 240.0, 280.0]
-
-
-@pytest.fixture(scope="module")
-def be_sweep():
-    return grasp_sweep(Gripper(_act("be-pam")), DIAMETERS, PRESSURES)
-
-
-@pytest.fixture(scope="module")
-def bc_sweep():
-    return grasp_sweep(Gripper(_act("bc-pam")), DIAMETERS, PRESSURES)
-
-
-def test_grip_force_rises_nearly_linearly_with_pressure(be_sweep, bc_sweep):
-    for ds in (be_sweep, bc_sweep):
-        for i in range(ds.sizes["diameter_mm"]):
-            g = ds["grip_force_n"].values[i]
-            ok = np.isfinite(g) & (g > 0) & ds["equilibrium"].values[i]
-            if ok.sum() >= 2:
-                assert np.all(np.diff(g[ok]) > 0)
-            if ok.sum() >= 3:  # nearly linear: a straight line explains > 99 % of the variation
-                P = ds["pressure_kpa"].values[ok]
-                r = np.corrcoef(P, g[ok])[0, 1]
-                assert r ** 2 > 0.99
-    # the BE-PAM gripper has at least three diameters with a full pressure series
-    full = [(be_sweep["grip_force_n"].values[i, 1:] > 0).all() for i in range(len(DIAMETERS))]
-    assert sum(full) >= 3
-
-
-def test_be_gripper_peaks_at_an_intermediate_diameter(be_sweep):
-    g = be_sweep["grip_force_n"].sel(pressure_kpa=250.0).values
-    j = int(np.nanargmax(g))
-    assert 0 < j < len(DIAMETERS) - 1 and g[j] > 1.2 * g[j + 1] and g[j] > 1.2 * g[0]
-    # because of the contact orientation: the normal force still rises, the contact moves up
-    N = be_sweep["contact_force_n"].sel(pressure_kpa=250.0).values
-    beta = be_sweep["contact_angle_deg"].sel(pressure_kpa=250.0).values
-    assert N[j + 1] > N[j] and beta[j + 1] > beta[j] + 20.0
-
-
-def test_bc_gripper_grips_harder_on_large_spheres(be_sweep, bc_sweep):
-    g_bc = bc_sweep["grip_force_n"].sel(pressure_kpa=130.0).values
-    g_be = be_sweep["grip_force_n"].sel(pressure_kpa=130.0).values
-    ok = np.flatnonzero(g_bc > 0)
-    assert ok.size >= 3 and np.all(np.diff(g_bc[ok]) > 0)  # rises with the diameter
-    big = ok[-1]
-    assert g_bc[big] > 3.0 * g_be[big]
-
-
-def test_be_gripper_accommodates_more_sizes(be_sweep, bc_sweep):
-    def sizes(ds):
-        return set(np.asarray(DIAMETERS)[(np.nan_to_num(ds["grip_force_n"].values) > 0).any(axis=1)])
-
-    assert sizes(bc_sweep) < sizes(be_sweep)
-
-
-def test_bc_gripper_above_its_fold_reports_no_equilibrium(bc_sweep):
-    row = bc_sweep.sel(diameter_mm=120.0)
-    above = row["pressure_kpa"].values > 145.0
-    assert not row["equilibrium"].values[above].any()
-    assert np.isnan(row["grip_force_n"].values[above]).all()
-    assert all("snaps through" in n for n in row["note"].values[above])
-
-
-def test_too_large_or_too_small_gives_no_contact_and_zero_force():
-    g = Gripper(_act("be-pam"))
-    big = solve_grasp(g, 400.0, 250.0)
-    small = solve_grasp(g, 10.0, 250.0)
-    low = solve_grasp(g, 80.0, 130.0)  # reachable only at higher pressure
-    for r in (big, small, low):
-        assert r.contact == "none" and r.grip_force_n == 0.0 and r.normal_force_n == 0.0 and r.equilibrium
-    assert "too large" in big.note and "too small" in small.note and "from" in low.note
-
-
-@pytest.mark.parametrize("name,D,P", [("be-pam", 120.0, 200.0), ("be-pam", 160.0, 130.0), ("bc-pam", 160.0, 130.0)])
-def test_contact_state_is_consistent(name, D, P):
-    g = Gripper(_act(name))
-    r = solve_grasp(g, D, P)
-    assert r.pressure_kpa == P
-    assert r.equilibrium and r.contact in ("tip", "body", "tip+body") and r.normal_force_n > 0
-    depth = g.center_depth(D)
-    R = D / 2
-    sh = r.shape
-    # the contact point lies on the sphere; no part of the finger penetrates it
-    for px, py in r.contact_xy:
-        assert math.hypot(px, py + depth) == pytest.approx(R, abs=1e-6)
-    gaps = np.hypot(sh.x, sh.y + depth) - (R + g.contact_offset_mm)
-    assert gaps.min() > -1e-3
-    assert sh.residual_nmm < 1e-4
-    # pull-out force from the contact orientation: N (cos beta + mu sin beta), times the fingers
-    b = math.radians(r.contact_angle_deg)
-    if r.contact != "tip+body":
-        expect = g.fingers * r.normal_force_n * (math.cos(b) + g.mu * math.sin(b))
-        assert r.grip_force_n == pytest.approx(max(expect, 0.0), rel=1e-9)
-    # more friction, more grip
-    r2 = solve_grasp(Gripper(_act(name), mu=1.0), D, P)
-    assert r2.grip_force_n > r.grip_force_n
-
-
-def test_gripper_validation():
-    with pytest.raises(InputError, match="fingers"):
-        Gripper(_act("be-pam"), fingers=1)
-    with pytest.raises(InputError, match="mu"):
-        Gripper(_act("be-pam"), mu=-0.1)
-    with pytest.raises(InputError, match="diameter_mm"):
-        solve_grasp(Gripper(_act("be-pam")), -5.0, 200.0)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -584,24 +478,6 @@ def test_cli_finger_no_equilibrium(capsys):
     res = json.loads(out)["results"]
     assert res[0]["equilibrium"] is True and res[1]["equilibrium"] is False
     assert res[1]["tip_x_mm"] is None and "fold" in res[1]["note"]
-
-
-def test_cli_grasp_json(capsys, tmp_path):
-    fig = tmp_path / "grasp.png"
-    code, out, err = run(capsys, "grasp", "--preset", "be-pam", "--l0-mm", "130", "--diameter-mm", "80", "160", "400",
-                         "--pressure-kpa", "160", "250", "--json", "--plot", str(fig))
-    assert code == 0, err
-    res = json.loads(out)["results"]
-    assert len(res) == 6
-    for key in ("diameter_mm", "pressure_kpa", "grip_force_n", "contact_force_n", "contact"):
-        assert key in res[0]
-    by = {(r["diameter_mm"], r["pressure_kpa"]): r for r in res}
-    assert by[(400.0, 250.0)]["contact"] == "none" and by[(400.0, 250.0)]["grip_force_n"] == 0.0
-    assert by[(160.0, 250.0)]["grip_force_n"] > by[(160.0, 160.0)]["grip_force_n"] > 0
-    assert by[(160.0, 250.0)]["contact"] in ("tip", "body", "tip+body")
-    ref = solve_grasp(Gripper(_act("be-pam")), 160.0, 250.0)
-    assert by[(160.0, 250.0)]["grip_force_n"] == pytest.approx(ref.grip_force_n, rel=1e-6)
-    assert fig.read_bytes()[:4] == b"\x89PNG"
 
 
 def test_cli_wrist(capsys):

@@ -40,18 +40,34 @@ def _check(name: str, value: Any, lo: float | None, hi: float | None, *, lo_open
 
 
 def t0_start_mm(R0_mm, t0_mm, R0_start_mm):
-    """Bladder wall thickness at P_start (mm), eq 52: constant wall area (eq 51); scalars or arrays."""
+    """Bladder wall thickness at P_start (mm), eq 52: constant wall area (eq 51); scalars or arrays.
+
+    >>> round(float(t0_start_mm(8.5, 2.5, 10.1)), 4)     # the paper's BE-PAM: 2.5 mm stretched to 10.1 mm
+    1.9907
+    """
     return R0_start_mm - np.sqrt(R0_start_mm * R0_start_mm - 2.0 * R0_mm * t0_mm + t0_mm * t0_mm)
 
 
 def bladder_area_mm2(R0_mm, t0_mm):
-    """Bladder wall cross-section area (mm^2), invariant under the prestrain (eq 51)."""
+    """Bladder wall cross-section area (mm^2), invariant under the prestrain (eq 51).
+
+    >>> round(float(bladder_area_mm2(8.5, 2.5)), 2)
+    113.88
+    """
     return np.pi * (2.0 * R0_mm * t0_mm - t0_mm * t0_mm)
 
 
 def frame_inertia_mm4(width_mm, thickness_mm):
-    """Second moment of area of the frame strip, ``I_f = w h^3 / 12`` (mm^4), eq 16 and 27."""
+    """Second moment of area of the frame strip, ``I_f = w h^3 / 12`` (mm^4), eq 16 and 27.
+
+    >>> frame_inertia_mm4(5.0, 0.5)                      # Table 1: 5 mm x 0.5 mm
+    0.052083...
+    """
     return width_mm * thickness_mm**3 / 12.0
+
+
+#: Actuator fields that are not inputs of the models (labels and the limits of :mod:`bendpam.limits`).
+_NOT_MODEL_PARAMS = ("name", "model", "frame_strength_mpa", "bladder_stretch_limit")
 
 
 def _suggest(key: str, known) -> str:
@@ -80,6 +96,15 @@ class ModelParams:
     C10, C01 : Mooney-Rivlin constants, MPa.
     P_start : threshold pressure, MPa (eq 50); ``P_start_kpa`` the same in kPa, exactly as given.
     L0 : active length, mm.  braid_thickness : t_br, mm.
+    R0 : outer radius of the as-made (unstressed) bladder, mm, for the stretches of
+        :mod:`bendpam.limits`; ``None`` (a hand-made block) means no prestrain, ``R0 = R0_start``.
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> p = bendpam.presets.be_pam().params
+    >>> round(float(p.C10), 4), p.P_start, round(float(p.frame_stiffness), 2)    # MPa, MPa, N*mm^2
+    (-0.3189, 0.068, 353.96)
     """
 
     alpha0: Any
@@ -95,6 +120,7 @@ class ModelParams:
     L0: Any
     braid_thickness: Any
     P_start_kpa: Any = 0.0
+    R0: Any = None
 
     @classmethod
     def build(cls, *, alpha0_deg, R0_mm, t0_mm, L0_mm, frame_thickness_mm, frame_width_mm, frame_modulus_mpa,
@@ -106,7 +132,7 @@ class ModelParams:
             frame_stiffness=frame_modulus_mpa * frame_inertia_mm4(frame_width_mm, frame_thickness_mm),
             frame_modulus=frame_modulus_mpa * 1.0, frame_thickness=frame_thickness_mm * 1.0,
             C10=C10_kpa * 1e-3, C01=C01_kpa * 1e-3, P_start=P_start_kpa * 1e-3, L0=L0_mm * 1.0,
-            braid_thickness=braid_thickness_mm * 1.0, P_start_kpa=P_start_kpa * 1.0,
+            braid_thickness=braid_thickness_mm * 1.0, P_start_kpa=P_start_kpa * 1.0, R0=R0_mm * 1.0,
         )
 
     @property
@@ -170,6 +196,32 @@ class Actuator:
         The model whose identification gave these constants (``"energy"``, ``"force_balance"``) or
         ``""`` (unknown).  Table 3 gives different constants for each model; the command line warns
         when an actuator is used with the other model.
+    frame_strength_mpa : float, optional
+        Strength of the frame material, MPa, > 0 (for a glass-fibre epoxy strip a few hundred MPa).
+        :func:`bendpam.limits` compares the frame's largest combined axial and bending stress with
+        it; ``None`` (default): no strength check.
+    bladder_stretch_limit : float, optional
+        Largest principal stretch the bladder may reach, dimensionless, > 1, counted from the
+        as-made tube (``R0_mm``, ``t0_mm``: the prestrain of eq 51-52 included), e.g. 3.0 for a
+        latex tube used well below its elongation at break.  :func:`bendpam.limits` reports the
+        margin in strain, ``(limit - 1) / (stretch - 1)``; ``None`` (default): no stretch check.
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> a = bendpam.Actuator(alpha0_deg=70, R0_mm=8.5, t0_mm=2.5, L0_mm=145, frame_thickness_mm=0.5,
+    ...                      frame_width_mm=5, frame_modulus_mpa=6796, C10_kpa=114, C01_kpa=300,
+    ...                      P_start_kpa=68, R0_start_mm=10.1)
+    >>> a.kind, a.bend_sign, round(a.t0_start_mm, 4)
+    ('BE-PAM', 1, 1.9907)
+    >>> a.replace(alpha0_deg=40).kind
+    'BC-PAM'
+    >>> print(a.to_toml().splitlines()[2])               # a.to_toml("a.toml") writes the file
+    alpha0_deg = 70.0
+    >>> bendpam.Actuator(**{**a.to_dict(), "t0_mm": 9.0})
+    Traceback (most recent call last):
+    ...
+    bendpam.errors.InputError: t0_mm = 9 mm is outside the allowed range (0, 8.5) mm
     """
 
     alpha0_deg: float
@@ -186,6 +238,8 @@ class Actuator:
     braid_thickness_mm: float = 0.3
     name: str = ""
     model: str = ""
+    frame_strength_mpa: float | None = None
+    bladder_stretch_limit: float | None = None
 
     # derived, filled in __post_init__
     _material: MooneyRivlin = field(init=False, repr=False, compare=False, hash=False)
@@ -223,9 +277,15 @@ class Actuator:
                              "'energy', 'force_balance' or '' (unknown)")
         if not isinstance(self.name, str):
             raise InputError(f"name = {self.name!r} must be a string")
+        if self.frame_strength_mpa is not None:
+            s(self, "frame_strength_mpa",
+              _check("frame_strength_mpa", self.frame_strength_mpa, 0.0, None, unit="MPa"))
+        if self.bladder_stretch_limit is not None:
+            s(self, "bladder_stretch_limit",
+              _check("bladder_stretch_limit", self.bladder_stretch_limit, 1.0, None))  # a stretch: no unit
         s(self, "_material", MooneyRivlin(self.C10_kpa * 1e-3, self.C01_kpa * 1e-3))
         s(self, "_params", ModelParams.build(**{f: getattr(self, f) for f in self.field_names()
-                                                     if f not in ("name", "model")}))
+                                                     if f not in _NOT_MODEL_PARAMS}))
 
     # ---- derived values (units in the names) ---------------------------------------------------
     @property

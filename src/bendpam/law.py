@@ -264,6 +264,20 @@ class MomentLaw:
 
         For a block of cases ``pressure_kpa`` is 1-D and the result has shape ``cases + (pressures,)``.
         """
+        return self.free_state_array(pressure_kpa, table=table, xtol=xtol)[0]
+
+    def free_state_array(self, pressure_kpa, *, table: BranchTable | None = None, xtol: float = 1e-13):
+        """``(k', u)``: the free-bending curvature of :meth:`free_curvature_array` and ``u = k'R`` there.
+
+        ``u`` is the branch parameter the root is solved in (eq 5), so the radius ``R = u / k'`` of
+        the free state comes without another solve of eq 5 (:func:`bendpam.limits.case_limits`);
+        NaN where ``k'`` is NaN, 0 where it is 0.
+
+        >>> import bendpam
+        >>> k, u = bendpam.MomentLaw.of(bendpam.presets.be_pam()).free_state_array([50.0, 200.0])
+        >>> k.round(5).tolist(), round(float(u[1] / k[1]), 4)  # R (mm) at 200 kPa
+        ([0.0, 0.01353], 9.891)
+        """
         P = _check_pressure(pressure_kpa)
         tab = self._branches if table is None else table
         if self.is_cases:
@@ -272,8 +286,9 @@ class MomentLaw:
             pa = np.maximum(P[None, :] - np.asarray(self.P_start_kpa).reshape(-1, 1), 0.0)
         else:
             pa = np.maximum(P - self.P_start_kpa, 0.0).reshape(1, -1)
-        k = _solve_free(self, tab, pa, xtol)
-        return k.reshape(self.params.shape + P.shape) if self.is_cases else k.reshape(P.shape)
+        k, u = _solve_free(self, tab, pa, xtol)
+        shape = self.params.shape + P.shape if self.is_cases else P.shape
+        return k.reshape(shape), u.reshape(shape)
 
     def free_curvature(self, pressure_kpa, *, xtol: float = 1e-13) -> FreeBending:
         """Free-bending equilibria ``M(P, k') = 0`` on the branch connected to the straight state.
@@ -690,16 +705,18 @@ def illinois(F, a, b, tol, maxiter: int = 100):
     return x.reshape(shape)
 
 
-def _solve_free(law: MomentLaw, tab: BranchTable, pa: np.ndarray, xtol: float) -> np.ndarray:
-    """Roots of ``M = 0`` at active pressures ``pa`` (cases, pressures) (kPa); NaN above the branch end."""
+def _solve_free(law: MomentLaw, tab: BranchTable, pa: np.ndarray, xtol: float) -> tuple[np.ndarray, np.ndarray]:
+    """Roots ``(k', u = k'R)`` of ``M = 0`` at active pressures ``pa`` (cases, pressures) (kPa); NaN above the end."""
     k = np.zeros(pa.shape)
+    u = np.zeros(pa.shape)
     above = pa > tab.p_end[:, None]
     # below 1e-9 kPa of active pressure the root is straight to rounding (B(0) = 0 is itself only
     # zero to rounding there, which would spoil the first bracket)
     solve = (pa > TINY_ACTIVE_KPA) & ~above & (tab.sgn[:, None] != 0)
     k[above] = np.nan
+    u[above] = np.nan
     if not np.any(solve):
-        return k
+        return k, u
     case, col = np.nonzero(solve)
     q = pa[case, col]
     # bracket: first table index with p >= q (the table is increasing up to its end, then inf)
@@ -724,8 +741,10 @@ def _solve_free(law: MomentLaw, tab: BranchTable, pa: np.ndarray, xtol: float) -
         return sgn[idx] * (q[idx] * A - B)
 
     tol = xtol * np.abs(tab.x_end[case]) + 1e-300
-    k[case, col] = ev.to_k(illinois(F, a, b, tol), case)
-    return k
+    x = illinois(F, a, b, tol)
+    k[case, col] = ev.to_k(x, case)
+    u[case, col] = x
+    return k, u
 
 
 @dataclass(frozen=True)
@@ -746,6 +765,13 @@ class FreeBranch:
     kind : ``"fold"``, ``"lock-up"``, ``"unbounded"`` or ``"neutral"``.
     reason : a sentence explaining the end of the branch.
     k_table_per_mm, p_table_kpa : the sampled branch ``(k', P_a)`` from k' = 0 to its end (monotone in P_a).
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> br = bendpam.free_branch(bendpam.presets.bc_pam())
+    >>> br.kind, br.direction, round(br.k_end_per_mm, 6), round(br.max_pressure_kpa, 1)
+    ('fold', -1, -0.010106, 134.2)
     """
 
     direction: int
@@ -804,6 +830,15 @@ class FreeBending:
     reason : empty for ``"ok"``, else an explanation.
     max_pressure_kpa : highest pressure that still has a free-bending equilibrium (inf if none).
     branch : the :class:`FreeBranch` used.
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> fb = bendpam.free_curvature(bendpam.presets.be_pam(), [50.0, 150.0])
+    >>> fb.status.tolist(), fb.curvature_per_mm.round(5).tolist(), fb.angle_deg.round(2).tolist()
+    (['deadband', 'ok'], [0.0, 0.00816], [0.0, 67.78])
+    >>> bendpam.free_curvature(bendpam.presets.bc_pam(), 150.0).status.item()   # above the BC-PAM's fold
+    'no-equilibrium'
     """
 
     pressure_kpa: np.ndarray
@@ -862,6 +897,16 @@ class MomentTable:
     Evaluation is a gather of 4 x 2 cubic coefficients per point (the interval index comes from
     ``arccos`` of the Chebyshev map, no search) and Horner steps; complex curvatures are accepted
     (the interval comes from the real part), for complex-step derivatives.
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> law = bendpam.MomentLaw.of(bendpam.presets.be_pam(), "energy")
+    >>> table = law.tabulated()                          # built once per law, then cached
+    >>> table.max_rel_error < 1e-6
+    True
+    >>> round(float(table.moment(200.0, 0.01)), 3), round(float(law.moment(200.0, 0.01)), 3)   # N*mm
+    (63.183, 63.183)
     """
 
     def __init__(self, law: MomentLaw, *, knots: int = 513, tol: float = 1e-6, max_knots: int = 32769):
@@ -1084,6 +1129,15 @@ class StableBranch:
     end_lo, end_hi : ``"fold"`` or ``"lock-up"``: what ends the branch on each side.
     free_curvature : the free curvature on the branch (1/mm), NaN if ``M = 0`` is outside the range.
     friction_nmm : the constant shift of the law (saturated friction), N*mm.
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> sb = bendpam.MomentLaw.of(bendpam.presets.be_pam(), "energy").stable_branch(150.0)
+    >>> round(sb.k_lo, 5), round(sb.k_hi, 5), sb.end_lo, sb.end_hi
+    (-0.04709, 0.03371, 'lock-up', 'fold')
+    >>> round(sb.free_curvature, 5)                     # 1/mm
+    0.00816
     """
 
     pressure_kpa: float

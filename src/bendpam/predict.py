@@ -60,7 +60,13 @@ def active_pressure_kpa(actuator: Actuator, pressure_kpa) -> np.ndarray:
 
 
 def kinematics(actuator: Actuator, curvature_per_mm, *, order: int = DEFAULT_ORDER) -> Kinematics:
-    """Braid kinematics at ``curvature_per_mm`` (1/mm): see :class:`bendpam.braid.Kinematics` (eq 1-5)."""
+    """Braid kinematics at ``curvature_per_mm`` (1/mm): see :class:`bendpam.braid.Kinematics` (eq 1-5).
+
+    >>> import bendpam
+    >>> kin = bendpam.kinematics(bendpam.presets.be_pam(), 0.01)
+    >>> round(float(kin.radius), 3), round(float(kin.eta), 4), round(float(kin.axis_curvature), 6)
+    (9.949, 0.9851, 0.009095)
+    """
     if not isinstance(actuator, Actuator):
         raise TypeError(f"actuator must be a bendpam.Actuator, got {type(actuator).__name__}")
     return _kinematics(actuator, curvature_per_mm, order)
@@ -259,10 +265,15 @@ def internal_stresses(actuator: Actuator, pressure_kpa, curvature_per_mm, *, n_p
 # ------------------------------------------------------------------------------------------------
 def prediction_table(actuator: Actuator, pressure_kpa, model: str = "energy", *, eq19_factor: bool = True,
                      order: int = DEFAULT_ORDER) -> Any:
-    """Blocked moment and free bending at each pressure, as a :class:`pandas.DataFrame`.
+    """Blocked moment, free bending and the structural limits at each pressure, as a :class:`pandas.DataFrame`.
 
     Columns: ``pressure_kpa``, ``blocked_moment_nmm``, ``free_curvature_per_mm``,
-    ``free_angle_deg``, ``status`` and ``note`` (the reason where there is no equilibrium).
+    ``free_angle_deg``; the limits of :func:`bendpam.limits` (the worse of the blocked and free
+    states): ``frame_axial_force_n``, ``frame_stress_mpa``, the safety factors
+    ``frame_strength_margin``, ``buckling_margin``, ``lockup_margin``, ``bladder_stretch_margin``
+    (>= 1 within the limit, inf without demand or limit), ``bladder_stretch_max`` and
+    ``min_margin``; ``status``, ``note`` (the reason where there is no equilibrium) and
+    ``limit_note`` (each limit the prediction is past, empty within every limit).
     Signs follow the paper: k' > 0 toward the frame, so BC-PAM values are negative.
 
     >>> import bendpam
@@ -271,16 +282,21 @@ def prediction_table(actuator: Actuator, pressure_kpa, model: str = "energy", *,
     """
     import pandas as pd
 
+    from .limits import OUTPUTS, limits
+
     law = _law(actuator, model, eq19_factor, order)
     P = np.atleast_1d(_check_pressure(pressure_kpa))
     fb = law.free_curvature(P)
+    lim = limits(actuator, P, model, eq19_factor=eq19_factor, order=order)
     return pd.DataFrame(
         {
             "pressure_kpa": P,
             "blocked_moment_nmm": law.blocked_moment(P),
             "free_curvature_per_mm": fb.curvature_per_mm,
             "free_angle_deg": fb.angle_deg,
+            **{name: getattr(lim, name) for name in OUTPUTS},
             "status": fb.status,
             "note": fb.reason,
+            "limit_note": lim.notes,
         }
     )

@@ -4,6 +4,8 @@
   moment law section by section), tip pose, blocked tip force, tip stiffness.
 * :mod:`bendpam.design.grasp`: an N-finger gripper closing on a sphere, contact and pull-out force
   (the paper's Figure 8 test).
+* :mod:`bendpam.design.inverse`: inverse design, actuator parameters from targets on its
+  predictions (:func:`design_actuator`).
 * :mod:`bendpam.design.wrist`: four BC-PAMs around a column (the paper's Figure 9 wrist): bending
   angle and direction, holding capacity.
 
@@ -31,6 +33,7 @@ from .finger import (
     tip_stiffness,
 )
 from .grasp import Grasp, Gripper, grasp_sweep, plot_grasp, solve_grasp
+from .inverse import DesignResult, Target, Variable, design_actuator
 from .wrist import (
     Wrist,
     WristHold,
@@ -45,17 +48,21 @@ from .wrist import (
 
 __all__ = [
     "BlockedTipForce",
+    "DesignResult",
     "Finger",
     "FingerLoads",
     "FingerShape",
     "Grasp",
     "Gripper",
     "StableBranch",
+    "Target",
     "TipStiffness",
+    "Variable",
     "Wrist",
     "WristHold",
     "WristState",
     "blocked_tip_force",
+    "design_actuator",
     "finger_sweep",
     "free_tip_trajectory",
     "grasp_sweep",

@@ -88,11 +88,13 @@ __all__ = [
     "G_N_PER_G",
     "BlockedTipForce",
     "Finger",
+    "FingerLimits",
     "FingerLoads",
     "FingerShape",
     "StableBranch",
     "TipStiffness",
     "blocked_tip_force",
+    "finger_limits",
     "finger_sweep",
     "free_tip_trajectory",
     "linear_tip_compliance",
@@ -200,6 +202,13 @@ def stable_branch(actuator: Actuator, pressure_kpa, model: str = "energy",
     ``friction_nmm`` shifts the law by a saturated hysteretic moment, ``M = M_load - friction``
     (signed, bendpam's convention): see :meth:`Finger.friction_nmm`.  Raises
     :class:`~bendpam.errors.NoEquilibrium` when the straight state is unstable at that pressure.
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> sb = stable_branch(bendpam.presets.be_pam(), 150.0)
+    >>> round(sb.k_hi, 5), sb.end_hi, round(sb.free_curvature, 5)     # 1/mm
+    (0.03371, 'fold', 0.00816)
     """
     if not isinstance(actuator, Actuator):
         raise TypeError(f"actuator must be a bendpam.Actuator, got {type(actuator).__name__}")
@@ -242,6 +251,14 @@ class Finger:
         back, the upper branch), so loading and unloading shapes differ.  Saturation assumes the
         finger moved more than the loop's angle since the last reversal.
     motion : {"unloading", "loading"}
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> finger = Finger(bendpam.presets.be_pam(), base_angle_deg=-90.0)   # hanging, curling counterclockwise
+    >>> shape = solve_finger(finger, 150.0)
+    >>> [round(v, 2) for v in shape.tip_xy]                   # mm
+    [76.22, -113.47]
     """
 
     actuator: Actuator
@@ -351,6 +368,14 @@ class FingerLoads:
         Self-weight of the actuator, g/mm, uniform along the active length.
     gravity : (gx, gy)
         Direction of gravity in the plane (normalised here); default ``(0, -1)``.
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> loads = FingerLoads(tip_force_n=(0.0, -0.5), tip_mass_g=20.0)   # 0.5 N down and a 20 g mass
+    >>> shape = solve_finger(Finger(bendpam.presets.be_pam()), 150.0, loads)
+    >>> shape.equilibrium, shape.loads.tip_mass_g
+    (True, 20.0)
     """
 
     tip_force_n: tuple[float, float] = (0.0, 0.0)
@@ -418,6 +443,15 @@ class FingerShape:
     note : empty on a plain success, else what happened (snap-through, no free shape, ...).
     limit : on failure, the last equilibrium reached (a FingerShape at ``load_fraction``), else None.
     branch : the :class:`bendpam.StableBranch` used.
+
+    Examples
+    --------
+    >>> import numpy as np, bendpam
+    >>> shape = solve_finger(Finger(bendpam.presets.be_pam()), 150.0)     # unloaded: a circular arc
+    >>> float(shape.s[-1]), round(float(np.degrees(shape.tip_angle)), 2)  # mm, deg
+    (145.0, 67.78)
+    >>> bool(np.allclose(shape.curvature, shape.curvature[0])), shape.equilibrium
+    (True, True)
     """
 
     finger: Finger
@@ -451,6 +485,10 @@ class FingerShape:
     @property
     def bend_angle_deg(self) -> float:
         return math.degrees(self.bend_angle)
+
+    def limits(self) -> FingerLimits:
+        """The structural limits along this shape, worst section (:func:`finger_limits`)."""
+        return finger_limits(self)
 
     def to_dataframe(self):
         """The shape as a :class:`pandas.DataFrame` (units in the column names)."""
@@ -700,6 +738,17 @@ def solve_finger(finger: Finger, pressure_kpa, loads: FingerLoads | None = None)
     no stable equilibrium exists (the loads need more moment than the stable branch supplies, or
     a structural limit point), ``equilibrium`` is False, the arrays are NaN, the note says why and
     ``limit`` holds the last equilibrium reached.  Never a shape on the unstable branch.
+
+    Examples
+    --------
+    >>> import numpy as np, bendpam
+    >>> finger = Finger(bendpam.presets.be_pam())
+    >>> free = solve_finger(finger, 150.0)
+    >>> loaded = solve_finger(finger, 150.0, FingerLoads(tip_force_n=(0.0, -0.5)))
+    >>> [round(v, 2) for v in free.tip_xy], [round(v, 2) for v in loaded.tip_xy]    # mm
+    ([113.47, 76.22], [125.45, 60.5])
+    >>> loaded.equilibrium, loaded.residual_nmm < 1e-6
+    (True, True)
     """
     loads = _check_finger(finger, loads)
     P = checked_pressure_kpa(pressure_kpa)
@@ -773,6 +822,13 @@ def finger_sweep(finger: Finger, pressures_kpa, loads: FingerLoads | None = None
     Returns ``(table, shapes)``: a :class:`pandas.DataFrame` with ``pressure_kpa``, ``tip_x_mm``,
     ``tip_y_mm``, ``tip_angle_deg``, ``bend_angle_deg``, ``base_moment_nmm``, ``residual_nmm``,
     ``equilibrium`` and ``note``, and the list of :class:`FingerShape`.
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> table, shapes = finger_sweep(Finger(bendpam.presets.be_pam()), [100.0, 150.0])
+    >>> table[["pressure_kpa", "tip_x_mm", "tip_y_mm", "bend_angle_deg"]].round(2).values.tolist()
+    [[100.0, 140.34, 31.49, 25.29], [150.0, 113.47, 76.22, 67.78]]
     """
     import pandas as pd
 
@@ -793,6 +849,104 @@ def finger_sweep(finger: Finger, pressures_kpa, loads: FingerLoads | None = None
     }), shapes
 
 
+@dataclass(frozen=True)
+class FingerLimits:
+    """The structural limits along a solved finger: :mod:`bendpam.limits` at every section.
+
+    Each section is checked at its own curvature ``k'(s)`` with the axial force the loads beyond it
+    put on the frame line (a section's compression is assumed along the whole frame for buckling:
+    conservative).  The lock-up margin is the stable branch's end (lock-up or a fold of the loaded
+    law, :class:`bendpam.StableBranch`) over ``|k'(s)|``.  The scalar fields are the worst section's
+    (every margin a safety factor: >= 1 within the limit, inf without demand or without a limit).
+
+    Attributes
+    ----------
+    pressure_kpa : kPa.  s_mm : (nodes,) arc length.
+    sections : per-section arrays (``axial_force_n``, ``stress_mpa``, ``buckling_margin``,
+        ``lockup_margin``, ``bladder_stretch``, ``stretch_margin``, ``external_axial_force_n`` ...,
+        see :func:`bendpam.limits.section_limits`).
+    frame_axial_force_n : the section force with the largest ``|N|`` (N, tension > 0).
+    frame_stress_mpa, bladder_stretch_max : largest along the finger.
+    frame_strength_margin, buckling_margin, lockup_margin, bladder_stretch_margin, min_margin : smallest.
+    worst_s_mm : where ``min_margin`` occurs.
+    violations : one line per margin below 1, e.g. ``"frame buckling: margin 0.8 at s = 0 mm (150 kPa)"``.
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> from bendpam.design import Finger, FingerLoads, solve_finger
+    >>> sh = solve_finger(Finger(bendpam.presets.bc_pam()), 100.0, FingerLoads(tip_force_n=(0.0, -2.0)))
+    >>> lim = sh.limits()
+    >>> round(lim.min_margin, 2), lim.worst_s_mm, lim.violations
+    (1.67, 145.0, ())
+    """
+
+    pressure_kpa: float
+    s_mm: np.ndarray
+    frame_axial_force_n: float
+    frame_stress_mpa: float
+    frame_strength_margin: float
+    buckling_margin: float
+    lockup_margin: float
+    bladder_stretch_max: float
+    bladder_stretch_margin: float
+    min_margin: float
+    worst_s_mm: float
+    violations: tuple[str, ...]
+    sections: dict[str, np.ndarray] = field(repr=False, compare=False)
+
+
+def finger_limits(shape: FingerShape) -> FingerLimits:
+    """The margins along the solved finger ``shape`` (worst section): see :class:`FingerLimits`.
+
+    Raises :class:`~bendpam.errors.NoEquilibrium` for a shape without an equilibrium.
+
+    >>> import bendpam
+    >>> from bendpam.design import Finger, solve_finger
+    >>> lim = finger_limits(solve_finger(Finger(bendpam.presets.be_pam()), 150.0))
+    >>> round(lim.lockup_margin, 1), lim.buckling_margin
+    (4.1, inf)
+    """
+    from ..limits import MARGINS, section_limits
+
+    if not isinstance(shape, FingerShape):
+        raise TypeError(f"shape must be a FingerShape, got {type(shape).__name__}")
+    if not shape.equilibrium or shape.branch is None:
+        raise NoEquilibrium(f"at {shape.pressure_kpa:g} kPa the finger has no equilibrium shape to check "
+                            f"({shape.note or 'no equilibrium'})")
+    rod = Rod(shape.finger, shape.loads)
+    lam = shape.load_fraction
+    Fx, Fy = rod.F
+    qx, qy = rod.q
+    # tension along the frame line from the dead loads beyond each section
+    tension = lam * ((Fx + qx * rod.rem) * np.cos(shape.angle) + (Fy + qy * rod.rem) * np.sin(shape.angle))
+    k = shape.curvature
+    br = shape.branch
+    sec = section_limits(shape.finger.actuator, shape.pressure_kpa, k, external_axial_force_n=tension,
+                         lockup_curvature_per_mm=np.where(k >= 0.0, br.k_hi, br.k_lo))
+    sec["external_axial_force_n"] = tension
+    margin = {"frame_strength_margin": sec["strength_margin"], "buckling_margin": sec["buckling_margin"],
+              "lockup_margin": sec["lockup_margin"], "bladder_stretch_margin": sec["stretch_margin"]}
+    worst_each = {name: float(np.min(v)) for name, v in margin.items()}
+    overall = np.minimum.reduce(list(margin.values()))
+    j = int(np.argmin(overall))
+    P = shape.pressure_kpa
+    lines = []
+    for name, label in MARGINS.items():
+        v = worst_each[name]
+        if v < 1.0:
+            i = int(np.argmin(margin[name]))
+            if name == "lockup_margin" and (br.end_hi if k[i] >= 0.0 else br.end_lo) == "fold":
+                label = "fold of the loaded moment law (snap-through)"
+            lines.append(f"{label}: margin {v:.2f} at s = {shape.s[i]:.4g} mm ({P:g} kPa)")
+    N = sec["axial_force_n"]
+    return FingerLimits(
+        pressure_kpa=P, s_mm=shape.s.copy(), frame_axial_force_n=float(N[int(np.argmax(np.abs(N)))]),
+        frame_stress_mpa=float(np.max(sec["stress_mpa"])), bladder_stretch_max=float(np.max(sec["bladder_stretch"])),
+        **worst_each, min_margin=float(overall[j]), worst_s_mm=float(shape.s[j]), violations=tuple(lines),
+        sections=sec)
+
+
 def free_tip_trajectory(finger: Finger, pressures_kpa):
     """Tip pose of the unloaded finger against pressure (kPa), vectorised.
 
@@ -800,6 +954,13 @@ def free_tip_trajectory(finger: Finger, pressures_kpa):
     rigid fingertip.  Returns a :class:`pandas.DataFrame` with ``pressure_kpa``,
     ``free_curvature_per_mm``, ``tip_x_mm``, ``tip_y_mm``, ``tip_angle_deg``, ``bend_angle_deg``,
     ``status`` and ``note`` (NaN pose where there is no free equilibrium).
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> t = free_tip_trajectory(Finger(bendpam.presets.be_pam()), [100.0, 150.0, 200.0])
+    >>> t[["tip_x_mm", "tip_y_mm", "bend_angle_deg"]].round(2).values.tolist()     # mm, mm, deg
+    [[140.34, 31.49, 25.29], [113.47, 76.22, 67.78], [68.36, 102.07, 112.38]]
     """
     import pandas as pd
 
@@ -848,6 +1009,13 @@ class BlockedTipForce:
     direction : unit vector of the roller (None for a pin).
     shape : the held :class:`FingerShape` (its ``loads`` include the holding force).
     equilibrium, note : as in :class:`FingerShape`.
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> held = blocked_tip_force(Finger(bendpam.presets.be_pam()), 150.0)
+    >>> held.constraint, [round(f, 3) for f in held.force_n], held.equilibrium    # N
+    ('roller', [0.0, -2.053], True)
     """
 
     force_n: tuple[float, float]
@@ -890,9 +1058,20 @@ def blocked_tip_force(finger: Finger, pressure_kpa, target_xy_mm=None, direction
     loads : FingerLoads, optional
         Further loads acting together with the holding force.
 
+    Notes
+    -----
     The force components are extra unknowns and the held coordinates extra equations; the target
     is reached by continuation from the free (or loaded) tip.  If the holder cannot be reached on
     the stable branch (a fold: snap-through), ``equilibrium`` is False with a note.
+
+    Examples
+    --------
+    The force a sensor at the straight tip position measures at 150 kPa:
+
+    >>> import bendpam
+    >>> held = blocked_tip_force(Finger(bendpam.presets.be_pam()), 150.0)
+    >>> round(held.force_n[1], 3)                         # N, on the tip (the finger pushes up)
+    -2.053
     """
     loads = _check_finger(finger, loads)
     P = checked_pressure_kpa(pressure_kpa)
@@ -1002,6 +1181,13 @@ class TipStiffness:
     ``matrix`` maps small changes of the tip load ``(dFx, dFy, dM)`` (N, N, N*mm) to the tip pose
     ``(dx, dy, dphi)`` (mm, mm, rad) by ``compliance``; ``matrix = inv(compliance)``.  Both include the
     geometric stiffness of the loads already acting; for dead loads they are symmetric.
+
+    Examples
+    --------
+    >>> import numpy as np, bendpam
+    >>> ts = tip_stiffness(Finger(bendpam.presets.be_pam()), 150.0)
+    >>> ts.matrix.shape, bool(np.allclose(ts.matrix @ ts.compliance, np.eye(3)))
+    ((3, 3), True)
     """
 
     matrix: np.ndarray
@@ -1014,6 +1200,16 @@ def tip_stiffness(finger: Finger, pressure_kpa, loads: FingerLoads | None = None
 
     From the exact (complex-step) Jacobian.  Raises :class:`~bendpam.errors.NoEquilibrium` where the
     finger has no stable equilibrium under these loads.
+
+    Examples
+    --------
+    Unloaded, it agrees with linear beam theory (:func:`linear_tip_compliance`):
+
+    >>> import numpy as np, bendpam
+    >>> finger = Finger(bendpam.presets.be_pam())
+    >>> ts = tip_stiffness(finger, 150.0)
+    >>> bool(np.allclose(ts.compliance, linear_tip_compliance(finger, 150.0), rtol=1e-3, atol=1e-6))
+    True
     """
     loads = _check_finger(finger, loads)
     P = checked_pressure_kpa(pressure_kpa)
@@ -1063,6 +1259,13 @@ def linear_tip_compliance(finger: Finger, pressure_kpa) -> np.ndarray:
     small tip load changes the curvature by ``dk' = dM_ext / K`` and the tip pose by the integral of
     the rotations, with no geometric stiffness (the finger is unloaded).  Integrated on 1001 nodes.
     Pressure in kPa; raises :class:`~bendpam.errors.NoEquilibrium` above the free branch.
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> c = linear_tip_compliance(Finger(bendpam.presets.be_pam()), 150.0)
+    >>> round(float(c[1, 1]), 2)                          # mm of tip travel per N of vertical tip force
+    26.96
     """
     _check_finger(finger, None)
     P = checked_pressure_kpa(pressure_kpa)
@@ -1097,6 +1300,16 @@ def plot_finger_shapes(shapes, ax=None, title: str | None = None):
     """Draw finger shapes (frame line, fingertip, tip point) on ``ax``; returns the figure.
 
     Shapes without equilibrium are drawn dashed from their last equilibrium (``limit``) if any.
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> import matplotlib.pyplot as plt
+    >>> finger = Finger(bendpam.presets.be_pam())
+    >>> fig = plot_finger_shapes([solve_finger(finger, p) for p in (100.0, 150.0)])
+    >>> len(fig.axes)                                     # fig.savefig("shapes.png") to keep it
+    1
+    >>> plt.close(fig)
     """
     from .. import plots  # noqa: F401, I001  (first: selects the Agg backend unless the caller chose one)
     import matplotlib.pyplot as plt

@@ -42,17 +42,30 @@ Model and assumptions
   fold: near the fingertip the contact moment is too small for the stable branch, that part
   snaps through), the result says so (``equilibrium=False``, NaN forces), never a wrong shape.
   The structural stability of contact equilibria is not checked (the finger statics are).
-* **Pull-out.**  The sphere is fixed; the arm pulls the gripper up.  Each contact keeps its normal
-  force ``N`` (the fingers are compliant and the pull is quick compared with pressure changes) and
-  transmits at most the edge of its friction cone; the largest upward force it can carry is
-  ``N (cos beta + mu sin beta)``, where ``beta`` is the angle of the sphere's outward normal at the
-  contact from the downward vertical (``cos beta = -n_y``, ``sin beta = n_x``).  A contact below
-  the equator (``beta < 90 deg``) cages the sphere through its normal force; above it only friction
-  holds, and a negative value counts as zero (that contact just opens).  The gripping force is the
-  sum over the fingers.  This neglects the change of ``N`` and of the contact point during the pull
-  and the friction-induced moment on the finger, friction while closing (a sticking fingertip
-  would hold a larger force on big spheres), gravity on the fingers and the sphere's weight (a
-  fixed sphere), out-of-plane finger deformation, and finger-finger and palm contacts.
+* **Pull-out (the grip force).**  The sphere is fixed; from the grasp the arm lifts the gripper
+  base step by step (displacement control, adaptive steps).  At every step the fingers' statics
+  are solved again with their moment law at the (unchanged) pressure under the contact loads: at
+  each contact a normal force ``N >= 0`` along the sphere's outward normal ``n`` and a tangential
+  (friction) force ``T`` along ``t = (-n_y, n_x)``.  Coulomb's law with ``mu``: a contact
+  **sticks** (its material point moves with the sphere's surface, no tangential slip in the step;
+  a body contact may roll) while ``|T| <= mu N``, and **slips** otherwise, with ``T = mu N``
+  against the slip; a contact whose ``N`` would become negative **opens**, a part of the finger
+  that would penetrate the sphere closes a contact, a flat pad rolling onto the sphere takes over
+  the fingertip's contact, and a body contact that runs off the pad's end becomes the tip
+  contact.  The lifting load is ``F = -fingers * sum F_y`` over the contacts of one finger
+  (``F_y = N n_y + T t_y``, the sphere's force on the finger; per contact
+  ``N cos beta - T sin beta`` with ``beta`` the angle of ``n`` from the downward vertical).  The
+  pull stops when every contact has opened (the sphere escapes), when the load has fallen below
+  half its peak (under a pulling force the sphere escapes at the peak), or when the fingers have
+  no equilibrium (they snap off); the **grip force** is the peak of ``F`` (0 if it never pulls).
+  Sticking contacts below the equator first load the fingers (the load rises with the lift); the
+  peak is usually at the onset of slip, after which the tip slides toward the equator and the
+  load falls.  The earlier estimate with the grasp's normal forces frozen,
+  ``fingers * sum N (cos beta + mu sin beta)``, is kept as ``frozen_grip_force_n`` for comparison
+  only.  Neglected: friction while closing, gravity on the fingers and the sphere's weight (a
+  fixed sphere), rate effects and hysteresis, out-of-plane finger deformation and twisting,
+  finger-finger and palm contacts, and more than one body contact per finger (the pull stops
+  with a note if one would be needed).
 
 Units: mm, N, kPa (every function takes and returns pressures in kPa, ``pressure_kpa``), degrees in
 names ending ``_deg``.  Bad input raises :class:`bendpam.InputError`.
@@ -61,7 +74,7 @@ names ending ``_deg``.  Bad input raises :class:`bendpam.InputError`.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -87,8 +100,11 @@ from .finger import (
 __all__ = [
     "DEFAULT_BASE_RADIUS_MM",
     "DEFAULT_FINGERTIP_MM",
+    "DEFAULT_MU",
+    "DEFAULT_SPLAY_DEG",
     "Grasp",
     "Gripper",
+    "PullOut",
     "grasp_sweep",
     "plot_grasp",
     "solve_grasp",
@@ -98,6 +114,10 @@ __all__ = [
 DEFAULT_BASE_RADIUS_MM = 100.0
 #: default rigid fingertip (tip pad) length, mm
 DEFAULT_FINGERTIP_MM = 10.0
+#: default outward tilt of the open fingers from the vertical, degrees (see :class:`Gripper`)
+DEFAULT_SPLAY_DEG = 15.0
+#: default friction coefficient pad-sphere
+DEFAULT_MU = 0.5
 
 _PEN_TOL = 1e-3  # mm, allowed penetration from the discretisation
 
@@ -115,24 +135,37 @@ class Gripper:
     fingers : int
         Number of fingers, in [2, 12] (default 3).
     base_radius_mm : float
-        Radius of the circle of the fingers' frame lines at the base, mm (default 100 mm: the
-        paper does not give it; with 130 mm BE-PAM fingers it takes spheres of 80 mm (from about
-        140 kPa) to 200 mm, the middle of the paper's 80-280 mm range).
+        Radius of the circle of the fingers' frame lines at the base, mm (default 100 mm).  The
+        paper does not give its gripper's geometry; the defaults (100 mm, ``splay_deg`` 15,
+        ``fingertip_mm`` 10, ``mu`` 0.5) were chosen so that three 130 mm fingers grasp the
+        paper's whole 80-280 mm range: with the BE-PAM's energy constants every diameter from
+        190 kPa (160-280 mm from 160 kPa, 180-280 mm at 130 kPa); the BC-PAM, only below its
+        134 kPa fold, 120-180 and 240-260 mm at 130 kPa.  See docs/grasp.md.
     fingertip_mm : float
         Rigid fingertip (tip pad) length, mm (default 10).
     contact_offset_mm : float, optional
         Distance from the frame line to the finger's contact surface on the sphere's side, mm.
         Default: half the frame thickness for a BE-PAM, ``2 R0_start_mm`` for a BC-PAM.
     mu : float
-        Friction coefficient pad-sphere for the pull-out, in [0, 5] (default 0.5).
+        Coulomb friction coefficient pad-sphere for the pull-out, in [0, 5] (default 0.5: TPU on
+        PLA).
     center_depth_mm : float, optional
         Depth of the sphere's centre below the base plane, mm.  Default: the placement rule in the
         module docstring.
     splay_deg : float
-        Outward tilt of the open fingers from the vertical, degrees, in [-45, 45] (default 0:
-        pointing straight down).
+        Outward tilt of the open (straight) fingers from the vertical, degrees, in [-45, 45]
+        (default 15; 0: pointing straight down).
     nodes : int
         Collocation nodes per finger (default 61).
+
+    Examples
+    --------
+    The paper's gripper: three 130 mm BE-PAM fingers.
+
+    >>> import bendpam
+    >>> gripper = Gripper(bendpam.presets.be_pam().replace(L0_mm=130.0))
+    >>> gripper.fingers, gripper.base_radius_mm, gripper.mu
+    (3, 100.0, 0.5)
     """
 
     actuator: Actuator
@@ -141,9 +174,9 @@ class Gripper:
     base_radius_mm: float = DEFAULT_BASE_RADIUS_MM
     fingertip_mm: float = DEFAULT_FINGERTIP_MM
     contact_offset_mm: float | None = None
-    mu: float = 0.5
+    mu: float = DEFAULT_MU
     center_depth_mm: float | None = None
-    splay_deg: float = 0.0
+    splay_deg: float = DEFAULT_SPLAY_DEG
     nodes: int = 61
 
     def __post_init__(self):
@@ -193,21 +226,35 @@ class Gripper:
 
 @dataclass(frozen=True)
 class Grasp:
-    """One grasp: a gripper on a sphere at one pressure.
+    """One grasp: a gripper on a sphere at one pressure, and its pull-out.
 
     Attributes
     ----------
     diameter_mm, pressure_kpa : sphere diameter (mm), gauge pressure (kPa).
-    contact : ``"tip"``, ``"body"``, ``"tip+body"`` or ``"none"``.
-    normal_force_n : normal (contact) force per finger, N (sum over its contacts; 0 for none).
-    grip_force_n : pull-out force of the whole gripper, N.
-    contact_xy : contact point(s) in the finger plane (x radial, y up), mm.
+    contact : contact at the grasp, before the pull: ``"tip"``, ``"body"``, ``"tip+body"`` or ``"none"``.
+    normal_force_n : normal (contact) force per finger at the grasp, N (sum over its contacts; 0 for none).
+    grip_force_n : pull-out (gripping) force of the whole gripper, N: the peak of the lifting load
+        of the quasi-static pull-out (0 without contact or when the load never pulls; NaN without
+        an equilibrium).
+    contact_xy : contact point(s) in the finger plane at the grasp (x radial, y up), mm.
     contact_angle_deg : angle beta of the sphere's outward normal at the (main) contact from the
-        downward vertical (0: under the sphere, 90: at the equator).
-    center_depth_mm : depth of the sphere's centre below the base plane.
-    equilibrium : False where the finger has no stable equilibrium (snap-through): forces NaN.
+        downward vertical at the grasp (0: under the sphere, 90: at the equator).
+    center_depth_mm : depth of the sphere's centre below the base plane at the grasp, mm.
+    equilibrium : False where the finger has no stable equilibrium at the grasp (snap-through): forces NaN.
     note : why there is no contact or no equilibrium, else empty.
-    shape : the finger's :class:`FingerShape` (free or in contact), None if not computed.
+    shape : the finger's :class:`FingerShape` at the grasp (free or in contact), None if not computed.
+    frozen_grip_force_n : the earlier estimate ``fingers * sum N (cos beta + mu sin beta)`` with the
+        grasp's normal forces frozen (a labelled comparison, not the grip force), N.
+    peak_lift_mm : lift of the base at the peak of the pull, mm (NaN without a pull-out).
+    pull_out : the :class:`PullOut` history, None without contact.
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> gripper = Gripper(bendpam.presets.be_pam().replace(L0_mm=130.0))
+    >>> grasp = solve_grasp(gripper, 180.0, 150.0)        # a 180 mm sphere at 150 kPa
+    >>> grasp.contact, grasp.equilibrium, grasp.grip_force_n > 0
+    ('tip', True, True)
     """
 
     diameter_mm: float
@@ -221,11 +268,26 @@ class Grasp:
     equilibrium: bool
     note: str
     shape: FingerShape | None = field(default=None, repr=False)
+    frozen_grip_force_n: float = math.nan
+    peak_lift_mm: float = math.nan
+    pull_out: PullOut | None = field(default=None, repr=False)
 
 
 def _none(D, P, depth, note, shape=None, equilibrium=True):
     f = 0.0 if equilibrium else math.nan
-    return Grasp(D, P, "none", f, f, (), math.nan, depth, equilibrium, note, shape)
+    return Grasp(D, P, "none", f, f, (), math.nan, depth, equilibrium, note, shape, frozen_grip_force_n=f)
+
+
+def _law_moment(branch: StableBranch, k):
+    """``branch.moment(k)[0]`` (N*mm); for a complex-step batch whose rows share one real part
+    (a Jacobian), the spline is evaluated once and the step carried by ``dM/dk'`` (the law is
+    local: ``M`` at a node depends on that node's curvature only), exactly as the complex step."""
+    if np.iscomplexobj(k) and k.ndim >= 2:
+        kr = np.real(k).reshape(-1, k.shape[-1])
+        if np.all(kr == kr[0]):
+            M, dM = branch.moment(kr[0])
+            return M + 1j * np.imag(k) * dM
+    return branch.moment(k)[0]
 
 
 class _Contact:
@@ -258,15 +320,7 @@ class _Contact:
             # from the frame line) for sigma <= L, on the flat fingertip pad beyond
             N = U[..., self.i_body] * self.fscale
             sc = U[..., self.i_body + 1] * self.Lr
-            b, off = rod.f.bend, rod.off
-            on_rod = np.real(sc) <= rod.L
-            sr = np.where(on_rod, sc, rod.L)
-            xr, yr, pr = rod.point(phi, x, y, sr)
-            pl = phi[..., -1]
-            tau = np.where(on_rod, 0.0, sc - rod.L)
-            pc = np.where(on_rod, pr, pl)
-            xc = np.where(on_rod, xr, x[..., -1] + tau * np.cos(pl)) - b * off * np.sin(pc)
-            yc = np.where(on_rod, yr, y[..., -1] + tau * np.sin(pl)) + b * off * np.cos(pc)
+            xc, yc, pc = _surface_point(rod, phi, x, y, sc)
             dx, dy = xc - self.cx, yc - self.cy
             d = np.sqrt(dx * dx + dy * dy)
             out["body"] = (N, xc, yc, dx / d, dy / d, d, sc, pc)
@@ -290,7 +344,7 @@ class _Contact:
                 m = m + beyond * cross(px[..., None] - x, py[..., None] - y, (N * nx)[..., None], (N * ny)[..., None])
                 extra.append(((d - self.R) / self.Lr)[..., None])
                 extra.append((np.cos(pc) * nx + np.sin(pc) * ny)[..., None])
-            M, _ = branch.moment(g["k"])
+            M = _law_moment(branch, g["k"])
             return np.concatenate([(M + c * m) / self.scale, *extra], axis=-1)
 
         lo = np.full(self.size, -np.inf)
@@ -483,7 +537,7 @@ def _check(ctx: _Ctx, mode: str, u):
     return "ok", None, None
 
 
-def _solve_at(ctx: _Ctx, mode, u, br, maxit=40):
+def _solve_at(ctx: _Ctx, mode, u, br, maxit=15):
     fun, lo, hi = ctx.contact(mode).system(br)
     return newton(fun, u, lo, hi, NEWTON_TOL, maxit=maxit)[:2]
 
@@ -549,12 +603,22 @@ def solve_grasp(gripper: Gripper, diameter_mm, pressure_kpa) -> Grasp:
     See the module docstring for the model.  A sphere that does not fit, or that the fingers do
     not reach at this pressure, gives contact ``"none"`` and zero force (not an error); where the
     fingers have no stable equilibrium in contact, ``equilibrium`` is False and the forces NaN.
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> gripper = Gripper(bendpam.presets.be_pam().replace(L0_mm=130.0))
+    >>> solve_grasp(gripper, 180.0, 120.0).contact       # the fingers do not reach it yet
+    'none'
+    >>> g = solve_grasp(gripper, 180.0, 160.0)
+    >>> g.contact, g.normal_force_n > 0, g.grip_force_n > 0
+    ('tip', True, True)
     """
     _check_gripper(gripper)
     D = number("diameter_mm", diameter_mm, 0.0, 1e5, lo_open=True, unit="mm")
     P = checked_pressure_kpa(pressure_kpa)
     with pressures_checked():
-        return _grasp_path(gripper, D, [P])[0]
+        return _pulled(gripper, [_grasp_path(gripper, D, [P])])[0][0]
 
 
 def _check_gripper(gripper) -> None:
@@ -562,11 +626,39 @@ def _check_gripper(gripper) -> None:
         raise TypeError(f"gripper must be a bendpam.design.Gripper, got {type(gripper).__name__}")
 
 
-def _grasp_path(gripper: Gripper, D: float, Ps: list[float]) -> list[Grasp]:
+_Item = tuple[Grasp, "_Seed | None"]
+
+
+def _pulled(gripper: Gripper, paths: list[list[_Item]]) -> list[list[Grasp]]:
+    """The grasps of ``paths`` with their pull-outs (all solved together, batched)."""
+    seeds = [s for path in paths for _g, s in path if s is not None]
+    pulls = iter(_Pull(gripper, seeds).run())
+    out = []
+    for path in paths:
+        row = []
+        for g, s in path:
+            if s is not None:
+                po = next(pulls)
+                grip = max(po.peak_force_n, 0.0)
+                note = "" if grip > 0.0 else ("the lifting load never pulls: the grasp pushes the sphere out of "
+                                              "the fingers and holds no load")
+                if po.end.startswith(_UNUSUAL_ENDS):  # the peak may be a lower bound: say so
+                    note = f"{note}; {po.end}" if note else po.end
+                g = replace(g, grip_force_n=grip, peak_lift_mm=po.peak_lift_mm if grip > 0.0 else math.nan,
+                            pull_out=po, note=note)
+            row.append(g)
+        out.append(row)
+    return out
+
+
+def _grasp_path(gripper: Gripper, D: float, Ps: list[float]) -> list[_Item]:
     """Grasps of a sphere of diameter ``D`` (mm) at pressures ``Ps`` (kPa, validated), inflating
-    quasi-statically (in ascending pressure)."""
+    quasi-statically (in ascending pressure), each with the seed of its pull-out (None without contact).
+
+    The grip force of these grasps is still the frozen-normal estimate; :func:`_pulled` adds the pull-out.
+    """
     order = np.argsort(Ps, kind="stable")
-    out: list[Grasp | None] = [None] * len(Ps)
+    out: list[_Item | None] = [None] * len(Ps)
     R = 0.5 * D
     delta = gripper.contact_offset_mm
     depth, beta0 = _landing(gripper, R)
@@ -574,7 +666,7 @@ def _grasp_path(gripper: Gripper, D: float, Ps: list[float]) -> list[Grasp]:
     if np.isfinite(beta0) and beta0 >= cone:
         note = (f"too large: the open fingers land on top of the {D:g} mm sphere (beta = {beta0:.1f} deg, beyond "
                 f"the friction cone at {cone:.1f} deg): nothing holds it")
-        return [_none(D, P, depth, note) for P in Ps]
+        return [(_none(D, P, depth, note), None) for P in Ps]
     finger = gripper.finger()
     act = gripper.actuator
     law = gripper.law
@@ -583,7 +675,8 @@ def _grasp_path(gripper: Gripper, D: float, Ps: list[float]) -> list[Grasp]:
     k_lock = lim.k_max if act.bend_sign > 0 else lim.k_min
     kap_c, kind, sig_c = _min_touch_curvature(finger, cx, cy, R, delta, 0.98 * abs(k_lock))
     if not np.isfinite(kap_c):
-        return [_none(D, P, depth, "too small: the fingers do not touch the sphere even fully curled") for P in Ps]
+        return [(_none(D, P, depth, "too small: the fingers do not touch the sphere even fully curled"), None)
+                for P in Ps]
     p_on = _onset_pressure_kpa(law, kap_c)
     rod = Rod(finger, FingerLoads())
     n = rod.n
@@ -600,16 +693,16 @@ def _grasp_path(gripper: Gripper, D: float, Ps: list[float]) -> list[Grasp]:
         free_ok = bool(fb.status != "no-equilibrium") and bool(np.isfinite(fb.curvature_per_mm))
         if free_ok and abs(float(fb.curvature_per_mm)) < kap_c:
             on = f"; contact from {p_on:.4g} kPa" if np.isfinite(p_on) else ""
-            out[i] = _none(D, P, depth, f"too small for this pressure: the fingers do not reach the sphere{on}",
-                           solve_finger(finger, P))
+            out[i] = (_none(D, P, depth, f"too small for this pressure: the fingers do not reach the sphere{on}",
+                            solve_finger(finger, P)), None)
             continue
         if stuck is not None:
-            out[i] = _none(D, P, depth, stuck[0], equilibrium=stuck[1])
+            out[i] = (_none(D, P, depth, stuck[0], equilibrium=stuck[1]), None)
             continue
         try:
             br_P = law.stable_branch(P)
         except NoEquilibrium as exc:
-            out[i] = _none(D, P, depth, str(exc), equilibrium=False)
+            out[i] = (_none(D, P, depth, str(exc), equilibrium=False), None)
             continue
         if state is not None:
             P0, mode0, u0 = state
@@ -629,22 +722,22 @@ def _grasp_path(gripper: Gripper, D: float, Ps: list[float]) -> list[Grasp]:
                 reason = fb.reason if not free_ok else "a limit point of the contact equilibrium"
                 stuck = (f"no stable contact equilibrium above {P_reached:.4g} kPa ({reason}); the finger "
                          "snaps through", False)
-            out[i] = _none(D, P, depth, stuck[0], equilibrium=stuck[1])
+            out[i] = (_none(D, P, depth, stuck[0], equilibrium=stuck[1]), None)
             continue
         # the contact needs more curvature than the free branch has (beyond the fold): direct solve
         res = _direct(ctx, gripper, D, P, depth, br_P, kind, k_c, sig0)
         if res is None:
             reason = fb.reason if not free_ok else "the contact needs more curvature than the stable branch reaches"
-            res = _none(D, P, depth, f"no stable contact equilibrium at {P:.4g} kPa ({reason}); near the "
-                        "fingertip the contact moment is too small for the stable branch, so the finger snaps "
-                        "through", equilibrium=False)
+            res = (_none(D, P, depth, f"no stable contact equilibrium at {P:.4g} kPa ({reason}); near the "
+                         "fingertip the contact moment is too small for the stable branch, so the finger snaps "
+                         "through", equilibrium=False), None)
         out[i] = res
-    grasps = [g for g in out if g is not None]
-    assert len(grasps) == len(Ps), "the loop fills in every pressure"
-    return grasps
+    items = [g for g in out if g is not None]
+    assert len(items) == len(Ps), "the loop fills in every pressure"
+    return items
 
 
-def _direct(ctx: _Ctx, gripper, D, P, depth, br_P, kind, k_c, sig0):
+def _direct(ctx: _Ctx, gripper, D, P, depth, br_P, kind, k_c, sig0) -> _Item | None:
     n = ctx.rod.n
     span = br_P.k_hi - br_P.k_lo
     for mode in (kind, "body" if kind == "tip" else "tip", "tip+body"):
@@ -673,7 +766,8 @@ def _onset_pressure_kpa(law: MomentLaw, kap_c: float) -> float:
     return float(law.P_start_kpa) + float(np.interp(kap_c, kt, pt))
 
 
-def _finish(gripper: Gripper, D, P, depth, sysm: _Contact, u, br, mode) -> Grasp:
+def _finish(gripper: Gripper, D, P, depth, sysm: _Contact, u, br, mode) -> tuple[Grasp, _Seed]:
+    """The grasp (with the frozen-normal estimate as its grip force until the pull-out) and its seed."""
     g = sysm.forces(u[None, :])
     mu = gripper.mu
     total_N, grip = 0.0, 0.0
@@ -707,7 +801,503 @@ def _finish(gripper: Gripper, D, P, depth, sysm: _Contact, u, br, mode) -> Grasp
     shape = FingerShape(rod.f, loads, P, rod.s.copy(), x, y, phi, k.copy(), m_act, (float(xt[0]), float(yt[0])),
                         float(phi[-1]), True, True, res, 1.0, f"in {mode} contact (normal force {total_N:.4g} N)",
                         None, br)
-    return Grasp(D, P, mode, total_N, gripper.fingers * grip, tuple(pts), betas[main], depth, True, "", shape)
+    frozen = gripper.fingers * grip
+    Nt = float(np.real(g["tip"][0][0])) if "tip" in g else 0.0
+    Nb = float(np.real(g["body"][0][0])) if "body" in g else 0.0
+    sig = float(np.real(g["body"][6][0])) if "body" in g else math.nan
+    seed = _Seed(D, P, depth, np.asarray(k, float).copy(), Nt, Nb, sig, br)
+    return Grasp(D, P, mode, total_N, frozen, tuple(pts), betas[main], depth, True, "", shape,
+                 frozen_grip_force_n=frozen), seed
+
+
+# ------------------------------------------------------------------------------------------------
+# quasi-static pull-out
+# ------------------------------------------------------------------------------------------------
+_OPEN, _STICK, _SLIP = 0, 1, 2
+_STATE_NAMES = ("open", "stick", "slip")
+_MAX_STEPS = 400  # accepted lift steps per pull-out
+_MAX_RETRIES = 8  # contact-state changes tried at one lift step before the step is halved
+_SLIP_OVERSHOOT = 0.01  # a step that overshoots the onset of slip by more (|T| / mu N - 1) is halved
+_FORCE_STEP = 0.2  # a step that changes the pull force by more (relative to the peak) is halved
+_PAST_PEAK = 0.5  # the pull stops once the load has fallen below this fraction of its peak
+#: how the pull-out ends when its peak may be only a lower bound (copied into the grasp's note)
+_UNUSUAL_ENDS = ("at a lift of", "the contact state does not settle", "no escape up to")
+
+
+@dataclass(frozen=True)
+class PullOut:
+    """History of a quasi-static pull-out (one row per accepted lift step, the grasp first).
+
+    Each finger has at most two contacts: its fingertip point (column 0) and one body contact on
+    the contact surface of the rod or the pad (column 1).
+
+    Attributes
+    ----------
+    lift_mm : (steps,) lift of the gripper base above its grasping position, mm.
+    pull_force_n : (steps,) vertical load the arm applies to the gripper (whole gripper, up > 0), N.
+    normal_force_n : (steps, 2) normal force of the tip and the body contact per finger, N (0 when open).
+    tangential_force_n : (steps, 2) friction force on the finger along the sphere's tangent
+        ``t = (-n_y, n_x)`` (``n`` the sphere's outward normal at the contact), N.
+    contact_angle_deg : (steps, 2) angle of the sphere's outward normal at each contact from the
+        downward vertical, degrees (NaN when open).
+    state : (steps, 2) ``"open"``, ``"stick"`` or ``"slip"``.
+    peak_index : the row of the peak pull force.
+    end : why the pull stopped (the sphere escaped, the load fell past its peak, ...).
+    """
+
+    lift_mm: np.ndarray
+    pull_force_n: np.ndarray
+    normal_force_n: np.ndarray
+    tangential_force_n: np.ndarray
+    contact_angle_deg: np.ndarray
+    state: np.ndarray
+    peak_index: int
+    end: str
+
+    @property
+    def peak_force_n(self) -> float:
+        """The peak pull force (whole gripper), N."""
+        return float(self.pull_force_n[self.peak_index])
+
+    @property
+    def peak_lift_mm(self) -> float:
+        """The lift at the peak, mm."""
+        return float(self.lift_mm[self.peak_index])
+
+    def to_dataframe(self):
+        """The history as a :class:`pandas.DataFrame` (units in the column names)."""
+        import pandas as pd
+
+        cols = {"lift_mm": self.lift_mm, "pull_force_n": self.pull_force_n}
+        for j, name in enumerate(("tip", "body")):
+            cols[f"{name}_normal_force_n"] = self.normal_force_n[:, j]
+            cols[f"{name}_tangential_force_n"] = self.tangential_force_n[:, j]
+            cols[f"{name}_contact_angle_deg"] = self.contact_angle_deg[:, j]
+            cols[f"{name}_state"] = self.state[:, j]
+        return pd.DataFrame(cols)
+
+
+@dataclass
+class _Seed:
+    """A converged grasp (the start of its pull-out): physical contact forces, N, and sigma, mm."""
+
+    D: float
+    P: float
+    depth: float
+    k: np.ndarray
+    Nt: float
+    Nb: float
+    sig_mm: float
+    branch: StableBranch
+
+
+def _surface_point(rod: Rod, phi, x, y, sc):
+    """Point of the finger's contact surface at contact coordinate ``sc`` (mm along rod and pad), batched.
+
+    On the rod (``sc <= L``) the frame line offset by ``contact_offset_mm`` toward the sphere, on the
+    rigid pad beyond it the pad's flat face.  Returns ``(x, y, angle)``: the point and the surface
+    tangent's angle (rad).
+    """
+    b, off = rod.f.bend, rod.off
+    on_rod = np.real(sc) <= rod.L
+    sr = np.where(on_rod, sc, rod.L)
+    xr, yr, pr = rod.point(phi, x, y, sr)
+    pl = phi[..., -1]
+    tau = np.where(on_rod, 0.0, sc - rod.L)
+    pc = np.where(on_rod, pr, pl)
+    xc = np.where(on_rod, xr, x[..., -1] + tau * np.cos(pl)) - b * off * np.sin(pc)
+    yc = np.where(on_rod, yr, y[..., -1] + tau * np.sin(pl)) + b * off * np.cos(pc)
+    return xc, yc, pc
+
+
+class _Pull:
+    """Batched quasi-static pull-out of several grasps of one gripper (displacement control).
+
+    Unknowns of each grasp (scaled): the nodal curvatures, then the tip contact's normal and
+    tangential force, then the body contact's normal and tangential force and its coordinate
+    ``sigma / (L + ell)``.  Each contact is open (its forces vanish), sticks (on the sphere, no
+    tangential slip in the step) or slips (on the sphere, ``T = s mu N``).
+    """
+
+    def __init__(self, gripper: Gripper, seeds: list[_Seed]):
+        self.g = gripper
+        finger = gripper.finger()
+        self.rod = rod = Rod(finger, FingerLoads())
+        self.n = n = rod.n
+        self.m = n + 5
+        self.Lr = rod.L + rod.ell
+        self.c = rod.c
+        self.mu = gripper.mu
+        self.delta = float(gripper.contact_offset_mm or 0.0)
+        B = len(seeds)
+        self.B = B
+        law = gripper.law
+        self.table = seeds[0].branch.table if B else None
+        self.pa = np.array([s.branch.p_active_kpa for s in seeds])
+        self.fr = np.array([s.branch.friction_nmm for s in seeds])
+        self.klo = np.array([s.branch.k_lo for s in seeds])
+        self.khi = np.array([s.branch.k_hi for s in seeds])
+        self.scale = np.array([max(abs(float(law.blocked_moment(s.P))), 1.0) for s in seeds])
+        self.fs = self.scale / self.Lr  # force scale, N
+        self.R = np.array([0.5 * s.D for s in seeds])
+        self.cy0 = np.array([-s.depth for s in seeds])
+        u = np.zeros((B, self.m))
+        st = np.zeros((B, 2), dtype=int)
+        for i, s in enumerate(seeds):
+            u[i, :n] = s.k
+            u[i, n] = s.Nt / self.fs[i]
+            u[i, n + 2] = s.Nb / self.fs[i]
+            u[i, n + 4] = s.sig_mm / self.Lr if np.isfinite(s.sig_mm) else 0.999
+            st[i, 0] = _STICK if s.Nt > 0.0 else _OPEN
+            st[i, 1] = _STICK if s.Nb > 0.0 else _OPEN
+        self.u = u  # accepted state
+        self.st = st  # accepted contact states
+        self.sgn = np.ones((B, 2))  # slip direction sign s (T = s mu N)
+        self.lift = np.zeros(B)
+        self.tol_gap = _PEN_TOL * np.maximum(1.0, self.R / 50.0)
+
+    # ---- residuals ---------------------------------------------------------------------------
+    def fun(self, U, idx, cy, st, sgn, u_old, details=False, law=True):
+        """Residuals of the grasps ``idx`` with centre heights ``cy``; ``U`` is (b, J, m).
+
+        ``law=False`` leaves out the moment law (for the complex-step Jacobian: it is diagonal in
+        the curvatures, :meth:`law_diagonal`).
+        """
+        rod, n, Lr, mu = self.rod, self.n, self.Lr, self.mu
+        col = (slice(None), None)
+        fs = self.fs[idx][col]
+        R = self.R[idx][col]
+        cyy = cy[col]
+        k = U[..., :n]
+        phi, x, y, xt, yt = rod.geometry(k)
+        # the old (accepted) configuration: the sphere's material points move with its centre
+        phio, xo, yo, xto, yto = rod.geometry(u_old[:, None, :n])
+        cyo = (self.cy0[idx] - self.lift[idx])[col]
+        Nt, Tt = U[..., n] * fs, U[..., n + 1] * fs
+        Nb, Tb = U[..., n + 2] * fs, U[..., n + 3] * fs
+        sg = U[..., n + 4]
+        # tip contact: the fingertip point on the sphere
+        dx, dy = xt, yt - cyy
+        dt = np.sqrt(dx * dx + dy * dy)
+        nx, ny = dx / dt, dy / dt
+        Fx, Fy = Nt * nx - Tt * ny, Nt * ny + Tt * nx
+        m = cross(xt[..., None] - x, yt[..., None] - y, Fx[..., None], Fy[..., None])
+        slip_t = (-ny * (xt - xto) + nx * ((yt - yto) - (cyy - cyo))) / Lr
+        # body contact: the contact surface tangent to the sphere at sigma
+        sc = sg * Lr
+        xc, yc, pc = _surface_point(rod, phi, x, y, sc)
+        ex, ey = xc, yc - cyy
+        db = np.sqrt(ex * ex + ey * ey)
+        bx, by = ex / db, ey / db
+        Gx, Gy = Nb * bx - Tb * by, Nb * by + Tb * bx
+        # the nodes beyond which the body force acts, ramped over one node spacing (continuous in sigma)
+        beyond = np.clip((sc[..., None] - rod.s) / rod.h + 0.5, 0.0, 1.0)
+        m = m + beyond * cross(xc[..., None] - x, yc[..., None] - y, Gx[..., None], Gy[..., None])
+        xco, yco, _ = _surface_point(rod, phio, xo, yo, sc)
+        slip_b = (-by * (xc - xco) + bx * ((yc - yco) - (cyy - cyo))) / Lr
+        if law:
+            A, Bm, _, _ = self.table.derivatives(k)
+            m = m + self.c * (self.pa[idx][:, None, None] * A - Bm - self.fr[idx][:, None, None])
+        r_mom = self.c * m / self.scale[idx][:, None, None]
+        s0, s1 = st[:, 0][col], st[:, 1][col]
+        g0, g1 = sgn[:, 0][col], sgn[:, 1][col]
+        un, ut = U[..., n], U[..., n + 1]
+        vn, vt = U[..., n + 2], U[..., n + 3]
+        r_t1 = np.where(s0 == _OPEN, un, (dt - R) / Lr)
+        r_t2 = np.where(s0 == _OPEN, ut, np.where(s0 == _STICK, slip_t, ut - g0 * mu * un))
+        r_b1 = np.where(s1 == _OPEN, vn, (db - R) / Lr)
+        r_b2 = np.where(s1 == _OPEN, vt, np.cos(pc) * bx + np.sin(pc) * by)
+        r_b3 = np.where(s1 == _OPEN, sg - u_old[:, None, n + 4],
+                        np.where(s1 == _STICK, slip_b, vt - g1 * mu * vn))
+        r = np.concatenate([r_mom, np.stack([r_t1, r_t2, r_b1, r_b2, r_b3], axis=-1)], axis=-1)
+        if not details:
+            return r
+        return dict(x=x, y=y, phi=phi, xt=xt, yt=yt, Nt=Nt, Tt=Tt, Nb=Nb, Tb=Tb, nt=(nx, ny), nb=(bx, by),
+                    gap_t=dt - R, slip=(slip_t * Lr, slip_b * Lr), sc=sc, pc=pc, Fy=Fy + Gy, cy=cyy)
+
+    def law_diagonal(self, idx, u):
+        """``dM/dk' / scale`` at the nodes of the grasps ``idx`` in the states ``u`` (b, m)."""
+        _, _, dA, dB = self.table.derivatives(u[:, : self.n])
+        return (self.pa[idx][:, None] * dA - dB) / self.scale[idx][:, None]
+
+    def bounds(self, idx):
+        b = idx.size
+        lo = np.full((b, self.m), -np.inf)
+        hi = np.full((b, self.m), np.inf)
+        lo[:, : self.n] = self.klo[idx][:, None]
+        hi[:, : self.n] = self.khi[idx][:, None]
+        lo[:, self.n + 4], hi[:, self.n + 4] = 0.0, 1.0
+        return lo, hi
+
+    # ---- batched damped Newton -----------------------------------------------------------------
+    def newton(self, idx, cy, st, sgn, u0, maxit=12):
+        """Solve the grasps ``idx`` from ``u0``; returns ``(u, ok)``."""
+        u_old = self.u[idx]
+        lo, hi = self.bounds(idx)
+        u = u0.copy()
+        m = self.m
+
+        def F(sel, V):
+            return np.real(self.fun(V[:, None, :], idx[sel], cy[sel], st[sel], sgn[sel], u_old[sel]))[:, 0]
+
+        allsel = np.arange(idx.size)
+        r = F(allsel, u)
+        nr = np.max(np.abs(r), axis=1)
+        ok = nr < NEWTON_TOL
+        live = ~ok & np.isfinite(nr)
+        eye = 1j * 1e-30 * np.eye(m)
+        for _ in range(maxit):
+            sel = np.flatnonzero(live)
+            if not sel.size:
+                break
+            Uc = u[sel][:, None, :] + eye[None]
+            Rc = self.fun(Uc, idx[sel], cy[sel], st[sel], sgn[sel], u_old[sel], law=False)
+            J = np.swapaxes(np.imag(Rc) / 1e-30, 1, 2)
+            diag = np.arange(self.n)
+            J[:, diag, diag] += self.law_diagonal(idx[sel], u[sel])
+            rs = r[sel]
+            try:
+                du = np.linalg.solve(J, -rs[..., None])[..., 0]
+            except np.linalg.LinAlgError:
+                du = np.stack([np.linalg.lstsq(J[i], -rs[i], rcond=None)[0] for i in range(sel.size)])
+            bad = ~np.all(np.isfinite(du), axis=1)
+            du[bad] = 0.0
+            us = u[sel]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                a_hi = np.where(du > 0, 0.9 * (hi[sel] - us) / du, np.inf)
+                a_lo = np.where(du < 0, 0.9 * (lo[sel] - us) / du, np.inf)
+            alpha = np.minimum(1.0, np.minimum(a_hi.min(axis=1), a_lo.min(axis=1)))
+            n2 = np.sum(rs * rs, axis=1)
+            acc = np.zeros(sel.size, dtype=bool)
+            un, rn = us.copy(), rs.copy()
+            pend = np.flatnonzero(~bad)
+            for _ls in range(30):
+                if not pend.size:
+                    break
+                trial = us[pend] + alpha[pend, None] * du[pend]
+                rt = F(sel[pend], trial)
+                n2t = np.sum(rt * rt, axis=1)
+                good = np.isfinite(n2t) & (n2t <= (1.0 - 1e-4 * alpha[pend]) * n2[pend])
+                gi = pend[good]
+                un[gi], rn[gi], acc[gi] = trial[good], rt[good], True
+                pend = pend[~good]
+                alpha[pend] *= 0.5
+            fail = ~acc | (alpha < 1e-12)
+            u[sel[acc]] = un[acc]
+            r[sel[acc]] = rn[acc]
+            nr[sel] = np.max(np.abs(r[sel]), axis=1)
+            done = nr[sel] < NEWTON_TOL
+            ok[sel[done]] = True
+            live[sel[done | fail]] = False
+        return u, ok
+
+    # ---- the pull ------------------------------------------------------------------------------
+    def _record(self, i, d, j):
+        """History row of grasp ``i`` from the details ``d`` (row ``j`` of a batch)."""
+        fingers = self.g.fingers
+        N = np.array([float(np.real(d["Nt"][j, 0])), float(np.real(d["Nb"][j, 0]))])
+        T = np.array([float(np.real(d["Tt"][j, 0])), float(np.real(d["Tb"][j, 0]))])
+        st = self.st[i]
+        N[st == _OPEN] = 0.0
+        T[st == _OPEN] = 0.0
+        beta = np.array([math.degrees(math.atan2(float(np.real(v[0][j, 0])), -float(np.real(v[1][j, 0]))))
+                         for v in (d["nt"], d["nb"])])
+        beta[st == _OPEN] = math.nan
+        F = -fingers * float(np.real(d["Fy"][j, 0]))
+        return (self.lift[i], F, N, T, beta, st.copy())
+
+    def run(self) -> list[PullOut]:
+        """Pull every grasp out; returns a list of :class:`PullOut`."""
+        B, n, mu = self.B, self.n, self.mu
+        hist: list[list] = [[] for _ in range(B)]
+        end = [""] * B
+        if B == 0:
+            return []
+        all_idx = np.arange(B)
+        d = self.fun(self.u[:, None, :], all_idx, self.cy0.copy(), self.st, self.sgn, self.u, details=True)
+        for i in range(B):
+            hist[i].append(self._record(i, d, i))
+        h = 0.002 * self.R
+        h_min = 1e-7 * self.R
+        h_max = 0.04 * self.R + 0.01 * self.Lr
+        lift_max = 2.0 * (2.0 * self.R) + self.Lr
+        Fs = self.g.fingers * self.fs  # force scale of the gripper
+        tst, tsg = self.st.copy(), self.sgn.copy()  # trial contact states at the pending step
+        retries = np.zeros(B, dtype=int)
+        tried_slip = np.zeros(B, dtype=bool)
+        du_last = np.zeros_like(self.u)
+        h_last = np.zeros(B)
+        live = np.ones(B, dtype=bool)
+        steps = np.zeros(B, dtype=int)
+        while live.any():
+            idx = np.flatnonzero(live)
+            cy = self.cy0[idx] - (self.lift[idx] + h[idx])
+            # predictor: the last step's change, scaled, while the contact states stay the same
+            same = np.all(tst[idx] == self.st[idx], axis=1) & (h_last[idx] > 0)
+            u0 = self.u[idx] + np.where(same, h[idx] / np.where(h_last[idx] > 0, h_last[idx], 1.0), 0.0)[:, None] \
+                * du_last[idx]
+            lo, hi = self.bounds(idx)
+            with np.errstate(invalid="ignore"):  # infinite bounds of the forces: no clipping
+                lo = np.where(np.isfinite(lo), lo + 0.05 * (self.u[idx] - lo), -np.inf)
+                hi = np.where(np.isfinite(hi), hi - 0.05 * (hi - self.u[idx]), np.inf)
+            u0 = np.clip(u0, lo, hi)
+            unew, ok = self.newton(idx, cy, tst[idx], tsg[idx], u0)
+            dd = self.fun(unew[:, None, :], idx, cy, tst[idx], tsg[idx], self.u[idx], details=True)
+            for j, i in enumerate(idx.tolist()):
+                if not ok[j]:
+                    stuck = tst[i] == _STICK
+                    if stuck.any() and not tried_slip[i]:
+                        # no sticking equilibrium (e.g. an inextensible finger dragged along its axis): slip,
+                        # the friction pulling the finger along with the sphere's surface (down)
+                        tried_slip[i] = True
+                        nxs = (float(np.real(dd["nt"][0][j, 0])), float(np.real(dd["nb"][0][j, 0])))
+                        for c in np.flatnonzero(stuck):
+                            tst[i, c], tsg[i, c] = _SLIP, -math.copysign(1.0, nxs[c])
+                        continue
+                    tried_slip[i] = False
+                    tst[i], tsg[i], retries[i] = self.st[i], self.sgn[i], 0
+                    h[i] *= 0.5
+                    if h[i] < h_min[i]:
+                        live[i] = False
+                        end[i] = (f"no equilibrium beyond a lift of {self.lift[i]:.4g} mm: the finger snaps off the "
+                                  "sphere (the contact load exceeds what its stable branch holds)")
+                    continue
+                changed = self._events(i, j, dd, unew[j], tst, tsg, mu, n, h[i] > 1e3 * h_min[i])
+                if changed == "bisect":
+                    h[i] *= 0.5
+                    continue
+                if changed == "two-body":
+                    live[i] = False
+                    end[i] = (f"at a lift of {self.lift[i] + h[i]:.4g} mm a second body contact would be needed "
+                              "(not modelled): the pull stops there")
+                    continue
+                if changed:
+                    retries[i] += 1
+                    if retries[i] > _MAX_RETRIES:
+                        tst[i], tsg[i], retries[i] = self.st[i], self.sgn[i], 0
+                        h[i] *= 0.5
+                        if h[i] < h_min[i]:
+                            live[i] = False
+                            end[i] = f"the contact state does not settle at a lift of {self.lift[i]:.4g} mm"
+                    continue
+                row_F = -self.g.fingers * float(np.real(dd["Fy"][j, 0]))
+                prev = hist[i][-1][1]
+                peak = max(r[1] for r in hist[i])
+                if abs(row_F - prev) > _FORCE_STEP * max(abs(peak), abs(prev), 0.2 * Fs[i]) and h[i] > 1e3 * h_min[i]:
+                    tst[i], tsg[i], retries[i] = self.st[i], self.sgn[i], 0
+                    h[i] *= 0.5
+                    continue
+                # accept the step
+                same_states = bool(np.all(tst[i] == self.st[i]))
+                du_last[i] = (unew[j] - self.u[i]) if same_states else 0.0
+                h_last[i] = h[i] if same_states else 0.0
+                self.u[i] = unew[j]
+                self.st[i], self.sgn[i] = tst[i].copy(), tsg[i].copy()
+                self.lift[i] += h[i]
+                retries[i] = 0
+                tried_slip[i] = False
+                steps[i] += 1
+                hist[i].append(self._record(i, dd, j))
+                h[i] = min(2.0 * h[i], h_max[i])
+                F = hist[i][-1][1]
+                peak = max(r[1] for r in hist[i])
+                if np.all(self.st[i] == _OPEN):
+                    live[i] = False
+                    end[i] = f"the sphere escapes: every contact opens at a lift of {self.lift[i]:.4g} mm"
+                elif peak > 0.0 and F < _PAST_PEAK * peak and F < prev:
+                    live[i] = False
+                    end[i] = (f"the load falls past its peak (to {F:.3g} N at a lift of {self.lift[i]:.4g} mm): "
+                              "under a pulling force the sphere escapes at the peak")
+                elif self.lift[i] > lift_max[i] or steps[i] >= _MAX_STEPS:
+                    live[i] = False
+                    end[i] = (f"no escape up to a lift of {self.lift[i]:.4g} mm ({steps[i]} steps): the peak is a "
+                              "lower bound")
+        out = []
+        for i in range(B):
+            rows = hist[i]
+            lift = np.array([r[0] for r in rows])
+            F = np.array([r[1] for r in rows])
+            N = np.array([r[2] for r in rows])
+            T = np.array([r[3] for r in rows])
+            beta = np.array([r[4] for r in rows])
+            st = np.array([[_STATE_NAMES[s] for s in r[5]] for r in rows])
+            out.append(PullOut(lift, F, N, T, beta, st, int(np.argmax(F)), end[i]))
+        return out
+
+    def _events(self, i, j, dd, u, tst, tsg, mu, n, locate):
+        """Contact-state changes after a converged trial step of grasp ``i`` (batch row ``j``).
+
+        Returns False (consistent), True (states changed: solve the step again) or ``"two-body"``.
+        """
+        ftol = 1e-9 * self.fs[i]
+        changed = False
+        N = (float(np.real(dd["Nt"][j, 0])), float(np.real(dd["Nb"][j, 0])))
+        T = (float(np.real(dd["Tt"][j, 0])), float(np.real(dd["Tb"][j, 0])))
+        slip = (float(np.real(dd["slip"][0][j, 0])), float(np.real(dd["slip"][1][j, 0])))
+        for c in (0, 1):
+            s = tst[i, c]
+            if s == _OPEN:
+                continue
+            if N[c] < -ftol:
+                tst[i, c] = _OPEN
+                changed = True
+            elif s == _STICK and abs(T[c]) > mu * N[c] * (1.0 + 1e-9) + ftol:
+                if self.st[i, c] == _STICK and abs(T[c]) > mu * N[c] * (1.0 + _SLIP_OVERSHOOT) + ftol and locate:
+                    return "bisect"  # locate the onset of slip (the peak is often there)
+                tst[i, c], tsg[i, c] = _SLIP, math.copysign(1.0, T[c])
+                changed = True
+            elif s == _SLIP and slip[c] * tsg[i, c] > 1e-9 * self.Lr:
+                tst[i, c] = _STICK  # the friction would not oppose the slip: it sticks
+                changed = True
+        if changed:
+            return True
+        # a body contact that runs off the pad's end becomes the tip contact
+        sig = float(u[n + 4])
+        if tst[i, 1] != _OPEN and sig > 0.995:
+            tst[i, 1] = _OPEN
+            if tst[i, 0] == _OPEN:
+                tst[i, 0] = _STICK
+            return True
+        # penetration: an open contact closes (sticking)
+        x, y = np.real(dd["x"][j, 0]), np.real(dd["y"][j, 0])
+        cy = float(np.real(dd["cy"][j, 0]))
+        R = self.R[i]
+        tol = self.tol_gap[i]
+        if tst[i, 0] == _OPEN and float(np.real(dd["gap_t"][j, 0])) < -tol:
+            tst[i, 0] = _STICK
+            return True
+        rod = self.rod
+        gap_nodes = np.hypot(x, y - cy) - R - self.delta
+        pl = float(np.real(dd["phi"][j, 0, -1]))
+        b = rod.f.bend
+        tau = np.linspace(0.0, rod.ell, 6)[:-1] if rod.ell > 0 else np.zeros(0)
+        ex = x[-1] - b * rod.off * math.sin(pl) + tau * math.cos(pl)
+        ey = y[-1] + b * rod.off * math.cos(pl) + tau * math.sin(pl)
+        gap_pad = np.hypot(ex, ey - cy) - R
+        if tst[i, 1] != _OPEN:
+            sc = float(np.real(dd["sc"][j, 0]))
+            near = np.abs(rod.s - sc) <= 0.1 * self.Lr
+            gap_nodes = np.where(near, np.maximum(gap_nodes, 0.0), gap_nodes)
+            near_p = np.abs(rod.L + tau - sc) <= 0.1 * self.Lr
+            gap_pad = np.where(near_p, np.maximum(gap_pad, 0.0), gap_pad)
+        gaps = np.concatenate([gap_nodes, gap_pad])
+        if gaps.size and gaps.min() < -tol:
+            if tst[i, 1] != _OPEN:
+                return "two-body"
+            jj = int(np.argmin(gaps))
+            sig_mm = rod.s[jj] if jj < n else rod.L + tau[jj - n]
+            self.u[i, n + 4] = min(max(sig_mm / self.Lr, 1e-3), 0.99)  # start of the new contact
+            self.u[i, n + 2] = self.u[i, n + 3] = 0.0
+            if jj >= n and tst[i, 0] != _OPEN:
+                # the flat pad rolls onto the sphere: its face takes over the fingertip's contact (a
+                # flat face cannot touch a convex sphere at its end and inside at once)
+                self.u[i, n + 2], self.u[i, n + 3] = self.u[i, n], self.u[i, n + 1]
+                tst[i, 1], tsg[i, 1] = _STICK if tst[i, 0] == _STICK else _SLIP, tsg[i, 0]
+                tst[i, 0] = _OPEN
+            else:
+                tst[i, 1] = _STICK
+            return True
+        return False
 
 
 def _diameters_mm(value) -> np.ndarray:
@@ -721,9 +1311,20 @@ def _diameters_mm(value) -> np.ndarray:
 def grasp_sweep(gripper: Gripper, diameters_mm, pressures_kpa):
     """Grasps over diameters (mm) and pressures (kPa): an :class:`xarray.Dataset`.
 
-    Dimensions ``diameter_mm`` and ``pressure_kpa``; variables ``grip_force_n`` (N),
-    ``contact_force_n`` (N, per finger), ``contact`` (str), ``contact_angle_deg``, ``equilibrium``
-    and ``note``.  ``.to_dataframe()`` gives the flat table.
+    Dimensions ``diameter_mm`` and ``pressure_kpa``; variables ``grip_force_n`` (N, the pull-out
+    force: the peak of the quasi-static pull), ``peak_lift_mm`` (lift at the peak), ``pull_end``
+    (why the pull stopped), ``frozen_grip_force_n`` (N, the frozen-normal estimate, for comparison
+    only), ``contact_force_n`` (N, per finger, at the grasp), ``contact`` (str),
+    ``contact_angle_deg``, ``equilibrium`` and ``note``.  ``.to_dataframe()`` gives the flat table.
+    All pull-outs are solved together (batched Newton), so a sweep costs little more than its grasps.
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> gripper = Gripper(bendpam.presets.be_pam().replace(L0_mm=130.0))
+    >>> ds = grasp_sweep(gripper, [180.0], [120.0, 160.0])
+    >>> list(ds.dims), ds["contact"].values.tolist()
+    (['diameter_mm', 'pressure_kpa'], [['none', 'tip']])
     """
     import xarray as xr
 
@@ -732,21 +1333,31 @@ def grasp_sweep(gripper: Gripper, diameters_mm, pressures_kpa):
     Ps = checked_pressures_kpa(pressures_kpa)
     shape = (Ds.size, Ps.size)
     grip = np.full(shape, np.nan)
+    frozen = np.full(shape, np.nan)
+    lift = np.full(shape, np.nan)
+    end = np.full(shape, "", dtype=object)
     normal = np.full(shape, np.nan)
     beta = np.full(shape, np.nan)
     contact = np.empty(shape, dtype=object)
     eq = np.zeros(shape, dtype=bool)
     note = np.empty(shape, dtype=object)
-    for i, D in enumerate(Ds):
-        with pressures_checked():
-            path = _grasp_path(gripper, float(D), [float(p) for p in Ps])
+    with pressures_checked():
+        paths = _pulled(gripper, [_grasp_path(gripper, float(D), [float(p) for p in Ps]) for D in Ds])
+    for i, path in enumerate(paths):
         for j, g in enumerate(path):
             grip[i, j], normal[i, j], beta[i, j] = g.grip_force_n, g.normal_force_n, g.contact_angle_deg
+            frozen[i, j], lift[i, j] = g.frozen_grip_force_n, g.peak_lift_mm
+            end[i, j] = g.pull_out.end if g.pull_out is not None else ""
             contact[i, j], eq[i, j], note[i, j] = g.contact, g.equilibrium, g.note
     dims = ("diameter_mm", "pressure_kpa")
     ds = xr.Dataset(
         {
             "grip_force_n": (dims, grip, {"units": "N", "long_name": "pull-out (gripping) force of the gripper"}),
+            "frozen_grip_force_n": (dims, frozen, {
+                "units": "N", "long_name": "frozen-normal estimate fingers * sum N (cos beta + mu sin beta), "
+                                           "for comparison only"}),
+            "peak_lift_mm": (dims, lift, {"units": "mm", "long_name": "lift of the base at the peak pull"}),
+            "pull_end": (dims, end.astype(str)),
             "contact_force_n": (dims, normal, {"units": "N", "long_name": "normal contact force per finger"}),
             "contact_angle_deg": (dims, beta, {"units": "deg",
                                                "long_name": "sphere normal at the contact from the downward vertical"}),
@@ -759,26 +1370,52 @@ def grasp_sweep(gripper: Gripper, diameters_mm, pressures_kpa):
     ds.attrs.update(actuator=gripper.actuator.name or gripper.actuator.kind, model=gripper.model,
                     fingers=gripper.fingers, base_radius_mm=gripper.base_radius_mm, mu=gripper.mu,
                     fingertip_mm=gripper.fingertip_mm, contact_offset_mm=gripper.contact_offset_mm,
-                    L0_mm=gripper.actuator.L0_mm)
+                    splay_deg=gripper.splay_deg, L0_mm=gripper.actuator.L0_mm)
     return ds
 
 
+_MARKERS = ("o", "s", "^", "D", "v", "P", "X", "*", "<", ">", "h", "p")
+
+
 def plot_grasp(ds, ax=None, title: str | None = None):
-    """Grip force against sphere diameter, one line per pressure (cf. the paper's Figure 8(c, d))."""
-    from .. import plots  # noqa: F401, I001  (first: the Agg backend unless chosen)
+    """Grip (pull-out) force against sphere diameter, one line per pressure (cf. the paper's Figure 8(c, d)).
+
+    ``ds`` is a :func:`grasp_sweep` result.  Where the gripper has no contact or no equilibrium the
+    line has a gap (no point, no line through it), never a 0 N point; each pressure has its own
+    marker and colour.  The figure is sized for a journal column (:func:`bendpam.plots.figure_size`).
+    Returns the figure.
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> import matplotlib.pyplot as plt
+    >>> gripper = Gripper(bendpam.presets.be_pam().replace(L0_mm=130.0))
+    >>> fig = plot_grasp(grasp_sweep(gripper, [160.0, 200.0], [160.0]))
+    >>> len(fig.axes)                                     # fig.savefig("grip.png") to keep it
+    1
+    >>> plt.close(fig)
+    """
+    from .. import plots  # noqa: I001  (first: the Agg backend unless chosen)
     import matplotlib.pyplot as plt
 
-    if ax is None:
-        fig, ax = plt.subplots(figsize=(6.5, 4.5))
-    else:
-        fig = ax.figure
-    P = ds["pressure_kpa"].values
-    colors = plt.cm.viridis(np.linspace(0.0, 0.9, max(P.size, 1)))
-    for j, p in enumerate(P):
-        ax.plot(ds["diameter_mm"].values, ds["grip_force_n"].values[:, j], "o-", color=colors[j], label=f"{p:g} kPa")
-    ax.set_xlabel("sphere diameter (mm)")
-    ax.set_ylabel("gripping force (N)")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
-    ax.set_title(title or f"{ds.attrs.get('fingers', '')}-finger gripper, {ds.attrs.get('actuator', '')}")
+    with plots.figure_style():
+        if ax is None:
+            fig, ax = plt.subplots(figsize=plots.figure_size("single", 0.8))
+        else:
+            fig = ax.figure
+        P = ds["pressure_kpa"].values
+        D = ds["diameter_mm"].values
+        grip = np.array(ds["grip_force_n"].values, dtype=float)
+        hole = (ds["contact"].values == "none") | ~ds["equilibrium"].values.astype(bool) | ~np.isfinite(grip)
+        colors = plt.cm.viridis(np.linspace(0.0, 0.85, max(P.size, 1)))
+        for j, p in enumerate(P):
+            y = np.where(hole[:, j], np.nan, grip[:, j])
+            ax.plot(D, y, "-", marker=_MARKERS[j % len(_MARKERS)], color=colors[j], label=f"{p:g} kPa")
+        ax.set_xlabel("sphere diameter (mm)")
+        ax.set_ylabel("grip (pull-out) force (N)")
+        ax.set_ylim(bottom=0.0)
+        ax.grid(alpha=0.3)
+        ax.legend(title="gaps: no contact or\nno equilibrium", ncol=1 if P.size <= 5 else 2)
+        ax.set_title(title or f"{ds.attrs.get('fingers', '')}-finger gripper, {ds.attrs.get('actuator', '')}")
+        fig.tight_layout()
     return fig

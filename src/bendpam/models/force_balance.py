@@ -41,7 +41,19 @@ import numpy as np
 
 from ..braid import DEFAULT_ORDER, case_column, gauss_nodes, ibar, radius_state, radius_terms
 
-__all__ = ["basis", "coefficients", "stress_state", "terms"]
+__all__ = ["axial_forces", "basis", "coefficients", "stress_state", "terms"]
+
+
+def _bladder_elastic(C1, C2, lbar, eta):
+    """Elastic (pressure-free) parts of eq 43-44: ``(const1, sig2e)`` in MPa.
+
+    ``const1`` is the Phi-independent part of ``sigma_bl,1^el`` and ``sig2e`` is ``sigma_bl,2^el``;
+    ``lbar = 1 + k'R`` (eq 39) and ``eta = R/R0`` (eq 5).
+    """
+    le2 = (lbar * eta) ** 2
+    const1 = -2.0 * C1 / le2 + 2.0 * C2 * le2
+    sig2e = 2.0 * C1 * (eta * eta - 1.0 / le2) - 2.0 * C2 * (1.0 / (eta * eta) - le2)
+    return const1, sig2e
 
 
 def _state(params, k, order):
@@ -57,10 +69,7 @@ def _state(params, k, order):
     cl2 = (case_column(c) * lam1) ** 2
     J = 2.0 * np.pi * ((lam1 * lam1 * omc / (1.0 - cl2)) @ wbar)
     C1, C2 = params.C10, params.C01
-    le2 = (lbar * eta) ** 2
-    # elastic (pressure-free) parts of eq 43 and eq 44
-    const1 = -2.0 * C1 / le2 + 2.0 * C2 * le2  # Phi-independent part of sigma_bl,1^el
-    sig2e = 2.0 * C1 * (eta * eta - 1.0 / le2) - 2.0 * C2 * (1.0 / (eta * eta) - le2)
+    const1, sig2e = _bladder_elastic(C1, C2, lbar, eta)
     varpart = 2.0 * np.pi * (((2.0 * case_column(C1) * lam1 * lam1 - 2.0 * case_column(C2) / (lam1 * lam1)) * omc)
                              @ wbar)
     m_bl = tbar * R * R * (varpart + 2.0 * np.pi * const1)
@@ -117,6 +126,13 @@ def basis(params, curvature, *, order: int = DEFAULT_ORDER):
     """Linear decomposition ``M = P_active A - E_f I_f k' - C10 b10 - C01 b01`` (C in MPa).
 
     Returns ``(A, b10, b01)``, see :func:`assemble`.
+
+    Examples
+    --------
+    >>> import numpy as np, bendpam
+    >>> A, b10, b01 = basis(bendpam.presets.be_pam("force_balance").params, np.array([0.0, 0.01]))
+    >>> A.round(2).tolist(), bool(abs(b10[0]) + abs(b01[0]) < 1e-9)    # no bladder terms when straight
+    ([2350.98, 1919.94], True)
     """
     k = np.asarray(curvature, dtype=float)
     u, R, dR, ib, dib = radius_state(k, params.alpha0, params.R0_start, order)
@@ -124,14 +140,27 @@ def basis(params, curvature, *, order: int = DEFAULT_ORDER):
 
 
 def coefficients(params, curvature, *, order: int = DEFAULT_ORDER):
-    """``(A, B)`` with ``M = P_active A - B`` (N*mm/MPa and N*mm), shape of ``curvature``."""
+    """``(A, B)`` with ``M = P_active A - B`` (N*mm/MPa and N*mm), shape of ``curvature``.
+
+    >>> import numpy as np, bendpam
+    >>> A, B = coefficients(bendpam.presets.be_pam("force_balance").params, np.array([0.0, 0.01]))
+    >>> A.round(2).tolist(), B.round(2).tolist()
+    ([2350.98, 1919.94], [0.0, 194.51])
+    """
     k = np.asarray(curvature, dtype=float)
     A, b10, b01 = basis(params, k, order=order)
     return A, params.C10 * b10 + params.C01 * b01 + params.frame_stiffness * k
 
 
 def terms(params, p_active, curvature, *, order: int = DEFAULT_ORDER):
-    """The parts of eq 49 in N*mm: ``M_load``, ``M_p``, ``M_frame``, ``M_bl``, ``M_br``."""
+    """The parts of eq 49 in N*mm: ``M_load``, ``M_p``, ``M_frame``, ``M_bl``, ``M_br``.
+
+    >>> import numpy as np, bendpam
+    >>> t = terms(bendpam.presets.be_pam("force_balance").params, 0.132, np.array([0.0, 0.01]))
+    >>> {name: v.round(2).tolist() for name, v in t.items()}
+    {'M_load': [310.33, 58.92], 'M_p': [427.26, 408.42], 'M_frame': [0.0, 3.54],
+     'M_bl': [0.0, 207.22], 'M_br': [116.93, 138.74]}
+    """
     k = np.asarray(curvature, dtype=float)
     p = np.asarray(p_active, dtype=float)
     st = _state(params, k, order)
@@ -160,6 +189,16 @@ def stress_state(params, p_active, curvature, phi, *, order: int = DEFAULT_ORDER
       ``braid_thickness_mm`` (eq 48, 31).
     * ``braid_angle`` (S, n): local braid angle alpha(Phi), rad.
     * ``t_bar`` (S): mean bladder thickness (mm), eq 40; ``R`` (S): radius (mm).
+
+    Examples
+    --------
+    The BC-PAM at 120 kPa (active 88 kPa) and k' = -0.006 1/mm, at the frame, a quarter turn and
+    the far side:
+
+    >>> import numpy as np, bendpam
+    >>> st = stress_state(bendpam.presets.bc_pam().params, 0.088, -0.006, np.radians([0.0, 90.0, 180.0]))
+    >>> st["sigma_bl1"].round(4).tolist(), round(float(st["P_e"]), 4)      # MPa
+    ([-0.0649, -0.0959, -0.0508], 0.0375)
     """
     k = np.asarray(curvature, dtype=float)
     p = np.asarray(p_active, dtype=float)
@@ -191,3 +230,55 @@ def stress_state(params, p_active, curvature, phi, *, order: int = DEFAULT_ORDER
         "t_bar": tbar,
         "R": R,
     }
+
+
+def axial_forces(params, p_active, u, R, *, order: int = DEFAULT_ORDER):
+    r"""Axial force balance of a cross-section (N): what the frame carries, eq 22 and 24-26 with eq 43-48.
+
+    The section's axial stress resultants, with the stresses of this model (:func:`stress_state`)
+    and eq 49's treatment of the pressure (docs/paper-reading.md item 9):
+
+    * ``F_p = pi R^2 P``: the pressure on the lumen plus the hydrostatic ``-P`` of the bladder's
+      axial stress over the wall (``pi (R - t)^2 P + 2 pi R t P ~ pi R^2 P``), the force whose
+      moment about the frame is eq 49's ``pi R^3 P``;
+    * ``F_br = \int N_br,1 R dPhi = (P R - sigma_bl,2^el t_bar) R \int_0^{2pi} cot^2 alpha dPhi``,
+      the braid's axial resultant (eq 31, 45-47);
+    * ``F_bl = t_bar R \int_0^{2pi} sigma_bl,1^el dPhi``, the bladder's elastic axial resultant (eq 43);
+    * ``N_frame = F_p - F_br - F_bl``: with no external axial load the section's resultants sum to
+      zero, so the frame carries the rest (tension positive).  At ``k' = 0`` this is
+      ``pi R0^2 P (1 - 2 cot^2 alpha0)``, the McKibben force with the opposite sign (the frame holds
+      the actuator at its length), and ``N_frame R0`` is the blocked moment (docs/paper-reading.md item 14).
+
+    ``u = k'R`` and ``R`` are the kinematic state of eq 5 (mm) and ``p_active`` the active pressure
+    (MPa); the parameter fields broadcast against ``u`` (a block of cases needs a trailing axis,
+    :meth:`~bendpam.ModelParams.col`).  Returns a dict of arrays: ``F_p``, ``F_br``, ``F_bl``,
+    ``N_frame`` (N), ``P_e`` (MPa, eq 45), ``t_bar`` (mm, eq 40) and ``eta`` (``R/R0``).
+
+    Examples
+    --------
+    Straight at 200 kPa: ``N_frame R0`` is the blocked moment (310.33 N*mm):
+
+    >>> import numpy as np, bendpam
+    >>> p = bendpam.presets.be_pam("force_balance").params
+    >>> f = axial_forces(p, 0.132, np.array(0.0), np.array(p.R0_start))
+    >>> round(float(f["N_frame"]), 3), round(float(f["N_frame"] * p.R0_start), 2)
+    (30.726, 310.33)
+    """
+    u = np.asarray(u, dtype=float)
+    p = np.asarray(p_active, dtype=float)
+    phi, wbar = gauss_nodes(order)
+    lam1 = 1.0 + u[..., None] * (1.0 - np.cos(phi))
+    lbar = 1.0 + u
+    eta = R / params.R0_start
+    tbar = params.t0_start / (lbar * eta)
+    const1, sig2e = _bladder_elastic(params.C10, params.C01, lbar, eta)
+    cl2 = (case_column(np.cos(params.alpha0)) * lam1) ** 2
+    mean_cot2 = (cl2 / (1.0 - cl2)) @ wbar  # circle mean of cot^2 alpha(Phi), eq 46-47
+    mean_lm2 = (1.0 / (lam1 * lam1)) @ wbar
+    mean_l2 = 1.0 + u * (2.0 + 1.5 * u)  # circle mean of lambda1^2: mean((1 - cos)^n) = 1, 3/2
+    n2 = p * R - sig2e * tbar  # braid hoop line tension P_e R (eq 31, 45)
+    f_p = p * np.pi * R * R
+    f_br = 2.0 * np.pi * n2 * R * mean_cot2
+    f_bl = 2.0 * np.pi * tbar * R * (2.0 * params.C10 * mean_l2 - 2.0 * params.C01 * mean_lm2 + const1)
+    return {"F_p": f_p, "F_br": f_br, "F_bl": f_bl, "N_frame": f_p - f_br - f_bl, "P_e": n2 / R, "t_bar": tbar,
+            "eta": eta}
