@@ -138,7 +138,8 @@ def simulate_processed(truth, pressures, model, st):
                                           ("bc-pam", "force_balance", [40, 60, 80, 100, 120])])
 def test_round_trip_recovers_the_loop(name, model, P):
     base = presets.get(name, model)
-    truth = base.replace(alpha0_deg=base.alpha0_deg + 0.6)
+    S = base.C10_kpa + base.C01_kpa  # an admissible material (Table 3's constants are not)
+    truth = base.replace(alpha0_deg=base.alpha0_deg + 0.6, C10_kpa=0.4 * S, C01_kpa=0.6 * S)
     st = SimulationSettings(hysteresis=0.05, hysteresis_offset_nmm=3.0, hysteresis_angle_deg=12.0, seed=11)
     ps, trs = simulate_processed(truth, P, model, st)
     r = fit(ps, base, model, hysteresis="pi")

@@ -56,6 +56,7 @@ __all__ = [
     "loss_ratio",
     "make_law",
     "predict_cycle",
+    "predict_cycles",
 ]
 
 LAWS = ("pi", "dahl")
@@ -183,15 +184,29 @@ class PrandtlIshlinskii:
             away from the blocked state:  s_j = -r_j + min(delta, m_j)
             back toward it:               s_j = -r_j + m_j - min(delta, m_j)
 
-        Returns ``(z_away, z_back)`` with ``z = sum_j s_j / sum_j r_j``.
+        Returns ``(z_away, z_back)`` with ``z = sum_j s_j / sum_j r_j``.  With the uniform
+        thresholds ``2 r_j = c (2j - 1)``, ``c = theta_h / (2n)``, the sums are closed forms: if
+        ``q(x)`` elements have ``2 r_j <= x``, ``sum_j min(x, 2 r_j) = c q^2 + x (n - q)``, so the
+        cost does not grow with ``n``.
         """
-        r = self.thresholds
-        dd = np.minimum(np.asarray(delta, dtype=float)[..., None], np.asarray(span, dtype=float)[..., None])
-        m = np.minimum(2.0 * r, np.asarray(span, dtype=float)[..., None])
-        step = np.minimum(dd, m)
-        norm = r.sum()
-        away = (-r + step).sum(-1) / norm
-        back = (-r + m - step).sum(-1) / norm
+        n = int(self.n)
+        c = 0.5 * self.theta_h_rad / n
+        span = np.asarray(span, dtype=float)
+        dd = np.minimum(np.asarray(delta, dtype=float), span)
+
+        def summin(x):  # sum_j min(x, 2 r_j) for x >= 0
+            q = np.clip(np.floor(x / (2.0 * c) + 0.5), 0, n)
+            # guard the rounding at the jumps: q counts 2 r_j = c (2j - 1) <= x exactly
+            q = np.where(c * (2.0 * q - 1.0) > x, q - 1, q)
+            q = np.where((q < n) & (c * (2.0 * q + 1.0) <= x), q + 1, q)
+            with np.errstate(invalid="ignore"):
+                return c * q * q + np.where(q < n, x * (n - q), 0.0)
+
+        norm = 0.5 * c * n * n  # sum_j r_j
+        m_sum = summin(span)
+        step = summin(np.maximum(dd, 0.0))
+        away = (step - norm) / norm
+        back = (m_sum - step - norm) / norm
         return away, back
 
 
@@ -307,25 +322,31 @@ def loss_ratio(k_mag, upper, lower, L0_mm: float) -> tuple[float, float, float]:
     return (loss / stored if stored > 0 else math.nan), loss, stored
 
 
-def loop_branches(actuator, loop: LoopModel, pressure_kpa: float, k_free: float, k, model: str = "energy", *,
-                  order: int = 32, eq19_factor: bool = True):
-    """Steady-cycle branches between the blocked state and ``k_free`` (magnitudes, 1/mm).
-
-    Returns ``(loading, unloading)``: the upper and the lower branch (N*mm, magnitudes) at the
-    curvature magnitudes ``k``.
-    """
-    from .law import MomentLaw
-
+def _cycle_branches(actuator, loop: LoopModel, law, P, k_free, k):
+    """Steady-cycle branches, broadcasting: ``P`` and ``k_free`` (kPa, 1/mm) against ``k`` (1/mm)."""
     s = actuator.bend_sign or 1
-    k = np.asarray(k, dtype=float)
-    P = float(pressure_kpa)
-    A, B = MomentLaw.of(actuator, model, order=order, eq19_factor=eq19_factor).coefficients(s * k)
-    Mqs = s * (max(P - actuator.P_start_kpa, 0.0) * A - B)
+    A, B = law.coefficients(s * k)
+    Mqs = s * (np.maximum(P - actuator.P_start_kpa, 0.0) * A - B)
     L0 = actuator.L0_mm
     z_unl, _ = loop.z_law.steady_branches(k * L0, k_free * L0)
     _, z_load = loop.z_law.steady_branches(np.maximum(k_free - k, 0.0) * L0, k_free * L0)
     amp = loop.amplitude_nmm(actuator, P, s * k)
     return Mqs - amp * z_load, Mqs - amp * z_unl
+
+
+def loop_branches(actuator, loop: LoopModel, pressure_kpa, k_free, k, model: str = "energy", *,
+                  order: int = 32, eq19_factor: bool = True):
+    """Steady-cycle branches between the blocked state and ``k_free`` (magnitudes, 1/mm).
+
+    Returns ``(loading, unloading)``: the upper and the lower branch (N*mm, magnitudes) at the
+    curvature magnitudes ``k``.  ``pressure_kpa`` and ``k_free`` may be arrays that broadcast
+    against ``k`` (one row per test).
+    """
+    from .law import MomentLaw
+
+    law = MomentLaw.of(actuator, model, order=order, eq19_factor=eq19_factor)
+    return _cycle_branches(actuator, loop, law, np.asarray(pressure_kpa, dtype=float),
+                           np.asarray(k_free, dtype=float), np.asarray(k, dtype=float))
 
 
 @dataclass(frozen=True)
@@ -340,38 +361,109 @@ class Cycle:
     energy_loss_ratio: float
     note: str = ""
 
+    @property
+    def blocked_moment_nmm(self) -> float:
+        """The cycle's largest moment: the loading branch at the blocked state (N*mm, NaN if no cycle)."""
+        return float(self.loading_nmm[0]) if self.loading_nmm.size else math.nan
 
-def predict_cycle(actuator, loop: LoopModel, pressure_kpa: float, model: str = "energy", *, n: int = 201,
-                  order: int = 32, eq19_factor: bool = True) -> Cycle:
-    """The loop a free-bending cycle traces at ``pressure_kpa``: blocked -> free -> blocked.
+
+_NO_CYCLE = "the unloading branch does not reach zero moment before lock-up: no free-bending cycle"
+_FLAT = "the actuator does not bend at this pressure (the cycle collapses onto the straight state)"
+
+
+def predict_cycles(actuator, loop: LoopModel, pressures_kpa, model: str = "energy", *, n: int = 201,
+                   order: int = 32, eq19_factor: bool = True) -> list[Cycle]:
+    """The loops free-bending cycles trace at several pressures: blocked -> free -> blocked.
 
     The free state is where the unloading (lower) branch reaches zero moment; friction lowers that
     branch, so it is reached before the quasi-static free curvature.  The steady branches depend on
-    the loop's span, so the free state is found by a short fixed-point iteration.  Where the
-    unloading branch never reaches zero before the lock-up limit, the cycle is empty (NaN) with a note.
+    the loop's span, so the free state is found by a short fixed-point iteration (at most 8 steps,
+    to a relative change of 1e-12) on a grid of 2001 curvatures up to the lock-up limit.  Where the
+    unloading branch never reaches zero before the lock-up limit, the cycle is empty (NaN) with a
+    note.  This is the one computation behind ``bendpam predict --cycle``, the loss ratios and the
+    loop metrics of ``bendpam fit`` and Figure 7.
+
+    Parameters
+    ----------
+    actuator : the :class:`~bendpam.Actuator`.
+    loop : the :class:`LoopModel`.
+    pressures_kpa : gauge pressures, kPa (scalar or 1-D).
+    model : ``"energy"`` or ``"force_balance"``.
+    n : points of each returned branch, from 0 to the free curvature.
+
+    Returns
+    -------
+    list of :class:`Cycle`, one per pressure.
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> from bendpam.hysteresis import LoopModel, predict_cycles
+    >>> a = bendpam.presets.be_pam()
+    >>> c = predict_cycles(a, LoopModel(a1_nmm_per_kpa=0.1, theta_h_deg=8.0), [150.0, 200.0])
+    >>> [round(100 * x.energy_loss_ratio, 1) for x in c]
+    [15.9, 17.0]
     """
     from .braid import curvature_limits
+    from .checks import pressure_kpa as check_pressure
+    from .law import MomentLaw
 
+    P = np.atleast_1d(np.asarray(check_pressure(pressures_kpa), dtype=float)).ravel()
+    law = MomentLaw.of(actuator, model, order=order, eq19_factor=eq19_factor)
     lim = curvature_limits(actuator)
     sgn = actuator.bend_sign or 1
     k_lim = abs(lim.k_max if sgn > 0 else lim.k_min) * 0.999
     grid = np.linspace(0.0, k_lim, 2001)
-    span = k_lim
-    kf = math.nan
+    A, B = law.coefficients(sgn * grid)
+    Mqs = sgn * (np.maximum(P - actuator.P_start_kpa, 0.0)[:, None] * A - B)
+    amp = np.broadcast_to(loop.amplitude_nmm(actuator, P[:, None], sgn * grid), Mqs.shape)
+    L0 = actuator.L0_mm
+    span = np.full(P.size, k_lim)
+    kf = np.full(P.size, math.nan)
+    active = np.ones(P.size, dtype=bool)
     for _ in range(8):
-        _, low = loop_branches(actuator, loop, pressure_kpa, span, grid, model, order=order, eq19_factor=eq19_factor)
-        cross = np.flatnonzero(low <= 0.0)
-        if cross.size == 0 or cross[0] == 0:
+        idx = np.flatnonzero(active)
+        if idx.size == 0:
             break
-        j = cross[0]
-        new = float(grid[j - 1] + (grid[j] - grid[j - 1]) * low[j - 1] / (low[j - 1] - low[j]))
-        if math.isfinite(kf) and abs(new - kf) <= 1e-12 * max(abs(new), 1e-30):
-            kf = new
-            break
-        kf = span = new
-    if not math.isfinite(kf):
-        return Cycle(float(pressure_kpa), math.nan, np.zeros(0), np.zeros(0), np.zeros(0), math.nan,
-                     "the unloading branch does not reach zero moment before lock-up: no free-bending cycle")
-    k = np.linspace(0.0, kf, int(n))
-    up, low = loop_branches(actuator, loop, pressure_kpa, kf, k, model, order=order, eq19_factor=eq19_factor)
-    return Cycle(float(pressure_kpa), kf, k, up, low, loss_ratio(k, up, low, actuator.L0_mm)[0])
+        z_unl, _ = loop.z_law.steady_branches(grid * L0, span[idx, None] * L0)
+        low = Mqs[idx] - amp[idx] * z_unl
+        neg = low <= 0.0
+        j = np.argmax(neg, axis=1)
+        stop = ~neg.any(axis=1) | (j == 0)
+        active[idx[stop]] = False
+        go = ~stop
+        ii, jj = idx[go], j[go]
+        lo_a, lo_b = low[go, jj - 1], low[go, jj]
+        new = grid[jj - 1] + (grid[jj] - grid[jj - 1]) * lo_a / (lo_a - lo_b)
+        old = kf[ii]
+        done = np.isfinite(old) & (np.abs(new - old) <= 1e-12 * np.maximum(np.abs(new), 1e-30))
+        kf[ii] = new
+        span[ii] = new
+        active[ii[done]] = False
+    flat = np.isfinite(kf) & (kf <= 1e-9 * k_lim)  # the fixed point collapsed onto the straight state
+    kf[flat] = math.nan
+    ok = np.isfinite(kf)
+    out: list[Cycle] = []
+    if ok.any():
+        k = np.linspace(0.0, 1.0, int(n))[None, :] * kf[ok, None]
+        up, low = _cycle_branches(actuator, loop, law, P[ok, None], kf[ok, None], k)
+        th = k * L0
+        loss = np.trapezoid(up - low, th, axis=-1)
+        stored = np.trapezoid(0.5 * (up + low), th, axis=-1)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = np.where(stored > 0, loss / stored, math.nan)
+    row = 0
+    for i, p in enumerate(P):
+        if ok[i]:
+            out.append(Cycle(float(p), float(kf[i]), k[row], up[row], low[row], float(ratio[row])))
+            row += 1
+        else:
+            out.append(Cycle(float(p), math.nan, np.zeros(0), np.zeros(0), np.zeros(0), math.nan,
+                             _FLAT if flat[i] else _NO_CYCLE))
+    return out
+
+
+def predict_cycle(actuator, loop: LoopModel, pressure_kpa: float, model: str = "energy", *, n: int = 201,
+                  order: int = 32, eq19_factor: bool = True) -> Cycle:
+    """The loop a free-bending cycle traces at ``pressure_kpa``: :func:`predict_cycles` at one pressure."""
+    return predict_cycles(actuator, loop, [pressure_kpa], model, n=n, order=order, eq19_factor=eq19_factor)[0]

@@ -330,6 +330,12 @@ class BindingState:
         The pair of directions ``(i, j)`` (1-based) a Baker-Ericksen bound concerns.
     limit : bool
         True when the bound is attained only as ``l_i -> l_j`` (near this state).
+
+    Examples
+    --------
+    >>> uniaxial = shape_limits(0.6, 1.6)[1]
+    >>> [round(l, 4) for l in uniaxial.upper_at.stretches]     # uniaxial stretch 1.6
+    [1.6, 0.7906, 0.7906]
     """
 
     stretches: tuple[float, float, float]
@@ -366,6 +372,14 @@ class ShapeLimit:
         Where each bound is attained.
     exact : bool
         True for a closed form, False for the grid computation (the energy condition).
+
+    Examples
+    --------
+    >>> for lim in shape_limits(0.6, 1.6):
+    ...     print(lim.condition, lim.exact)
+    energy False
+    uniaxial True
+    baker_ericksen True
     """
 
     condition: str

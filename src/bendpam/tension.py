@@ -50,8 +50,10 @@ from .material import MooneyRivlin, admissible_shape_range, within
 __all__ = [
     "DEFAULT_ADMISSIBLE_RANGE",
     "SHAPE_RESOLVED_FRACTION",
+    "TensionData",
     "TensionFit",
     "fit_tension",
+    "tension_data",
     "tension_from_test",
 ]
 
@@ -386,6 +388,112 @@ def _identifiable(
             f"reliable, not C10 and C01 apart (correlation {corr:+.3f}).")
 
 
+@dataclass(frozen=True)
+class TensionData:
+    """The points of a uniaxial tension test the fits use (the loading branch, in the stretch range).
+
+    Attributes
+    ----------
+    stretch : np.ndarray
+        Stretches ``l = L / L0``.
+    nominal_stress_kpa : np.ndarray
+        Nominal stresses, kPa.
+    source : str
+        Where they came from (file name), may be empty.
+    """
+
+    stretch: np.ndarray
+    nominal_stress_kpa: np.ndarray
+    source: str = ""
+
+
+def tension_data(
+    raw: Any,
+    *,
+    gauge_length_mm: float,
+    area_mm2: float,
+    stretch_range: tuple[float, float] | None = None,
+) -> TensionData:
+    """The loading branch of a raw tension-test export as stretches and nominal stresses.
+
+    Stretch ``1 + stroke / gauge_length_mm`` (stroke relative to the first sample) and nominal
+    stress ``force / area_mm2`` (N/mm^2, reported in kPa).  A machine that records tension as
+    negative force or stroke is handled by flipping the sign of a column whose median is negative.
+
+    Only the first loading branch, from the start to the maximum stretch, is used: that is the
+    elastic response the Mooney-Rivlin law stands for.  The unloading branch lies below it
+    (hysteresis, Mullins softening, relaxation during a hold), so fitting both would average two
+    different curves, and anything after the maximum (unloading, further cycles) is dropped.
+
+    Parameters
+    ----------
+    raw : bendpam.lab.RawTest
+        The test; ``raw.data`` has columns ``time_s``, ``stroke_mm``, ``force_n``.
+    gauge_length_mm : float
+        Initial gauge length, mm (> 0).
+    area_mm2 : float
+        Initial cross-section of the specimen, mm^2 (> 0).
+    stretch_range : (float, float), optional
+        Keep only points with ``lo <= stretch <= hi``.
+
+    Returns
+    -------
+    TensionData
+        With ``source`` the file name.
+
+    Raises
+    ------
+    InputError
+        A non-positive or non-finite ``gauge_length_mm`` or ``area_mm2``, a bad ``stretch_range``.
+    ProcessingError
+        Fewer than 5 samples on the loading branch, or no stretch above 1.01.
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> from pathlib import Path
+    >>> from bendpam.lab import RawTest
+    >>> df = pd.DataFrame({"time_s": [0, 1, 2, 3, 4, 5], "stroke_mm": [0, 2, 4, 6, 8, 4],
+    ...                    "force_n": [0, 1, 2, 3, 4, 1]})
+    >>> td = tension_data(RawTest(df, Path("t.csv"), "csv"), gauge_length_mm=20, area_mm2=2)
+    >>> td.stretch.tolist(), td.nominal_stress_kpa.tolist()
+    ([1.0, 1.1, 1.2, 1.3, 1.4], [0.0, 500.0, 1000.0, 1500.0, 2000.0])
+    """
+    gauge = _positive("gauge_length_mm", gauge_length_mm, "mm")
+    area = _positive("area_mm2", area_mm2, "mm^2")
+    name = str(getattr(raw, "path", "") or "tension test")
+    stroke = np.asarray(raw.data["stroke_mm"], dtype=float)
+    force = np.asarray(raw.data["force_n"], dtype=float)
+    if stroke.size == 0:
+        raise ProcessingError(f"{name}: no samples; a tension fit needs at least "
+                              f"{_MIN_TEST_POINTS} on the loading branch")
+    ext = stroke - stroke[0]
+    if np.median(ext) < 0:
+        ext = -ext
+    if np.median(force) < 0:
+        force = -force
+    i = int(np.argmax(ext))
+    ext, force = ext[: i + 1], force[: i + 1]
+    if ext.size < _MIN_TEST_POINTS:
+        raise ProcessingError(
+            f"{name}: {ext.size} sample(s) up to the maximum stretch; a tension fit "
+            f"needs at least {_MIN_TEST_POINTS} on the loading branch"
+        )
+    lam = 1.0 + ext / gauge
+    if float(lam.max()) <= _MIN_TEST_STRETCH:
+        raise ProcessingError(
+            f"{name}: the largest stretch is {float(lam.max()):.5g} (stroke "
+            f"{float(ext.max()):.4g} mm on a {gauge:g} mm gauge); a tension fit needs "
+            f"a stretch above {_MIN_TEST_STRETCH:g}"
+        )
+    stress = force / area * 1e3
+    if stretch_range is not None:
+        lo, hi = _pair("stretch_range", stretch_range)
+        keep = (lam >= lo) & (lam <= hi)
+        lam, stress = lam[keep], stress[keep]
+    return TensionData(lam, stress, name)
+
+
 def tension_from_test(
     raw: Any,
     *,
@@ -396,16 +504,7 @@ def tension_from_test(
 ) -> TensionFit:
     """Fit a raw tension-test export (:class:`~bendpam.lab.RawTest`).
 
-    Through :func:`fit_tension`, with stretch ``1 + stroke / gauge_length_mm`` (stroke
-    relative to the first sample) and nominal stress ``force / area_mm2`` (N/mm^2,
-    reported in kPa).  A machine that records tension as negative force or stroke is
-    handled by flipping the sign of a column whose median is negative.
-
-    Only the first loading branch, from the start to the maximum stretch, is used: that
-    is the elastic response the Mooney-Rivlin law stands for.  The unloading branch lies
-    below it (hysteresis, Mullins softening, relaxation during a hold), so fitting
-    both would average two different curves, and anything after the maximum (unloading,
-    further cycles) is dropped.
+    The loading branch of :func:`tension_data` through :func:`fit_tension`.
 
     Parameters
     ----------
@@ -444,35 +543,9 @@ def tension_from_test(
     >>> round(fit.C10_kpa, 6), round(fit.C01_kpa, 6), fit.n_points
     (200.0, 100.0, 21)
     """
-    gauge = _positive("gauge_length_mm", gauge_length_mm, "mm")
-    area = _positive("area_mm2", area_mm2, "mm^2")
-    name = str(getattr(raw, "path", "") or "tension test")
-    stroke = np.asarray(raw.data["stroke_mm"], dtype=float)
-    force = np.asarray(raw.data["force_n"], dtype=float)
-    if stroke.size == 0:
-        raise ProcessingError(f"{name}: no samples; a tension fit needs at least "
-                              f"{_MIN_TEST_POINTS} on the loading branch")
-    ext = stroke - stroke[0]
-    if np.median(ext) < 0:
-        ext = -ext
-    if np.median(force) < 0:
-        force = -force
-    i = int(np.argmax(ext))
-    ext, force = ext[: i + 1], force[: i + 1]
-    if ext.size < _MIN_TEST_POINTS:
-        raise ProcessingError(
-            f"{name}: {ext.size} sample(s) up to the maximum stretch; a tension fit "
-            f"needs at least {_MIN_TEST_POINTS} on the loading branch"
-        )
-    lam = 1.0 + ext / gauge
-    if float(lam.max()) <= _MIN_TEST_STRETCH:
-        raise ProcessingError(
-            f"{name}: the largest stretch is {float(lam.max()):.5g} (stroke "
-            f"{float(ext.max()):.4g} mm on a {gauge:g} mm gauge); a tension fit needs "
-            f"a stretch above {_MIN_TEST_STRETCH:g}"
-        )
-    return fit_tension(lam, force / area * 1e3, stretch_range=stretch_range,
-                       admissible_range=admissible_range, source=name)
+    td = tension_data(raw, gauge_length_mm=gauge_length_mm, area_mm2=area_mm2)
+    return fit_tension(td.stretch, td.nominal_stress_kpa, stretch_range=stretch_range,
+                       admissible_range=admissible_range, source=td.source)
 
 
 def _positive(name: str, value: Any, unit: str) -> float:

@@ -11,9 +11,11 @@ import typer
 from .app import app
 from .options import (
     ActuatorOpt,
+    FigureFormatOpt,
     Model,
     ModelOpt,
     PresetOpt,
+    QuietOpt,
     UserError,
     load_actuator,
     model_name,
@@ -27,10 +29,14 @@ WidthOpt = Annotated[Optional[float], typer.Option("--width-mm", help="Tension s
 ThickOpt = Annotated[Optional[float], typer.Option("--thickness-mm", help="Tension specimen thickness (mm).")]
 
 
-def tension_fit(path: Path, gauge_length_mm, area_mm2, width_mm, thickness_mm):
-    """Read and fit a tension test from the command-line options."""
+RangeOpt = Optional[tuple[float, float]]
+
+
+def tension_fit(path: Path, gauge_length_mm, area_mm2, width_mm, thickness_mm, stretch_range=None,
+                admissible_range=(0.6, 1.6)):
+    """Read and fit a tension test from the command-line options: ``(TensionFit, TensionData)``."""
     from ..lab import read_test
-    from ..tension import tension_from_test
+    from ..tension import fit_tension, tension_data
 
     positive("--gauge-length-mm", gauge_length_mm, "mm")
     positive("--area-mm2", area_mm2, "mm^2")
@@ -42,7 +48,10 @@ def tension_fit(path: Path, gauge_length_mm, area_mm2, width_mm, thickness_mm):
         if width_mm is None or thickness_mm is None:
             raise UserError("the tension test needs --area-mm2, or --width-mm and --thickness-mm")
         area_mm2 = width_mm * thickness_mm
-    return tension_from_test(read_test(path), gauge_length_mm=gauge_length_mm, area_mm2=area_mm2)
+    td = tension_data(read_test(path), gauge_length_mm=gauge_length_mm, area_mm2=area_mm2,
+                      stretch_range=stretch_range)
+    tf = fit_tension(td.stretch, td.nominal_stress_kpa, admissible_range=admissible_range, source=td.source)
+    return tf, td
 
 
 @app.command()
@@ -53,8 +62,8 @@ def fit(
     model: ModelOpt = Model.energy,
     free: Annotated[str, typer.Option("--free", help="Parameters to identify: alpha0,C10,C01,P_start,E_f,R0_start.")]
     = "alpha0,C10,C01",
-    tension: Annotated[Optional[Path], typer.Option("--tension", help="Bladder tension-test export (start values).")]
-    = None,
+    tension: Annotated[Optional[Path], typer.Option(
+        "--tension", help="Bladder tension-test export: fitted together with the curves (one likelihood).")] = None,
     gauge_length_mm: GaugeOpt = None,
     area_mm2: AreaOpt = None,
     width_mm: WidthOpt = None,
@@ -62,37 +71,56 @@ def fit(
     fit_range: Annotated[str, typer.Option("--fit-range", help="'developed' (loop developed) or 'all' points.")]
     = "developed",
     hysteresis: Annotated[
-        bool, typer.Option("--hysteresis", help="Also identify a rate-independent loop from both branches.")
-    ] = False,
+        bool, typer.Option("--hysteresis/--no-hysteresis",
+                           help="Fit both branches with the loop model when the tests show a loop (default); "
+                           "--no-hysteresis fits the mean curves, as the paper.")
+    ] = True,
     hysteresis_law: Annotated[str, typer.Option("--hysteresis-law", help="Loop law: pi (Prandtl-Ishlinskii) or dahl.")]
     = "pi",
+    admissible_range: Annotated[RangeOpt, typer.Option(
+        "--admissible-range", help="Stretches LO HI the bladder material must be physical over besides the "
+        "tested ones (the range it will predict).")] = (0.6, 1.6),
     out: Annotated[Optional[Path], typer.Option("--out", help="Output folder.")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print fit.json to stdout.")] = False,
+    fig_format: FigureFormatOpt = None,
+    quiet: QuietOpt = False,
+    figure: Annotated[bool, typer.Option("--figure/--no-figure", help="Draw figure7 (default).")] = True,
 ):
     """Identify model parameters (alpha0, C10, C01, ...) from processed cyclic tests (section 3.4)."""
     from ..identify import fit as run_fit
     from ..lab.processing import load_processed
-    from ..plots import figure7, save_figure
+    from ..progress import Progress
 
     if out is None:
         raise UserError("give an output folder with --out OUTDIR")
+    fig_name = f"figure7.{fig_format.value if fig_format is not None else 'png'}"
     act = load_actuator(preset, actuator, model)
-    data = load_processed(processed_dir)
-    tfit = tension_fit(tension, gauge_length_mm, area_mm2, width_mm, thickness_mm) if tension else None
-    res = run_fit(data, act, model_name(model), free=free, tension=tfit, fit_range=fit_range,
-                  hysteresis=hysteresis_law if hysteresis else None)
-    with output_set(out, [processed_dir, actuator, tension]) as o:
-        res.save(o.staging)
-        if tfit is not None:
-            obj = json.loads((o.staging / "fit.json").read_text())
-            obj["tension"] = tfit.to_dict()
-            o.write_json("fit.json", obj)
-        save_figure(figure7(data, res), o.path("figure7.png"))
+    # the identification reports no steps: the stage it is in and the time taken
+    with Progress(None, "fit (reading)", quiet=quiet) as bar:
+        data = load_processed(processed_dir)
+        tfit, tdata = tension_fit(tension, gauge_length_mm, area_mm2, width_mm, thickness_mm,
+                                  admissible_range=admissible_range) if tension else (None, None)
+        bar.advance(0, description="fit (identifying)")
+        res = run_fit(data, act, model_name(model), free=free, tension=tfit, tension_data=tdata,
+                      fit_range=fit_range, hysteresis="auto" if hysteresis else None, hysteresis_law=hysteresis_law,
+                      admissible_range=admissible_range)
+        bar.advance(0, description="fit (writing)")
+        with output_set(out, [processed_dir, actuator, tension]) as o:
+            res.save(o.staging)
+            if tfit is not None:
+                obj = json.loads((o.staging / "fit.json").read_text())
+                obj["tension"] = tfit.to_dict()
+                o.write_json("fit.json", obj)
+            if figure:  # matplotlib is imported only when a figure is drawn
+                from ..plots import figure7, save_figure
+
+                save_figure(figure7(data, res), o.path(fig_name))
+        bar.advance(0, description="fit")
     if as_json:
         typer.echo((out / "fit.json").read_text())
         return
     typer.echo(str(res))
-    typer.echo(f"wrote {out}/ (fit.json, fitted_actuator.toml, figure7.png)")
+    typer.echo(f"wrote {out}/ (fit.json, fitted_actuator.toml{', ' + fig_name if figure else ''})")
 
 
 @app.command("fit-material")
@@ -102,13 +130,20 @@ def fit_material(
     area_mm2: AreaOpt = None,
     width_mm: WidthOpt = None,
     thickness_mm: ThickOpt = None,
+    stretch_range: Annotated[RangeOpt, typer.Option(
+        "--stretch-range", help="Fit only the points with stretch in LO HI (default: the whole loading branch).")]
+    = None,
+    admissible_range: Annotated[RangeOpt, typer.Option(
+        "--admissible-range", help="Stretches LO HI the constants must be physical over besides the data's.")]
+    = (0.6, 1.6),
     out: Annotated[Optional[Path], typer.Option("--out", help="Write tension_fit.json here (a folder).")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print the result as JSON.")] = False,
 ):
     """Fit Mooney-Rivlin C10, C01 to a uniaxial tension test of the bladder material."""
     if not tension_file.exists():
         raise UserError(f"{tension_file}: no such file")
-    tf = tension_fit(tension_file, gauge_length_mm, area_mm2, width_mm, thickness_mm)
+    tf, _ = tension_fit(tension_file, gauge_length_mm, area_mm2, width_mm, thickness_mm, stretch_range,
+                        admissible_range)
     text = json.dumps(tf.to_dict(), indent=2, allow_nan=False)
     if out is not None:
         with output_set(out, [tension_file]) as o:
