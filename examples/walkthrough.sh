@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The README's story, in order, in one empty folder: predict -> simulate a test -> inspect and
-# process -> fit -> report -> a finger -> a sweep.  Run it as `bash examples/walkthrough.sh` from an
+# process -> fit -> report -> a finger -> a design from targets -> a sweep.  Run it as `bash examples/walkthrough.sh` from an
 # empty folder; tests/test_walkthrough.py runs it and checks what it writes.
 set -euo pipefail
 
@@ -19,11 +19,11 @@ bendpam process raw-be --out processed-be
 bendpam fit processed-be --actuator be.toml --out fit-be
 bendpam predict --actuator fit-be/fitted_actuator.toml --pressure-kpa 100 150 200
 
-# 5. A test with a pronounced friction loop, fitted with both branches, and the predicted cycle
+# 5. A test with a pronounced friction loop (fitted with both branches by default), and the predicted cycle
 bendpam simulate-test --preset be-pam --pressure-kpa 100:200:5 --out raw-loop --hysteresis 0.05 \
     --hysteresis-law pi --hysteresis-angle-deg 12 --seed 2
 bendpam process raw-loop --out processed-loop
-bendpam fit processed-loop --preset be-pam --hysteresis --out fit-loop
+bendpam fit processed-loop --preset be-pam --out fit-loop
 bendpam predict --actuator fit-loop/fitted_actuator.toml --pressure-kpa 150 --cycle
 
 # 6. One HTML page from the raw files: Table 2, Table 3 for both models, Figures 4 and 7
@@ -33,6 +33,11 @@ bendpam report raw-be --actuator be.toml --out report-be.html
 bendpam finger --actuator fit-be/fitted_actuator.toml --pressure-kpa 100 150 200 --tip-force-n 0,-0.5 \
     --plot finger.png
 
-# 8. A design sweep over the braid angle and the bladder wall
+# 8. Design from targets: 400 N*mm blocked and 90 deg free at 200 kPa, every margin >= 1.5 up to 250 kPa
+bendpam design --preset be-pam --target blocked_moment_nmm=400@200 --target free_angle_deg=90@200 \
+    --vary alpha0_deg=60:80 --vary R0_mm=6:12 --vary t0_mm=1:3 --max-pressure-kpa 250 --min-margin 1.5 --out design-be
+bendpam predict --actuator design-be/design.toml --pressure-kpa 200
+
+# 9. A design sweep over the braid angle and the bladder wall
 bendpam sweep --preset be-pam --param alpha0_deg=60:80:21 --param t0_mm=1.5:3:4 --pressure-kpa 100:250:16 \
     --out sweep.nc --plot sweep.png

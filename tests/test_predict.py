@@ -106,7 +106,9 @@ def test_eq19_factor_option_moves_be_free_angle():
 def test_prediction_table_columns(bc):
     df = bendpam.prediction_table(bc, [40, 140], "energy")
     assert list(df.columns) == ["pressure_kpa", "blocked_moment_nmm", "free_curvature_per_mm", "free_angle_deg",
-                                "status", "note"]
+                                "frame_axial_force_n", "frame_stress_mpa", "frame_strength_margin", "buckling_margin",
+                                "lockup_margin", "bladder_stretch_max", "bladder_stretch_margin", "min_margin",
+                                "status", "note", "limit_note"]
     assert df.blocked_moment_nmm.iloc[0] < 0 and df.free_curvature_per_mm.iloc[0] < 0
     assert math.isnan(df.free_curvature_per_mm.iloc[1]) and "fold" in df.note.iloc[1]
 

@@ -34,3 +34,8 @@ def test_walkthrough_runs_in_order(tmp_path):
     for f in ("finger.png", "sweep.nc", "sweep.png"):
         assert (tmp_path / f).stat().st_size > 1000
     assert "energy-loss ratio" in r.stdout and "wrote sweep.nc" in r.stdout
+    design = json.loads((tmp_path / "design-be" / "design.json").read_text())
+    assert design["feasible"] is True
+    assert {t["quantity"]: round(t["achieved"], 1) for t in design["targets"]} == {
+        "blocked_moment_nmm": 400.0, "free_angle_deg": 90.0}
+    assert (tmp_path / "design-be" / "design.toml").is_file()

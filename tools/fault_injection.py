@@ -103,7 +103,7 @@ def classify(r: Run) -> tuple[str, str]:
         return "ok", ""
     if r.rc == 2:
         errors = [ln for ln in err_lines if ln.startswith("bendpam: error:")]
-        others = [ln for ln in err_lines if not ln.startswith(("bendpam: error:", "bendpam: warning:"))]
+        others = [ln for ln in err_lines if not ln.startswith(("bendpam: error:", *NOTE_PREFIXES))]
         if len(errors) == 1 and not others and err_lines[-1] == errors[0]:
             return "error", errors[0]
         return "bad-error", r.stderr.strip()[-800:]
@@ -115,6 +115,13 @@ def classify(r: Run) -> tuple[str, str]:
 
 
 CLEAN = {"ok", "error", "interrupt"}
+#: stderr lines a successful command may print (warnings about the result, not errors)
+NOTE_PREFIXES = ("bendpam: warning:", "bendpam: caution:")
+
+
+def _only_notes(stderr: str) -> bool:
+    """True when stderr is empty or holds only warning/caution lines."""
+    return all(ln.startswith(NOTE_PREFIXES) for ln in stderr.splitlines() if ln.strip())
 
 
 # ----------------------------------------------------------------------------------------------
@@ -300,7 +307,7 @@ def kill_case(tally: Tally, command: str, inputs: dict[str, Path], folder: Path,
     if r.rc == -signal.SIGKILL:
         tally.counts["cases"] += 1
         tally.counts["killed"] += 1
-    elif r.rc == -sig and not r.stderr.strip() and r.stdout.strip() and set_problem(target, None) is None:
+    elif r.rc == -sig and _only_notes(r.stderr) and r.stdout.strip() and set_problem(target, None) is None:
         # the signal came after the command had finished and printed its result (the new output is complete):
         # the process ended by the signal's default action while exiting (a shell reports 128 + signal)
         tally.counts["cases"] += 1

@@ -26,6 +26,7 @@ from .braid import CurvatureLimits, Kinematics, curvature_limits
 from .checks import UnitWarning
 from .errors import BendpamError, FileFormatError, FitError, InputError, NoEquilibrium, ProcessingError
 from .law import FreeBending, FreeBranch, MomentLaw, MomentTable, StableBranch
+from .limits import Limits, limits
 from .material import MooneyRivlin
 from .predict import (
     active_pressure_kpa,
@@ -40,7 +41,7 @@ from .predict import (
     tangent_stiffness,
 )
 
-__version__ = "0.2.0"
+__version__ = "0.3.0"
 
 __all__ = [
     "NEUTRAL_ANGLE_DEG",
@@ -53,6 +54,7 @@ __all__ = [
     "FreeBranch",
     "InputError",
     "Kinematics",
+    "Limits",
     "ModelParams",
     "MomentLaw",
     "MomentTable",
@@ -65,12 +67,14 @@ __all__ = [
     "blocked_moment",
     "braid",
     "curvature_limits",
+    "design_actuator",
     "errors",
     "fit",
     "free_branch",
     "free_curvature",
     "internal_stresses",
     "kinematics",
+    "limits",
     "material",
     "models",
     "moment",
@@ -87,6 +91,7 @@ __all__ = [
 # Functions whose modules import heavy dependencies are loaded on first use.
 _LAZY = {
     "sweep": ("sweeps", "sweep"),
+    "design_actuator": ("design.inverse", "design_actuator"),
     "fit": ("identify", "fit"),
     "read_test": ("lab.readers", "read_test"),
     "process_tests": ("lab.processing", "process_tests"),

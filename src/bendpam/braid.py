@@ -131,6 +131,13 @@ def solve_u(q_target, alpha0: float, order: int = DEFAULT_ORDER, u_bounds: tuple
     -------
     u, ibar, dibar : ndarray
         The root, and the circle mean ``Ibar(u)`` and its derivative at the root.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> u, ibar, dibar = solve_u(np.array([0.0, 0.05]), np.radians(69.7))
+    >>> u.round(5).tolist()                      # u = k'R: R shrinks as the actuator bends
+    [0.0, 0.04964]
     """
     c, s = np.cos(alpha0), np.sin(alpha0)
     q = np.asarray(q_target, dtype=float)
@@ -250,6 +257,19 @@ class CurvatureLimits:
     For one actuator the fields are floats; for a block of cases (:class:`~bendpam.ModelParams`
     with array fields) ``k_min``, ``k_max``, ``u_min`` and ``u_max`` are arrays and the reasons
     describe the first case.
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> lim = bendpam.curvature_limits(bendpam.presets.be_pam())
+    >>> round(lim.k_min, 4), round(lim.k_max, 4)        # 1/mm
+    (-0.0471, 0.1878)
+    >>> lim.reason_max
+    "braid lock-up: far-side fibres within 1% of straight (u = k'R = 0.9318 of u_lock = 0.9412)"
+    >>> lim.check(0.2)
+    Traceback (most recent call last):
+    ...
+    bendpam.errors.InputError: curvature_per_mm k' = 0.2 1/mm is beyond the braid lock-up limit ...
     """
 
     k_min: Any
@@ -296,6 +316,16 @@ def limits(params, order: int = DEFAULT_ORDER) -> CurvatureLimits:
     On each side the limit is the first of: the lumen closing (``R = t_bar``, found on a
     201-point scan of ``u`` and refined by bisection) or the braid limit (99 % of ``u_lock`` for
     k' > 0; far-side stretch 1 % for k' < 0).  Vectorised over cases; no Python loop over them.
+
+    Examples
+    --------
+    Three braid angles at once (the paper's BE-PAM otherwise):
+
+    >>> import dataclasses, numpy as np, bendpam
+    >>> be = bendpam.presets.be_pam()
+    >>> cases = dataclasses.replace(be.params, alpha0=np.radians([60.0, 70.0, 80.0]))
+    >>> limits(cases).k_max.round(4).tolist()            # 1/mm
+    [0.1038, 0.1917, 0.4511]
     """
     phi, wbar = gauss_nodes(order)
     omc = 1.0 - np.cos(phi)
@@ -363,6 +393,13 @@ def curvature_limits(actuator, order: int = DEFAULT_ORDER) -> CurvatureLimits:
     """The braid lock-up limits ``[k'_min, k'_max]`` of ``actuator`` (1/mm), cached per geometry.
 
     ``actuator`` is an :class:`~bendpam.Actuator` or a :class:`~bendpam.ModelParams`.
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> lim = bendpam.curvature_limits(bendpam.presets.bc_pam())
+    >>> round(lim.k_min, 4), round(lim.k_max, 4)          # 1/mm; a BC-PAM bends toward k' < 0
+    (-0.0413, 0.0275)
     """
     p = getattr(actuator, "params", actuator)
     if np.ndim(p.alpha0) == 0 and np.ndim(p.R0_start) == 0 and np.ndim(p.t0_start) == 0:
@@ -394,6 +431,15 @@ class Kinematics:
     lambda1 : axial stretch around the section (eq 3/34), shape S + (n,).
     lambda2_braid : braid circumferential stretch (eq 4), shape S + (n,).
     braid_angle : local braid angle alpha(Phi) (rad), cos alpha = lambda1 cos alpha0, shape S + (n,).
+
+    Examples
+    --------
+    >>> import numpy as np, bendpam
+    >>> kin = bendpam.kinematics(bendpam.presets.be_pam(), [0.0, 0.01])
+    >>> kin.radius.round(3).tolist(), np.degrees(kin.angle).round(2).tolist()   # mm, deg
+    ([10.1, 9.949], [0.0, 83.08])
+    >>> kin.lambda1.shape                                  # 2 curvatures x 32 quadrature angles
+    (2, 32)
     """
 
     curvature: np.ndarray

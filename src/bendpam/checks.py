@@ -14,20 +14,29 @@ from __future__ import annotations
 import math
 import numbers
 import warnings
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from .errors import InputError
 
-__all__ = ["MPA_SUSPECT_KPA", "UnitWarning", "float_array", "number", "pressure_kpa"]
+__all__ = ["KNOWN_SUFFIXES", "MPA_SUSPECT_KPA", "UnitWarning", "file_format", "float_array", "number", "pressure_kpa"]
 
 #: Below this (kPa), a set of pressures is suspected to be in MPa.
 MPA_SUSPECT_KPA = 5.0
 
 
 class UnitWarning(UserWarning):
-    """A value whose size suggests a unit mistake (e.g. MPa passed as kPa)."""
+    """A value whose size suggests a unit mistake (e.g. MPa passed as kPa).
+
+    >>> import warnings, bendpam
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     _ = bendpam.blocked_moment(bendpam.presets.be_pam(), 0.2)     # 0.2 MPa meant
+    >>> caught[0].category is UnitWarning
+    True
+    """
 
 
 def _range_text(lo, hi, lo_open, hi_open) -> str:
@@ -94,3 +103,48 @@ def pressure_kpa(value: Any, name: str = "pressure_kpa", *, warn: bool = True) -
                 UnitWarning, stacklevel=3,
             )
     return p
+
+
+#: File name suffixes that name a format (a suffix outside this list is just part of the name).
+KNOWN_SUFFIXES = {".png": "png", ".pdf": "pdf", ".svg": "svg", ".nc": "nc", ".csv": "csv", ".parquet": "parquet",
+                  ".pq": "parquet", ".jpg": "jpg", ".jpeg": "jpg", ".eps": "eps", ".ps": "ps", ".tif": "tif",
+                  ".tiff": "tif", ".json": "json", ".toml": "toml", ".txt": "txt", ".html": "html"}
+
+
+def file_format(path: Any, fmt: Any, formats: tuple[str, ...], *, option: str = "path",
+                format_option: str = "format", default: str | None = None) -> str:
+    """The format of an output file: ``fmt`` if given, else the suffix of ``path``; one rule for API and CLI.
+
+    A suffix that names a format (:data:`KNOWN_SUFFIXES`) must be one of ``formats`` and agree with
+    ``fmt``; a name without a recognised suffix (none, or digits as in ``run.1``) takes ``fmt``,
+    else ``default``.  Every refusal is one :class:`~bendpam.errors.InputError` line naming
+    ``option`` (the path's argument or CLI option) and ``format_option``.
+
+    Examples
+    --------
+    >>> file_format("fig.PDF", None, ("png", "pdf", "svg")), file_format("fig", "svg", ("png", "svg"))
+    ('pdf', 'svg')
+    >>> file_format("sweep.1", None, ("nc", "csv"), default="nc")
+    'nc'
+    """
+    value = getattr(fmt, "value", fmt)
+    if value is not None:
+        value = str(value).lower().lstrip(".")
+        if value not in formats:
+            raise InputError(f"{format_option} {value!r} is not a format of {option}; choose from {', '.join(formats)}")
+    suffix = Path(str(path)).suffix.lower()
+    from_name = KNOWN_SUFFIXES.get(suffix)
+    if from_name is not None:
+        if from_name not in formats:
+            raise InputError(f"{option} {str(path)!r}: {suffix} is not a format of {option}; use a "
+                             + ", ".join(f".{f}" for f in formats) + " file")
+        if value is not None and value != from_name:
+            raise InputError(f"{option} {str(path)!r} is a {suffix} file but {format_option} is {value!r}; "
+                             f"give a matching file name or drop {format_option}")
+        return from_name
+    if value is not None:
+        return value
+    if default is not None and (not suffix or suffix[1:].isdigit()):
+        return default
+    raise InputError(f"{option} {str(path)!r}: no format in the file name; use "
+                     + ", ".join(f".{f}" for f in formats) + f" or give {format_option}")

@@ -23,24 +23,87 @@ __all__ = ["BendpamError", "FileFormatError", "FitError", "InputError", "NoEquil
 
 
 class BendpamError(Exception):
-    """Base class of the errors that a user can act on (one-line messages)."""
+    """Base class of the errors that a user can act on (one-line messages).
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> try:
+    ...     bendpam.presets.get("xx-pam")
+    ... except bendpam.BendpamError as exc:
+    ...     print(type(exc).__name__, "-", exc)
+    InputError - unknown preset 'xx-pam'; choose one of: be-pam, bc-pam
+    """
 
 
 class InputError(BendpamError, ValueError):
-    """A bad argument or option value: out of range, unknown, of the wrong type or inconsistent."""
+    """A bad argument or option value: out of range, unknown, of the wrong type or inconsistent.
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> bendpam.blocked_moment(bendpam.presets.be_pam(), -10.0)
+    Traceback (most recent call last):
+    ...
+    bendpam.errors.InputError: pressure_kpa = -10 kPa at index 0 is below zero; allowed range [0, inf) kPa (gauge)
+    """
 
 
 class FileFormatError(InputError):
-    """A file that cannot be read or understood (message starts with the file name)."""
+    """A file that cannot be read or understood (message starts with the file name).
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> bendpam.Actuator.from_toml("no-such-file.toml")
+    Traceback (most recent call last):
+    ...
+    bendpam.errors.FileFormatError: no-such-file.toml: actuator file not found
+    """
 
 
 class ProcessingError(InputError):
-    """A raw test that reads but cannot be processed (message starts with the file name)."""
+    """A raw test that reads but cannot be processed (message starts with the file name).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bendpam.lab.processing import process_series
+    >>> process_series(np.arange(10.0), np.zeros(10), np.zeros(10), 150.0)
+    Traceback (most recent call last):
+    ...
+    bendpam.errors.ProcessingError: <data>: only 10 samples; a cyclic test needs at least 20
+    """
 
 
 class NoEquilibrium(BendpamError, ValueError):
-    """No physical equilibrium exists for the request (e.g. above a fold or beyond lock-up)."""
+    """No physical equilibrium exists for the request (e.g. above a fold or beyond lock-up).
+
+    Examples
+    --------
+    The paper's BC-PAM folds at 134 kPa (energy-model constants), so a finger of it has no free
+    shape at 150 kPa:
+
+    >>> import bendpam
+    >>> from bendpam.design import Finger, linear_tip_compliance
+    >>> try:
+    ...     linear_tip_compliance(Finger(bendpam.presets.bc_pam()), 150.0)
+    ... except bendpam.NoEquilibrium as exc:
+    ...     print(exc)
+    pressure_kpa = 150 kPa has no free-bending equilibrium: fold of the moment-curvature curve ...
+    """
 
 
 class FitError(BendpamError, ValueError):
-    """Identification failed for a reason that lies in the data."""
+    """Identification failed for a reason that lies in the data.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bendpam.tension import fit_tension
+    >>> stretch = np.linspace(1.0, 1.5, 10)
+    >>> fit_tension(stretch, -100.0 * (stretch - 1.0))      # stress falling with stretch
+    Traceback (most recent call last):
+    ...
+    bendpam.errors.FitError: tension data: no positive shear modulus fits: ...
+    """

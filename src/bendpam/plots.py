@@ -1,12 +1,25 @@
-"""Figures: moment-curvature maps and the force-balance model's internal stresses.
+"""Figures: moment-curvature maps, the force-balance model's internal stresses, test and fit figures.
 
-Every function draws on a matplotlib ``Axes``/``Figure`` and returns it; ``save_figure`` writes
-atomically.  The non-interactive Agg backend is used unless the caller already chose one.
+Every function draws on a matplotlib ``Axes``/``Figure`` and returns it; :func:`save_figure`
+writes PNG, PDF or SVG atomically.  The non-interactive Agg backend is used unless the caller
+already chose one.
+
+Figures are sized for a journal column (single column :data:`SINGLE_COLUMN_IN` = 3.5 in / 89 mm,
+double column :data:`DOUBLE_COLUMN_IN` = 7.2 in / 183 mm) with 7-9 pt text and consistent line
+widths.  The style is applied through :func:`figure_style` (a :func:`matplotlib.rc_context`), so
+matplotlib's global settings are never changed: every figure function here draws inside it, and
+:func:`save_figure` saves inside it (PDF and SVG keep their text as text, with embedded TrueType
+fonts, and carry no creation date, so the same figure gives the same bytes).
 """
 
 from __future__ import annotations
 
+import functools
 import os
+import textwrap
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any, TypeVar
 
 import matplotlib
 
@@ -15,23 +28,150 @@ if not os.environ.get("MPLBACKEND"):
 
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.ticker import MaxNLocator
 
 from .atomic import atomic_path
 from .braid import curvature_limits
+from .checks import file_format
 from .errors import InputError
 from .predict import active_pressure_kpa, free_curvature, internal_stresses, moment
 
 __all__ = [
+    "DOUBLE_COLUMN_IN",
+    "FIGURE_FORMATS",
+    "SINGLE_COLUMN_IN",
+    "STYLE",
     "curve_range",
     "demo_figure",
     "figure4",
     "figure7",
+    "figure_format",
+    "figure_size",
+    "figure_style",
+    "moment_curvature_figure",
     "moment_curves",
     "plot_internal_stresses",
     "plot_moment_curvature",
     "save_figure",
+    "styled_figure",
     "sweep_figure",
 ]
+
+#: Width of a single journal column, in (89 mm).
+SINGLE_COLUMN_IN = 3.5
+#: Width of a double (full-page) journal column, in (183 mm).
+DOUBLE_COLUMN_IN = 7.2
+#: The figure formats :func:`save_figure` writes.
+FIGURE_FORMATS = ("png", "pdf", "svg")
+
+#: The rc settings of every bendpam figure (applied with :func:`figure_style`).
+STYLE: dict[str, Any] = {
+    "figure.figsize": (SINGLE_COLUMN_IN, 2.6),
+    "figure.dpi": 100,
+    "savefig.dpi": 300,
+    "font.size": 8,
+    "axes.titlesize": 8,
+    "axes.labelsize": 8,
+    "xtick.labelsize": 7,
+    "ytick.labelsize": 7,
+    "legend.fontsize": 7,
+    "legend.title_fontsize": 7,
+    "figure.titlesize": 9,
+    "lines.linewidth": 1.0,
+    "lines.markersize": 3.0,
+    "axes.linewidth": 0.6,
+    "grid.linewidth": 0.4,
+    "xtick.major.width": 0.6,
+    "ytick.major.width": 0.6,
+    "xtick.minor.width": 0.4,
+    "ytick.minor.width": 0.4,
+    "xtick.major.size": 3.0,
+    "ytick.major.size": 3.0,
+    "patch.linewidth": 0.6,
+    "errorbar.capsize": 2.0,
+    "legend.frameon": False,
+    "legend.handlelength": 1.8,
+    "axes.titlepad": 4.0,
+    "pdf.fonttype": 42,
+    "ps.fonttype": 42,
+    "svg.fonttype": "none",
+    "svg.hashsalt": "bendpam",
+}
+
+_F = TypeVar("_F", bound=Callable[..., Any])
+
+
+def figure_style():
+    """A context manager applying :data:`STYLE` (journal sizes and fonts) without touching rcParams.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> with figure_style():
+    ...     inside = matplotlib.rcParams["font.size"]
+    >>> inside, matplotlib.rcParams["font.size"] == inside
+    (8.0, False)
+    """
+    return matplotlib.rc_context(STYLE)
+
+
+def _styled(fn: _F) -> _F:
+    """Run a figure function inside :func:`figure_style`."""
+
+    @functools.wraps(fn)
+    def wrapper(*args, **kwargs):
+        with figure_style():
+            return fn(*args, **kwargs)
+
+    return wrapper  # type: ignore[return-value]
+
+
+def figure_size(width: str = "single", aspect: float = 0.75) -> tuple[float, float]:
+    """Figure size (in) for a journal column: ``width`` ``'single'`` or ``'double'``, height = aspect x width.
+
+    Examples
+    --------
+    >>> figure_size("single"), figure_size("double", 0.35)
+    ((3.5, 2.625), (7.2, 2.52))
+    """
+    if width not in ("single", "double"):
+        raise InputError(f"width = {width!r} must be 'single' or 'double' (journal column)")
+    if not (np.isfinite(aspect) and aspect > 0):
+        raise InputError(f"aspect = {aspect!r} must be a positive number")
+    w = SINGLE_COLUMN_IN if width == "single" else DOUBLE_COLUMN_IN
+    return (w, round(w * float(aspect), 4))
+
+
+def _wrap(text: str, width_in: float, size_pt: float = 8.0) -> str:
+    """Wrap ``text`` into lines that fit ``width_in`` inches at ``size_pt`` (about 0.5 em per character)."""
+    chars = max(int(width_in * 72.0 / (0.52 * size_pt)), 12)
+    return "\n".join(textwrap.fill(part, chars) for part in text.split("\n"))
+
+
+@_styled
+def styled_figure(draw: Callable[[Any], Any], width: str = "single", aspect: float = 0.8):
+    """A one-axes figure of journal size drawn by ``draw(ax)`` inside :func:`figure_style`; returns the figure.
+
+    For drawing functions that take an ``ax`` (the design figures).
+    """
+    fig, ax = plt.subplots(figsize=figure_size(width, aspect))
+    draw(ax)
+    fig.tight_layout()
+    return fig
+
+
+def figure_format(path, format: str | None = None) -> str:
+    """The figure format for ``path``: ``format`` if given, else the suffix (png, pdf or svg; png if none).
+
+    Raises :class:`~bendpam.errors.InputError` (one line) for another format or a suffix that
+    disagrees with ``format``.
+
+    Examples
+    --------
+    >>> figure_format("fig.PDF"), figure_format("fig", "svg"), figure_format("fig")
+    ('pdf', 'svg', 'png')
+    """
+    return file_format(path, format, FIGURE_FORMATS, default="png")
 
 
 def curve_range(actuator, pressures_kpa, model: str = "energy", k_max: float | None = None, n: int = 200) -> np.ndarray:
@@ -71,6 +211,7 @@ def moment_curves(actuator, pressures_kpa, model: str = "energy", k_max: float |
     return k, moment(actuator, P[:, None], k[None, :], model)
 
 
+@_styled
 def plot_moment_curvature(ax, actuator, pressures_kpa, model: str = "energy", k_max: float | None = None, n: int = 200,
                           title: str | None = None):
     """Draw M(P, k') curves and the free-bending points on ``ax``.  Returns ``ax``."""
@@ -85,12 +226,24 @@ def plot_moment_curvature(ax, actuator, pressures_kpa, model: str = "energy", k_
     ax.axhline(0.0, color="0.6", lw=0.8)
     ax.set_xlabel("frame curvature k' (1/mm)")
     ax.set_ylabel("moment M (N·mm)")
-    ax.set_title(title or f"{actuator.name or actuator.kind}\n{model.replace('_', '-')} model", fontsize=9)
-    ax.legend(fontsize=7, ncol=2)
-    if np.any(~fb.ok):
-        ax.text(0.02, 0.02, f"no equilibrium above {fb.max_pressure_kpa:.4g} kPa (fold)", transform=ax.transAxes,
-                fontsize=7, color="crimson")
+    ax.set_title(title or f"{actuator.name or actuator.kind}\n{model.replace('_', '-')} model")
+    ax.xaxis.set_major_locator(MaxNLocator(5))
+    # the fold note is the legend's title, so that the two never overlap
+    fold = f"no equilibrium above {fb.max_pressure_kpa:.4g} kPa (fold)" if np.any(~fb.ok) else None
+    leg = ax.legend(ncol=2, title=fold)
+    if fold:
+        leg.get_title().set_color("crimson")
     return ax
+
+
+@_styled
+def moment_curvature_figure(actuator, pressures_kpa, model: str = "energy", k_max: float | None = None,
+                            n: int = 200, title: str | None = None):
+    """A single-column figure of :func:`plot_moment_curvature` (the figure of ``bendpam curve``)."""
+    fig, ax = plt.subplots(figsize=figure_size("single", 0.85))
+    plot_moment_curvature(ax, actuator, pressures_kpa, model, k_max, n, title=title)
+    fig.tight_layout()
+    return fig
 
 
 def _section_panel(ax, phi, R, values, label, unit, color):
@@ -100,71 +253,77 @@ def _section_panel(ax, phi, R, values, label, unit, color):
     # Phi = 0 (frame) at the bottom: x = R sin(Phi), y = -R cos(Phi)
     x0, y0 = R * np.sin(phi), -R * np.cos(phi)
     x1, y1 = r * np.sin(phi), -r * np.cos(phi)
-    ax.plot(x0, y0, color="0.3", lw=1.2)
-    ax.plot(x1, y1, color=color, lw=1.5)
+    ax.plot(x0, y0, color="0.3", lw=1.0)
+    ax.plot(x1, y1, color=color, lw=1.2)
     for j in range(0, phi.size, max(phi.size // 48, 1)):
-        ax.plot([x0[j], x1[j]], [y0[j], y1[j]], color=color, lw=0.6, alpha=0.6)
-    ax.plot([-0.35 * R, 0.35 * R], [-R, -R], color="k", lw=4, solid_capstyle="butt")
-    ax.annotate("frame (Φ = 0)", (0, -R), xytext=(0, -1.75 * R), ha="center", fontsize=7,
-                arrowprops=dict(arrowstyle="-", lw=0.5))
+        ax.plot([x0[j], x1[j]], [y0[j], y1[j]], color=color, lw=0.5, alpha=0.6)
+    ax.plot([-0.35 * R, 0.35 * R], [-R, -R], color="k", lw=3, solid_capstyle="butt")
+    ax.text(0.0, -1.6 * R, "frame (Φ = 0)", ha="center", va="top", fontsize=7)
     j = int(np.argmax(np.abs(values)))
-    ax.annotate(f"{values[j]:.3g} {unit}", (x1[j], y1[j]), fontsize=7, color=color)
+    ax.plot([x1[j]], [y1[j]], "o", color=color, ms=3)  # the extreme value, given in the title
     ax.set_aspect("equal")
-    ax.set_xlim(-1.9 * R, 1.9 * R)
-    ax.set_ylim(-1.9 * R, 1.9 * R)
+    ax.set_xlim(-1.6 * R, 1.6 * R)
+    ax.set_ylim(-2.0 * R, 1.6 * R)
     ax.axis("off")
-    ax.set_title(f"{label}\n(radial band: value / max, circle = 0)", fontsize=8)
+    ax.set_title(f"{label}\nband: value / max (circle = 0)\n"
+                 f"dot: {values[j]:.3g} {unit} at Φ = {np.degrees(phi[j]):.0f}°")
 
 
+@_styled
 def plot_internal_stresses(actuator, pressure_kpa: float, curvature: float, *, fig=None):
     """Force-balance internal state (eq 37-48) around the cross-section at one (P, k').
 
-    Left two panels: the section (frame at the bottom, Phi = 0) with the bladder axial stress
-    sigma_bl,1(Phi) and the braid axial line tension N_br,1(Phi) drawn as radial bands.  Right: the
-    same fields unrolled over Phi, with the uniform hoop stress sigma_bl,2, radial stress
-    sigma_bl,3 = -P and interfacial pressure P_e as horizontal lines.
+    Top: the section (frame at the bottom, Phi = 0) with the bladder axial stress sigma_bl,1(Phi)
+    and the braid axial line tension N_br,1(Phi) drawn as radial bands.  Bottom: the same fields
+    unrolled over Phi, with the uniform hoop stress sigma_bl,2, radial stress sigma_bl,3 = -P and
+    interfacial pressure P_e as horizontal lines.  A double-column figure whose labels do not
+    overlap (tested).
     """
     ds = internal_stresses(actuator, float(pressure_kpa), float(curvature), n_phi=361)
-    fig = fig or plt.figure(figsize=(13, 4.4))
-    ax_a = fig.add_subplot(1, 3, 1)
-    ax_b = fig.add_subplot(1, 3, 2)
-    ax1 = fig.add_subplot(1, 3, 3)
+    fig = fig or plt.figure(figsize=(DOUBLE_COLUMN_IN, 5.6))
+    grid = fig.add_gridspec(2, 2, height_ratios=(1.25, 1.0))
+    ax_a = fig.add_subplot(grid[0, 0])
+    ax_b = fig.add_subplot(grid[0, 1])
+    ax1 = fig.add_subplot(grid[1, :])
     phi = np.radians(ds["phi_deg"].values)
     R = float(ds["R"])
     s1 = ds["sigma_bl1"].values
     n1 = ds["N_br1"].values
-    _section_panel(ax_a, phi, R, s1, "bladder axial stress σ_bl,1 (kPa)", "kPa", "C0")
-    _section_panel(ax_b, phi, R, n1, "braid axial line tension N_br,1 (N/mm)", "N/mm", "C1")
+    _section_panel(ax_a, phi, R, s1, "(a) bladder axial stress σ_bl,1 (kPa)", "kPa", "C0")
+    _section_panel(ax_b, phi, R, n1, "(b) braid axial line tension N_br,1 (N/mm)", "N/mm", "C1")
     deg = ds["phi_deg"].values
     ax1.plot(deg, s1, color="C0", label="σ_bl,1 bladder axial (kPa)")
     ax1.axhline(float(ds["sigma_bl2"]), color="C2", ls="--", label="σ_bl,2 bladder hoop (kPa)")
     ax1.axhline(float(ds["P_e"]), color="C3", ls=":", label="P_e interfacial (kPa)")
     ax1.axhline(float(ds["sigma_bl3"]), color="C4", ls="-.", label="σ_bl,3 = -P (kPa)")
     ax2 = ax1.twinx()
-    ax2.plot(deg, n1, color="C1", label="N_br,1 braid axial tension (N/mm)")
+    ax2.plot(deg, n1, color="C1", label="N_br,1 braid axial (N/mm)")
     ax2.set_ylabel("braid line tension (N/mm)")
     ax1.set_xlabel("Φ (deg), 0 at the frame")
     ax1.set_ylabel("stress (kPa)")
     ax1.set_xlim(0, 360)
+    ax1.set_xticks(np.arange(0, 361, 45))
+    ax1.set_title("(c) around the section")
     h1, l1 = ax1.get_legend_handles_labels()
     h2, l2 = ax2.get_legend_handles_labels()
-    ax1.legend(h1 + h2, l1 + l2, fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.15), ncol=2)
+    ax1.legend(h1 + h2, l1 + l2, loc="upper center", bbox_to_anchor=(0.5, -0.3), ncol=3)
     pa = float(active_pressure_kpa(actuator, pressure_kpa))
     fig.suptitle(
-        f"{actuator.name or actuator.kind}: force-balance internal state at P = {pressure_kpa:g} kPa "
-        f"(active {pa:g} kPa), k' = {curvature:g} 1/mm, R = {R:.3g} mm, t̄ = {float(ds['t_bar']):.3g} mm",
-        fontsize=10,
+        _wrap(f"{actuator.name or actuator.kind}: force-balance internal state", DOUBLE_COLUMN_IN, 9) + "\n"
+        f"P = {pressure_kpa:g} kPa (active {pa:g} kPa), k' = {curvature:g} 1/mm, R = {R:.3g} mm, "
+        f"t̄ = {float(ds['t_bar']):.3g} mm",
     )
     fig.tight_layout()
     return fig
 
 
+@_styled
 def demo_figure(items):
     """A grid of moment-curvature plots; ``items`` is a list of ``(actuator, pressures_kpa, model)``."""
     n = len(items)
     ncol = 2
     nrow = (n + 1) // 2
-    fig, axes = plt.subplots(nrow, ncol, figsize=(11, 4.2 * nrow), squeeze=False)
+    fig, axes = plt.subplots(nrow, ncol, figsize=(DOUBLE_COLUMN_IN, 2.7 * nrow), squeeze=False)
     for ax, (act, P, model) in zip(axes.ravel(), items, strict=False):  # spare axes are hidden below
         plot_moment_curvature(ax, act, P, model)
     for ax in axes.ravel()[n:]:
@@ -173,13 +332,38 @@ def demo_figure(items):
     return fig
 
 
-def save_figure(fig, path, dpi: int = 130) -> None:
-    """Save ``fig`` atomically to ``path`` (format from the suffix) and close it."""
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=dpi)
+def save_figure(fig, path, format: str | None = None, dpi: int | None = None) -> Path:
+    """Save ``fig`` atomically to ``path`` as PNG, PDF or SVG, close it, and return the path.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+    path : str or os.PathLike
+        Output file; its folder must exist.
+    format : {'png', 'pdf', 'svg'}, optional
+        Default: from the suffix of ``path`` (png when it has none); a suffix that disagrees is
+        an error (see :func:`figure_format`).
+    dpi : int, optional
+        Resolution of a PNG (default 300 dots per inch; vector formats ignore it).
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> fig = styled_figure(lambda ax: ax.plot([0, 1], [0, 1]))
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     p = save_figure(fig, pathlib.Path(d) / "line.pdf")
+    ...     p.read_bytes()[:5]
+    b'%PDF-'
+    """
+    fmt = figure_format(path, format)
+    metadata: dict[str, Any] = {"pdf": {"CreationDate": None}, "svg": {"Date": None}}.get(fmt, {})
+    with figure_style(), atomic_path(path) as tmp:
+        fig.savefig(tmp, format=fmt, dpi=dpi or STYLE["savefig.dpi"], metadata=metadata)
     plt.close(fig)
+    return Path(path)
 
 
+@_styled
 def figure4(processed, title: str = ""):
     """A figure like the paper's Figure 4 for a :class:`~bendpam.lab.processing.ProcessedSet`.
 
@@ -190,7 +374,7 @@ def figure4(processed, title: str = ""):
     from .lab.processing import deadband_fit
 
     res = processed.results
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.5))
+    fig, axes = plt.subplots(1, 3, figsize=(DOUBLE_COLUMN_IN, 2.8))
     ax = axes[0]
     colors = plt.cm.viridis(np.linspace(0.0, 0.9, len(res)))
     for c, r in zip(colors, res, strict=True):
@@ -204,35 +388,36 @@ def figure4(processed, title: str = ""):
         ax.plot(r.curvature_grid, r.mean_curve, "--", color=c, lw=1.2, label=f"{r.pressure_kpa:g} kPa")
     ax.set_xlabel("curvature |k'| (1/mm)")
     ax.set_ylabel("moment |M| (N·mm)")
-    ax.set_title("(a) cyclic loops (dashed: mean of the branches)", fontsize=9)
-    ax.legend(fontsize=7)
+    ax.set_title("(a) cyclic loops\n(dashed: mean of the branches)")
+    ax.legend()
     P = processed.pressures_kpa
     bm = np.array([r.blocked_moment for r in res])
     kf = np.array([r.free_curvature for r in res])
     ax = axes[1]
-    ax.errorbar(P, bm[:, 0], yerr=np.nan_to_num(bm[:, 1]), fmt="o", capsize=3, label="max moment per cycle (mean ± SE)")
+    ax.errorbar(P, bm[:, 0], yerr=np.nan_to_num(bm[:, 1]), fmt="o", label="max moment per cycle\n(mean ± SE)")
     p0, se, a, b = deadband_fit(P, bm[:, 0])
     if np.isfinite(a):
         xx = np.linspace(min(p0 if np.isfinite(p0) else P.min(), P.min()), P.max(), 50)
         ax.plot(xx, a * xx + b, "-", color="C1",
-                label=(f"linear fit, deadband {p0:.3g} ± {se:.2g} kPa" if np.isfinite(se)
-                       else f"linear fit, deadband {p0:.3g} kPa"))
+                label=(f"linear fit, deadband\n{p0:.3g} ± {se:.2g} kPa" if np.isfinite(se)
+                       else f"linear fit, deadband\n{p0:.3g} kPa"))
     ax.axhline(0, color="0.6", lw=0.8)
     ax.set_xlabel("pressure (kPa)")
     ax.set_ylabel("blocked moment (N·mm)")
-    ax.set_title("(b) blocked moment", fontsize=9)
-    ax.legend(fontsize=7)
+    ax.set_title("(b) blocked moment")
+    ax.legend()
     ax = axes[2]
-    ax.errorbar(P, kf[:, 0], yerr=np.nan_to_num(kf[:, 1]), fmt="s", capsize=3, color="C2")
+    ax.errorbar(P, kf[:, 0], yerr=np.nan_to_num(kf[:, 1]), fmt="s", color="C2")
     ax.set_xlabel("pressure (kPa)")
-    ax.set_ylabel("free-bending curvature |k'| (1/mm)")
-    ax.set_title("(c) free-bending curvature", fontsize=9)
+    ax.set_ylabel("free-bending |k'| (1/mm)")
+    ax.set_title("(c) free-bending curvature")
     if title:
-        fig.suptitle(title, fontsize=10)
+        fig.suptitle(_wrap(title, DOUBLE_COLUMN_IN, 9))
     fig.tight_layout()
     return fig
 
 
+@_styled
 def figure7(processed, fit_result, title: str = ""):
     """A figure like the paper's Figure 7: a fitted model against processed data.
 
@@ -240,12 +425,19 @@ def figure7(processed, fit_result, title: str = ""):
     (b) blocked moment against pressure, data (mean ± SE) and model; (c) free-bending curvature
     against pressure, data (mean ± SE) and model (pressures without an equilibrium are marked).
     Magnitudes, as in the paper.
+
+    With a fitted loop every panel shows the model the fit used, the computations behind its
+    metrics (:func:`bendpam.identify.score`): (a) both branches on each test's own path, blocked
+    state to its measured free curvature; (b) and (c) the predicted free cycle of
+    :func:`bendpam.hysteresis.predict_cycles` (its largest moment and the curvature where its
+    unloading branch reaches zero, as ``bendpam predict --cycle``), the quasi-static model dashed.
     """
     act = fit_result.actuator
     model = fit_result.model
+    loop = getattr(fit_result, "loop", None)
     s = act.bend_sign or 1
     res = processed.results
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.5))
+    fig, axes = plt.subplots(1, 3, figsize=(DOUBLE_COLUMN_IN, 3.0))
     ax = axes[0]
     colors = plt.cm.viridis(np.linspace(0.0, 0.9, len(res)))
     for c, r in zip(colors, res, strict=True):
@@ -254,52 +446,64 @@ def figure7(processed, fit_result, title: str = ""):
         ax.plot(k, r.mean_unloading, color=c, lw=0.6, alpha=0.5)
         ax.plot(k[::4], r.mean_curve[::4], "o", color=c, ms=3, label=f"{r.pressure_kpa:g} kPa")
         kk = np.linspace(0.0, k[-1], 120)
-        if getattr(fit_result, "loop", None) is not None:
+        if loop is not None:
             from .hysteresis import loop_branches
 
             kf_r = float(r.free_curvature[0])
-            kk = np.linspace(0.0, kf_r, 160)
-            up, low = loop_branches(act, fit_result.loop, r.pressure_kpa, kf_r, kk, model)
+            up, low = loop_branches(act, loop, r.pressure_kpa, kf_r, k, model)
+            kk = k
             ax.plot(kk, up, "-", color=c, lw=1.3)
             ax.plot(kk, low, "-", color=c, lw=1.3)
         else:
             ax.plot(kk, s * moment(act, r.pressure_kpa, s * kk, model), "-", color=c, lw=1.5)
     ax.set_xlabel("curvature |k'| (1/mm)")
     ax.set_ylabel("moment |M| (N·mm)")
-    loop_txt = " with its loop" if getattr(fit_result, "loop", None) is not None else ""
-    ax.set_title(f"(a) data (thin: branches, markers: mean) and {model.replace('_', '-')} model{loop_txt}",
-                 fontsize=9)
-    ax.legend(fontsize=7)
+    loop_txt = " with its loop" if loop is not None else ""
+    ax.set_title(f"(a) data (thin: branches, markers:\nmean), {model.replace('_', '-')} model{loop_txt}")
+    ax.legend()
     P = processed.pressures_kpa
     bm = np.array([r.blocked_moment for r in res])
     kf = np.array([r.free_curvature for r in res])
     Pm = np.linspace(min(P.min(), act.P_start_kpa), P.max() * 1.05, 100)
     ax = axes[1]
-    ax.errorbar(P, bm[:, 0], yerr=np.nan_to_num(bm[:, 1]), fmt="o", capsize=3, label="data")
-    ax.plot(Pm, np.abs(moment(act, Pm, 0.0, model)), "-", label="model")
+    ax.errorbar(P, bm[:, 0], yerr=np.nan_to_num(bm[:, 1]), fmt="o", label="data")
+    cycles = None
+    if loop is not None:
+        from .hysteresis import predict_cycles
+
+        cycles = predict_cycles(act, loop, Pm, model)
+        ax.plot(Pm, [c.blocked_moment_nmm for c in cycles], "-", label="model with its loop")
+        ax.plot(Pm, np.abs(moment(act, Pm, 0.0, model)), "--", color="0.5", lw=0.8, label="quasi-static")
+    else:
+        ax.plot(Pm, np.abs(moment(act, Pm, 0.0, model)), "-", label="model")
     ax.set_xlabel("pressure (kPa)")
     ax.set_ylabel("blocked moment (N·mm)")
-    ax.set_title(f"(b) blocked moment, NRMSE {100 * fit_result.metrics.nrmse_blocked_moment:.2f} %", fontsize=9)
-    ax.legend(fontsize=7)
+    ax.set_title(f"(b) blocked moment\nNRMSE {100 * fit_result.metrics.nrmse_blocked_moment:.2f} %")
+    ax.legend()
     ax = axes[2]
-    ax.errorbar(P, kf[:, 0], yerr=np.nan_to_num(kf[:, 1]), fmt="s", capsize=3, color="C2", label="data")
+    ax.errorbar(P, kf[:, 0], yerr=np.nan_to_num(kf[:, 1]), fmt="s", color="C2", label="data")
     fb = free_curvature(act, Pm, model)
-    ax.plot(Pm, np.abs(fb.curvature_per_mm), "-", color="C3", label="model")
+    if cycles is not None:
+        ax.plot(Pm, [c.free_curvature_per_mm for c in cycles], "-", color="C3", label="model with its loop\n"
+                "(unloading branch)")
+        ax.plot(Pm, np.abs(fb.curvature_per_mm), "--", color="0.5", lw=0.8, label="quasi-static")
+    else:
+        ax.plot(Pm, np.abs(fb.curvature_per_mm), "-", color="C3", label="model")
     if np.any(~fb.ok):
         ax.axvline(fb.max_pressure_kpa, color="crimson", ls=":", lw=1,
-                   label=f"no equilibrium above {fb.max_pressure_kpa:.4g} kPa")
+                   label=f"no equilibrium above\n{fb.max_pressure_kpa:.4g} kPa")
     nf = fit_result.metrics.nrmse_free_curvature
-    ax.set_title("(c) free-bending curvature, NRMSE " + ("n/a" if not np.isfinite(nf) else f"{100 * nf:.2f} %"),
-                 fontsize=9)
+    ax.set_title("(c) free-bending curvature\nNRMSE " + ("n/a" if not np.isfinite(nf) else f"{100 * nf:.2f} %"))
     ax.set_xlabel("pressure (kPa)")
-    ax.set_ylabel("free-bending curvature |k'| (1/mm)")
-    ax.legend(fontsize=7)
-    fig.suptitle(title or f"{act.name or act.kind}: {model.replace('_', '-')} model fit, NRMSE of the cycles "
-                 f"{100 * fit_result.metrics.nrmse_cycles:.2f} %", fontsize=10)
+    ax.set_ylabel("free-bending |k'| (1/mm)")
+    ax.legend()
+    fig.suptitle(_wrap(title or f"{act.name or act.kind}: {model.replace('_', '-')} model fit, NRMSE of the cycles "
+                       f"{100 * fit_result.metrics.nrmse_cycles:.2f} %", DOUBLE_COLUMN_IN, 9))
     fig.tight_layout()
     return fig
 
 
+@_styled
 def sweep_figure(ds, var: str = "free_angle_deg", x: str | None = None, y: str | None = None,
                  at: dict[str, float] | None = None):
     """Colour map (or line) of one sweep output against one or two of its dimensions.
@@ -330,7 +534,7 @@ def sweep_figure(ds, var: str = "free_angle_deg", x: str | None = None, y: str |
         index[d] = int(np.argmin(np.abs(vals - float(at[d])))) if d in at else vals.size // 2
     fixed = {d: float(da_[d].values[i]) for d, i in index.items()}
     sel = da_.isel(index) if index else da_
-    fig, ax = plt.subplots(figsize=(6.5, 4.8))
+    fig, ax = plt.subplots(figsize=figure_size("single", 0.85))
     if yd is None:
         ax.plot(sel[xd].values, np.asarray(sel.values, dtype=float), "-o", ms=3)
         ax.set_ylabel(f"{var} ({da_.attrs.get('units', '')})")
@@ -343,9 +547,9 @@ def sweep_figure(ds, var: str = "free_angle_deg", x: str | None = None, y: str |
                        linewidths=1.0)
         ax.set_ylabel(yd)
     ax.set_xlabel(xd)
-    title = da_.attrs.get("long_name", var)
+    title = _wrap(da_.attrs.get("long_name", var), 0.8 * SINGLE_COLUMN_IN)
     if fixed:
-        title += "\n" + ", ".join(f"{d} = {v:g}" for d, v in fixed.items())
-    ax.set_title(title, fontsize=9)
+        title += "\n" + _wrap(", ".join(f"{d} = {v:g}" for d, v in fixed.items()), 0.8 * SINGLE_COLUMN_IN)
+    ax.set_title(title)
     fig.tight_layout()
     return fig

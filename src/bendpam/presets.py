@@ -53,12 +53,24 @@ def _make(which: str, model: str) -> Actuator:
 
 
 def be_pam(model: str = "energy") -> Actuator:
-    """The paper's bending-extensile PAM (nominal alpha0 = 68 deg) with ``model``'s Table 3 constants."""
+    """The paper's bending-extensile PAM (nominal alpha0 = 68 deg) with ``model``'s Table 3 constants.
+
+    >>> be = be_pam()
+    >>> be.kind, be.alpha0_deg, be.C10_kpa, be.C01_kpa, be.P_start_kpa
+    ('BE-PAM', 69.7, -318.9, 515.5, 68.0)
+    >>> be_pam("force-balance").C10_kpa
+    -133.7
+    """
     return _make("be-pam", model)
 
 
 def bc_pam(model: str = "energy") -> Actuator:
-    """The paper's bending-contractile PAM (nominal alpha0 = 35 deg) with ``model``'s Table 3 constants."""
+    """The paper's bending-contractile PAM (nominal alpha0 = 35 deg) with ``model``'s Table 3 constants.
+
+    >>> bc = bc_pam()
+    >>> bc.kind, bc.alpha0_deg, bc.P_start_kpa, bc.name
+    ('BC-PAM', 36.57, 32.0, 'BC-PAM (paper, energy constants)')
+    """
     return _make("bc-pam", model)
 
 
@@ -66,7 +78,11 @@ PRESETS = {"be-pam": be_pam, "bc-pam": bc_pam}
 
 
 def get(name: str, model: str = "energy") -> Actuator:
-    """Look a preset up by name (``"be-pam"`` or ``"bc-pam"``, case and ``_``/``-`` insensitive)."""
+    """Look a preset up by name (``"be-pam"`` or ``"bc-pam"``, case and ``_``/``-`` insensitive).
+
+    >>> get("BC_PAM", "force_balance").name
+    'BC-PAM (paper, force-balance constants)'
+    """
     key = str(name).strip().lower().replace("_", "-")
     if key not in PRESETS:
         raise InputError(f"unknown preset {name!r}; choose one of: {', '.join(PRESETS)}")

@@ -12,10 +12,13 @@ combination of the swept parameters (an "actuator case") at every pressure and r
 * ``max_pressure_kpa`` (case): the highest pressure with a free-bending equilibrium (the fold or
   lock-up pressure; ``inf`` if unbounded) and ``branch_end`` (0 lock-up, 1 fold, 2 unbounded,
   3 neutral);
-* ``lockup_margin`` (case, pressure): ``1 - |k'_free| / |k'_lock|``, the fraction of the admissible
-  curvature range left before braid lock-up in the bending direction;
-* ``frame_stress_mpa`` (case, pressure): the frame's bending stress ``E_f (h_f / 2) |k'_free|`` at
-  free bending.
+* the structural limits of :mod:`bendpam.limits` (case, pressure), each the worse of the blocked and
+  free-bending states: ``frame_axial_force_n``, ``frame_stress_mpa`` (largest combined axial and
+  bending stress), and the safety factors (capacity / demand, >= 1 within the limit, inf without
+  demand or limit) ``frame_strength_margin``, ``buckling_margin`` (frame on the bladder as an
+  elastic foundation), ``lockup_margin`` (end of the free-bending branch over ``|k'_free|``; past
+  it ``P_a,end / P_a``), ``bladder_stretch_max`` with ``bladder_stretch_margin``, and
+  ``min_margin``.  The strength and stretch limits are the base actuator's.
 
 How it is computed
     The kernel evaluates a whole block of cases at once: the braid kinematics and both models
@@ -38,11 +41,19 @@ Scaling out
 
 When only ``R0_mm`` is swept, ``R0_start_mm`` keeps the base actuator's ratio ``R0_start / R0``;
 ``t0_start`` always follows from eq 52.
+
+Files and progress
+    :func:`to_table` turns a sweep into a tidy long table (one row per case and pressure,
+    unit-named columns); :func:`write_sweep` writes it atomically as NetCDF, CSV or Parquet
+    (Parquet needs ``pip install "bendpam[parquet]"``).  ``progress`` reports each finished block
+    (a :class:`bendpam.progress.Progress` on stderr, or a callback), in-process and on a cluster.
 """
 
 from __future__ import annotations
 
+import contextlib
 import sys
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -51,9 +62,12 @@ from .actuator import Actuator, ModelParams
 from .braid import DEFAULT_ORDER
 from .errors import InputError
 from .law import MomentLaw
+from .limits import OUTPUTS as _LIMIT_OUTPUTS
+from .limits import case_limits
 from .models import normalise_model
 
-__all__ = ["SWEEP_PARAMETERS", "build_cases", "evaluate_cases", "sweep"]
+__all__ = ["SWEEP_FORMATS", "SWEEP_PARAMETERS", "build_cases", "evaluate_cases", "sweep", "sweep_format", "to_table",
+           "write_sweep"]
 
 #: Parameters that can be swept (Actuator field names; units in the names).
 SWEEP_PARAMETERS = (
@@ -62,13 +76,13 @@ SWEEP_PARAMETERS = (
 )
 _BRANCH_SAMPLES = 150  # the shared-table path makes a sample cheap; folds are refined, roots polished
 _OUTPUTS = ("blocked_moment_nmm", "free_curvature_per_mm", "free_angle_deg", "lockup_margin", "frame_stress_mpa",
-            "max_pressure_kpa", "branch_end")
+            "frame_axial_force_n", "frame_strength_margin", "buckling_margin", "bladder_stretch_max",
+            "bladder_stretch_margin", "min_margin", "max_pressure_kpa", "branch_end")
 _UNITS = {
     "blocked_moment_nmm": ("N*mm", "blocked moment M(P, 0)"),
     "free_curvature_per_mm": ("1/mm", "free-bending frame curvature k' (NaN: no equilibrium on the branch)"),
     "free_angle_deg": ("deg", "free-bending angle k' L0"),
-    "lockup_margin": ("1", "1 - |k'_free| / |k'_lock|: curvature range left before braid lock-up"),
-    "frame_stress_mpa": ("MPa", "frame bending stress E_f h_f |k'_free| / 2 at free bending"),
+    **_LIMIT_OUTPUTS,  # frame force and stress, the margins (bendpam.limits)
     "max_pressure_kpa": ("kPa", "highest pressure with a free-bending equilibrium (fold or lock-up)"),
     "branch_end": ("1", "end of the free-bending branch: 0 lock-up, 1 fold, 2 unbounded, 3 neutral"),
 }
@@ -129,16 +143,14 @@ def evaluate_cases(base: Actuator, model: str, values: dict[str, np.ndarray], pr
     pa = np.maximum(P[None, :] - np.asarray(law.P_start_kpa)[:, None], 0.0)
     A0, _ = law.coefficients(np.zeros(cs.shape))
     tab = law.branches(_BRANCH_SAMPLES)
-    k = law.free_curvature_array(P, table=tab)
-    k_lim = np.abs(tab.k_lim)[:, None]
-    with np.errstate(invalid="ignore"):
-        margin = 1.0 - np.abs(k) / k_lim
+    k, u = law.free_state_array(P, table=tab)
+    lim = case_limits(law, P, k, tab, free_u=u, frame_strength_mpa=base.frame_strength_mpa,
+                      bladder_stretch_limit=base.bladder_stretch_limit)
     return {
         "blocked_moment_nmm": pa * A0[:, None],
         "free_curvature_per_mm": k,
         "free_angle_deg": np.degrees(k * cs.L0[:, None]),
-        "lockup_margin": margin,
-        "frame_stress_mpa": cs.frame_modulus[:, None] * cs.frame_thickness[:, None] * 0.5 * np.abs(k),
+        **{name: lim[name] for name in _LIMIT_OUTPUTS},
         "max_pressure_kpa": law.P_start_kpa + tab.p_end,
         "branch_end": tab.kind.astype(float),
     }
@@ -180,8 +192,9 @@ def _block(base, model, names, grids, P, order, eq19, idx_block):
 
 
 def sweep(base_actuator: Actuator, pressure_kpa, model: str = "energy", *, chunk_cases: int = 256,
-          scheduler: str | None = None, workers: int | None = None, compute: bool = True, progress: bool | None = None,
-          order: int = DEFAULT_ORDER, eq19_factor: bool = True, **params) -> Any:
+          scheduler: str | None = None, workers: int | None = None, compute: bool = True,
+          progress: bool | Callable[[int], Any] | None = None, order: int = DEFAULT_ORDER, eq19_factor: bool = True,
+          **params) -> Any:
     """Sweep actuator parameters crossed with pressures.  See the module docstring.
 
     Parameters
@@ -193,8 +206,22 @@ def sweep(base_actuator: Actuator, pressure_kpa, model: str = "energy", *, chunk
     scheduler : address of a Dask distributed scheduler (e.g. ``"tcp://127.0.0.1:8786"``).
     workers : start a ``LocalCluster`` with this many worker processes (loopback only).
     compute : return computed (NumPy-backed) data; ``False`` keeps a lazy Dask-backed dataset.
-    progress : show a progress bar (default: for sweeps of at least 20 blocks).
+    progress : ``True``: report progress on stderr with :class:`bendpam.progress.Progress` (a bar
+        on a terminal, periodic lines otherwise); a callable: called as ``progress(n)`` with the
+        number of cases of each block when it is done (from worker threads on the Dask
+        threaded scheduler, so it must be thread-safe; ``Progress.advance`` is); ``False``: no
+        report; ``None`` (default): a bar for sweeps of at least 20 blocks when stderr is a
+        terminal.  Ignored with ``compute=False``.
     **params : Actuator field names with 1-D values, e.g. ``alpha0_deg=np.linspace(60, 80, 41)``.
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> ds = bendpam.sweep(bendpam.presets.be_pam(), pressure_kpa=[150.0, 200.0], alpha0_deg=[65.0, 70.0, 75.0])
+    >>> list(ds.dims), ds["blocked_moment_nmm"].attrs["units"]
+    (['alpha0_deg', 'pressure_kpa'], 'N*mm')
+    >>> ds["free_angle_deg"].round(1).values.tolist()      # rows: braid angle, columns: pressure
+    [[50.1, 77.8], [68.7, 114.2], [80.2, 137.1]]
     """
     if not isinstance(base_actuator, Actuator):
         raise TypeError(f"base_actuator must be a bendpam.Actuator, got {type(base_actuator).__name__}")
@@ -222,16 +249,29 @@ def sweep(base_actuator: Actuator, pressure_kpa, model: str = "energy", *, chunk
         import dask.array as da
     except ImportError:
         da = None
-    if da is None:
-        if scheduler or workers or not compute:
-            raise InputError("distributed or lazy sweeps need Dask: pip install 'bendpam[distributed]'")
-        data = _loop_blocks(fn, shape, chunks, show)
-    else:
-        idx = da.arange(n_cases, chunks=n_cases).reshape(shape or (1,)).rechunk(chunks or ((1,),))
-        nd = idx.ndim
-        arr = idx.map_blocks(fn, dtype=float, new_axis=[nd, nd + 1],
-                             chunks=(*idx.chunks, (P.size,), (len(_OUTPUTS),)), meta=np.empty((0,) * (nd + 2)))
-        data = _compute(arr, scheduler, workers, show) if compute else arr
+    if da is None and (scheduler or workers or not compute):
+        raise InputError("distributed or lazy sweeps need Dask: pip install 'bendpam[distributed]'")
+    with contextlib.ExitStack() as stack:
+        report: Callable[[int], Any] | None
+        if callable(show):
+            report = show
+        elif show and compute:
+            from .progress import Progress
+
+            report = stack.enter_context(Progress(n_cases, "sweep")).advance
+        else:
+            report = None
+        remote = bool(scheduler or workers)
+        if da is None:
+            data = _loop_blocks(_Counted(fn, report), shape, chunks)
+        else:
+            idx = da.arange(n_cases, chunks=n_cases).reshape(shape or (1,)).rechunk(chunks or ((1,),))
+            nd = idx.ndim
+            # in-process the kernel reports each block itself; on a cluster the futures do
+            kernel = fn if remote or not compute or report is None else _Counted(fn, report)
+            arr = idx.map_blocks(kernel, dtype=float, new_axis=[nd, nd + 1],
+                                 chunks=(*idx.chunks, (P.size,), (len(_OUTPUTS),)), meta=np.empty((0,) * (nd + 2)))
+            data = _compute(arr, scheduler, workers, report, idx.chunks) if compute else arr
     return _dataset(data, names, grids, shape, P, base_actuator, model, order)
 
 
@@ -284,15 +324,24 @@ class _block_fn:
         return _block(*self.args, idx_block)
 
 
-def _loop_blocks(fn, shape, chunks, show):
+class _Counted:
+    """The block kernel, reporting the number of cases of each finished block to ``report``."""
+
+    def __init__(self, fn, report):
+        self.fn, self.report = fn, report
+
+    def __call__(self, idx_block):
+        res = self.fn(idx_block)
+        if self.report is not None:
+            self.report(int(np.asarray(idx_block).size))
+        return res
+
+
+def _loop_blocks(fn, shape, chunks):
     """The same blocks as the Dask path, computed in a loop (no Dask installed)."""
     flat = np.arange(int(np.prod(shape)) if shape else 1).reshape(shape or (1,))
     bounds = [np.cumsum((0, *c)) for c in (chunks or ((1,),))]
     blocks = list(np.ndindex(*[len(c) for c in (chunks or ((1,),))]))
-    if show:
-        from rich.progress import track
-
-        blocks = track(blocks, description="sweep", transient=True)
     out = None
     for b in blocks:
         sl = tuple(slice(bd[i], bd[i + 1]) for bd, i in zip(bounds, b, strict=True))
@@ -303,12 +352,20 @@ def _loop_blocks(fn, shape, chunks, show):
     return out
 
 
-def _compute(arr, scheduler, workers, show):
+def _block_cases(key, case_chunks) -> int:
+    """Number of cases in the block of a Dask key ``(name, i, j, ..., 0, 0)``."""
+    try:
+        ids = key[1:1 + len(case_chunks)]
+        return int(np.prod([case_chunks[d][i] for d, i in enumerate(ids)]))
+    except (TypeError, IndexError):
+        return 0
+
+
+def _compute(arr, scheduler, workers, report, case_chunks):
     import dask
 
     if scheduler or workers:
-        from distributed import Client, LocalCluster
-        from distributed import progress as dprogress
+        from distributed import Client, LocalCluster, as_completed, futures_of
 
         if scheduler:
             client = Client(scheduler)
@@ -318,19 +375,16 @@ def _compute(arr, scheduler, workers, show):
                                    host="127.0.0.1", dashboard_address=None)
             client = Client(cluster)
         try:
-            fut = client.compute(arr)
-            if show:
-                dprogress(fut)
-            return fut.result()
+            if report is None:
+                return client.compute(arr).result()
+            persisted = client.persist(arr)  # the blocks as futures, reported as they finish
+            for done in as_completed(futures_of(persisted)):
+                report(_block_cases(done.key, case_chunks))
+            return client.compute(persisted).result()
         finally:
             client.close()
             if cluster is not None:
                 cluster.close()
-    if show:
-        from dask.diagnostics import ProgressBar
-
-        with ProgressBar(out=sys.stderr):
-            return dask.compute(arr, scheduler="threads")[0]
     return dask.compute(arr, scheduler="threads")[0]
 
 
@@ -363,3 +417,140 @@ def _dataset(data, names, grids, shape, P, base, model, order) -> Any:
                     branch_end_meanings="0 lock-up, 1 fold, 2 unbounded, 3 neutral",
                     sign_convention="k' > 0 toward the frame; BC-PAM values are negative")
     return ds
+
+
+# ------------------------------------------------------------------------------------------------
+# tables and files
+# ------------------------------------------------------------------------------------------------
+#: The file formats :func:`write_sweep` writes (NetCDF, a tidy CSV table, a tidy Parquet table).
+SWEEP_FORMATS = ("nc", "csv", "parquet")
+_SWEEP_SUFFIXES = {".nc": "nc", ".csv": "csv", ".parquet": "parquet", ".pq": "parquet"}
+
+
+def to_table(ds) -> Any:
+    """A sweep dataset as a tidy long table: one row per (case, pressure), a column per quantity.
+
+    The columns are the swept parameters (one per dimension, e.g. ``alpha0_deg``), then
+    ``pressure_kpa``, then every output under its own unit-named name (``blocked_moment_nmm``,
+    ``free_angle_deg``, ...); per-case outputs (``max_pressure_kpa``, ``branch_end``) repeat on
+    every pressure of their case.  Rows run through the cases in C order, pressures innermost.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A result of :func:`sweep` (computed or lazy; a lazy one is computed here).
+
+    Returns
+    -------
+    pandas.DataFrame
+        With ``attrs["units"]`` (column -> unit) and the dataset's attributes in ``attrs``.
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> from bendpam.sweeps import sweep, to_table
+    >>> ds = sweep(bendpam.presets.get("be-pam"), [100, 200], alpha0_deg=[70, 72, 74])
+    >>> t = to_table(ds)
+    >>> t.shape[0], list(t.columns[:3])
+    (6, ['alpha0_deg', 'pressure_kpa', 'blocked_moment_nmm'])
+    """
+    dims = [str(d) for d in ds.dims]
+    if "pressure_kpa" in dims:  # pressures innermost
+        dims = [d for d in dims if d != "pressure_kpa"] + ["pressure_kpa"]
+    df = ds.to_dataframe(dim_order=dims).reset_index() if dims else ds.to_dataframe().reset_index(drop=True)
+    df = df[[*dims, *[str(v) for v in ds.data_vars]]]
+    units = {str(n): str(ds[n].attrs.get("units", "")) for n in (*dims, *ds.data_vars)}
+    df.attrs = {k: v for k, v in ds.attrs.items() if isinstance(v, (str, int, float))} | {"units": units}
+    return df
+
+
+def sweep_format(path, format: str | None = None) -> str:
+    """The file format of a sweep output: ``format`` (nc, csv, parquet) or else from the suffix of ``path``.
+
+    Raises :class:`~bendpam.errors.InputError` (one line) for an unknown format or a suffix that
+    disagrees with ``format``.
+
+    Examples
+    --------
+    >>> sweep_format("runs/a.parquet"), sweep_format("table", "csv")
+    ('parquet', 'csv')
+    """
+    from pathlib import Path
+
+    fmt = None if format is None else str(format).lower().lstrip(".")
+    if fmt is not None and fmt not in SWEEP_FORMATS:
+        raise InputError(f"format = {format!r} is not a sweep format; choose {', '.join(SWEEP_FORMATS)}")
+    suffix = Path(path).suffix.lower()
+    from_name = _SWEEP_SUFFIXES.get(suffix)
+    if from_name is not None and fmt is not None and from_name != fmt:
+        raise InputError(f"path {str(path)!r} is a {suffix} file but format = {fmt!r}; give a matching name or format")
+    out = from_name or fmt
+    if out is None:
+        raise InputError(f"path {str(path)!r}: {suffix or 'no suffix'} is not a sweep format; use .nc, .csv or "
+                         ".parquet (or give format)")
+    return out
+
+
+def write_sweep(ds, path, format: str | None = None) -> Any:
+    """Write a sweep dataset atomically as NetCDF, or as a tidy CSV or Parquet table (:func:`to_table`).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A result of :func:`sweep`.
+    path : str or os.PathLike
+        Output file; its folder must exist.
+    format : {'nc', 'csv', 'parquet'}, optional
+        Default: from the suffix of ``path`` (see :func:`sweep_format`).
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+
+    Notes
+    -----
+    CSV keeps every float exactly (shortest round-trip repr) and has a header row of unit-named
+    columns; Parquet (needs ``pyarrow``: ``pip install "bendpam[parquet]"``) also keeps the column
+    types and stores the units and the dataset's attributes (model, base actuator TOML) in the
+    file's key-value metadata (``bendpam`` key, JSON).
+
+    Examples
+    --------
+    >>> import tempfile, pathlib, pandas as pd, bendpam
+    >>> ds = sweep(bendpam.presets.get("be-pam"), [150], alpha0_deg=[70, 74])
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     p = write_sweep(ds, pathlib.Path(d) / "s.csv")
+    ...     len(pd.read_csv(p))
+    2
+    """
+    from pathlib import Path
+
+    from .atomic import atomic_path
+
+    fmt = sweep_format(path, format)
+    if fmt == "parquet":
+        try:
+            import pyarrow  # noqa: F401
+        except ImportError:
+            raise InputError('writing Parquet needs pyarrow: pip install "bendpam[parquet]"') from None
+    with atomic_path(path) as tmp:
+        if fmt == "nc":
+            ds.to_netcdf(tmp)
+        elif fmt == "csv":
+            to_table(ds).to_csv(tmp, index=False)
+        else:
+            _write_parquet(to_table(ds), tmp)
+    return Path(path)
+
+
+def _write_parquet(df, path) -> None:
+    import json
+
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    table = pa.Table.from_pandas(df, preserve_index=False)
+    meta = dict(table.schema.metadata or {})
+    meta[b"bendpam"] = json.dumps(df.attrs, allow_nan=False).encode()
+    pq.write_table(table.replace_schema_metadata(meta), path)

@@ -7,12 +7,13 @@
 * :mod:`.identify`: ``fit``, ``fit-material``;
 * :mod:`.sweep`: ``sweep``;
 * :mod:`.design`: ``finger``, ``grasp``, ``wrist``;
+* :mod:`.inverse`: ``design`` (inverse design from targets);
 * :mod:`.report`: ``report``.
 """
 
 from __future__ import annotations
 
-from . import design, identify, lab, predict, report, sweep  # noqa: F401  (registers the commands)
+from . import design, identify, inverse, lab, predict, report, sweep  # noqa: F401  (registers the commands)
 from .app import app, main
 
 report.register(app)

@@ -60,7 +60,14 @@ def _one_line(exc: BaseException) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Entry point: run the app; user errors are one line and exit code 2, bugs exit code 1."""
+    """Entry point: run the app; user errors are one line and exit code 2, bugs exit code 1.
+
+    >>> main(["--version"])
+    bendpam ...
+    0
+    >>> main(["predict", "--preset", "xx-pam", "--pressure-kpa", "100"])   # one line on stderr
+    2
+    """
     from ..errors import BendpamError
 
     args = list(sys.argv[1:] if argv is None else argv)

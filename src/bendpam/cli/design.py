@@ -44,15 +44,24 @@ def _pair(text: str, name: str, unit: str) -> tuple[float, float]:
     return vals[0], vals[1]
 
 
-def _plot_target(plot: Optional[Path]):
-    from .options import UserError
+def _plot_target(plot: Optional[Path], fmt=None):
+    """Check --plot and --format (png, pdf or svg; from the suffix if --format is not given); returns --plot."""
+    from .options import UserError, figure_format
 
     if plot is None:
+        if fmt is not None:
+            raise UserError(f"--format {fmt.value}: there is no figure to write; give --plot FILE")
         return None
-    if plot.suffix.lower() not in {".png", ".pdf", ".svg"}:
-        raise UserError(
-            f"--plot {str(plot)!r}: unknown figure format {plot.suffix or '(none)'}; use .png, .pdf or .svg")
+    figure_format(plot, fmt, "--plot")
     return plot
+
+
+def _save_plot(draw, plot: Path, fmt=None, aspect: float = 0.8) -> None:
+    """Draw ``draw(ax)`` on a single-column journal figure and write it to --plot (format as checked above)."""
+    from ..plots import save_figure, styled_figure
+    from .options import figure_format
+
+    save_figure(styled_figure(draw, "single", aspect), plot, format=figure_format(plot, fmt, "--plot"))
 
 
 #: The most equilibrium solutions one design command may compute (each takes about 10 ms).
@@ -79,7 +88,16 @@ def _length(act, l0_mm):
 
 def register(app: typer.Typer) -> typer.Typer:
     """Add the ``finger``, ``grasp`` and ``wrist`` commands to ``app`` (once; returns ``app``)."""
-    from .options import ActuatorOpt, Model, ModelOpt, MultiValueCommand, PresetOpt, PressureOpt
+    from .options import (
+        ActuatorOpt,
+        FigureFormatOpt,
+        Model,
+        ModelOpt,
+        MultiValueCommand,
+        PresetOpt,
+        PressureOpt,
+        QuietOpt,
+    )
 
     names = {c.name or (c.callback.__name__ if c.callback else None) for c in app.registered_commands}
     if {"finger", "grasp", "wrist"} <= names:
@@ -114,6 +132,7 @@ def register(app: typer.Typer) -> typer.Typer:
                                               "position (roller normal to the base).")] = False,
         as_json: JsonOpt = False,
         plot: PlotOpt = None,
+        fig_format: FigureFormatOpt = None,
     ):
         """Equilibrium shape and tip pose of a finger under tip force, tip mass and self-weight."""
         from ..design.finger import Finger, FingerLoads, blocked_tip_force, finger_sweep
@@ -123,7 +142,7 @@ def register(app: typer.Typer) -> typer.Typer:
         P = pressures_kpa(pressure_kpa)
         _budget(len(P), "--pressure-kpa")
         mname = model_name(model)
-        plot = _plot_target(plot)
+        plot = _plot_target(plot, fig_format)
         bend_key = bend.strip().lower()
         if bend_key not in ("ccw", "cw"):
             raise UserError(f"--bend: {bend!r} is not allowed; choose ccw or cw")
@@ -134,12 +153,13 @@ def register(app: typer.Typer) -> typer.Typer:
         loads = FingerLoads(tip_force_n=F, tip_moment_nmm=tip_moment_nmm, tip_mass_g=tip_mass_g,
                             mass_per_length_g_per_mm=mass_per_length, gravity=(math.cos(g), math.sin(g)))
         df, shapes = finger_sweep(finger, P, loads)
+        lims = [sh.limits() if sh.equilibrium else None for sh in shapes]  # worst section along the finger
         bforce = [blocked_tip_force(finger, p, loads=loads) for p in P] if blocked else None
         if plot is not None:
             from ..design.finger import plot_finger_shapes
-            from ..plots import save_figure
 
-            save_figure(plot_finger_shapes(shapes, title=f"{act.name or act.kind}, L0 = {act.L0_mm:g} mm"), plot)
+            _save_plot(lambda ax: plot_finger_shapes(shapes, ax=ax, title=f"{act.name or act.kind}, "
+                                                     f"L0 = {act.L0_mm:g} mm"), plot, fig_format, aspect=0.9)
         if as_json:
             rows = []
             for i, r in enumerate(df.itertuples()):
@@ -151,6 +171,12 @@ def register(app: typer.Typer) -> typer.Typer:
                 if bforce is not None:
                     b = bforce[i]
                     row["blocked_force_n"] = [_num(b.force_n[0]), _num(b.force_n[1])] if b.equilibrium else None
+                lm = lims[i]
+                row["limits"] = None if lm is None else {  # worst section; margins: inf (no demand/limit) is null
+                    k: _num(getattr(lm, k)) for k in ("frame_axial_force_n", "frame_stress_mpa",
+                                                      "frame_strength_margin", "buckling_margin", "lockup_margin",
+                                                      "bladder_stretch_max", "bladder_stretch_margin", "min_margin",
+                                                      "worst_s_mm")} | {"violations": list(lm.violations)}
                 rows.append(row)
             obj = {"model": mname, "actuator": act.name or act.kind, "L0_mm": act.L0_mm,
                    "loads": {"tip_force_n": list(F), "tip_moment_nmm": tip_moment_nmm, "tip_mass_g": tip_mass_g,
@@ -175,6 +201,22 @@ def register(app: typer.Typer) -> typer.Typer:
                     line += f" {_fmt(b.force_n[0], '7.3f')},{_fmt(b.force_n[1], '8.3f')}" if b.equilibrium \
                         else f" {'—':>16}"
                 typer.echo(line + ("  " + r.note if r.note else ""))
+            typer.echo("limits along the finger (worst section; safety factors, >= 1 within the limit; "
+                       "inf: no demand or no limit)")
+            typer.echo(f"{'P (kPa)':>8} {'N_frame (N)':>11} {'σ_frame (MPa)':>13} {'strength':>8} {'buckling':>8} "
+                       f"{'lock-up':>8} {'stretch':>8} {'min':>7} {'at s (mm)':>9}")
+            for p_kpa, lm in zip(P, lims, strict=True):
+                if lm is None:
+                    typer.echo(f"{p_kpa:8.4g} {'—':>11}  (no equilibrium)")
+                    continue
+                mg = [("inf" if v == math.inf else f"{v:.2f}") for v in (
+                    lm.frame_strength_margin, lm.buckling_margin, lm.lockup_margin, lm.bladder_stretch_margin,
+                    lm.min_margin)]
+                typer.echo(f"{p_kpa:8.4g} {lm.frame_axial_force_n:11.2f} {lm.frame_stress_mpa:13.2f} {mg[0]:>8} "
+                           f"{mg[1]:>8} {mg[2]:>8} {mg[3]:>8} {mg[4]:>7} {lm.worst_s_mm:9.4g}")
+        for lm in lims:  # a prediction past a limit says so
+            for v in (lm.violations if lm is not None else ()):
+                typer.echo(f"bendpam: warning: past a limit: {v}", err=True)
         if plot is not None and not as_json:
             typer.echo(f"wrote {plot}")
 
@@ -194,19 +236,35 @@ def register(app: typer.Typer) -> typer.Typer:
         base_radius_mm: Annotated[
             Optional[float], typer.Option("--base-radius-mm", help="Base-circle radius of the fingers (mm); "
                                           "default 100.")] = None,
-        mu: Annotated[float, typer.Option("--mu", help="Friction coefficient pad-sphere.")] = 0.5,
+        mu: Annotated[
+            Optional[float], typer.Option("--mu", help="Coulomb friction coefficient pad-sphere; default 0.5.")] = None,
         fingertip_mm: Annotated[
             Optional[float],
             typer.Option("--fingertip-mm", help="Rigid fingertip (pad) length (mm); default 10.")] = None,
         contact_offset_mm: Annotated[
             Optional[float], typer.Option("--contact-offset-mm", help="Frame line to contact surface (mm); default "
                                           "by actuator type.")] = None,
-        splay_deg: Annotated[float, typer.Option("--splay-deg", help="Outward tilt of the open fingers (deg).")] = 0.0,
+        splay_deg: Annotated[
+            Optional[float], typer.Option("--splay-deg", help="Outward tilt of the open fingers (deg); "
+                                          "default 15.")] = None,
         as_json: JsonOpt = False,
         plot: PlotOpt = None,
+        fig_format: FigureFormatOpt = None,
     ):
-        """Gripping (pull-out) force of an N-finger gripper on spheres against diameter and pressure."""
-        from ..design.grasp import DEFAULT_BASE_RADIUS_MM, DEFAULT_FINGERTIP_MM, Gripper, grasp_sweep
+        """Grip (pull-out) force of an N-finger gripper on spheres against diameter and pressure.
+
+        Each grasp is pulled out quasi-statically (the base lifted step by step, the fingers'
+        statics with their moment law, Coulomb stick/slip at the contacts); the grip force is the
+        peak lifting load before the sphere escapes.
+        """
+        from ..design.grasp import (
+            DEFAULT_BASE_RADIUS_MM,
+            DEFAULT_FINGERTIP_MM,
+            DEFAULT_MU,
+            DEFAULT_SPLAY_DEG,
+            Gripper,
+            grasp_sweep,
+        )
         from .options import UserError, load_actuator, model_name, parse_values, pressures_kpa
 
         act = _length(load_actuator(preset, actuator, model), l0_mm)
@@ -219,17 +277,17 @@ def register(app: typer.Typer) -> typer.Typer:
         P = pressures_kpa(pressure_kpa, None)
         _budget(len(P) * len(D), "--pressure-kpa x --diameter-mm")
         mname = model_name(model)
-        plot = _plot_target(plot)
+        plot = _plot_target(plot, fig_format)
         gr = Gripper(act, mname, fingers=fingers,
                      base_radius_mm=DEFAULT_BASE_RADIUS_MM if base_radius_mm is None else base_radius_mm,
                      fingertip_mm=DEFAULT_FINGERTIP_MM if fingertip_mm is None else fingertip_mm,
-                     contact_offset_mm=contact_offset_mm, mu=mu, splay_deg=splay_deg)
+                     contact_offset_mm=contact_offset_mm, mu=DEFAULT_MU if mu is None else mu,
+                     splay_deg=DEFAULT_SPLAY_DEG if splay_deg is None else splay_deg)
         ds = grasp_sweep(gr, D, P)
         if plot is not None:
             from ..design.grasp import plot_grasp
-            from ..plots import save_figure
 
-            save_figure(plot_grasp(ds), plot)
+            _save_plot(lambda ax: plot_grasp(ds, ax=ax), plot, fig_format)
         rows = []
         for i, d in enumerate(ds["diameter_mm"].values):
             for j, p in enumerate(ds["pressure_kpa"].values):
@@ -237,26 +295,36 @@ def register(app: typer.Typer) -> typer.Typer:
                     "diameter_mm": float(d),
                     "pressure_kpa": float(p),
                     "grip_force_n": _num(ds["grip_force_n"].values[i, j]),
+                    "peak_lift_mm": _num(ds["peak_lift_mm"].values[i, j]),
+                    "frozen_grip_force_n": _num(ds["frozen_grip_force_n"].values[i, j]),
                     "contact_force_n": _num(ds["contact_force_n"].values[i, j]),
                     "contact": str(ds["contact"].values[i, j]),
                     "contact_angle_deg": _num(ds["contact_angle_deg"].values[i, j]),
                     "equilibrium": bool(ds["equilibrium"].values[i, j]),
                     "note": str(ds["note"].values[i, j]) or None,
+                    "pull_end": str(ds["pull_end"].values[i, j]) or None,
                 })
         if as_json:
             obj = {"model": mname, "actuator": act.name or act.kind, "L0_mm": act.L0_mm, "fingers": gr.fingers,
                    "base_radius_mm": gr.base_radius_mm, "fingertip_mm": gr.fingertip_mm,
                    "contact_offset_mm": gr.contact_offset_mm, "mu": gr.mu, "splay_deg": gr.splay_deg,
-                   "units": {"grip_force_n": "N (whole gripper)", "contact_force_n": "N (per finger)",
-                             "contact_angle_deg": "deg (sphere normal from the downward vertical)"},
+                   "units": {"grip_force_n": "N (whole gripper: peak load of the quasi-static pull-out)",
+                             "peak_lift_mm": "mm (lift of the base at the peak)",
+                             "frozen_grip_force_n": "N (frozen-normal estimate, for comparison only)",
+                             "contact_force_n": "N (per finger, at the grasp)",
+                             "contact_angle_deg": "deg (sphere normal from the downward vertical, at the grasp)"},
                    "results": rows}
             typer.echo(json.dumps(obj, indent=2))
             return
         typer.echo(f"{gr.fingers}-finger gripper, {act.name or act.kind}, L0 = {act.L0_mm:g} mm, base radius "
-                   f"{gr.base_radius_mm:g} mm, mu = {gr.mu:g} — {mname.replace('_', '-')} model")
-        typer.echo(f"{'D (mm)':>7} {'P (kPa)':>8} {'grip (N)':>9} {'N/finger':>9} {'contact':>8} {'β (deg)':>8}  note")
+                   f"{gr.base_radius_mm:g} mm, splay {gr.splay_deg:g}°, mu = {gr.mu:g} — "
+                   f"{mname.replace('_', '-')} model; grip = peak load of the quasi-static pull-out "
+                   "(frozen = frozen-normal estimate, for comparison)")
+        typer.echo(f"{'D (mm)':>7} {'P (kPa)':>8} {'grip (N)':>9} {'lift (mm)':>9} {'frozen (N)':>10} "
+                   f"{'N/finger':>9} {'contact':>8} {'β (deg)':>8}  note")
         for r in rows:
             typer.echo(f"{r['diameter_mm']:7.4g} {r['pressure_kpa']:8.4g} {_fmt(r['grip_force_n'], '9.2f')} "
+                       f"{_fmt(r['peak_lift_mm'], '9.2f')} {_fmt(r['frozen_grip_force_n'], '10.2f')} "
                        f"{_fmt(r['contact_force_n'], '9.2f')} {r['contact']:>8} {_fmt(r['contact_angle_deg'], '8.1f')}"
                        + (f"  {r['note']}" if r["note"] else ""))
         if plot is not None:
@@ -287,6 +355,8 @@ def register(app: typer.Typer) -> typer.Typer:
         hand_lever_mm: Annotated[float, typer.Option("--hand-lever-mm", help="Lever of the hand's mass (mm).")] = 50.0,
         as_json: JsonOpt = False,
         plot: PlotOpt = None,
+        fig_format: FigureFormatOpt = None,
+        quiet: QuietOpt = False,
     ):
         """Bending angle of a four-actuator wrist per direction, and the load it holds horizontally."""
         from ..design.wrist import Wrist, wrist_hold, wrist_sweep
@@ -297,17 +367,31 @@ def register(app: typer.Typer) -> typer.Typer:
         dirs = parse_values(direction_deg, "--direction-deg") if direction_deg else [0.0, 90.0, 180.0, 270.0]
         _budget(len(P) * len(dirs), "--pressure-kpa x --direction-deg")
         mname = model_name(model)
-        plot = _plot_target(plot)
+        plot = _plot_target(plot, fig_format)
         w = Wrist(act, mname, radius_mm=radius_mm, length_mm=length_mm, lateral_stiffness_nmm2=lateral_stiffness,
                   column_stiffness_nmm2=column_stiffness)
-        table = wrist_sweep(w, P, dirs)
-        holds = [wrist_hold(w, p, load_g=load_g, lever_mm=lever_mm, hand_mass_g=hand_mass_g,
-                            hand_lever_mm=hand_lever_mm) for p in P]
+        import pandas as pd
+
+        from ..progress import Progress
+
+        # one step per direction (each is independent of the others) and per holding pressure
+        with Progress(len(dirs) + len(P), "wrist", quiet=quiet) as bar:
+            parts = []
+            for d in dirs:
+                parts.append(wrist_sweep(w, P, [d]))
+                bar.advance()
+            table = pd.concat(parts, ignore_index=True)
+            holds = []
+            for p in P:
+                holds.append(wrist_hold(w, p, load_g=load_g, lever_mm=lever_mm, hand_mass_g=hand_mass_g,
+                                        hand_lever_mm=hand_lever_mm))
+                bar.advance()
         if plot is not None:
             from ..design.wrist import plot_wrist
-            from ..plots import save_figure
 
-            save_figure(plot_wrist(table, holds, title=f"wrist of four {act.kind}s, L = {w.length_mm:g} mm"), plot)
+            _save_plot(lambda ax: plot_wrist(table, holds, ax=ax, positions_deg=w.positions_deg,
+                                             title=f"wrist of four {act.kind}s, L = {w.length_mm:g} mm"),
+                       plot, fig_format, aspect=1.15)
         results = [{"direction_deg": float(r.direction_deg), "pressure_kpa": float(r.pressure_kpa),
                     "angle_deg": _num(r.angle_deg), "bend_direction_deg": _num(r.bend_direction_deg),
                     "curvature_per_mm": _num(r.curvature_per_mm), "equilibrium": bool(r.equilibrium),

@@ -10,12 +10,14 @@ import typer
 from .app import app
 from .options import (
     ActuatorOpt,
+    FigureFormatOpt,
     Format,
     Model,
     ModelOpt,
     MultiValueCommand,
     PresetOpt,
     PressureOpt,
+    QuietOpt,
     UserError,
     collect_raw_files,
     fmt_num,
@@ -85,11 +87,13 @@ def process(
     ] = 0.05,
     grid_points: Annotated[int, typer.Option("--grid-points", min=5, max=100000,
                                              help="Points of the common curvature grid.")] = 101,
-    figure: Annotated[bool, typer.Option("--figure/--no-figure", help="Write figure4.png.")] = True,
+    figure: Annotated[bool, typer.Option("--figure/--no-figure", help="Write figure4.png (or .pdf/.svg).")] = True,
+    fig_format: FigureFormatOpt = None,
     columns: ColumnsOpt = None,
     rate_hz: RateOpt = None,
     repair: RepairOpt = False,
     as_json: Annotated[bool, typer.Option("--json", help="Print summary.json to stdout.")] = False,
+    quiet: QuietOpt = False,
 ):
     """Process raw four-point-bending cyclic tests into moment-curvature curves and Table 2 values."""
     from ..fixture import Fixture
@@ -110,11 +114,29 @@ def process(
     fx = Fixture.from_string(fixture, L0_mm=l0_mm)
     opts = ProcessingOptions(cutoff_hz=cutoff_hz, reversal_fraction=reversal_fraction, grid_points=grid_points,
                              tare_n=tare_n)
-    with output_set(out, inputs) as o:
-        tests = [read_test(f, pressure_kpa=pressures[i] if pressures else None, columns=columns, rate_hz=rate_hz,
-                           repair=repair) for i, f in enumerate(files)]
-        processed = process_tests(tests, fixture=fx, options=opts)
-        processed.save(o.staging, figure=figure)
+    fig_name = f"figure4.{fig_format.value if fig_format is not None else 'png'}"
+    if fig_format is not None and not figure:
+        raise UserError(f"--format {fig_format.value}: there is no figure with --no-figure")
+
+    def tests(bar):
+        # read lazily: process_tests takes each test in turn, so a file counts as done (read and
+        # processed) when the next one is asked for
+        for i, f in enumerate(files):
+            yield read_test(f, pressure_kpa=pressures[i] if pressures else None, columns=columns, rate_hz=rate_hz,
+                            repair=repair)
+            bar.advance()
+
+    from ..progress import Progress
+
+    with output_set(out, inputs) as o, Progress(len(files) + 1, "process", quiet=quiet) as bar:
+        processed = process_tests(tests(bar), fixture=fx, options=opts)
+        bar.advance(0, description="process: writing")
+        processed.save(o.staging, figure=False)
+        if figure:
+            from ..plots import save_figure
+
+            save_figure(processed.plot(), o.path(fig_name))
+        bar.advance()
     if as_json:
         typer.echo((out / "summary.json").read_text())
         return
@@ -129,7 +151,7 @@ def process(
         for note in r["notes"]:
             typer.echo(f"         note: {note}")
     typer.echo(f"deadband: {fmt_num(summ['deadband_kpa'], '.4g')} ± {fmt_num(summ['deadband_se_kpa'], '.2g')} kPa")
-    typer.echo(f"wrote {out}/ (curves.nc, curves.csv, summary.json{', figure4.png' if figure else ''})")
+    typer.echo(f"wrote {out}/ (curves.nc, curves.csv, summary.json{', ' + fig_name if figure else ''})")
 
 
 @app.command("simulate-test", cls=MultiValueCommand)

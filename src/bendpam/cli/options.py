@@ -15,14 +15,18 @@ from typing import TYPE_CHECKING, Annotated, Optional
 import typer
 from typer.core import TyperCommand
 
+from ..checks import file_format
 from ..errors import InputError
 
 if TYPE_CHECKING:
     from ..actuator import Actuator
 
 __all__ = [
+    "FIGURE_FORMATS",
     "MULTI_VALUE_OPTIONS",
     "ActuatorOpt",
+    "FigureFormat",
+    "FigureFormatOpt",
     "Format",
     "Model",
     "ModelOpt",
@@ -30,13 +34,16 @@ __all__ = [
     "Preset",
     "PresetOpt",
     "PressureOpt",
+    "QuietOpt",
     "UserError",
     "collect_raw_files",
     "echo",
+    "figure_format",
     "fmt_num",
     "format_prediction_table",
     "load_actuator",
     "model_name",
+    "output_format",
     "parse_values",
     "pressures_kpa",
 ]
@@ -248,3 +255,36 @@ def positive(name: str, value: float | None, unit: str) -> float | None:
     if not (math.isfinite(value) and value > 0):
         raise UserError(f"{name}: {value:g} {unit} must be > 0")
     return value
+
+
+# ---- figure formats and progress (issue 16) -------------------------------------------------
+class FigureFormat(str, Enum):
+    png = "png"
+    pdf = "pdf"
+    svg = "svg"
+
+
+#: The figure formats every figure-writing command accepts.
+FIGURE_FORMATS = tuple(f.value for f in FigureFormat)
+FigureFormatOpt = Annotated[
+    Optional[FigureFormat],
+    typer.Option("--format", help="Figure format: png, pdf or svg (default: from the file name, else png)."),
+]
+QuietOpt = Annotated[
+    bool, typer.Option("--quiet", "-q", help="No progress on stderr (neither the bar nor the progress lines).")
+]
+
+def output_format(path: Path | None, fmt: str | Enum | None, formats: tuple[str, ...], *, option: str = "--out",
+                  default: str | None = None) -> str | None:
+    """The format of an output file from ``--format`` or the suffix of ``path`` (:func:`bendpam.checks.file_format`).
+
+    Returns None when ``path`` is None.
+    """
+    if path is None:
+        return None
+    return file_format(path, fmt, formats, option=option, format_option="--format", default=default)
+
+
+def figure_format(path: Path | None, fmt: str | Enum | None, option: str = "--out") -> str | None:
+    """:func:`output_format` for a figure (png, pdf or svg; png when neither the name nor --format says)."""
+    return output_format(path, fmt, FIGURE_FORMATS, option=option, default="png")

@@ -11,25 +11,35 @@ from typing import Annotated, Optional
 import numpy as np
 import typer
 
+from ..limits import OUTPUTS as LIMIT_OUTPUTS
 from .app import app
 from .options import (
+    FIGURE_FORMATS,
     ActuatorOpt,
+    FigureFormatOpt,
     Model,
     ModelOpt,
     MultiValueCommand,
     PresetOpt,
     PressureOpt,
     UserError,
+    figure_format,
     fmt_num,
     format_prediction_table,
     load_actuator,
     model_name,
     output_file,
+    output_format,
     pressures_kpa,
 )
 from .options import pressure_kpa as checked_pressure
 
-FIGURE_SUFFIXES = {".png", ".pdf", ".svg"}
+
+def _data_or_figure(out: Path, fmt, data_formats: tuple[str, ...]) -> str:
+    """The format of an --out that may be data (``data_formats``) or a figure (--format png/pdf/svg)."""
+    kind = output_format(out, fmt, (*data_formats, *FIGURE_FORMATS), option="--out")
+    assert kind is not None  # out is given
+    return kind
 
 
 @app.command(cls=MultiValueCommand)
@@ -64,9 +74,10 @@ def predict(
     loop = _loop_model(actuator, loop_law, loop_a0_nmm, loop_a1_nmm_per_kpa, loop_angle_deg) if cycle else None
     cycles = None
     if loop is not None:
-        from ..hysteresis import predict_cycle
+        from ..hysteresis import predict_cycles
 
-        cycles = [predict_cycle(act, loop, p, mname) for p in P]
+        # the same computation as the loss ratios and loop metrics of `bendpam fit` (one function)
+        cycles = predict_cycles(act, loop, P, mname)
     if as_json:
         obj = {
             "model": mname,
@@ -74,14 +85,16 @@ def predict(
             "max_equilibrium_pressure_kpa": br.max_pressure_kpa,
             "branch_end": br.kind,
             "units": {"pressure_kpa": "kPa", "blocked_moment_nmm": "N*mm", "free_curvature_per_mm": "1/mm",
-                      "free_angle_deg": "deg"},
+                      "free_angle_deg": "deg", **{k: u for k, (u, _) in LIMIT_OUTPUTS.items()}},
             "results": [
                 {
                     "pressure_kpa": r.pressure_kpa,
                     "blocked_moment_nmm": r.blocked_moment_nmm,
                     "free_curvature_per_mm": r.free_curvature_per_mm,
                     "free_angle_deg": r.free_angle_deg,
+                    **{k: getattr(r, k) for k in LIMIT_OUTPUTS},
                     "note": r.note or None,
+                    "limit_note": r.limit_note or None,
                     **({"cycle": _cycle_json(cycles[i])} if cycles is not None else {}),
                 }
                 for i, r in enumerate(df.itertuples())
@@ -89,10 +102,13 @@ def predict(
             **({"hysteresis": loop.to_dict()} if loop is not None else {}),
         }
         typer.echo(json.dumps(json_safe(obj), indent=2, allow_nan=False))
+        _warn_limits(df)
         return
     typer.echo(format_prediction_table(df, f"{act.name or act.kind} — {mname.replace('_', '-')} model"))
     if math.isfinite(br.max_pressure_kpa):
         typer.echo(f"highest pressure with a free-bending equilibrium: {br.max_pressure_kpa:.4g} kPa ({br.kind})")
+    typer.echo("\n".join(_limits_table(df)))
+    _warn_limits(df)
     if cycles is not None and loop is not None:
         typer.echo(f"\nloop ({loop.law}, a0 = {loop.a0_nmm:g} N·mm, a1 = {loop.a1_nmm_per_kpa:g} N·mm/kPa, "
                    f"angle {loop.theta_h_deg:g} deg): free-bending cycle blocked -> free -> blocked")
@@ -114,6 +130,33 @@ def _loop_model(actuator_file, law, a0, a1_per_kpa, angle):
                         "(bendpam fit --hysteresis writes one) or --loop-a0-nmm / --loop-a1-nmm-per-kpa")
     d = (base.to_dict() if base is not None else {}) | given
     return LoopModel.from_dict(d, source="loop parameters")
+
+
+def _margin(x, width: int) -> str:
+    """A safety factor for the limits table: 2 decimals, ``inf`` (no demand or no limit), a dash for NaN."""
+    x = float(x)
+    return ("inf" if x == math.inf else fmt_num(x, f"{width}.2f")).rjust(width)
+
+
+def _limits_table(df) -> list[str]:
+    """The margins of the prediction table (:func:`bendpam.limits`), one line per pressure."""
+    lines = ["limits (safety factors, >= 1 within the limit; inf: no demand or no limit given)",
+             f"{'P (kPa)':>8}  {'N_frame (N)':>11}  {'σ_frame (MPa)':>13}  {'strength':>8}  {'buckling':>8}  "
+             f"{'lock-up':>8}  {'stretch':>7}  {'(max)':>6}  {'min':>6}"]
+    for r in df.itertuples():
+        lines.append(f"{r.pressure_kpa:8.4g}  {fmt_num(r.frame_axial_force_n, '11.2f')}  "
+                     f"{fmt_num(r.frame_stress_mpa, '13.2f')}  {_margin(r.frame_strength_margin, 8)}  "
+                     f"{_margin(r.buckling_margin, 8)}  {_margin(r.lockup_margin, 8)}  "
+                     f"{_margin(r.bladder_stretch_margin, 7)}  {fmt_num(r.bladder_stretch_max, '6.3f')}  "
+                     f"{_margin(r.min_margin, 6)}")
+    return lines
+
+
+def _warn_limits(df) -> None:
+    """One ``bendpam: warning:`` line on stderr per limit a prediction is past."""
+    for note in df.limit_note:
+        for line in filter(None, str(note).split("; ")):
+            typer.echo(f"bendpam: warning: past a limit: {line}", err=True)
 
 
 def _cycle_json(c) -> dict:
@@ -141,34 +184,28 @@ def curve(
                      "default: 15% past free bending."),
     ] = None,
     points: Annotated[int, typer.Option("--points", min=2, max=100000, help="Curvature points per curve.")] = 200,
+    fig_format: FigureFormatOpt = None,
 ):
     """Moment-curvature curves M(P, k') as CSV or a figure."""
     if out is None:
         raise UserError("give an output file with --out FILE.csv or --out FILE.png")
-    suffix = out.suffix.lower()
-    if suffix not in {".csv"} | FIGURE_SUFFIXES:
-        raise UserError(f"--out {str(out)!r}: unknown format {suffix or '(none)'}; use .csv, .png, .pdf or .svg")
+    kind = _data_or_figure(out, fig_format, ("csv",))
     act = load_actuator(preset, actuator, model)
     P = np.asarray(pressures_kpa(pressure_kpa))
     if P.size * points > 10_000_000:
         raise UserError(f"--pressure-kpa x --points = {P.size * points} curve points; at most 10000000")
     mname = model_name(model)
-    from ..plots import moment_curves, plot_moment_curvature, save_figure
+    from ..plots import moment_curvature_figure, moment_curves, save_figure
 
     with output_file(out, [actuator]) as f:
-        if suffix == ".csv":
+        if kind == "csv":
             k, M = moment_curves(act, P, mname, k_max, points)
             rows = ["pressure_kpa,curvature_per_mm,moment_nmm"]
             for i, p in enumerate(P):
                 rows.extend(f"{p:.10g},{kk:.12g},{mm:.12g}" for kk, mm in zip(k, M[i], strict=True))
             f.write_text("\n".join(rows) + "\n")
         else:
-            import matplotlib.pyplot as plt
-
-            fig, ax = plt.subplots(figsize=(6.5, 4.5))
-            plot_moment_curvature(ax, act, P, mname, k_max, points)
-            fig.tight_layout()
-            save_figure(fig, f.path)
+            save_figure(moment_curvature_figure(act, P, mname, k_max, points), f.path, format=kind)
     typer.echo(f"wrote {out}")
 
 
@@ -179,6 +216,7 @@ def stresses(
     pressure_kpa: Annotated[float, typer.Option("--pressure-kpa", help="Gauge pressure, kPa.")] = 200.0,
     curvature: Annotated[float, typer.Option("--curvature", help="Frame curvature k', 1/mm.")] = 0.0,
     out: Annotated[Optional[Path], typer.Option("--out", help="Figure (.png/.pdf/.svg) or data (.nc/.csv).")] = None,
+    fig_format: FigureFormatOpt = None,
 ):
     """Force-balance internal stresses around the cross-section (eq 37-48)."""
     from ..predict import internal_stresses
@@ -187,15 +225,13 @@ def stresses(
     pressure_kpa = checked_pressure(pressure_kpa)
     if out is None:
         raise UserError("give an output file with --out FILE.png (figure), FILE.nc or FILE.csv (data)")
-    suffix = out.suffix.lower()
-    if suffix not in FIGURE_SUFFIXES | {".nc", ".csv"}:
-        raise UserError(f"--out {str(out)!r}: unknown format {suffix or '(none)'}; use .png, .pdf, .svg, .nc or .csv")
+    kind = _data_or_figure(out, fig_format, ("nc", "csv"))
     with output_file(out, [actuator]) as f:
-        if suffix in FIGURE_SUFFIXES:
+        if kind in FIGURE_FORMATS:
             from ..plots import plot_internal_stresses, save_figure
 
-            save_figure(plot_internal_stresses(act, pressure_kpa, curvature), f.path)
-        elif suffix == ".nc":
+            save_figure(plot_internal_stresses(act, pressure_kpa, curvature), f.path, format=kind)
+        elif kind == "nc":
             internal_stresses(act, pressure_kpa, curvature).to_netcdf(f.path)
         else:
             f.write_text(internal_stresses(act, pressure_kpa, curvature).to_dataframe().to_csv())
@@ -229,8 +265,10 @@ def actuator_cmd(
 
 @app.command()
 def demo(
-    out: Annotated[Path, typer.Option("--out", help="Moment-curvature figure to write.")] = Path(
-        "bendpam-demo/moment-curvature.png"),
+    out: Annotated[Optional[Path], typer.Option(
+        "--out", help="Moment-curvature figure to write (.png, .pdf, .svg); default "
+        "bendpam-demo/moment-curvature.png (or the --format's suffix).", show_default=False)] = None,
+    fig_format: FigureFormatOpt = None,
 ):
     """Predictions for the paper's BE-PAM and BC-PAM with both models, and a moment-curvature figure."""
     from .. import presets
@@ -238,6 +276,9 @@ def demo(
     from ..plots import demo_figure, save_figure
     from ..predict import prediction_table
 
+    if out is None:
+        out = Path(f"bendpam-demo/moment-curvature.{fig_format.value if fig_format is not None else 'png'}")
+    fmt = figure_format(out, fig_format)
     t0 = time.perf_counter()
     cases = [("be-pam", [100, 125, 150, 175, 200]), ("bc-pam", [40, 60, 80, 100, 120, 140])]
     items = []
@@ -252,5 +293,5 @@ def demo(
             items.append((act, np.asarray(P, dtype=float), mname))
     out.parent.mkdir(parents=True, exist_ok=True)
     with output_file(out) as f:
-        save_figure(demo_figure(items), f.path)
+        save_figure(demo_figure(items), f.path, format=fmt)
     typer.echo(f"\nwrote {out}  ({time.perf_counter() - t0:.1f} s)")

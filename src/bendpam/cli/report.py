@@ -19,7 +19,7 @@ def register(app: typer.Typer) -> None:
     """Add the ``report`` command to ``app`` (does nothing if it has one already)."""
     if any(getattr(c, "name", None) == "report" for c in app.registered_commands):
         return
-    from .options import ActuatorOpt, PresetOpt
+    from .options import ActuatorOpt, PresetOpt, QuietOpt
 
     @app.command("report")
     def report(
@@ -45,19 +45,22 @@ def register(app: typer.Typer) -> None:
             typer.Option("--model", help="Model(s) to fit: energy, force-balance (repeat or comma-separate; "
                          "default both)."),
         ] = None,
-        progress: Annotated[
-            bool, typer.Option("--progress/--no-progress", help="Progress bar on stderr (drawn only on a terminal).")
-        ] = True,
+        quiet: QuietOpt = False,
+        progress: Annotated[bool, typer.Option("--progress/--no-progress", hidden=True,
+                                               help="Same as --quiet (--no-progress).")] = True,
     ):
-        """Process raw cyclic tests, fit the models and write ONE self-contained HTML report."""
-        _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, model, progress)
+        """Process raw cyclic tests, fit the models and write ONE self-contained HTML report.
+
+        The page warns at the top when a fit is poor or the data do not match the actuator, and
+        prints cleanly to PDF from a browser.
+        """
+        _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, model, progress and not quiet)
 
 
 def _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, model, progress) -> None:
     from ..fixture import Fixture
-    from ..report import build_report
+    from ..report import build_report, fmt_value
     from .options import Model, UserError, collect_raw_files, load_actuator, output_file, parse_values
-    from .options import fmt_num as _num
 
     if out is None:
         raise UserError("give the report to write with --out report.html")
@@ -89,13 +92,18 @@ def _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, m
 
     summ = res.summary
     for row in res.table2:
-        typer.echo(f"{row['pressure_kpa']:>6} kPa  {row['cycles']} cycles  blocked {row['blocked_moment_nmm']} N·mm  "
-                   f"free k' {row['free_curvature_per_mm']} 1/mm  loss {row['energy_loss_percent']} %")
-    typer.echo(f"deadband: {_num(summ['deadband_kpa'], '.4g')} ± {_num(summ['deadband_se_kpa'], '.2g')} kPa")
+        typer.echo(f"{row['pressure_kpa']:>6} kPa  {row['cycles']} cycles  blocked moment (N·mm) "
+                   f"{row['blocked_moment_nmm']}  free curvature (1/mm) {row['free_curvature_per_mm']}  "
+                   f"energy loss (%) {row['energy_loss_percent']}")
+    typer.echo(f"deadband: {fmt_value(summ['deadband_kpa'], summ['deadband_se_kpa'], 'kPa')}")
     for row in res.table3:
-        typer.echo(f"{row['model']}: alpha0 {row['alpha0']} deg, C10 {row['C10']} kPa, C01 {row['C01']} kPa; NRMSE "
-                   f"cycles {row['nrmse_cycles']} %, blocked moment {row['nrmse_blocked_moment']} %, free curvature "
-                   f"{row['nrmse_free_curvature']} %")
+        typer.echo(f"{row['model']}: α₀ (°) {row['alpha0']}, C₁₀ (kPa) {row['C10']}, C₀₁ (kPa) {row['C01']}, "
+                   f"μ (kPa) {row['mu']}; NRMSE (%) cycles {row['nrmse_cycles']}, blocked moment "
+                   f"{row['nrmse_blocked_moment']}, free curvature {row['nrmse_free_curvature']}")
+    for w in res.warnings:
+        typer.echo(f"bendpam: {w.severity}: {w.title}", err=True)
     for note in res.notes:
         typer.echo(f"bendpam: warning: {note}", err=True)
-    typer.echo(f"wrote {out} ({res.bytes / 1024:.0f} KiB, {len(res.figures)} figures)")
+    n_w = sum(w.severity == "warning" for w in res.warnings)
+    box = f", {n_w} warning(s) and {len(res.warnings) - n_w} caution(s) at the top" if res.warnings else ""
+    typer.echo(f"wrote {out} ({res.bytes / 1024:.0f} KiB, {len(res.figures)} figures{box})")

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-import sys
+from enum import Enum
 from pathlib import Path
 from typing import Annotated, Any, Optional
 
@@ -16,10 +16,12 @@ from .options import (
     Model,
     ModelOpt,
     PresetOpt,
+    QuietOpt,
     UserError,
     load_actuator,
     model_name,
     output_file,
+    output_format,
     parse_values,
     pressures_kpa,
 )
@@ -28,6 +30,34 @@ from .options import (
 MAX_BLOCK_POINTS = 1_000_000
 #: The largest value of --max-points (the result alone takes 40 bytes per point).
 MAX_POINTS_LIMIT = 1_000_000_000
+
+
+class SweepFormat(str, Enum):
+    """Formats of ``bendpam sweep --format``: data (--out) or figure (--plot)."""
+
+    nc = "nc"
+    csv = "csv"
+    parquet = "parquet"
+    png = "png"
+    pdf = "pdf"
+    svg = "svg"
+
+
+DATA_FORMATS = ("nc", "csv", "parquet")
+FIGURE_FORMATS = ("png", "pdf", "svg")
+
+
+def sweep_formats(out: Path | None, plot: Path | None, fmt: SweepFormat | None) -> tuple[str | None, str | None]:
+    """The formats of --out and --plot: --format applies to the one whose kind it names."""
+    value = fmt.value if fmt is not None else None
+    if value in DATA_FORMATS and out is None:
+        raise UserError(f"--format {value} is a data format, for --out; there is no --out")
+    if value in FIGURE_FORMATS and plot is None:
+        raise UserError(f"--format {value} is a figure format, for --plot; there is no --plot")
+    data_fmt = output_format(out, value if value in DATA_FORMATS else None, DATA_FORMATS, option="--out")
+    fig_fmt = output_format(plot, value if value in FIGURE_FORMATS else None, FIGURE_FORMATS, option="--plot",
+                            default="png")
+    return data_fmt, fig_fmt
 
 
 def max_local_workers() -> int:
@@ -69,8 +99,14 @@ def sweep_cmd(
     max_points: Annotated[int, typer.Option("--max-points", min=1, max=MAX_POINTS_LIMIT,
                                             help="Refuse sweeps larger than this many (case, pressure) points.")]
     = 100_000_000,
-    out: Annotated[Optional[Path], typer.Option("--out", help="Output NetCDF file (.nc).")] = None,
-    plot: Annotated[Optional[Path], typer.Option("--plot", help="Quick figure (.png) of one output.")] = None,
+    out: Annotated[Optional[Path], typer.Option(
+        "--out", help="Output file: NetCDF (.nc), or a tidy table of one row per case and pressure (.csv, .parquet)."
+    )] = None,
+    plot: Annotated[Optional[Path], typer.Option("--plot", help="Quick figure of one output (.png, .pdf, .svg).")]
+    = None,
+    fmt: Annotated[Optional[SweepFormat], typer.Option(
+        "--format", help="Format of --out (nc, csv, parquet) or of --plot (png, pdf, svg); default: from the file "
+        "names.")] = None,
     plot_var: Annotated[str, typer.Option("--plot-var", help="Output to plot.")] = "free_angle_deg",
     plot_x: Annotated[Optional[str], typer.Option("--plot-x", help="Parameter on the x axis (default: first).")]
     = None,
@@ -82,13 +118,15 @@ def sweep_cmd(
         typer.Option("--at", metavar="NAME=VALUE", help="Fix a dimension of the plot, e.g. pressure_kpa=150 "
                      "(repeat for more; default: the middle value)."),
     ] = None,
-    progress: Annotated[bool, typer.Option("--progress/--no-progress", help="Progress bar.")] = True,
+    quiet: QuietOpt = False,
+    progress: Annotated[bool, typer.Option("--progress/--no-progress", hidden=True,
+                                           help="Same as --quiet (--no-progress).")] = True,
 ):
     """Design sweep: actuator parameters crossed with pressures (in-process or on Dask)."""
     from ..sweeps import SWEEP_PARAMETERS, sweep
 
     if out is None and plot is None:
-        raise UserError("give --out FILE.nc and/or --plot FILE.png")
+        raise UserError("give --out FILE.nc|.csv|.parquet and/or --plot FILE.png|.pdf|.svg")
     fixed_at = {}
     for item in at or []:
         name, sep, value = item.partition("=")
@@ -96,8 +134,13 @@ def sweep_cmd(
         if len(vals) != 1:
             raise UserError(f"--at {item!r}: expected NAME=VALUE, e.g. pressure_kpa=150")
         fixed_at[name.strip()] = vals[0]
-    if out is not None and out.suffix.lower() != ".nc":
-        raise UserError(f"--out {str(out)!r}: the sweep is written as NetCDF; use a .nc file")
+    data_fmt, fig_fmt = sweep_formats(out, plot, fmt)
+    if data_fmt == "parquet":
+        try:
+            import pyarrow  # noqa: F401
+        except ImportError:
+            raise UserError(f'--out {str(out)!r}: writing Parquet needs pyarrow: pip install "bendpam[parquet]"') \
+                from None
     if scheduler and workers:
         raise UserError("give either --scheduler or --workers, not both")
     if workers is not None and workers < 1:
@@ -125,15 +168,22 @@ def sweep_cmd(
                         f"{max(MAX_BLOCK_POINTS // len(P), 1)} or fewer, or fewer pressures")
     # typed Any: mypy would check the arrays against sweep()'s other keyword parameters
     grids: dict[str, Any] = {k: np.asarray(v) for k, v in params.items()}
-    ds = sweep(act, P, model_name(model), chunk_cases=chunk_cases, scheduler=scheduler, workers=workers,
-               progress=progress and sys.stderr.isatty(), **grids)
+    from ..progress import Progress
+
+    with Progress(n_cases, "sweep", quiet=quiet or not progress) as bar:
+        ds = sweep(act, P, model_name(model), chunk_cases=chunk_cases, scheduler=scheduler, workers=workers,
+                   progress=bar.advance, **grids)
     if out is not None:
+        from ..sweeps import write_sweep
+
         with output_file(out, [actuator]) as f:
-            ds.to_netcdf(f.path)
-        typer.echo(f"wrote {out} ({' x '.join(f'{d}={n}' for d, n in ds.sizes.items())})")
+            write_sweep(ds, f.path, data_fmt)
+        shape = " x ".join(f"{d}={n}" for d, n in ds.sizes.items())
+        rows = f", {int(np.prod(list(ds.sizes.values())))} rows" if data_fmt != "nc" else ""
+        typer.echo(f"wrote {out} ({shape}{rows})")
     if plot is not None:
         from ..plots import save_figure, sweep_figure
 
         with output_file(plot, [actuator]) as f:
-            save_figure(sweep_figure(ds, plot_var, plot_x, plot_y, at=fixed_at), f.path)
+            save_figure(sweep_figure(ds, plot_var, plot_x, plot_y, at=fixed_at), f.path, format=fig_fmt)
         typer.echo(f"wrote {plot}")

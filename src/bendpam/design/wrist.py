@@ -102,6 +102,12 @@ class Wrist:
         Bending stiffness of the column, N*mm^2 (default 0: a free joint).
     positions_deg : tuple of 4 floats
         Angular positions of the actuators (default 0, 90, 180, 270).
+
+    Examples
+    --------
+    >>> w = Wrist()                                       # the paper's BC-PAMs around a column
+    >>> w.actuator.name, w.radius_mm, w.positions_deg
+    ('BC-PAM (paper, energy constants)', 20.0, (0.0, 90.0, 180.0, 270.0))
     """
 
     actuator: Actuator | None = None
@@ -174,6 +180,12 @@ class WristState:
     load_moment_nmm : the external moment vector balanced (N*mm, 2 components).
     equilibrium : a stable equilibrium was found on every actuator's stable branch.
     note : why not, else empty.
+
+    Examples
+    --------
+    >>> state = wrist_bend(Wrist(), (0.0, 150.0, 0.0, 0.0))
+    >>> round(state.angle_deg, 1), state.direction_deg, state.equilibrium
+    (24.4, 90.0, True)
     """
 
     pressures_kpa: tuple
@@ -189,7 +201,11 @@ class WristState:
 def wrist_pressures(direction_deg: float, pressure_kpa, positions_deg=(0.0, 90.0, 180.0, 270.0)) -> tuple:
     """The four pressures (kPa) that bend the wrist toward ``direction_deg``: the actuator there at
     ``pressure_kpa``, or the two neighbours at that pressure for a direction halfway between them
-    (multiples of 45 deg)."""
+    (multiples of 45 deg).
+
+    >>> wrist_pressures(90.0, 150.0), wrist_pressures(45.0, 150.0)
+    ((0.0, 150.0, 0.0, 0.0), (150.0, 150.0, 0.0, 0.0))
+    """
     P = checked_pressure_kpa(pressure_kpa)
     return _wrist_pressures(direction_deg, P, positions_deg)
 
@@ -332,6 +348,12 @@ def wrist_bend(wrist: Wrist, pressures_kpa=None, *, direction_deg=None, pressure
 
     Give the four ``pressures_kpa`` (kPa), or ``direction_deg`` and ``pressure_kpa`` (kPa) to inflate
     the actuator(s) of that direction (:func:`wrist_pressures`).
+
+    Examples
+    --------
+    >>> state = wrist_bend(Wrist(), direction_deg=90.0, pressure_kpa=150.0)
+    >>> state.pressures_kpa, round(state.angle_deg, 1)    # kPa, deg
+    ((0.0, 150.0, 0.0, 0.0), 24.4)
     """
     _check_wrist(wrist)
     if pressures_kpa is None:
@@ -357,6 +379,14 @@ def wrist_moment(wrist: Wrist, pressures_kpa, angle_deg, direction_deg):
     ``pressures_kpa``: the four pressures (kPa).  This is the load it holds there: an external
     moment ``-m`` keeps it at that angle.  Returns ``(m, on_branch, note)``; ``on_branch`` is False
     (with a note) where an actuator is beyond its stable branch at that curvature.
+
+    Examples
+    --------
+    Held at 10 deg, short of its free 24.4 deg, the wrist pushes on toward 90 deg:
+
+    >>> m, on_branch, note = wrist_moment(Wrist(), (0.0, 150.0, 0.0, 0.0), 10.0, 90.0)
+    >>> bool(abs(m[0]) < 1e-9), round(float(m[1]), 1), on_branch    # N*mm
+    (True, 363.4, True)
     """
     _check_wrist(wrist)
     P = _four_pressures_kpa(pressures_kpa)
@@ -384,6 +414,12 @@ class WristHold:
     pressure_needed_kpa : pressure of the upper actuator that holds the load exactly horizontal.
     load_moment_nmm : the load's moment at kappa = 0, ``W (L/2 + lever)`` summed, N*mm.
     equilibrium, note : as in :class:`WristState`.
+
+    Examples
+    --------
+    >>> hold = wrist_hold(Wrist(), 150.0)                 # the paper's 335 g bottle, 100 mm out
+    >>> hold.holds_horizontal, round(hold.pressure_needed_kpa)       # kPa
+    (True, 140)
     """
 
     pressure_kpa: float
@@ -419,6 +455,12 @@ def wrist_hold(wrist: Wrist, pressure_kpa, *, load_g: float = BOTTLE_G, lever_mm
 
     The actuator at ``up_deg`` (default 90) is on top and inflated; the others are at P = 0.
     Gravity acts toward ``up_deg + 180``.  See the module docstring for the model.
+
+    Examples
+    --------
+    >>> w = Wrist()
+    >>> wrist_hold(w, 100.0).holds_horizontal, wrist_hold(w, 150.0).holds_horizontal
+    (False, True)
     """
     _check_wrist(wrist)
     P = checked_pressure_kpa(pressure_kpa)
@@ -468,6 +510,12 @@ def wrist_sweep(wrist: Wrist, pressures_kpa, directions_deg=(0.0, 90.0, 180.0, 2
 
     Columns ``direction_deg``, ``pressure_kpa``, ``angle_deg``, ``bend_direction_deg``,
     ``curvature_per_mm``, ``equilibrium``, ``note``.
+
+    Examples
+    --------
+    >>> table = wrist_sweep(Wrist(), [100.0, 150.0], directions_deg=(0.0, 90.0))
+    >>> table[["direction_deg", "pressure_kpa", "angle_deg"]].round(1).values.tolist()
+    [[0.0, 100.0, 14.7], [0.0, 150.0, 24.4], [90.0, 100.0, 14.7], [90.0, 150.0, 24.4]]
     """
     import pandas as pd
 
@@ -485,27 +533,104 @@ def wrist_sweep(wrist: Wrist, pressures_kpa, directions_deg=(0.0, 90.0, 180.0, 2
     return pd.DataFrame(rows)
 
 
-def plot_wrist(table, holds=(), ax=None, title: str | None = None):
-    """Bending angle against pressure per direction (and the holding angles with the load, dashed)."""
-    from .. import plots  # noqa: F401, I001  (first: the Agg backend unless chosen)
+def _wrist_curve_groups(table, positions_deg) -> list[tuple[list[float], np.ndarray, np.ndarray, str]]:
+    """Free-bending curves of ``table`` grouped where they coincide: ``(directions, P, angle, label)``.
+
+    With identical actuators the curves of symmetric directions (each single actuator, or each
+    pair) are the same; such curves are drawn once and the label says which directions share it.
+    """
+    groups: list[tuple[list[float], np.ndarray, np.ndarray]] = []
+    for d, grp in table.groupby("direction_deg", sort=False):
+        grp = grp.sort_values("pressure_kpa")
+        P = grp["pressure_kpa"].to_numpy(dtype=float)
+        a = grp["angle_deg"].to_numpy(dtype=float)
+        for dirs, P0, a0 in groups:
+            scale = max(float(np.nanmax(np.abs(a0), initial=0.0)), 1.0)
+            if P0.shape == P.shape and np.array_equal(P0, P) and np.allclose(a0, a, rtol=0.0, atol=1e-6 * scale,
+                                                                           equal_nan=True):
+                dirs.append(float(d))
+                break
+        else:
+            groups.append(([float(d)], P, a))
+    out = []
+    for dirs, P, a in groups:
+        names = []
+        for d in dirs:
+            on = [p for p, v in zip(positions_deg, _wrist_pressures(d, 1.0, positions_deg), strict=True) if v > 0]
+            names.append("+".join(f"{p:g}" for p in on) + "°")
+        pair = len(names[0].split("+")) > 1
+        if len(dirs) == 1:
+            label = f"actuator{'s' if pair else ''} {names[0]} inflated (toward {dirs[0]:g}°)"
+        else:
+            label = (f"{'pairs' if pair else 'actuators'} {', '.join(names)}, {'each pair' if pair else 'one'} "
+                     "inflated:\nthe same curve by symmetry")
+        out.append((dirs, P, a, label))
+    return out
+
+
+def plot_wrist(table, holds=(), ax=None, title: str | None = None, positions_deg=(0.0, 90.0, 180.0, 270.0)):
+    """Bending angle against pressure per inflated actuator (and the holding angles with the load, dashed).
+
+    Each curve has its own colour, line style and marker, and its legend entry names the inflated
+    actuator(s) by their position (deg) and the bending direction.  Directions whose curves
+    coincide (identical actuators at symmetric positions) are drawn once, and the legend says so
+    instead of drawing identical lines on top of each other.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        From :func:`wrist_sweep`.
+    holds : sequence of :class:`WristHold`, optional
+        From :func:`wrist_hold`, one per pressure (drawn dashed in black).
+    ax : matplotlib Axes, optional
+        Default: a new single-column figure.
+    title : str, optional
+    positions_deg : 4 floats
+        The actuators' positions (deg), to name them (default the :class:`Wrist` default).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+
+    Examples
+    --------
+    >>> import matplotlib.pyplot as plt
+    >>> fig = plot_wrist(wrist_sweep(Wrist(), [100.0, 150.0], directions_deg=(90.0,)))
+    >>> len(fig.axes) >= 1                                # fig.savefig("wrist.png") to keep it
+    True
+    >>> plt.close(fig)
+    """
+    from .. import plots  # noqa: I001  (first: the Agg backend unless chosen)
     import matplotlib.pyplot as plt
 
-    if ax is None:
-        fig, ax = plt.subplots(figsize=(6.5, 4.5))
-    else:
-        fig = ax.figure
-    for d, grp in table.groupby("direction_deg"):
-        ax.plot(grp["pressure_kpa"], grp["angle_deg"], "o-", label=f"free, toward {d:g} deg")
+    own = ax is None
+    with plots.figure_style():
+        if ax is None:
+            fig, ax = plt.subplots(figsize=plots.figure_size("single", 1.15))
+        else:
+            fig = ax.figure
+        _draw_wrist(ax, table, holds, title, positions_deg)
+        if own:
+            fig.tight_layout()
+    return fig
+
+
+def _draw_wrist(ax, table, holds, title, positions_deg) -> None:
+    """The curves of :func:`plot_wrist` on ``ax``: a colour, line style and marker per distinct curve."""
+    styles = ("-", "--", "-.", ":")
+    markers = ("o", "s", "^", "D", "v", "P")
+    for i, (_, P, a, label) in enumerate(_wrist_curve_groups(table, positions_deg)):
+        ax.plot(P, a, linestyle=styles[i % len(styles)], marker=markers[i % len(markers)], color=f"C{i % 10}",
+                label=label)
     holds = list(holds)
     if holds:
-        ax.plot([h.pressure_kpa for h in holds], [h.angle_deg for h in holds], "s--", color="k",
+        ax.plot([h.pressure_kpa for h in holds], [h.angle_deg for h in holds], "s--", color="k", mfc="none",
                 label=f"holding {holds[0].load_g:g} g at {holds[0].lever_mm:g} mm")
         ax.axhline(0.0, color="0.5", lw=0.8)
-    ax.axhline(30.0, color="tab:red", lw=0.8, ls=":", label="30 deg")
+    ax.axhline(30.0, color="tab:red", lw=0.8, ls=":", label="30°")
     ax.set_xlabel("pressure (kPa)")
     ax.set_ylabel("bending angle (deg)")
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
+    ax.legend(fontsize="small", loc="upper center", bbox_to_anchor=(0.5, -0.2), borderaxespad=0.0)
     if title:
         ax.set_title(title)
-    return fig

@@ -597,6 +597,25 @@ def process_tests(tests, *, fixture: Fixture = PAPER_FIXTURE, options: Processin
 
     Every test needs a pressure (from the reader: option, metadata or filename).  Two tests at one
     pressure are an error.
+
+    Examples
+    --------
+    Three virtual tests (two cycles at 5 Hz each, to be quick), processed without files:
+
+    >>> from pathlib import Path
+    >>> import bendpam
+    >>> from bendpam.lab import RawTest
+    >>> from bendpam.lab.simulate import SimulationSettings, simulate_test
+    >>> be, settings = bendpam.presets.be_pam(), SimulationSettings(cycles=2, rate_hz=5.0, seed=1)
+    >>> raws = [RawTest(simulate_test(be, p, settings=settings)[0], Path(f"be_{p:g}kPa.csv"), "csv",
+    ...                 pressure_kpa=p) for p in (100.0, 150.0, 200.0)]
+    >>> processed = process_tests(raws, keep_series=False)
+    >>> processed.pressures_kpa.tolist()
+    [100.0, 150.0, 200.0]
+    >>> [round(p["blocked_moment_nmm"]) for p in processed.summary()["pressures"]]   # N*mm
+    [80, 205, 330]
+    >>> round(processed.deadband()[0])                  # kPa: the x-intercept (P_start = 68 kPa)
+    68
     """
     results = []
     seen: dict[float, str] = {}

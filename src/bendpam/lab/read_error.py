@@ -47,6 +47,14 @@ class ReadError(FileFormatError):
     column : str or None
     message : str
         The message without the ``FILE:LINE:`` prefix.
+
+    Examples
+    --------
+    >>> err = ReadError("no header row naming time, stroke and force columns", "x.csv", 3)
+    >>> str(err)
+    'x.csv:3: no header row naming time, stroke and force columns'
+    >>> err.line, err.message
+    (3, 'no header row naming time, stroke and force columns')
     """
 
     def __init__(

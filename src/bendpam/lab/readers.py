@@ -215,6 +215,17 @@ class RawTest:
         Every data block of the file: ``{"line", "columns", "rows", "read"}``.
     sample_rate_hz : float or None
         The rate time was made from, when the file has no time column.
+
+    Examples
+    --------
+    :func:`read_test` makes one; so can a script, from data already in library units:
+
+    >>> import pandas as pd
+    >>> from pathlib import Path
+    >>> data = pd.DataFrame({"time_s": [0.0, 0.05], "stroke_mm": [0.0, 0.027], "force_n": [11.8, 11.71]})
+    >>> raw = RawTest(data, Path("be_150kPa.csv"), "csv", pressure_kpa=150.0, pressure_source="option")
+    >>> raw
+    RawTest(path='be_150kPa.csv', dialect='csv', rows=2, pressure=150 kPa (option), source_units={})
     """
 
     data: pd.DataFrame
@@ -282,6 +293,11 @@ def parse_pressure(value: str | float, unit: str | None = None) -> float:
     ReadError
         (a ``ValueError``) if the value is not a finite number, has no unit, or the unit is
         unknown, or ``value`` and ``unit`` name different units.
+
+    Examples
+    --------
+    >>> parse_pressure("0,2 MPa"), parse_pressure("2 bar"), round(parse_pressure(29, "psi"), 2)
+    (200.0, 200.0, 199.95)
     """
     if isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool):
         number, text_unit, shown = float(value), "", repr(value)
@@ -342,6 +358,13 @@ def pressure_from_filename(name: str | os.PathLike) -> float | None:
     -------
     float or None
         Pressure in kPa.
+
+    Examples
+    --------
+    >>> pressure_from_filename("be-pam_200kPa.csv"), pressure_from_filename("run_2,5bar.txt")
+    (200.0, 250.0)
+    >>> pressure_from_filename("run.csv") is None
+    True
     """
     base = Path(os.fspath(name)).name if str(name) else ""
     for m in _FILE_PRESSURE.finditer(base):
@@ -390,6 +413,11 @@ def parse_columns(columns: Mapping[str, str] | str | None) -> dict[str, str]:
     ------
     bendpam.errors.InputError
         For an unknown role, an empty name or a malformed string.
+
+    Examples
+    --------
+    >>> parse_columns("time=Zeit,force=Kraft"), parse_columns({"Stroke": "Weg"})
+    ({'time': 'Zeit', 'force': 'Kraft'}, {'stroke': 'Weg'})
     """
     from ..errors import InputError
 
@@ -1545,6 +1573,19 @@ def read_test(
     bendpam.errors.InputError
         (a ``ValueError``) for a bad option: unknown ``dialect``, a non-finite or out-of-range
         ``pressure_kpa`` or ``rate_hz``, a malformed ``columns``.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = Path(folder) / "be_150kPa.csv"
+    ...     _ = path.write_text("time_s,stroke_mm,force_n\\n0,0.000,11.80\\n0.05,0.027,11.71\\n0.1,0.051,11.54\\n")
+    ...     raw = read_test(path)
+    >>> raw.dialect, len(raw), raw.pressure_kpa, raw.pressure_source
+    ('csv', 3, 150.0, 'filename')
+    >>> raw.data["force_n"].tolist()                     # N
+    [11.8, 11.71, 11.54]
     """
     pressure_kpa, rate_hz = _check_options(pressure_kpa, dialect, rate_hz)
     overrides = parse_columns(columns)
@@ -1594,6 +1635,11 @@ def detect_dialect(path_or_text_lines: str | os.PathLike | Iterable[str]) -> str
     ------
     ReadError
         If no data block with time (or a rate), stroke and force is found.
+
+    Examples
+    --------
+    >>> detect_dialect("Test time;Standard travel;Standard force\\ns;mm;N\\n0;0,000;11,80\\n0,05;0,027;11,71\\n")
+    'testxpert'
     """
     sources, path = _text_source(path_or_text_lines)
     kw: dict[str, Any] = {"dialect": None, "overrides": {}, "rate_hz": None, "repair": False,
@@ -1635,6 +1681,18 @@ def check_cycle_count(raw: RawTest, n_cycles_found: int) -> str | None:
     str or None
         A warning sentence when the counts disagree, None when they agree or the file has no
         cycle counter.
+
+    Examples
+    --------
+    >>> import numpy as np, pandas as pd
+    >>> from pathlib import Path
+    >>> data = pd.DataFrame({"time_s": np.arange(7.0), "stroke_mm": np.zeros(7), "force_n": np.ones(7)})
+    >>> raw = RawTest(data, Path("t.csv"), "csv", cycle_counter=np.array([0, 0, 1, 1, 2, 2, 3.0]),
+    ...               cycle_counter_source="Total Cycle Count")
+    >>> check_cycle_count(raw, 3) is None
+    True
+    >>> print(check_cycle_count(raw, 2))
+    t.csv: the machine's cycle counter 'Total Cycle Count' counts 3 cycle(s) (from 0 to 3) but the segmentation ...
     """
     if raw.cycle_counter is None or raw.cycle_counter.size == 0:
         return None
@@ -1686,6 +1744,20 @@ def inspect_file(
         "metadata", "pressure_kpa", "cycle_counter": {"source", "max"} or None, "warnings"}``;
         for a file that cannot be read ``{"file", "error"}``.  No NaN or infinity anywhere
         (None instead).  Values are in s, mm, N and kPa.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = Path(folder) / "be_150kPa.csv"
+    ...     _ = path.write_text("time_s,stroke_mm,force_n\\n0,0.000,11.80\\n0.05,0.027,11.71\\n")
+    ...     info = inspect_file(path)
+    ...     bad = inspect_file(Path(folder) / "missing.csv")
+    >>> info["format"], info["n_samples"], info["columns"]["force"], info["pressure_kpa"]
+    ('csv', 2, {'source': 'force_n', 'unit': 'N'}, 150.0)
+    >>> sorted(bad)
+    ['error', 'file']
     """
     from ..errors import BendpamError
 
@@ -1730,7 +1802,25 @@ _DELIM_NAMES = {"\t": "tab", ";": "';'", ",": "','", " ": "space"}
 
 
 def format_inspection(info: Mapping[str, Any]) -> str:
-    """A short readable multi-line summary of one :func:`inspect_file` result."""
+    """A short readable multi-line summary of one :func:`inspect_file` result.
+
+    >>> info = {"file": "be_150kPa.csv", "format": "csv", "encoding": "utf-8", "delimiter": ",",
+    ...         "decimal": ".", "header_line": 1, "n_samples": 2,
+    ...         "columns": {r: {"source": f"{r}_col", "unit": u} for r, u in (("time", "s"), ("stroke", "mm"),
+    ...                                                                       ("force", "N"))},
+    ...         "first": {"time_s": 0.0, "stroke_mm": 0.0, "force_n": 11.8},
+    ...         "last": {"time_s": 0.05, "stroke_mm": 0.027, "force_n": 11.71}, "pressure_kpa": 150.0}
+    >>> print(format_inspection(info))
+    be_150kPa.csv
+      format csv, encoding utf-8, delimiter ',', decimal '.', header at line 1
+      2 samples
+      time   <- 'time_col' (s)
+      stroke <- 'stroke_col' (mm)
+      force  <- 'force_col' (N)
+      first: 0 s, 0 mm, 11.8 N
+      last:  0.05 s, 0.027 mm, 11.71 N
+      pressure: 150 kPa
+    """
     name = info.get("file", "?")
     if "error" in info:
         return f"{name}\n  error: {info['error']}"

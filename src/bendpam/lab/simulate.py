@@ -109,6 +109,15 @@ def simulate_test(actuator, pressure_kpa: float, model: str = "energy", *, fixtu
 
     ``data`` is a DataFrame with ``time_s``, ``stroke_mm``, ``force_n`` as a machine records them;
     ``truth`` is a dict of the values processing should recover (magnitudes).
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> data, truth = simulate_test(bendpam.presets.be_pam(), 150.0, settings=SimulationSettings(seed=1))
+    >>> data.columns.tolist(), len(data)
+    (['time_s', 'stroke_mm', 'force_n'], 5250)
+    >>> round(truth["blocked_moment_nmm"], 1), round(truth["free_curvature_per_mm"], 5)   # N*mm, 1/mm
+    (204.3, 0.00729)
     """
     st = settings or SimulationSettings()
     model = normalise_model(model)

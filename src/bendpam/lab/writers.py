@@ -118,6 +118,26 @@ def write_test(
     ValueError
         For an unknown dialect, language or force unit, missing columns, non-finite values or
         unwritable metadata.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> import pandas as pd
+    >>> from pathlib import Path
+    >>> data = pd.DataFrame({"time_s": [0.0, 0.05], "stroke_mm": [0.0, 0.027], "force_n": [11.8, 11.71]})
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = Path(folder) / "be.txt"
+    ...     write_test(path, data, "testxpert", pressure_kpa=150.0)
+    ...     print(path.read_text(encoding="utf-8"))
+    $testXpert II ASCII export
+    $written by bendpam
+    Pressure;150;kPa
+    <BLANKLINE>
+    Test time;Standard travel;Standard force
+    s;mm;N
+    0;0;11,8
+    0,05;0,027;11,71
+    <BLANKLINE>
     """
     if dialect not in DIALECTS:
         raise ValueError(f"unknown dialect {dialect!r}; expected one of {', '.join(DIALECTS)}")

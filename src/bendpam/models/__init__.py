@@ -18,7 +18,11 @@ MODEL_NAMES = ("energy", "force_balance")
 
 
 def normalise_model(model: str) -> str:
-    """Map ``"energy"``, ``"force_balance"``, ``"force-balance"``, ``"fb"`` to a canonical name."""
+    """Map ``"energy"``, ``"force_balance"``, ``"force-balance"``, ``"fb"`` to a canonical name.
+
+    >>> normalise_model("Force-Balance"), normalise_model("fb"), normalise_model("energy")
+    ('force_balance', 'force_balance', 'energy')
+    """
     key = str(model).strip().lower().replace("-", "_")
     aliases = {"energy": "energy", "virtual_work": "energy", "force_balance": "force_balance", "fb": "force_balance"}
     if key not in aliases:
@@ -27,5 +31,9 @@ def normalise_model(model: str) -> str:
 
 
 def get_model(model: str):
-    """Return the module implementing ``model`` (``"energy"`` or ``"force_balance"``/``"force-balance"``)."""
+    """Return the module implementing ``model`` (``"energy"`` or ``"force_balance"``/``"force-balance"``).
+
+    >>> get_model("force-balance").__name__
+    'bendpam.models.force_balance'
+    """
     return {"energy": energy, "force_balance": force_balance}[normalise_model(model)]

@@ -110,6 +110,13 @@ def basis(params, curvature, *, order: int = DEFAULT_ORDER, eq19_factor: bool = 
 
     Returns ``(A, b10, b01)``; they depend only on the kinematics (alpha0, R0_start, t0_start), so
     identification can solve for C10, C01, E_f and P_start by linear least squares.
+
+    Examples
+    --------
+    >>> import numpy as np, bendpam
+    >>> A, b10, b01 = basis(bendpam.presets.be_pam().params, np.array([0.0, 0.01]))
+    >>> A.round(2).tolist(), b10.round(1).tolist(), b01.round(1).tolist()
+    ([2350.98, 1932.5], [0.0, 1088.7], [0.0, 1038.9])
     """
     k = np.asarray(curvature, dtype=float)
     u, R, dR, ib, dib = radius_state(k, params.alpha0, params.R0_start, order)
@@ -121,6 +128,15 @@ def coefficients(params, curvature, *, order: int = DEFAULT_ORDER, eq19_factor: 
     """``(A, B)`` with ``M = P_active A - B`` (N*mm/MPa and N*mm), shape of ``curvature``.
 
     No range checks: callers validate the curvature against the lock-up limits.
+
+    Examples
+    --------
+    The blocked moment at 200 kPa is ``P_active A(0)`` with ``P_active = 0.2 - 0.068`` MPa:
+
+    >>> import numpy as np, bendpam
+    >>> A, B = coefficients(bendpam.presets.be_pam().params, np.array([0.0, 0.01]))
+    >>> A.round(2).tolist(), B.round(2).tolist(), round(0.132 * float(A[0]), 2)
+    ([2350.98, 1932.5], [0.0, 191.91], 310.33)
     """
     k = np.asarray(curvature, dtype=float)
     A, b10, b01 = basis(params, k, order=order, eq19_factor=eq19_factor)
@@ -131,6 +147,13 @@ def terms(params, p_active, curvature, *, order: int = DEFAULT_ORDER, eq19_facto
     """The parts of eq 21 in N*mm: ``M_load``, ``M_air`` (eq 13), ``M_bl`` (eq 19), ``M_f`` (eq 16).
 
     ``p_active`` is ``max(P - P_start, 0)`` in MPa and broadcasts against ``curvature``.
+
+    Examples
+    --------
+    >>> import numpy as np, bendpam
+    >>> t = terms(bendpam.presets.be_pam().params, 0.132, np.array([0.0, 0.01]))   # 200 kPa
+    >>> {name: v.round(2).tolist() for name, v in t.items()}
+    {'M_load': [310.33, 63.18], 'M_air': [310.33, 255.09], 'M_bl': [0.0, 188.37], 'M_f': [0.0, 3.54]}
     """
     k = np.asarray(curvature, dtype=float)
     A, b10, b01 = basis(params, k, order=order, eq19_factor=eq19_factor)
@@ -147,6 +170,12 @@ def bladder_energy(params, curvature, *, order: int = DEFAULT_ORDER):
 
     ``dU_bl/dk'`` is the bladder moment of eq 19 without its ``(1 + k'R)`` factor; the tests check
     :func:`terms` against a finite difference of this function.
+
+    Examples
+    --------
+    >>> import numpy as np, bendpam
+    >>> bladder_energy(bendpam.presets.be_pam().params, np.array([0.0, 0.01])).round(4).tolist()
+    [0.0, 0.9774]
     """
     k = np.asarray(curvature, dtype=float)
     _u, R, _dR, _omc, wbar, lam1 = _state(params, k, order)
