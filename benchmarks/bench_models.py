@@ -5,7 +5,8 @@ For each preset (BE-PAM, BC-PAM) and model (energy, force-balance):
 * scattered ``M(P, k')`` on N random pairs (default 10^6; k' uniform over the whole admissible
   range, P uniform on 0-300 kPa):
   - ``fast``: ``law.tabulated().moment`` (the spline table, built once; build time below),
-  - ``exact``: ``law.moment`` (eq 5 by Newton, 32 Gauss nodes),
+  - ``exact``: ``law.moment`` (closed-form section integrals: elliptic K and E; eq 5 by one Newton step
+    from a uniform-in-q Hermite table),
   - ``baseline``: the competent NumPy baseline of ``baseline.py`` (24 nodes, Hermite start +
     bracketed Newton, closed-form moments, analytic dR/dk', 4096-point blocks),
   - ``per-point``: ``quad`` + ``brentq`` one pair at a time, on a few hundred pairs;

@@ -142,3 +142,51 @@ def test_property_kinematics_finite_and_consistent(a, frac):
     assert np.all(kin.lambda1 >= 0)
     # the sign of dR/dk' is negative on both sides (R falls as k' increases)
     assert kin.dradius < 0
+
+
+# ------------------------------------------------------------------------------------------------
+# closed forms of the section integrals (order = 0, the default)
+# ------------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("alpha0_deg", [12.0, 30.0, 45.0, 56.0, 69.7, 80.0, 88.0])
+def test_ibar_closed_form_equals_adaptive_quadrature(alpha0_deg):
+    from bendpam.braid import ibar_closed_form
+
+    c = math.cos(math.radians(alpha0_deg))
+    u_lock = (1 / c - 1) / 2
+    for u in (-0.49, -0.2, -1e-9, 0.0, 1e-9, 0.3 * u_lock, 0.9 * u_lock, LOCK_FRACTION * u_lock):
+        f = lambda p, u=u: 1.0 / math.sqrt(1 - (c * (1 + u * (1 - math.cos(p)))) ** 2)
+        df = lambda p, u=u, f=f: c * c * (1 + u * (1 - math.cos(p))) * (1 - math.cos(p)) * f(p) ** 3
+        ref = quad(f, 0, math.pi, epsabs=0, epsrel=1e-13, limit=200)[0] / math.pi
+        dref = quad(df, 0, math.pi, epsabs=0, epsrel=1e-13, limit=200)[0] / math.pi
+        ib, dib = ibar_closed_form(np.array(u), c)
+        assert float(ib) == pytest.approx(ref, rel=1e-12), u
+        assert float(dib) == pytest.approx(dref, rel=1e-11, abs=1e-13), u
+
+
+def test_closed_form_models_equal_high_order_quadrature(preset_model, span):
+    a, model = preset_model
+    k = span(a, 0.98, 41)
+    exact = bendpam.moment_terms(a, 150.0, k, model)
+    quad256 = bendpam.moment_terms(a, 150.0, k, model, order=256)
+    scale = np.max(np.abs(quad256["M_load"]))
+    for name in exact:
+        assert_allclose(exact[name], quad256[name], rtol=0, atol=1e-11 * scale, err_msg=name)
+    assert_allclose(bendpam.kinematics(a, k).radius, bendpam.kinematics(a, k, order=256).radius, rtol=1e-13)
+
+
+@pytest.mark.parametrize("alpha0_deg", [15.0, 40.0, 69.7, 85.0])
+def test_one_newton_step_from_the_uniform_table_reaches_rounding(alpha0_deg):
+    from bendpam.braid import _hermite_start, _inverse_table, _newton, solve_u
+
+    a0 = math.radians(alpha0_deg)
+    c = math.cos(a0)
+    u_lock = (1 / c - 1) / 2
+    u_true = np.concatenate([np.linspace(-0.49, 0, 200), np.linspace(0, LOCK_FRACTION * u_lock, 200)])
+    q = math.sin(a0) * u_true * bendpam.braid.circle_ibar(u_true, c)[0]
+    u, ib, dib = solve_u(q, a0)
+    qt, ut, dt = _inverse_table(a0, 0)
+    u_ref, ib_ref, dib_ref = _newton(q, a0, 0, _hermite_start(q, qt, ut, dt), (-0.5, u_lock))
+    assert_allclose(u, u_ref, rtol=1e-13, atol=1e-15)
+    assert_allclose(u, u_true, rtol=1e-12, atol=1e-15)
+    assert_allclose(ib, ib_ref, rtol=1e-13)
+    assert_allclose(dib, dib_ref, rtol=1e-10, atol=1e-12)

@@ -60,7 +60,7 @@ def test_of_shares_one_law_per_actuator_and_options(be):
     law = MomentLaw.of(be, "energy")
     assert MomentLaw.of(be, "energy") is law
     assert MomentLaw.of(presets.be_pam("energy"), "energy") is law  # an equal actuator
-    assert MomentLaw.of(be, "energy", eq19_factor=True, order=32) is law  # the defaults spelled out
+    assert MomentLaw.of(be, "energy", eq19_factor=True, order=0) is law  # the defaults spelled out
     assert MomentLaw.of(be, "force-balance") is MomentLaw.of(be, "force_balance")  # aliases normalised
     assert MomentLaw.of(be, "force_balance") is not law
     assert MomentLaw.of(be, "energy", eq19_factor=False) is not law
@@ -140,7 +140,7 @@ def test_block_of_cases_equals_one_by_one(name, model):
         kk = np.array([0.0, 0.3 * one.limits.k_min, 0.3 * one.limits.k_max])
         A_c, B_c = law.coefficients(kk[:, None], cases.take(np.array([i])))
         A_1, B_1 = one.coefficients(kk)
-        assert_allclose(A_c[:, 0], A_1, rtol=1e-14)
+        assert_allclose(A_c[:, 0], A_1, rtol=1e-13, atol=1e-13 * np.abs(A_1).max())  # A changes sign: rounding
         assert_allclose(B_c[:, 0], B_1, rtol=1e-13, atol=1e-12 * np.abs(B_1).max())  # B(0) = 0 up to rounding
     # a fold somewhere in the block: the BC-PAMs stop having equilibria at high pressure
     if name == "bc-pam" and model == "energy":

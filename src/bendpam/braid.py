@@ -21,9 +21,21 @@ frame is ``h = R (1 - cos Phi)`` with ``R`` the *deformed* radius.  With the fra
 * axis curvature, eq 1: ``k = k' / (1 + k' R)``; bending angle ``theta = k' L0``; axis length
   ``L = L0 (1 + k' R)``.
 
-Every integrand is even about ``Phi = pi``, so the integrals use fixed-order Gauss-Legendre nodes on
-``[0, pi]`` (default 32 nodes, i.e. 64 on the full circle); the convergence is exponential, see
-``tests/test_kinematics.py``.
+Section integrals.  By default (``order = 0``, :data:`CLOSED_FORM`) every circle mean is evaluated in
+closed form: with ``lambda1 = a - b cos Phi`` (``a = 1 + u``, ``b = u``) the factor
+``1 - c^2 lambda1^2 = (1 - c lambda1)(1 + c lambda1)`` is a product of two terms linear in
+``cos Phi``, so ``Ibar`` is a complete elliptic integral of the first kind (Byrd & Friedman 256.00)::
+
+    Ibar(u) = (2/pi) K(m) / sqrt(D),   m = 4 c |u| / D,
+    D = (1 - c)(1 + c (1 + 2u))  (u >= 0),   D = (1 + c)(1 - c (1 + 2u))  (u < 0)
+
+and ``dIbar/du`` follows with ``dK/dm = (E - (1 - m) K) / (2 m (1 - m))`` (a series near
+``m = 0``).  The means of rational functions of ``lambda1`` the models need are elementary (from
+``mean 1/(alpha + beta cos Phi) = (alpha^2 - beta^2)^(-1/2)``).  A positive ``order`` uses
+fixed-order Gauss-Legendre nodes on ``[0, pi]`` instead (every integrand is even about
+``Phi = pi``; ``order`` nodes there, twice as many on the full circle), whose convergence to the
+closed forms is exponential, see ``tests/test_kinematics.py``.  Distributions over the section
+(internal stresses) always use nodes: :data:`NODE_ORDER` of them when ``order = 0``.
 
 All lengths are mm and curvatures 1/mm.  ``R0`` and ``t0`` here are the prestrain-corrected
 ``R0_start`` and ``t0_start`` of the actuator (eq 51-52).
@@ -54,19 +66,27 @@ import numpy as np
 from .errors import InputError
 
 __all__ = [
+    "CLOSED_FORM",
     "DEFAULT_ORDER",
     "LOCK_FRACTION",
     "MIN_FAR_STRETCH",
+    "NODE_ORDER",
     "CurvatureLimits",
     "Kinematics",
+    "circle_ibar",
     "curvature_limits",
     "gauss_nodes",
+    "ibar_closed_form",
     "kinematics",
     "limits",
     "solve_u",
 ]
 
-DEFAULT_ORDER = 32
+#: ``order = 0``: the section integrals in closed form (elliptic integrals, elementary means).
+CLOSED_FORM = 0
+DEFAULT_ORDER = CLOSED_FORM
+#: Gauss-Legendre nodes on [0, pi] for distributions over the section when ``order = 0``.
+NODE_ORDER = 32
 LOCK_FRACTION = 0.99
 MIN_FAR_STRETCH = 0.01
 _NEWTON_MAXITER = 60
@@ -83,8 +103,10 @@ def gauss_nodes(order: int = DEFAULT_ORDER) -> tuple[np.ndarray, np.ndarray]:
     Returns read-only arrays ``(phi, wbar)`` of length ``order``.
     """
     order = int(order)
+    if order == CLOSED_FORM:
+        order = NODE_ORDER
     if order < 4 or order > 1024:
-        raise InputError(f"quadrature order = {order} is outside the allowed range [4, 1024]")
+        raise InputError(f"quadrature order = {order} is outside the allowed range 0 (closed form) or [4, 1024]")
     x, w = np.polynomial.legendre.leggauss(order)
     phi = (x + 1.0) * (np.pi / 2.0)
     wbar = w / 2.0  # (pi/2 * w) / pi
@@ -112,6 +134,69 @@ def ibar(u, c, omc, wbar):
     return ib, dib
 
 
+# series of dK/dm about m = 0: (pi/2) sum n c_n m^(n-1), c_n = ((2n-1)!! / (2n)!!)^2, used for m < 0.05
+_DK_SERIES = []
+_cn = 1.0
+for _n in range(1, 15):
+    _cn *= ((2 * _n - 1) / (2 * _n)) ** 2
+    _DK_SERIES.append(0.5 * math.pi * _n * _cn)
+_DK_SERIES_M = 0.05
+
+
+def ibar_closed_form(u, c):
+    """``Ibar(u)`` and ``dIbar/du`` of eq 5 in closed form (complete elliptic integrals K and E).
+
+    ``u`` and ``c = cos(alpha0)`` broadcast; ``u`` must lie inside the admissible range
+    (``c (1 + 2 max(u, 0)) < 1``, ``1 + 2u > 0``).  Agrees with Gauss-Legendre quadrature to
+    rounding (about 1e-14, tests/test_kinematics.py).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> ib, dib = ibar_closed_form(np.array([0.0, 0.05]), np.cos(np.radians(69.7)))
+    >>> ib.round(6).tolist(), dib.round(6).tolist()      # Ibar(0) = 1 / sin(alpha0)
+    ([1.066224, 1.073917], [0.145896, 0.162064])
+    """
+    from scipy.special import ellipe, ellipk
+
+    u = np.asarray(u, dtype=float)
+    pos = u >= 0.0
+    cu = c * u
+    D = np.where(pos, (1.0 - c) * (1.0 + c + 2.0 * cu), (1.0 + c) * (1.0 - c - 2.0 * cu))
+    dD = np.where(pos, 2.0 * c * (1.0 - c), -2.0 * c * (1.0 + c))
+    m = 4.0 * np.abs(cu) / D
+    K, E = ellipk(m), ellipe(m)
+    rD = 1.0 / np.sqrt(D)
+    ib = (2.0 / math.pi) * K * rD
+    small = m < _DK_SERIES_M
+    ms = np.where(small, m, 0.0)
+    ser = np.zeros_like(ms)
+    for coef in reversed(_DK_SERIES):
+        ser = ser * ms + coef
+    mm = np.where(small, 0.5, m)
+    dKdm = np.where(small, ser, (E - (1.0 - mm) * K) / (2.0 * mm * (1.0 - mm)))
+    dm = (4.0 * c * np.where(pos, 1.0, -1.0) - m * dD) / D
+    dib = (2.0 / math.pi) * rD * (dKdm * dm - 0.5 * K * dD / D)
+    return ib, dib
+
+
+def circle_ibar(u, c, order: int = DEFAULT_ORDER):
+    """``Ibar(u)`` and ``dIbar/du``: closed form for ``order = 0``, else Gauss-Legendre with ``order`` nodes.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> c = np.cos(np.radians(69.7))
+    >>> exact, quad = circle_ibar(np.array([0.05]), c), circle_ibar(np.array([0.05]), c, order=32)
+    >>> bool(abs(exact[0][0] - quad[0][0]) < 1e-12)
+    True
+    """
+    if order == CLOSED_FORM:
+        return ibar_closed_form(u, c)
+    phi, wbar = gauss_nodes(order)
+    return ibar(np.asarray(u, dtype=float), c, 1.0 - np.cos(phi), wbar)
+
+
 def solve_u(q_target, alpha0: float, order: int = DEFAULT_ORDER, u_bounds: tuple[float, float] | None = None):
     """Solve eq 5 for ``u = k' R`` given ``q = k' R0`` (vectorised safeguarded Newton).
 
@@ -122,7 +207,7 @@ def solve_u(q_target, alpha0: float, order: int = DEFAULT_ORDER, u_bounds: tuple
     alpha0 : float
         Initial braid angle, rad.
     order : int
-        Gauss-Legendre order on [0, pi].
+        0 (default): closed-form section integrals; N > 0: N Gauss-Legendre nodes on [0, pi].
     u_bounds : (float, float), optional
         Bracket for ``u``; defaults to ``(-1/2, u_lock)``.  Each target must lie inside
         ``q(u_bounds)``; callers check the curvature limits first.
@@ -143,13 +228,24 @@ def solve_u(q_target, alpha0: float, order: int = DEFAULT_ORDER, u_bounds: tuple
     q = np.asarray(q_target, dtype=float)
     if np.ndim(alpha0):
         q = np.broadcast_to(q, np.broadcast_shapes(q.shape, np.shape(alpha0)))
-    phi, wbar = gauss_nodes(order)
-    omc = 1.0 - np.cos(phi)
+    if np.ndim(alpha0) == 0 and u_bounds is None:
+        # one actuator: a start within about 1e-13 of the root from a uniform-in-q Hermite table, then one
+        # Newton step; Ibar and its slope at the root follow from the values at the start (the step is
+        # below 1e-13 |u|, so the corrections leave errors far below 1e-12).  Points whose step is larger
+        # (none expected) take the safeguarded iteration below.
+        u0 = _uniform_inverse(float(alpha0), int(order)).start(q)
+        ib, dib = circle_ibar(u0, c, order)
+        step = (s * u0 * ib - q) / (s * (ib + u0 * dib))
+        u = np.where(q == 0.0, 0.0, u0 - step)
+        ib = ib - dib * (u0 - u)
+        bad = ~(np.abs(step) <= 1e-13 * np.abs(u0) + 1e-16)
+        if np.any(bad):
+            u, ib, dib = (np.array(x, dtype=float, copy=True) for x in np.broadcast_arrays(u, ib, dib))
+            ub, ibb, dibb = _newton(q[bad], float(alpha0), order, u0[bad], (-0.5, (1.0 / c - 1.0) / 2.0))
+            u[bad], ib[bad], dib[bad] = ub, ibb, dibb
+        return u, ib, dib
     if u_bounds is None:
         u_bounds = (-0.5, (1.0 / c - 1.0) / 2.0)
-    lo = np.where(q >= 0.0, 0.0, u_bounds[0])
-    hi = np.where(q >= 0.0, u_bounds[1], 0.0)
-    eps = 1e-9 * (hi - lo)
     if np.ndim(alpha0) == 0:
         # start from a monotone interpolation of the inverse q -> u (tabulated once per alpha0)
         qt, ut, dt = _inverse_table(float(alpha0), int(order))
@@ -157,9 +253,18 @@ def solve_u(q_target, alpha0: float, order: int = DEFAULT_ORDER, u_bounds: tuple
     else:
         # per-point braid angles (sweeps): interpolate a table of q over (alpha0, normalised u)
         u0 = _universal_start(q, np.broadcast_to(alpha0, q.shape), int(order))
+    return _newton(q, alpha0, order, u0, u_bounds)
+
+
+def _newton(q, alpha0, order: int, u0, u_bounds):
+    """Bracketed Newton iteration on ``s u Ibar(u) = q`` from ``u0``; returns ``u, Ibar, dIbar/du``."""
+    c, s = np.cos(alpha0), np.sin(alpha0)
+    lo = np.where(q >= 0.0, 0.0, u_bounds[0])
+    hi = np.where(q >= 0.0, u_bounds[1], 0.0)
+    eps = 1e-9 * (hi - lo)
     u = np.where(q == 0.0, 0.0, np.clip(u0, lo + eps, hi - eps))
     for _ in range(_NEWTON_MAXITER):
-        ib, dib = ibar(u, c, omc, wbar)
+        ib, dib = circle_ibar(u, c, order)
         f = s * u * ib - q
         # maintain the bracket (q is increasing in u)
         lo = np.where(f < 0.0, u, lo)
@@ -173,8 +278,49 @@ def solve_u(q_target, alpha0: float, order: int = DEFAULT_ORDER, u_bounds: tuple
         u = np.where(f == 0.0, u, un)
         if np.all(done):
             break
-    ib, dib = ibar(u, c, omc, wbar)
+    ib, dib = circle_ibar(u, c, order)
     return u, ib, dib
+
+
+@dataclass(frozen=True)
+class _UniformInverse:
+    """Cubic Hermite table of the inverse ``u(q)`` of eq 5 on a uniform grid in ``q`` (one braid angle)."""
+
+    q0: float
+    inv_h: float
+    u: np.ndarray
+    du: np.ndarray  # du/dq times the grid step
+
+    def start(self, q):
+        """``u`` at ``q`` (clipped to the table's range): the interval from one multiply, no search."""
+        n = self.u.size - 1
+        x = np.clip((q - self.q0) * self.inv_h, 0.0, float(n))
+        j = np.minimum(x.astype(np.intp), n - 1)
+        x = x - j
+        u0, u1, d0, d1 = self.u[j], self.u[j + 1], self.du[j], self.du[j + 1]
+        y = 1.0 - x
+        return y * y * ((1.0 + 2.0 * x) * u0 + x * d0) + x * x * ((3.0 - 2.0 * x) * u1 - y * d1)
+
+
+#: Intervals of the uniform inverse table: the start is within about 1e-13 of the root (tested).
+_UNIFORM_INTERVALS = 8192
+
+
+@lru_cache(maxsize=64)
+def _uniform_inverse(alpha0: float, order: int) -> _UniformInverse:
+    """Build :class:`_UniformInverse` between ``q`` at 99.99 % of the range to each limit."""
+    c, s = math.cos(alpha0), math.sin(alpha0)
+    ends = np.array([-0.5 * 0.9999, 0.9999 * (1.0 / c - 1.0) / 2.0])
+    ib_e, _ = circle_ibar(ends, c, order)
+    q_ends = s * ends * ib_e
+    qg = np.linspace(q_ends[0], q_ends[1], _UNIFORM_INTERVALS + 1)
+    qt, ut, dt = _inverse_table(alpha0, order)
+    u, ib, dib = _newton(qg, alpha0, order, _hermite_start(qg, qt, ut, dt), (-0.5, (1.0 / c - 1.0) / 2.0))
+    h = (q_ends[1] - q_ends[0]) / _UNIFORM_INTERVALS
+    du = h / (s * (ib + u * dib))
+    for a in (u, du):
+        a.setflags(write=False)
+    return _UniformInverse(float(q_ends[0]), 1.0 / h, u, du)
 
 
 _A_GRID = np.radians(np.linspace(0.5, 89.5, 179))
@@ -185,11 +331,10 @@ _NU = np.concatenate([-(1.0 - (1.0 - np.linspace(0.0, 1.0, 65)[::-1]) ** 2)[:-1]
 @lru_cache(maxsize=8)
 def _universal_table(order: int) -> np.ndarray:
     """q(alpha0, nu) on a grid: nu in (-1, 0) means u = nu / 2, nu in [0, 1) means u = nu u_lock."""
-    phi, wbar = gauss_nodes(order)
     c, s = np.cos(_A_GRID)[:, None], np.sin(_A_GRID)[:, None]
     u_lock = (1.0 / c - 1.0) / 2.0
     u = np.where(_NU < 0.0, 0.5 * _NU, _NU * u_lock)
-    ib, _ = ibar(u, c, 1.0 - np.cos(phi), wbar)
+    ib, _ = circle_ibar(u, c, order)
     q = s * u * ib
     q.setflags(write=False)
     return q
@@ -228,8 +373,7 @@ def _inverse_table(alpha0: float, order: int) -> tuple[np.ndarray, np.ndarray, n
     u_lock = (1.0 / c - 1.0) / 2.0
     t = np.linspace(0.0, 1.0, 513)
     u = np.concatenate([-0.5 * (1.0 - (1.0 - t[::-1]) ** 2)[:-1] * 0.9999, u_lock * (1.0 - (1.0 - t) ** 2) * 0.9999])
-    phi, wbar = gauss_nodes(order)
-    ib, dib = ibar(u, c, 1.0 - np.cos(phi), wbar)
+    ib, dib = circle_ibar(u, c, order)
     q = s * u * ib
     dudq = 1.0 / (s * (ib + u * dib))
     for a in (q, u, dudq):
@@ -327,8 +471,6 @@ def limits(params, order: int = DEFAULT_ORDER) -> CurvatureLimits:
     >>> limits(cases).k_max.round(4).tolist()            # 1/mm
     [0.1038, 0.1917, 0.4511]
     """
-    phi, wbar = gauss_nodes(order)
-    omc = 1.0 - np.cos(phi)
     scalar = np.ndim(params.alpha0) == 0 and np.ndim(params.R0_start) == 0 and np.ndim(params.t0_start) == 0
     shape = np.broadcast_shapes(np.shape(params.alpha0), np.shape(params.R0_start), np.shape(params.t0_start))
     a0 = np.broadcast_to(np.asarray(params.alpha0, dtype=float), shape).ravel()
@@ -338,7 +480,7 @@ def limits(params, order: int = DEFAULT_ORDER) -> CurvatureLimits:
     u_lock = (1.0 / c - 1.0) / 2.0
 
     def xi(u, cc, ss):
-        ib, _ = ibar(u, cc, omc, wbar)
+        ib, _ = circle_ibar(u, cc, order)
         return 1.0 / (ss * ib)
 
     def lumen(u):  # R - t_bar, scaled: R0 xi^2 (1 + u) - t0  (t_bar = t0 / ((1 + u) xi))

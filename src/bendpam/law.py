@@ -42,7 +42,15 @@ from typing import Any
 import numpy as np
 
 from .actuator import NEUTRAL_ANGLE_DEG, Actuator, ModelParams
-from .braid import DEFAULT_ORDER, LOCK_FRACTION, MIN_FAR_STRETCH, CurvatureLimits, curvature_limits, radius_from_u
+from .braid import (
+    CLOSED_FORM,
+    DEFAULT_ORDER,
+    LOCK_FRACTION,
+    MIN_FAR_STRETCH,
+    CurvatureLimits,
+    curvature_limits,
+    radius_from_u,
+)
 from .checks import float_array
 from .checks import pressure_kpa as _check_pressure
 from .errors import InputError, NoEquilibrium
@@ -74,8 +82,8 @@ _END_NAME = {v: k for k, v in BRANCH_END.items()}
 def _order(order) -> int:
     if isinstance(order, bool) or not isinstance(order, int | np.integer):
         raise InputError(f"order = {order!r} must be an integer (Gauss-Legendre nodes on [0, pi])")
-    if not 4 <= int(order) <= 1024:
-        raise InputError(f"order = {order} is outside the allowed range [4, 1024]")
+    if int(order) != CLOSED_FORM and not 4 <= int(order) <= 1024:
+        raise InputError(f"order = {order} is outside the allowed range: 0 (closed form) or [4, 1024]")
     return int(order)
 
 
@@ -93,7 +101,8 @@ class MomentLaw:
         Energy model only: keep eq 19's ``(1 + k'R)`` factor (default, as printed; see
         docs/paper-reading.md item 7).  Ignored by the force-balance model, which has no such factor.
     order : int
-        Gauss-Legendre nodes on [0, pi] for the section integrals (default 32).
+        0 (default): the section integrals in closed form (elliptic integrals); N in [4, 1024]: N
+        Gauss-Legendre nodes on [0, pi] instead.
 
     Notes
     -----

@@ -116,7 +116,7 @@ from typing import Any
 import numpy as np
 
 from .actuator import Actuator, ModelParams
-from .braid import DEFAULT_ORDER, LOCK_FRACTION, curvature_limits, gauss_nodes, ibar, radius_state
+from .braid import DEFAULT_ORDER, LOCK_FRACTION, circle_ibar, curvature_limits, radius_state
 from .checks import float_array, number
 from .checks import pressure_kpa as _check_pressure
 from .errors import InputError
@@ -354,8 +354,6 @@ def _polish_u(cs: ModelParams, k, u, order: int):
     One step for every point (the start is within about 1e-7, so the step leaves an error near
     1e-14); the few points whose step was larger than 1e-5 of ``u`` take more steps.
     """
-    phi, wbar = gauss_nodes(order)
-    omc = 1.0 - np.cos(phi)
     c, s = np.cos(cs.alpha0), np.sin(cs.alpha0)
     q = k * cs.R0_start
     u_lo, u_hi = -0.5 * (1.0 - 1e-12), LOCK_FRACTION * (1.0 / c - 1.0) / 2.0
@@ -363,7 +361,7 @@ def _polish_u(cs: ModelParams, k, u, order: int):
     act = np.arange(u.size)
     for it in range(12):
         ua = u[act]
-        ib, dib = ibar(ua, c[act], omc, wbar)
+        ib, dib = circle_ibar(ua, c[act], order)
         step = (s[act] * ua * ib - q[act]) / (s[act] * (ib + ua * dib))
         un = np.clip(ua - step, u_lo, u_hi[act])
         u[act] = un

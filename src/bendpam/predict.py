@@ -88,7 +88,7 @@ def moment(actuator: Actuator, pressure_kpa, curvature_per_mm, model: str = "ene
     eq19_factor : bool
         Energy model only: keep eq 19's ``(1 + k'R)`` factor (default, as printed).
     order : int
-        Gauss-Legendre order on [0, pi] (default 32).
+        0 (default): closed-form section integrals; N in [4, 1024]: N Gauss-Legendre nodes on [0, pi].
 
     Returns
     -------

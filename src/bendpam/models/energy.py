@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..braid import DEFAULT_ORDER, gauss_nodes, ibar, radius_state, radius_terms
+from ..braid import CLOSED_FORM, DEFAULT_ORDER, circle_ibar, gauss_nodes, radius_state, radius_terms
 from ..material import MooneyRivlin
 
 __all__ = ["basis", "bladder_energy", "coefficients", "terms"]
@@ -65,20 +65,28 @@ def section_means(u, alpha0, order: int = DEFAULT_ORDER, ib=None, dib=None) -> d
     Everything else in the moment is per-actuator arithmetic (:func:`assemble`), so actuators that
     share a braid angle share these (the sweeps tabulate them once per angle).
     """
-    phi, wbar = gauss_nodes(order)
-    omc = 1.0 - np.cos(phi)
     c, s = np.cos(alpha0), np.sin(alpha0)
     u = np.asarray(u, dtype=float)
     if ib is None or dib is None:
-        ib, dib = ibar(u, c, omc, wbar)
+        ib, dib = circle_ibar(u, c, order)
     xi = np.where(u == 0.0, 1.0, 1.0 / (s * ib))
     # With lambda2 = xi uniform, the Mooney-Rivlin derivatives (MooneyRivlin.dW_dl1, dW_dl2) reduce to
     # four circle means of powers of lambda1 = 1 + u (1 - cos Phi): two are polynomials in u
-    # (mean(1 - cos) = 1, mean((1 - cos)^2) = 3/2), two need the quadrature.
-    inv = 1.0 / (1.0 + u[..., None] * omc)
-    inv2 = inv * inv
-    m_im2 = inv2 @ wbar  # mean(lambda1^-2)
-    m_oim3 = (omc * inv2 * inv) @ wbar  # mean((1 - cos) lambda1^-3)
+    # (mean(1 - cos) = 1, mean((1 - cos)^2) = 3/2), two are elementary: from
+    # mean 1/(a - b cos) = (a^2 - b^2)^(-1/2) with a = 1 + u, b = u and its derivatives in a,
+    # mean(lambda1^-2) = (1 + u) / (1 + 2u)^(3/2) and mean((1 - cos) lambda1^-3) = (2 + u) / (2 (1 + 2u)^(5/2)).
+    if order == CLOSED_FORM:
+        r = 1.0 / (1.0 + 2.0 * u)
+        sr = np.sqrt(r)
+        m_im2 = (1.0 + u) * r * sr
+        m_oim3 = 0.5 * (2.0 + u) * r * r * sr
+    else:
+        phi, wbar = gauss_nodes(order)
+        omc = 1.0 - np.cos(phi)
+        inv = 1.0 / (1.0 + u[..., None] * omc)
+        inv2 = inv * inv
+        m_im2 = inv2 @ wbar  # mean(lambda1^-2)
+        m_oim3 = (omc * inv2 * inv) @ wbar  # mean((1 - cos) lambda1^-3)
     m_lo = 1.0 + 1.5 * u  # mean(lambda1 (1 - cos))
     m_l2 = 1.0 + u * (2.0 + 1.5 * u)  # mean(lambda1^2)
     x2 = xi * xi

@@ -39,7 +39,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..braid import DEFAULT_ORDER, case_column, gauss_nodes, ibar, radius_state, radius_terms
+from ..braid import CLOSED_FORM, DEFAULT_ORDER, case_column, circle_ibar, gauss_nodes, radius_state, radius_terms
 
 __all__ = ["axial_forces", "basis", "coefficients", "stress_state", "terms"]
 
@@ -81,6 +81,25 @@ def _state(params, k, order):
 MEANS = ("J", "L2", "Lm2")
 
 
+def _rsqrt_m1(y):
+    """``(1 + y)^(-1/2) - 1`` without cancellation for small ``y``."""
+    return np.expm1(-0.5 * np.log1p(y))
+
+
+def _j_closed_form(u, c):
+    """``J = 2 pi mean(lambda1^2 (1 - cos) / (1 - c^2 lambda1^2))`` in closed form.
+
+    ``lambda1^2 / (1 - c^2 lambda1^2) = (-1 + 1/(1 - c^2 lambda1^2)) / c^2``, ``(1 - cos) = (lambda1 - 1)/u``
+    and partial fractions in ``1 -+ c lambda1`` leave means of ``1/(alpha + beta cos Phi)``, which are
+    ``(alpha^2 - beta^2)^(-1/2)``: ``mean((1 - cos)/(1 - c^2 lambda1^2)) = (g(-x/(1 - c)) - g(x/(1 + c))) / x``
+    with ``x = 2 c u`` and ``g(y) = (1 + y)^(-1/2) - 1``, whose limit at ``u = 0`` is ``1/s^2``.
+    """
+    x = 2.0 * c * u
+    x = np.where(x == 0.0, 1e-300, x)  # the formula's limit at u = 0 (1/s^2) without a 0/0
+    t = (_rsqrt_m1(-x / (1.0 - c)) - _rsqrt_m1(x / (1.0 + c))) / x
+    return 2.0 * np.pi * (t - 1.0) / (c * c)
+
+
 def section_means(u, alpha0, order: int = DEFAULT_ORDER, ib=None, dib=None) -> dict:
     """The section integrals of the force-balance model that depend on ``u = k'R`` and ``alpha0`` only.
 
@@ -88,16 +107,20 @@ def section_means(u, alpha0, order: int = DEFAULT_ORDER, ib=None, dib=None) -> d
     ``L2`` and ``Lm2``: the circle means of ``lambda1^2 (1 - cos Phi)`` and ``(1 - cos Phi) / lambda1^2``
     (eq 43).  The rest is per-actuator arithmetic (:func:`assemble`).
     """
-    phi, wbar = gauss_nodes(order)
-    omc = 1.0 - np.cos(phi)
     c = np.cos(alpha0)
     u = np.asarray(u, dtype=float)
     if ib is None or dib is None:
-        ib, dib = ibar(u, c, omc, wbar)
-    lam1 = 1.0 + u[..., None] * omc
-    l2o = lam1 * lam1 * omc
-    J = 2.0 * np.pi * ((l2o / (1.0 - case_column(c * c) * (lam1 * lam1))) @ wbar)
-    Lm2 = ((omc / lam1) / lam1) @ wbar
+        ib, dib = circle_ibar(u, c, order)
+    if order == CLOSED_FORM:
+        J = _j_closed_form(u, c)
+        Lm2 = (1.0 + 2.0 * u) ** -1.5  # mean((1 - cos) / lambda1^2), elementary
+    else:
+        phi, wbar = gauss_nodes(order)
+        omc = 1.0 - np.cos(phi)
+        lam1 = 1.0 + u[..., None] * omc
+        l2o = lam1 * lam1 * omc
+        J = 2.0 * np.pi * ((l2o / (1.0 - case_column(c * c) * (lam1 * lam1))) @ wbar)
+        Lm2 = ((omc / lam1) / lam1) @ wbar
     # mean(lambda1^2 (1 - cos)) is a polynomial in u: mean((1 - cos)^n) = 1, 3/2, 5/2 for n = 1, 2, 3
     return {"ib": ib, "dib": dib, "J": J, "L2": 1.0 + u * (3.0 + 2.5 * u), "Lm2": Lm2}
 
