@@ -88,8 +88,9 @@ def sweeps(rec: Recorder, quick: bool) -> None:
                                                     "ratio": ratio, "max_dk_rel": dk, "same_nan": same_nan})
         rec.row(f"sweep cases/s at {P.size} pressures", st["sweep"].rate, "/s", ">= 1e4" if P.size == 16 else "",
                 st["sweep"].rate >= TARGET_SWEEP if P.size == 16 else None, f"{n_cases} cases")
-        rec.row(f"sweep / one-by-one baseline, {P.size} pressures", ratio, "x", ">= 30x",
-                ratio >= TARGET_SWEEP_RATIO, f"baseline {fmt(st['baseline'].rate)} cases/s")
+        # the 30x target is set at 16 pressures; at 1000 the ratio is reported, not judged
+        rec.row(f"sweep / one-by-one baseline, {P.size} pressures", ratio, "x", ">= 30x" if P.size == 16 else "",
+                ratio >= TARGET_SWEEP_RATIO if P.size == 16 else None, f"baseline {fmt(st['baseline'].rate)} cases/s")
         rate_points = st["sweep"].rate * P.size
     projected = 1e8 / rate_points
     print(f"  projected time of a 10^8-point sweep at the 1000-pressure rate: {fmt_time(projected)}")

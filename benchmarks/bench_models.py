@@ -170,10 +170,11 @@ def scattered(rec: Recorder, quick: bool) -> None:
     row("fast / baseline", "ratio_fast", "x", "", None)
     row("exact / baseline", "ratio_exact", "x", ">= 2x", lambda x: x >= TARGET_EXACT_RATIO)
     row("exact / baseline with 32 nodes", "ratio_32", "x", "", None)
-    row("baseline vs exact, terms (whole range)", "agree", "", "~1e-8 (<= 2e-8)", lambda x: x <= 2e-8, max,
+    # the baseline's own accuracy (is it a fair one?): its 24 nodes against bendpam's closed forms
+    row("baseline vs exact, terms (whole range)", "agree", "", "<= 1e-7", lambda x: x <= 1e-7, max,
         "24 nodes lose digits near lock-up")
-    row("baseline vs exact, terms (inner 98 %)", "agree_inner", "", "~1e-8 (<= 2e-8)", lambda x: x <= 2e-8, max)
-    row("32-node baseline vs exact, terms", "agree32", "", "~1e-8 (<= 2e-8)", lambda x: x <= 2e-8, max)
+    row("baseline vs exact, terms (inner 98 %)", "agree_inner", "", "<= 1e-7", lambda x: x <= 1e-7, max)
+    row("32-node baseline vs exact, terms", "agree32", "", "<= 1e-8", lambda x: x <= 1e-8, max)
 
 
 _COLD = r"""

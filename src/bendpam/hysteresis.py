@@ -44,6 +44,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from .braid import DEFAULT_ORDER
 from .errors import InputError
 
 __all__ = [
@@ -335,7 +336,7 @@ def _cycle_branches(actuator, loop: LoopModel, law, P, k_free, k):
 
 
 def loop_branches(actuator, loop: LoopModel, pressure_kpa, k_free, k, model: str = "energy", *,
-                  order: int = 32, eq19_factor: bool = True):
+                  order: int = DEFAULT_ORDER, eq19_factor: bool = True):
     """Steady-cycle branches between the blocked state and ``k_free`` (magnitudes, 1/mm).
 
     Returns ``(loading, unloading)``: the upper and the lower branch (N*mm, magnitudes) at the
@@ -372,7 +373,7 @@ _FLAT = "the actuator does not bend at this pressure (the cycle collapses onto t
 
 
 def predict_cycles(actuator, loop: LoopModel, pressures_kpa, model: str = "energy", *, n: int = 201,
-                   order: int = 32, eq19_factor: bool = True) -> list[Cycle]:
+                   order: int = DEFAULT_ORDER, eq19_factor: bool = True) -> list[Cycle]:
     """The loops free-bending cycles trace at several pressures: blocked -> free -> blocked.
 
     The free state is where the unloading (lower) branch reaches zero moment; friction lowers that
@@ -464,6 +465,6 @@ def predict_cycles(actuator, loop: LoopModel, pressures_kpa, model: str = "energ
 
 
 def predict_cycle(actuator, loop: LoopModel, pressure_kpa: float, model: str = "energy", *, n: int = 201,
-                  order: int = 32, eq19_factor: bool = True) -> Cycle:
+                  order: int = DEFAULT_ORDER, eq19_factor: bool = True) -> Cycle:
     """The loop a free-bending cycle traces at ``pressure_kpa``: :func:`predict_cycles` at one pressure."""
     return predict_cycles(actuator, loop, [pressure_kpa], model, n=n, order=order, eq19_factor=eq19_factor)[0]

@@ -101,6 +101,7 @@ import numpy as np
 
 from .actuator import NEUTRAL_ANGLE_DEG, Actuator
 from .atomic import atomic_write_text, json_safe
+from .braid import DEFAULT_ORDER
 from .errors import FileFormatError, FitError, InputError
 from .law import MomentLaw
 from .material import admissible_shape_range
@@ -1116,7 +1117,8 @@ def _pct(x, digits: int = 2):
 
 
 def score(
-    processed, actuator: Actuator, model: str = "energy", *, loop=None, order: int = 32, eq19_factor: bool = True
+    processed, actuator: Actuator, model: str = "energy", *, loop=None, order: int = DEFAULT_ORDER,
+    eq19_factor: bool = True,
 ) -> Metrics:
     """Metrics of eq 53-55 (and plain RMSEs) of ``actuator`` against processed data, without fitting.
 
@@ -1198,8 +1200,9 @@ def _loop_law(hysteresis, hysteresis_law: str, processed) -> str | None:
 
 
 def fit(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C10", "C01"), *,
-        bounds: dict[str, tuple[float, float]] | None = None, tension=None, tension_data=None, order: int = 32,
-        eq19_factor: bool = True, grid_alpha: int = 41, grid_r0: int = 9, corr_flag: float = 0.95,
+        bounds: dict[str, tuple[float, float]] | None = None, tension=None, tension_data=None,
+        order: int = DEFAULT_ORDER, eq19_factor: bool = True, grid_alpha: int = 41, grid_r0: int = 9,
+        corr_flag: float = 0.95,
         fit_range: str = "developed", hysteresis: str | None = "auto", hysteresis_law: str = "pi",
         law_uncertainty: bool = True, admissible_range: tuple[float, float] | None = (0.6, 1.6),
         profile_points: int = 13) -> FitResult:
@@ -1808,7 +1811,7 @@ def _result(processed, actuator, model, prob: _Problem, bnd, unc: _Uncertainty, 
     )
 
 
-def predicted_loss_ratios(processed, actuator: Actuator, loop, model: str = "energy", *, order: int = 32,
+def predicted_loss_ratios(processed, actuator: Actuator, loop, model: str = "energy", *, order: int = DEFAULT_ORDER,
                           eq19_factor: bool = True) -> list[dict]:
     """Energy-loss ratio of each test, measured (processing) and predicted (the loop's free cycle).
 
@@ -1824,7 +1827,7 @@ def predicted_loss_ratios(processed, actuator: Actuator, loop, model: str = "ene
              "predicted": c.energy_loss_ratio} for r, c in zip(processed.results, cycles, strict=True)]
 
 
-def branch_nrmse(processed, actuator: Actuator, loop, model: str = "energy", *, order: int = 32,
+def branch_nrmse(processed, actuator: Actuator, loop, model: str = "energy", *, order: int = DEFAULT_ORDER,
                  eq19_factor: bool = True) -> float:
     """eq-53-style NRMSE of both branches (loading and unloading) against the loop model (:func:`score`)."""
     return score(processed, actuator, model, loop=loop, order=order, eq19_factor=eq19_factor).nrmse_cycles
