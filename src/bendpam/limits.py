@@ -116,7 +116,7 @@ from typing import Any
 import numpy as np
 
 from .actuator import Actuator, ModelParams
-from .braid import DEFAULT_ORDER, LOCK_FRACTION, circle_ibar, curvature_limits, radius_state
+from .braid import DEFAULT_ORDER, curvature_limits, radius_state, solve_u
 from .checks import float_array, number
 from .checks import pressure_kpa as _check_pressure
 from .errors import InputError
@@ -348,31 +348,6 @@ def _u_from_table(tab: BranchTable, rows, k):
     return np.where(np.isfinite(u), np.clip(u, lo, hi), y1)
 
 
-def _polish_u(cs: ModelParams, k, u, order: int):
-    """Newton on eq 5, ``s u Ibar(u) = k' R0_start``, from the interpolated ``u`` (per-point parameters).
-
-    One step for every point (the start is within about 1e-7, so the step leaves an error near
-    1e-14); the few points whose step was larger than 1e-5 of ``u`` take more steps.
-    """
-    c, s = np.cos(cs.alpha0), np.sin(cs.alpha0)
-    q = k * cs.R0_start
-    u_lo, u_hi = -0.5 * (1.0 - 1e-12), LOCK_FRACTION * (1.0 / c - 1.0) / 2.0
-    u = u.copy()
-    act = np.arange(u.size)
-    for it in range(12):
-        ua = u[act]
-        ib, dib = circle_ibar(ua, c[act], order)
-        step = (s[act] * ua * ib - q[act]) / (s[act] * (ib + ua * dib))
-        un = np.clip(ua - step, u_lo, u_hi[act])
-        u[act] = un
-        act = act[~(np.abs(step) <= (1e-5 if it == 0 else 1e-8) * np.abs(un))]
-        if act.size == 0:
-            return u
-    uu = radius_state(k[act], cs.alpha0[act], cs.R0_start[act], order)[0]  # not expected: the exact solve
-    u[act] = uu
-    return u
-
-
 def case_limits(law: MomentLaw, pressure_kpa, free_curvature, table: BranchTable | None = None, *,
                 free_u=None, frame_strength_mpa: float | None = None,
                 bladder_stretch_limit: float | None = None) -> dict[str, Any]:
@@ -430,7 +405,7 @@ def case_limits(law: MomentLaw, pressure_kpa, free_curvature, table: BranchTable
         if free_u is not None:
             u = np.asarray(free_u, dtype=float).reshape(m, P.size)[rows, cols]
         else:
-            u = _polish_u(sub, kk, _u_from_table(tab, rows, kk), law.order)
+            u = solve_u(kk * sub.R0_start, sub.alpha0, law.order, u_start=_u_from_table(tab, rows, kk))[0]
         st = _section(sub, pa[rows, cols], kk, u, u / kk, **opts)
         for key in _STATE_KEYS:
             free[key][rows, cols] = st[key]
