@@ -205,11 +205,15 @@ def test_figure7_draws_the_loop(tmp_path):
     from bendpam.plots import figure7, save_figure
 
     fig = figure7(ps, r)
-    n_lines = len(fig.axes[0].lines)
+    from matplotlib.collections import LineCollection
+
+    thin, thick = [c for c in fig.axes[0].collections if isinstance(c, LineCollection)]
     save_figure(fig, tmp_path / "f7.png")
     assert (tmp_path / "f7.png").read_bytes()[:4] == b"\x89PNG"
-    # per pressure: two data branches, the mean markers and two model branches
-    assert n_lines == 5 * 3
+    # per pressure: two data branches (thin) and two model branches, the loop's (thick)
+    assert len(thin.get_segments()) == 2 * 3 and len(thick.get_segments()) == 2 * 3
+    up, low = thick.get_segments()[:2]
+    assert np.max(np.abs(up[:, 1] - low[:, 1])) > 1.0  # the loop is open: two different branches (N*mm)
     write_processed(ps, tmp_path / "p", figure=False)
 
 

@@ -181,7 +181,8 @@ def test_one_newton_step_from_the_uniform_table_reaches_rounding(alpha0_deg):
     a0 = math.radians(alpha0_deg)
     c = math.cos(a0)
     u_lock = (1 / c - 1) / 2
-    u_true = np.concatenate([np.linspace(-0.49, 0, 200), np.linspace(0, LOCK_FRACTION * u_lock, 200)])
+    # 4200 points (>= _UNIFORM_MIN_POINTS): the uniform-table path
+    u_true = np.concatenate([np.linspace(-0.49, 0, 2100), np.linspace(0, LOCK_FRACTION * u_lock, 2100)])
     q = math.sin(a0) * u_true * bendpam.braid.circle_ibar(u_true, c)[0]
     u, ib, dib = solve_u(q, a0)
     qt, ut, dt = _inverse_table(a0, 0)

@@ -36,6 +36,7 @@ _MEASURE = textwrap.dedent(
     """
     import json, os, re, resource, sys, time
     import bendpam.lab as lab
+    import bendpam.lab.readers  # the package loads its readers (and pandas) lazily: not part of the growth
 
     def status(key):
         with open("/proc/self/status") as fh:

@@ -277,18 +277,25 @@ def kill_args(command: str, inputs: dict[str, Path], out: Path) -> list[str]:
     return [a.format(raw=inputs["raw"], proc=inputs["proc"], out=out) for a in args]
 
 
-def kill_case(tally: Tally, command: str, inputs: dict[str, Path], folder: Path, sig: int, delay: float) -> None:
-    """Run ``command`` into a target holding a previous complete output; send ``sig`` after ``delay``."""
+def kill_case(tally: Tally, command: str, inputs: dict[str, Path], folder: Path, sig: int, delay: float,
+              fraction: float | None = None) -> None:
+    """Run ``command`` into a target holding a previous complete output; send ``sig`` after ``delay``.
+
+    With ``fraction``, the signal is sent at that fraction of the baseline run's duration instead
+    (at least 0.3 s, after start-up), so that it lands mid-work however fast the command has become.
+    """
     _, target_name = KILL_COMMANDS[command]
     folder.mkdir(parents=True, exist_ok=True)
     target = folder / target_name
     args = kill_args(command, inputs, target)
-    what = f"{command} killed by {signal.Signals(sig).name} after {delay:.2f} s"
     if snapshot(target) is None:  # a previous complete set to compare with
         r = run(args, folder)
         if classify(r)[0] != "ok":
             tally.fail("bad-error", f"{command} (baseline)", r.stderr[-500:])
             return
+        if fraction is not None:
+            delay = max(0.3, fraction * r.seconds)
+    what = f"{command} killed by {signal.Signals(sig).name} after {delay:.2f} s"
     before = snapshot(target)
     t0 = time.monotonic()
     p = subprocess.Popen(cli(*args), cwd=folder, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,

@@ -28,6 +28,7 @@ if not os.environ.get("MPLBACKEND"):
 
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.collections import LineCollection
 from matplotlib.ticker import MaxNLocator
 
 from .atomic import atomic_path
@@ -440,27 +441,39 @@ def figure7(processed, fit_result, title: str = ""):
     fig, axes = plt.subplots(1, 3, figsize=(DOUBLE_COLUMN_IN, 3.0))
     ax = axes[0]
     colors = plt.cm.viridis(np.linspace(0.0, 0.9, len(res)))
-    for c, r in zip(colors, res, strict=True):
+    # at most about six pressures in the legend (the colours run in order of pressure)
+    shown = set(np.unique(np.linspace(0, len(res) - 1, min(len(res), 6)).round().astype(int)).tolist())
+    # one collection per kind of line and one scatter for the markers (a few artists, not five per
+    # pressure: drawing 25 pressures stays fast)
+    thin, thick, thick_c, mk_x, mk_y, mk_c = [], [], [], [], [], []
+    for i, (c, r) in enumerate(zip(colors, res, strict=True)):
         k = r.curvature_grid
-        ax.plot(k, r.mean_loading, color=c, lw=0.6, alpha=0.5)
-        ax.plot(k, r.mean_unloading, color=c, lw=0.6, alpha=0.5)
-        ax.plot(k[::4], r.mean_curve[::4], "o", color=c, ms=3, label=f"{r.pressure_kpa:g} kPa")
-        kk = np.linspace(0.0, k[-1], 120)
+        thin += [np.column_stack([k, r.mean_loading]), np.column_stack([k, r.mean_unloading])]
+        mk_x.append(k[::4])
+        mk_y.append(r.mean_curve[::4])
+        mk_c += [c] * k[::4].size
+        if i in shown:
+            ax.plot([], [], "o", color=c, ms=3, label=f"{r.pressure_kpa:g} kPa")
         if loop is not None:
             from .hysteresis import loop_branches
 
             kf_r = float(r.free_curvature[0])
             up, low = loop_branches(act, loop, r.pressure_kpa, kf_r, k, model)
-            kk = k
-            ax.plot(kk, up, "-", color=c, lw=1.3)
-            ax.plot(kk, low, "-", color=c, lw=1.3)
+            thick += [np.column_stack([k, up]), np.column_stack([k, low])]
+            thick_c += [c, c]
         else:
-            ax.plot(kk, s * moment(act, r.pressure_kpa, s * kk, model), "-", color=c, lw=1.5)
+            kk = np.linspace(0.0, k[-1], 120)
+            thick.append(np.column_stack([kk, s * moment(act, r.pressure_kpa, s * kk, model)]))
+            thick_c.append(c)
+    ax.add_collection(LineCollection(thin, colors=np.repeat(colors, 2, axis=0), linewidths=0.6, alpha=0.5))
+    ax.add_collection(LineCollection(thick, colors=thick_c, linewidths=1.3 if loop is not None else 1.5))
+    ax.scatter(np.concatenate(mk_x), np.concatenate(mk_y), s=9, c=mk_c, marker="o", linewidths=0, zorder=3)
+    ax.autoscale_view()
     ax.set_xlabel("curvature |k'| (1/mm)")
     ax.set_ylabel("moment |M| (N·mm)")
     loop_txt = " with its loop" if loop is not None else ""
     ax.set_title(f"(a) data (thin: branches, markers:\nmean), {model.replace('_', '-')} model{loop_txt}")
-    ax.legend()
+    ax.legend(loc="upper right")
     P = processed.pressures_kpa
     bm = np.array([r.blocked_moment for r in res])
     kf = np.array([r.free_curvature for r in res])
@@ -479,7 +492,7 @@ def figure7(processed, fit_result, title: str = ""):
     ax.set_xlabel("pressure (kPa)")
     ax.set_ylabel("blocked moment (N·mm)")
     ax.set_title(f"(b) blocked moment\nNRMSE {100 * fit_result.metrics.nrmse_blocked_moment:.2f} %")
-    ax.legend()
+    ax.legend(loc="upper left")
     ax = axes[2]
     ax.errorbar(P, kf[:, 0], yerr=np.nan_to_num(kf[:, 1]), fmt="s", color="C2", label="data")
     fb = free_curvature(act, Pm, model)
@@ -496,7 +509,7 @@ def figure7(processed, fit_result, title: str = ""):
     ax.set_title("(c) free-bending curvature\nNRMSE " + ("n/a" if not np.isfinite(nf) else f"{100 * nf:.2f} %"))
     ax.set_xlabel("pressure (kPa)")
     ax.set_ylabel("free-bending |k'| (1/mm)")
-    ax.legend()
+    ax.legend(loc="upper left")
     fig.suptitle(_wrap(title or f"{act.name or act.kind}: {model.replace('_', '-')} model fit, NRMSE of the cycles "
                        f"{100 * fit_result.metrics.nrmse_cycles:.2f} %", DOUBLE_COLUMN_IN, 9))
     fig.tight_layout()

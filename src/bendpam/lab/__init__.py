@@ -11,23 +11,26 @@ counter.
 
 from __future__ import annotations
 
-from .readers import (
-    COLUMNS,
-    DIALECTS,
-    FORMATS,
-    PRESSURE_RANGE_KPA,
-    RawTest,
-    ReadError,
-    check_cycle_count,
-    detect_dialect,
-    format_inspection,
-    inspect_file,
-    parse_columns,
-    parse_pressure,
-    pressure_from_filename,
-    read_test,
-)
-from .writers import write_test
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from .readers import (
+        COLUMNS,
+        DIALECTS,
+        FORMATS,
+        PRESSURE_RANGE_KPA,
+        RawTest,
+        ReadError,
+        check_cycle_count,
+        detect_dialect,
+        format_inspection,
+        inspect_file,
+        parse_columns,
+        parse_pressure,
+        pressure_from_filename,
+        read_test,
+    )
+    from .writers import write_test
 
 __all__ = [
     "COLUMNS",
@@ -46,3 +49,16 @@ __all__ = [
     "read_test",
     "write_test",
 ]
+
+_FROM = {name: "writers" if name == "write_test" else "readers" for name in __all__}
+
+
+def __getattr__(name: str):
+    """Import the readers (and pandas) only when one of their names is used: ``bendpam fit`` needs neither."""
+    if name in _FROM:
+        import importlib
+
+        value = getattr(importlib.import_module(f".{_FROM[name]}", __name__), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

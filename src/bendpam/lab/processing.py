@@ -40,14 +40,16 @@ import itertools
 import math
 import warnings
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
-import xarray as xr
 
 from ..errors import InputError, ProcessingError
 from ..fixture import PAPER_FIXTURE, Fixture
-from .readers import check_cycle_count
+
+if TYPE_CHECKING:  # pandas and xarray are imported by the functions that use them (fast start-up of `fit`)
+    import pandas as pd
+    import xarray as xr
 
 __all__ = [
     "PressureResult",
@@ -394,6 +396,8 @@ def process_series(
             cyc[a:c + 1] = ci + 1
             br[a:b + 1] = "unloading"
             br[b:c + 1] = "loading"
+        import pandas as pd
+
         series = pd.DataFrame({
             "time_s": t, "stroke_mm": s_z, "force_n": f_f, "beta_rad": beta, "curvature_per_mm": k,
             "moment_nmm": M, "cycle": cyc, "branch": br.astype(str),
@@ -490,6 +494,8 @@ class ProcessedSet:
             bmc[i, : r.n_cycles] = r.blocked_moments
             kfc[i, : r.n_cycles] = r.free_curvatures
             elc[i, : r.n_cycles] = r.energy_loss_ratios
+        import xarray as xr
+
         P = self.pressures_kpa
         ds = xr.Dataset(
             {
@@ -574,6 +580,8 @@ class ProcessedSet:
 
     def to_frame(self) -> pd.DataFrame:
         """Tidy table of the resampled branches: pressure, cycle, branch, curvature, moment."""
+        import pandas as pd
+
         rows = []
         for r in self.results:
             for ci in range(r.n_cycles):
@@ -635,6 +643,8 @@ def process_tests(tests, *, fixture: Fixture = PAPER_FIXTURE, options: Processin
             res = process_series(d["time_s"].to_numpy(), d["stroke_mm"].to_numpy(), d["force_n"].to_numpy(),
                                  p, fixture=fixture, options=options, source=src, keep_series=keep_series)
         res.notes.extend(getattr(rt, "warnings", []) or [])
+        from .readers import check_cycle_count
+
         mismatch = check_cycle_count(rt, res.n_cycles)
         if mismatch:
             res.notes.append(mismatch)
@@ -653,6 +663,41 @@ def write_processed(processed: ProcessedSet, out_dir, *, figure: bool = True) ->
     return processed.save(out_dir, figure=figure)
 
 
+class _Curves:
+    """The variables (``ds[name].values``), ``data_vars`` and ``attrs`` of a ``curves.nc``, read without xarray."""
+
+    def __init__(self, values: dict, attrs: dict):
+        self._values, self.attrs, self.data_vars = values, attrs, set(values)
+
+    def __getitem__(self, name):
+        from types import SimpleNamespace
+
+        return SimpleNamespace(values=self._values[name])
+
+
+def _read_curves(nc):
+    """A ``curves.nc`` as :class:`_Curves`: SciPy's NetCDF-3 reader (what bendpam writes), else xarray.
+
+    SciPy's reader is used for NetCDF-3 files (xarray's own scipy backend reads them the same way;
+    every variable is float64 or int with NaN as the fill value, so no CF decoding is needed), which
+    spares ``bendpam fit`` importing xarray, pandas and Dask.  Other files (NetCDF-4) go through xarray.
+    """
+    with open(nc, "rb") as fh:
+        magic = fh.read(3)
+    if magic == b"CDF":
+        from scipy.io import netcdf_file
+
+        with netcdf_file(nc, "r", mmap=False) as f:
+            values = {k: np.array(v.data) for k, v in f.variables.items()}
+            attrs = {k: (v.decode("utf-8") if isinstance(v, bytes) else v) for k, v in f._attributes.items()}
+        return _Curves(values, attrs)
+    import xarray as xr
+
+    with xr.open_dataset(nc) as ds:
+        ds = ds.load()
+        return _Curves({k: ds[k].values for k in ds.variables}, dict(ds.attrs))
+
+
 def load_processed(path) -> ProcessedSet:
     """Read the output of :func:`write_processed` (a folder or its ``curves.nc``) back."""
     from pathlib import Path
@@ -662,8 +707,7 @@ def load_processed(path) -> ProcessedSet:
     if not nc.exists():
         raise ProcessingError(f"{p}: no curves.nc here; give the output folder of 'bendpam process'")
     try:
-        with xr.open_dataset(nc) as ds:
-            ds = ds.load()
+        ds = _read_curves(nc)
     except Exception as exc:
         raise ProcessingError(f"{nc}: cannot read as a bendpam processed-curves file ({type(exc).__name__})") from None
     need = {"moment_nmm", "blocked_moment_cycle_nmm", "free_curvature_cycle_per_mm", "energy_loss_ratio_cycle"}
