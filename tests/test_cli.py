@@ -93,8 +93,8 @@ def test_stresses_outputs(capsys, tmp_path):
         assert code == 0, err
     ds = xr.open_dataset(tmp_path / "s.nc")
     # stresses are in kPa at every public edge (issue 10; they were MPa before)
-    assert "sigma_bl1" in ds and ds["sigma_bl1"].attrs["units"] == "kPa"
-    assert ds["P_e"].attrs["units"] == "kPa" and ds.attrs["pressure_kpa"] == 200.0
+    assert "sigma_bl1_kpa" in ds and ds["sigma_bl1_kpa"].attrs["units"] == "kPa"
+    assert ds["P_e_kpa"].attrs["units"] == "kPa" and ds.attrs["pressure_kpa"] == 200.0
     ds.close()
 
 

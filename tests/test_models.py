@@ -115,44 +115,45 @@ def test_force_balance_stresses_integrate_to_moment_parts(preset_model):
     a, model = preset_model
     P, k = 150.0, 0.4 * bendpam.curvature_limits(a).k_min if a.bend_sign < 0 else 0.01  # kPa, 1/mm
     ds = bendpam.internal_stresses(a, P, k, n_phi=4001)
-    assert ds["sigma_bl1"].attrs["units"] == "kPa" and ds["N_br1"].attrs["units"] == "N/mm"
+    assert ds["sigma_bl1_kpa"].attrs["units"] == "kPa" and ds["N_br1_n_per_mm"].attrs["units"] == "N/mm"
     phi = np.radians(ds["phi_deg"].values)
     kin = bendpam.kinematics(a, k)
     R, tb = float(kin.radius), float(kin.mean_thickness)
     h = R * (1 - np.cos(phi))
     pa = P - a.P_start_kpa  # kPa
     # elastic part (-P is in M_p, eq 49); stresses in kPa, so 1e-3 to N/mm^2 and N*mm
-    m_bl = np.trapezoid((ds["sigma_bl1"].values + pa) * 1e-3 * h * tb * R, phi)
-    m_br = np.trapezoid(ds["N_br1"].values * h * R, phi)
+    m_bl = np.trapezoid((ds["sigma_bl1_kpa"].values + pa) * 1e-3 * h * tb * R, phi)
+    m_br = np.trapezoid(ds["N_br1_n_per_mm"].values * h * R, phi)
     t = bendpam.moment_terms(a, P, k, "force_balance")
     assert m_bl == pytest.approx(t["M_bl"], rel=1e-6, abs=1e-6)
     assert m_br == pytest.approx(t["M_br"], rel=1e-6)
     # the braid hoop tension is P_e R (eq 31; P_e in kPa -> N/mm^2) and sigma = N / t_br (N/mm^2 -> kPa)
-    assert float(ds["N_br2"]) == pytest.approx(float(ds["P_e"]) * 1e-3 * R)
-    assert_allclose(ds["sigma_br1"].values, ds["N_br1"].values / a.braid_thickness_mm * 1e3)
+    assert float(ds["N_br2_n_per_mm"]) == pytest.approx(float(ds["P_e_kpa"]) * 1e-3 * R)
+    assert_allclose(ds["sigma_br1_kpa"].values, ds["N_br1_n_per_mm"].values / a.braid_thickness_mm * 1e3)
 
 
 def test_stresses_when_straight_are_hydrostatic(be):
     # at k' = 0 the bladder is unstretched: sigma_1 = sigma_2 = sigma_3 = -P_active and P_e = P_active
     ds = bendpam.internal_stresses(be, 200.0, 0.0)
     pa = 200.0 - be.P_start_kpa  # kPa, as the stresses
-    assert_allclose(ds["sigma_bl1"].values, -pa, atol=1e-9)  # 1e-9 kPa = the former 1e-12 MPa
-    assert float(ds["sigma_bl2"]) == pytest.approx(-pa)
-    assert float(ds["P_e"]) == pytest.approx(pa)
-    assert ds["P_e"].attrs["units"] == "kPa"
+    assert_allclose(ds["sigma_bl1_kpa"].values, -pa, atol=1e-9)  # 1e-9 kPa = the former 1e-12 MPa
+    assert float(ds["sigma_bl2_kpa"]) == pytest.approx(-pa)
+    assert float(ds["P_e_kpa"]) == pytest.approx(pa)
+    assert ds["P_e_kpa"].attrs["units"] == "kPa"
     # McKibben: axial braid tension / hoop = cot^2 alpha0
-    assert_allclose(ds["N_br1"].values / float(ds["N_br2"]), 1 / math.tan(math.radians(be.alpha0_deg)) ** 2,
-                    rtol=1e-12)
+    assert_allclose(ds["N_br1_n_per_mm"].values / float(ds["N_br2_n_per_mm"]),
+                    1 / math.tan(math.radians(be.alpha0_deg)) ** 2, rtol=1e-12)
 
 
 def test_internal_stresses_labelled_grid(be):
     ds = bendpam.internal_stresses(be, np.array([100.0, 200.0]), np.array([0.0, 0.005, 0.01]), n_phi=37)
-    assert ds["sigma_bl1"].dims == ("pressure_kpa", "curvature_per_mm", "phi_deg")
-    assert ds["P_e"].dims == ("pressure_kpa", "curvature_per_mm")
-    assert ds["sigma_bl1"].attrs["units"] == "kPa" and ds["N_br1"].attrs["units"] == "N/mm"
+    assert ds["sigma_bl1_kpa"].dims == ("pressure_kpa", "curvature_per_mm", "phi_deg")
+    assert ds["P_e_kpa"].dims == ("pressure_kpa", "curvature_per_mm")
+    assert ds["sigma_bl1_kpa"].attrs["units"] == "kPa" and ds["N_br1_n_per_mm"].attrs["units"] == "N/mm"
     assert ds["pressure_kpa"].attrs["units"] == "kPa" and ds["pressure_kpa"].values.tolist() == [100.0, 200.0]
     one = bendpam.internal_stresses(be, 200.0, 0.005, n_phi=37)
-    assert_allclose(ds["sigma_bl1"].sel(pressure_kpa=200.0, curvature_per_mm=0.005).values, one["sigma_bl1"].values)
+    assert_allclose(ds["sigma_bl1_kpa"].sel(pressure_kpa=200.0, curvature_per_mm=0.005).values,
+                    one["sigma_bl1_kpa"].values)
 
 
 def test_broadcasting_grid_equals_pointwise(preset_model):

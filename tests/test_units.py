@@ -171,20 +171,22 @@ def test_stresses_netcdf_in_kpa(capsys, tmp_path):
     ref = bendpam.internal_stresses(presets.be_pam("force_balance"), P_KPA, k)  # stresses use force balance
     with xr.open_dataset(f) as ds:
         assert ds.attrs["pressure_kpa"] == P_KPA and ds.attrs["P_start_kpa"] == 68.0
-        for name in ("sigma_bl1", "sigma_bl2", "sigma_bl3", "P_e", "sigma_br1", "sigma_br2"):
+        for name in ("sigma_bl1_kpa", "sigma_bl2_kpa", "sigma_bl3_kpa", "P_e_kpa", "sigma_br1_kpa", "sigma_br2_kpa"):
             assert ds[name].attrs["units"] == "kPa", name
             assert_allclose(ds[name].values, ref[name].values, rtol=1e-12)
-        for name in ("N_br1", "N_br2"):
+        for name in ("N_br1_n_per_mm", "N_br2_n_per_mm"):
             assert ds[name].attrs["units"] == "N/mm", name
+        # every variable's name says its unit (the one unit rule)
+        assert all(n.endswith(("_kpa", "_n_per_mm", "_mm", "_deg")) for n in ds.data_vars), list(ds.data_vars)
         # straight-state check of the unit: sigma_bl3 is -P_active, in kPa
-        assert float(ds["sigma_bl3"]) == pytest.approx(-(P_KPA - 68.0), rel=1e-12)
+        assert float(ds["sigma_bl3_kpa"]) == pytest.approx(-(P_KPA - 68.0), rel=1e-12)
 
 
 def test_stresses_pressure_coordinate_is_kpa():
     ds = bendpam.internal_stresses(presets.be_pam("force_balance"), np.array([100.0, P_KPA]), 0.0, n_phi=9)
     assert ds["pressure_kpa"].attrs["units"] == "kPa" and ds["pressure_kpa"].values.tolist() == [100.0, P_KPA]
-    assert ds["P_e"].attrs["units"] == "kPa"
-    assert_allclose(ds["P_e"].values, [100.0 - 68.0, P_KPA - 68.0], rtol=1e-12)  # straight: P_e = P_active
+    assert ds["P_e_kpa"].attrs["units"] == "kPa"
+    assert_allclose(ds["P_e_kpa"].values, [100.0 - 68.0, P_KPA - 68.0], rtol=1e-12)  # straight: P_e = P_active
 
 
 # ------------------------------------------------------------------------------------------------

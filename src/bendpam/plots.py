@@ -287,16 +287,16 @@ def plot_internal_stresses(actuator, pressure_kpa: float, curvature: float, *, f
     ax_b = fig.add_subplot(grid[0, 1])
     ax1 = fig.add_subplot(grid[1, :])
     phi = np.radians(ds["phi_deg"].values)
-    R = float(ds["R"])
-    s1 = ds["sigma_bl1"].values
-    n1 = ds["N_br1"].values
+    R = float(ds["R_mm"])
+    s1 = ds["sigma_bl1_kpa"].values
+    n1 = ds["N_br1_n_per_mm"].values
     _section_panel(ax_a, phi, R, s1, "(a) bladder axial stress σ_bl,1 (kPa)", "kPa", "C0")
     _section_panel(ax_b, phi, R, n1, "(b) braid axial line tension N_br,1 (N/mm)", "N/mm", "C1")
     deg = ds["phi_deg"].values
     ax1.plot(deg, s1, color="C0", label="σ_bl,1 bladder axial (kPa)")
-    ax1.axhline(float(ds["sigma_bl2"]), color="C2", ls="--", label="σ_bl,2 bladder hoop (kPa)")
-    ax1.axhline(float(ds["P_e"]), color="C3", ls=":", label="P_e interfacial (kPa)")
-    ax1.axhline(float(ds["sigma_bl3"]), color="C4", ls="-.", label="σ_bl,3 = -P (kPa)")
+    ax1.axhline(float(ds["sigma_bl2_kpa"]), color="C2", ls="--", label="σ_bl,2 bladder hoop (kPa)")
+    ax1.axhline(float(ds["P_e_kpa"]), color="C3", ls=":", label="P_e interfacial (kPa)")
+    ax1.axhline(float(ds["sigma_bl3_kpa"]), color="C4", ls="-.", label="σ_bl,3 = -P (kPa)")
     ax2 = ax1.twinx()
     ax2.plot(deg, n1, color="C1", label="N_br,1 braid axial (N/mm)")
     ax2.set_ylabel("braid line tension (N/mm)")
@@ -312,7 +312,7 @@ def plot_internal_stresses(actuator, pressure_kpa: float, curvature: float, *, f
     fig.suptitle(
         _wrap(f"{actuator.name or actuator.kind}: force-balance internal state", DOUBLE_COLUMN_IN, 9) + "\n"
         f"P = {pressure_kpa:g} kPa (active {pa:g} kPa), k' = {curvature:g} 1/mm, R = {R:.3g} mm, "
-        f"t̄ = {float(ds['t_bar']):.3g} mm",
+        f"t̄ = {float(ds['t_bar_mm']):.3g} mm",
     )
     fig.tight_layout()
     return fig

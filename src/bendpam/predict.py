@@ -178,6 +178,21 @@ def free_curvature(actuator: Actuator, pressure_kpa, model: str = "energy", *, e
 # ------------------------------------------------------------------------------------------------
 # internal stresses (force-balance model)
 # ------------------------------------------------------------------------------------------------
+#: User-facing names (with their units) of the force-balance stress state's variables.
+_STRESS_NAMES = {
+    "sigma_bl1": "sigma_bl1_kpa",
+    "sigma_bl2": "sigma_bl2_kpa",
+    "sigma_bl3": "sigma_bl3_kpa",
+    "P_e": "P_e_kpa",
+    "N_br1": "N_br1_n_per_mm",
+    "N_br2": "N_br2_n_per_mm",
+    "sigma_br1": "sigma_br1_kpa",
+    "sigma_br2": "sigma_br2_kpa",
+    "t_bar": "t_bar_mm",
+    "R": "R_mm",
+}
+
+
 def internal_stresses(actuator: Actuator, pressure_kpa, curvature_per_mm, *, n_phi: int = 181,
                       order: int = DEFAULT_ORDER) -> Any:
     """Internal state of the force-balance model (eq 37-48) around the cross-section.
@@ -192,15 +207,16 @@ def internal_stresses(actuator: Actuator, pressure_kpa, curvature_per_mm, *, n_p
     -------
     xarray.Dataset
         Dimensions ``pressure_kpa`` and ``curvature_per_mm`` (when given as arrays) and
-        ``phi_deg`` (0 at the frame).  Variables, units in ``attrs["units"]``: ``sigma_bl1``,
-        ``sigma_bl2``, ``sigma_bl3``, ``P_e``, ``sigma_br1``, ``sigma_br2`` (kPa), ``N_br1``,
-        ``N_br2`` (N/mm), ``braid_angle_deg`` (deg), ``t_bar``, ``R`` (mm).
+        ``phi_deg`` (0 at the frame).  Variables, each named with its unit (also in
+        ``attrs["units"]``): ``sigma_bl1_kpa``, ``sigma_bl2_kpa``, ``sigma_bl3_kpa``, ``P_e_kpa``,
+        ``sigma_br1_kpa``, ``sigma_br2_kpa``, ``N_br1_n_per_mm``, ``N_br2_n_per_mm``,
+        ``braid_angle_deg``, ``t_bar_mm``, ``R_mm``.
 
     Examples
     --------
     >>> import bendpam
     >>> ds = bendpam.internal_stresses(bendpam.presets.bc_pam("force_balance"), 120.0, -0.006)
-    >>> ds["P_e"].attrs["units"], ds["sigma_bl1"].dims
+    >>> ds["P_e_kpa"].attrs["units"], ds["sigma_bl1_kpa"].dims
     ('kPa', ('phi_deg',))
     """
     import xarray as xr
@@ -240,6 +256,8 @@ def internal_stresses(actuator: Actuator, pressure_kpa, curvature_per_mm, *, n_p
         unit, long_name, scale = units[name]
         if name == "braid_angle":
             full, name = np.degrees(full), "braid_angle_deg"
+        else:
+            name = _STRESS_NAMES[name]
         data[name] = xr.DataArray(np.array(full) * scale, dims=d, attrs={"units": unit, "long_name": long_name})
     coords: dict[str, Any] = {"phi_deg": np.degrees(phi)}
     if P.ndim:
