@@ -314,3 +314,13 @@ def test_property_free_curvature_is_a_root(a, model, P):
         # on the branch the actuator bends along: k' has the sign of the blocked moment
         active = P[ok] > a.P_start_kpa
         assert np.all(np.sign(k[ok][active]) == a.bend_sign)
+
+
+def test_tangent_stiffness_of_a_block_equals_one_by_one():
+    base = presets.be_pam()
+    a0 = np.array([62.0, 69.7, 78.0])
+    law = MomentLaw(build_cases(base, {"alpha0_deg": a0}), "energy")
+    k = np.array([0.0, 0.004, 0.9 * 0.139])  # the last one near the first case's lock-up: a shifted stencil
+    got = law.tangent_stiffness(180.0, k)
+    ref = [float(MomentLaw(base.replace(alpha0_deg=a), "energy").tangent_stiffness(180.0, kk)) for a, kk in zip(a0, k)]
+    assert_allclose(got, ref, rtol=1e-12)

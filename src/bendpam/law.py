@@ -241,15 +241,18 @@ class MomentLaw:
         p = self.active_pressure_kpa(pressure_kpa)
         k = self.check_curvature(curvature_per_mm)
         lim = self.limits
-        h = 1e-4 * (lim.k_max - lim.k_min)
+        h = 1e-4 * (lim.k_max - lim.k_min)  # per case for a block of cases
+        if np.ndim(h):
+            k = np.broadcast_to(k, np.broadcast_shapes(k.shape, np.shape(h)))
         s = np.zeros(k.shape)
         s = np.where(k + 2 * h > lim.k_max, np.ceil((k + 2 * h - lim.k_max) / h), s)
         s = np.where(k - 2 * h < lim.k_min, -np.ceil((lim.k_min - k + 2 * h) / h), s)
         s = np.clip(s, -2, 2).astype(int)
-        pts = k[..., None] + (_FD_NODES - s[..., None]) * h
+        # the five stencil points on a leading axis, so that a block of cases broadcasts on the trailing ones
+        pts = k[None, ...] + (_FD_NODES.reshape((5,) + (1,) * k.ndim) - s[None, ...]) * h
         A, B = self.coefficients(pts)
-        w = _FD_WEIGHTS[s + 2]
-        return p * (np.sum(w * A, axis=-1) / h) - np.sum(w * B, axis=-1) / h
+        w = np.moveaxis(_FD_WEIGHTS[s + 2], -1, 0)
+        return p * (np.sum(w * A, axis=0) / h) - np.sum(w * B, axis=0) / h
 
     # ---- free bending -------------------------------------------------------------------------
     def branches(self, samples: int = BRANCH_SAMPLES) -> BranchTable:
