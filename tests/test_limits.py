@@ -261,7 +261,7 @@ def test_sweep_kernel_on_a_shared_table_block():
 
 
 def test_case_kernel_without_u_interpolates_and_polishes_eq5():
-    """Given only k', the kernel finds u = k'R on the branch table and by Newton on eq 5: the same limits."""
+    """Given only k', the kernel solves eq 5 for u = k'R: the same limits."""
     from bendpam.limits import case_limits
     from bendpam.sweeps import build_cases
 

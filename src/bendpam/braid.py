@@ -197,8 +197,7 @@ def circle_ibar(u, c, order: int = DEFAULT_ORDER):
     return ibar(np.asarray(u, dtype=float), c, 1.0 - np.cos(phi), wbar)
 
 
-def solve_u(q_target, alpha0: float, order: int = DEFAULT_ORDER, u_bounds: tuple[float, float] | None = None,
-            u_start=None):
+def solve_u(q_target, alpha0: float, order: int = DEFAULT_ORDER, u_bounds: tuple[float, float] | None = None):
     """Solve eq 5 for ``u = k' R`` given ``q = k' R0`` (vectorised safeguarded Newton).
 
     Parameters
@@ -212,9 +211,6 @@ def solve_u(q_target, alpha0: float, order: int = DEFAULT_ORDER, u_bounds: tuple
     u_bounds : (float, float), optional
         Bracket for ``u``; defaults to ``(-1/2, u_lock)``.  Each target must lie inside
         ``q(u_bounds)``; callers check the curvature limits first.
-    u_start : array_like, optional
-        Starting values (e.g. interpolated from a table) instead of the built-in ones; the
-        bracketed iteration then runs from them.
 
     Returns
     -------
@@ -232,10 +228,6 @@ def solve_u(q_target, alpha0: float, order: int = DEFAULT_ORDER, u_bounds: tuple
     q = np.asarray(q_target, dtype=float)
     if np.ndim(alpha0):
         q = np.broadcast_to(q, np.broadcast_shapes(q.shape, np.shape(alpha0)))
-    if u_start is not None:
-        c_ = np.asarray(c)
-        return _newton(q, alpha0, order, np.asarray(u_start, dtype=float),
-                       u_bounds or (-0.5, (1.0 / c_ - 1.0) / 2.0))
     if np.ndim(alpha0) == 0 and u_bounds is None and q.size >= _UNIFORM_MIN_POINTS:
         # one actuator, many points: a start within about 1e-13 of the root from a uniform-in-q Hermite table, then one
         # Newton step; Ibar and its slope at the root follow from the values at the start (the step is

@@ -322,32 +322,6 @@ def _flat(params: ModelParams) -> ModelParams:
                           for key, v in params.__dict__.items()})
 
 
-def _u_from_table(tab: BranchTable, rows, k):
-    """``u = k'R`` at curvatures ``k`` on rows ``rows`` of the sampled branches (quadratic interpolation of kt, xt).
-
-    The sampled ``(k', u)`` pairs of every branch are increasing in ``sgn k'``; three neighbours give
-    ``u`` to about 1e-7 relative, a start from which one Newton step of eq 5 is exact to rounding.
-    """
-    key = tab.sgn[:, None] * tab.kt  # increasing along every branch (from k' = 0 toward lock-up)
-    ns = key.shape[1]
-    off = float(np.nanmax(np.abs(key))) + 1.0
-    flat = (key + off * np.arange(key.shape[0])[:, None]).ravel()
-    q = tab.sgn[rows] * k
-    if np.all(np.diff(flat) >= 0.0):
-        j = np.searchsorted(flat, q + off * rows, side="right") - rows * ns
-    else:  # not expected: fall back to a comparison per point
-        j = (key[rows] <= q[:, None]).sum(-1)
-    j = np.clip(j, 1, ns - 2)
-    x0, x1, x2 = tab.kt[rows, j - 1], tab.kt[rows, j], tab.kt[rows, j + 1]
-    y0, y1, y2 = tab.xt[rows, j - 1], tab.xt[rows, j], tab.xt[rows, j + 1]
-    d0, d1, d2 = k - x0, k - x1, k - x2
-    with np.errstate(divide="ignore", invalid="ignore"):
-        u = (y0 * d1 * d2 / ((x0 - x1) * (x0 - x2)) + y1 * d0 * d2 / ((x1 - x0) * (x1 - x2))
-             + y2 * d0 * d1 / ((x2 - x0) * (x2 - x1)))
-    lo, hi = np.minimum(y0, y2), np.maximum(y0, y2)
-    return np.where(np.isfinite(u), np.clip(u, lo, hi), y1)
-
-
 def case_limits(law: MomentLaw, pressure_kpa, free_curvature, table: BranchTable | None = None, *,
                 free_u=None, frame_strength_mpa: float | None = None,
                 bladder_stretch_limit: float | None = None) -> dict[str, Any]:
@@ -364,8 +338,7 @@ def case_limits(law: MomentLaw, pressure_kpa, free_curvature, table: BranchTable
     table : the :class:`~bendpam.law.BranchTable` the curvatures came from (default: the law's).
     free_u : (cases, p) or (p,), optional
         ``u = k'R`` at the free curvatures (:meth:`MomentLaw.free_state_array`), so that ``R = u/k'``
-        needs no solve of eq 5.  Without it ``u`` is interpolated on the branch table and polished by
-        Newton steps on eq 5.
+        needs no solve of eq 5.  Without it ``u`` comes from :func:`bendpam.braid.solve_u`.
     frame_strength_mpa, bladder_stretch_limit : the limits (the same for every case), or None.
 
     Returns
@@ -405,7 +378,7 @@ def case_limits(law: MomentLaw, pressure_kpa, free_curvature, table: BranchTable
         if free_u is not None:
             u = np.asarray(free_u, dtype=float).reshape(m, P.size)[rows, cols]
         else:
-            u = solve_u(kk * sub.R0_start, sub.alpha0, law.order, u_start=_u_from_table(tab, rows, kk))[0]
+            u = solve_u(kk * sub.R0_start, sub.alpha0, law.order)[0]  # eq 5, per-case braid angles
         st = _section(sub, pa[rows, cols], kk, u, u / kk, **opts)
         for key in _STATE_KEYS:
             free[key][rows, cols] = st[key]
