@@ -13,7 +13,6 @@ stress-free at ``P_start`` with outer radius ``R0_start`` and thickness ``t0_sta
 from __future__ import annotations
 
 import dataclasses
-import difflib
 import math
 import os
 import tomllib
@@ -25,7 +24,7 @@ import numpy as np
 import tomli_w
 
 from .atomic import atomic_write_text
-from .checks import number
+from .checks import did_you_mean, number
 from .errors import FileFormatError, InputError
 from .material import MooneyRivlin
 
@@ -72,9 +71,7 @@ _NOT_MODEL_PARAMS = ("name", "model", "frame_strength_mpa", "bladder_stretch_lim
 
 def _suggest(key: str, known) -> str:
     """``'alpha_deg' (did you mean 'alpha0_deg'?); known: ...`` for an unknown key."""
-    near = difflib.get_close_matches(str(key), list(known), n=1, cutoff=0.5)
-    hint = f" (did you mean {near[0]!r}?)" if near else ""
-    return f"{key!r}{hint}; known: {', '.join(known)}"
+    return f"{key!r}{did_you_mean(key, known)}; known: {', '.join(known)}"
 
 
 @dataclass(frozen=True)

@@ -21,7 +21,10 @@ import numpy as np
 
 from .errors import InputError
 
-__all__ = ["KNOWN_SUFFIXES", "MPA_SUSPECT_KPA", "UnitWarning", "file_format", "float_array", "number", "pressure_kpa"]
+__all__ = [
+    "KNOWN_SUFFIXES", "MPA_SUSPECT_KPA", "UnitWarning", "did_you_mean", "file_format", "float_array", "number",
+    "pressure_kpa",
+]
 
 #: Below this (kPa), a set of pressures is suspected to be in MPa.
 MPA_SUSPECT_KPA = 5.0
@@ -148,3 +151,17 @@ def file_format(path: Any, fmt: Any, formats: tuple[str, ...], *, option: str = 
         return default
     raise InputError(f"{option} {str(path)!r}: no format in the file name; use "
                      + ", ".join(f".{f}" for f in formats) + f" or give {format_option}")
+
+
+def did_you_mean(name: Any, known) -> str:
+    """``" (did you mean 'alpha0_deg'?)"`` for a mistyped name close to one of ``known``, else ``""``.
+
+    Examples
+    --------
+    >>> did_you_mean("alpha_deg", ["alpha0_deg", "R0_mm"]), did_you_mean("zzz", ["R0_mm"])
+    (" (did you mean 'alpha0_deg'?)", '')
+    """
+    import difflib
+
+    near = difflib.get_close_matches(str(name), [str(k) for k in known], n=1, cutoff=0.5)
+    return f" (did you mean {near[0]!r}?)" if near else ""

@@ -74,7 +74,6 @@ Results are deterministic for a given ``seed``.
 
 from __future__ import annotations
 
-import difflib
 import math
 import re
 import time
@@ -87,6 +86,7 @@ import numpy as np
 
 from ..actuator import NEUTRAL_ANGLE_DEG, Actuator
 from ..atomic import atomic_write_text
+from ..checks import did_you_mean
 from ..errors import BendpamError, InputError
 from ..law import MomentLaw
 from ..models import normalise_model
@@ -134,11 +134,6 @@ _TOL = 1e-3  # a target is met within 0.1 %, a margin to 0.1 % of the required v
 _BLOCK = 256  # designs per block of the coarse map
 
 
-def _suggest(name: str, known: Iterable[str]) -> str:
-    near = difflib.get_close_matches(name, list(known), n=1, cutoff=0.5)
-    return f" (did you mean {near[0]!r}?)" if near else ""
-
-
 def _finite_number(text: str) -> float | None:
     try:
         v = float(text)
@@ -181,7 +176,7 @@ class Target:
     def _check(self, label: str) -> None:
         where = f"{label} {self.text!r}" if self.quantity in QUANTITIES else label
         if self.quantity not in QUANTITIES:
-            raise InputError(f"{label}: unknown quantity {self.quantity!r}{_suggest(self.quantity, QUANTITIES)}; "
+            raise InputError(f"{label}: unknown quantity {self.quantity!r}{did_you_mean(self.quantity, QUANTITIES)}; "
                              f"allowed: {', '.join(QUANTITIES)}")
         if self.sense not in _SENSES:
             raise InputError(f"{where}: comparison {self.sense!r} is not allowed; use =, >= or <=")
@@ -218,7 +213,7 @@ class Target:
         name, sense, val, at = m.groups()
         sense = "=" if sense == "==" else sense
         if name not in QUANTITIES:
-            raise InputError(f"{label} {s!r}: unknown quantity {name!r}{_suggest(name, QUANTITIES)}; "
+            raise InputError(f"{label} {s!r}: unknown quantity {name!r}{did_you_mean(name, QUANTITIES)}; "
                              f"allowed: {', '.join(QUANTITIES)}")
         v = _finite_number(val)
         if v is None:
@@ -308,7 +303,7 @@ class Variable:
                              f"the moment); vary one of: {', '.join(DESIGN_VARIABLES)}")
         if self.name not in DESIGN_VARIABLES:
             raise InputError(f"{label} {text!r}: {self.name!r} is not a numeric actuator parameter"
-                             f"{_suggest(self.name, DESIGN_VARIABLES)}; vary one of: {', '.join(DESIGN_VARIABLES)}")
+                             f"{did_you_mean(self.name, DESIGN_VARIABLES)}; vary one of: {', '.join(DESIGN_VARIABLES)}")
         for v in (self.low, self.high):
             if isinstance(v, bool) or not isinstance(v, int | float | np.floating | np.integer) or not math.isfinite(v):
                 raise InputError(f"{label} {text!r}: the range ends must be finite numbers")
@@ -586,11 +581,21 @@ def _jumps(V: np.ndarray) -> np.ndarray:
 
 
 def _stiffness(cases, model: str, P: float, k: np.ndarray) -> np.ndarray:
-    """``|dM/dk'|`` (N*mm^2) of each case at pressure ``P`` and curvature ``k`` (NaN where k is NaN)."""
+    """``|dM/dk'|`` (N*mm^2) of each case at pressure ``P`` and curvature ``k`` (NaN where k is NaN).
+
+    One law for the whole block; should a curvature be refused, the cases are taken one by one so
+    that only the refused ones are NaN.
+    """
     out = np.full(k.shape, np.nan)
-    for c in range(k.size):
-        if not np.isfinite(k[c]):
-            continue
+    ok = np.flatnonzero(np.isfinite(k))
+    if ok.size == 0:
+        return out
+    try:
+        out[ok] = np.abs(MomentLaw(cases.take(ok), model).tangent_stiffness(P, k[ok]))
+        return out
+    except BendpamError:
+        pass
+    for c in ok:
         try:
             out[c] = abs(float(MomentLaw(cases.take(c), model).tangent_stiffness(P, k[c])))
         except BendpamError:
