@@ -284,6 +284,10 @@ def test_bad_arguments():
     (["--target", "free_angle_deg=90@200", "--vary", "R0=6:12"], "--vary 'R0=6:12'"),
     (["--vary", "alpha0_deg=60:80"], "give at least one --target"),
     (["--target", "free_angle_deg=90@200", "--vary", "alpha0_deg=60:80", "--min-margin", "0.5"], "--min-margin"),
+    # a pressure in MPa where kPa is meant: refused, as --pressure-kpa is
+    (["--target", "blocked_moment_nmm=400@0.2", "--vary", "alpha0_deg=60:80"], "--target ...@P: every pressure"),
+    (["--target", "free_angle_deg=90@200", "--vary", "alpha0_deg=60:80", "--max-pressure-kpa", "0.25"],
+     "--max-pressure-kpa: every pressure"),
 ])
 def test_cli_bad_input_exit_2_one_line(capsys, args, start):
     code, out, err = run(capsys, "design", "--preset", "be-pam", *args)

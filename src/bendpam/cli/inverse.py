@@ -11,7 +11,18 @@ from typing import Annotated, Optional
 import typer
 
 from .app import app
-from .options import ActuatorOpt, Model, ModelOpt, PresetOpt, UserError, load_actuator, model_name, output_set
+from .options import (
+    ActuatorOpt,
+    Model,
+    ModelOpt,
+    PresetOpt,
+    UserError,
+    load_actuator,
+    model_name,
+    output_set,
+    pressure_kpa,
+    pressures_kpa,
+)
 
 __all__ = ["design_cmd"]
 
@@ -67,10 +78,15 @@ def design_cmd(
     if not vary:
         raise UserError("give at least one --vary range, e.g. --vary alpha0_deg=60:80")
     targets = parse_targets(target, "--target")
+    at = [repr(t.pressure_kpa) for t in targets if t.pressure_kpa is not None]
+    if at:  # the pressures after '@' are kPa: the same refusal of MPa-looking values as --pressure-kpa
+        pressures_kpa(at, None, "--target ...@P")
     act = load_actuator(preset, actuator, model)
     variables = parse_variables(act, vary, "--vary")
     if max_pressure_kpa is not None and not max_pressure_kpa > 0:
         raise UserError(f"--max-pressure-kpa: {max_pressure_kpa:g} kPa must be > 0")
+    if max_pressure_kpa is not None:
+        pressure_kpa(max_pressure_kpa, "--max-pressure-kpa")
     if not min_margin >= 1.0:
         raise UserError(f"--min-margin: {min_margin:g} must be a safety factor >= 1")
     if pareto and len(targets) != 2:
