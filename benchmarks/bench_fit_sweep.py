@@ -11,7 +11,7 @@ Sweeps (BE-PAM base, energy model, an ``alpha0_deg x t0_mm`` grid of actuator ca
 
 Identification (BE-PAM energy; the truth has alpha0 + 0.8 deg and C10 x 1.05):
 
-* ``bendpam.identify.fit`` on 6 and on 25 pressures of simulated, processed tests;
+* ``bendpam.identify.fitting.fit`` on 6 and on 25 pressures of simulated, processed tests;
 * the CLI ``bendpam fit`` on 25 pressures (a fresh process each time, start-up and figure included).
 
 Run: ``python benchmarks/bench_fit_sweep.py [--quick]``.
@@ -56,7 +56,7 @@ def _one_by_one(params, P):
 
 
 def sweeps(rec: Recorder, quick: bool) -> None:
-    base = bendpam.presets.be_pam()
+    base = bendpam.physics.presets.be_pam()
     bendpam.sweep(base, pressure_kpa=[100.0, 200.0], alpha0_deg=[65.0, 70.0], t0_mm=[2.0])  # imports, caches
     configs = [  # (pressures, (n_alpha0, n_t0) for the sweep, cases for the one-by-one baseline, repeats)
         (np.linspace(80.0, 250.0, 16), (20, 10) if quick else (50, 40), 20 if quick else 100, 3),
@@ -117,9 +117,9 @@ def sweeps(rec: Recorder, quick: bool) -> None:
 
 
 def _processed_set(truth, pressures):
-    from bendpam.fixture import PAPER_FIXTURE
     from bendpam.lab.processing import ProcessedSet, ProcessingOptions, process_series
     from bendpam.lab.simulate import SimulationSettings, simulate_test
+    from bendpam.physics.fixture import PAPER_FIXTURE
 
     rng = np.random.default_rng(0)
     res = []
@@ -131,14 +131,14 @@ def _processed_set(truth, pressures):
 
 
 def fits(rec: Recorder, quick: bool) -> None:
-    from bendpam.identify import fit
+    from bendpam.identify.fitting import fit
     from bendpam.lab.simulate import simulate_tests
 
-    base = bendpam.presets.be_pam()
+    base = bendpam.physics.presets.be_pam()
     truth = base.replace(alpha0_deg=base.alpha0_deg + 0.8, C10_kpa=base.C10_kpa * 1.05)
     P6 = np.linspace(100.0, 200.0, 6)
     P25 = np.linspace(100.0, 220.0, 25)
-    header("Identification: bendpam.identify.fit (alpha0, C10, C01), BE-PAM energy, simulated and processed tests")
+    header("Identification: bendpam.fit (alpha0, C10, C01), BE-PAM energy, simulated and processed tests")
     ps6, ps25 = _processed_set(truth, P6), _processed_set(truth, P25)
     st = compare({"6 pressures": lambda: fit(ps6, base, MODEL), "25 pressures": lambda: fit(ps25, base, MODEL)},
                  repeats=3 if quick else 5)

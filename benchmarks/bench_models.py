@@ -55,7 +55,7 @@ def _rel_err(M, ref, scale):
 
 def _scattered_case(rec: Recorder, name: str, model: str, n: int, n_pp: int, reps: int, quick: bool) -> dict:
     """One actuator and model of :func:`scattered`; returns its headline figures."""
-    a = bendpam.presets.get(name, model)
+    a = bendpam.physics.presets.get(name, model)
     law = bendpam.MomentLaw.of(a, model)
     tab = law.tabulated()
     bl = Baseline(a, model)
@@ -182,7 +182,7 @@ import json, sys, time
 sys.path.insert(0, {here!r})
 import numpy as np, bendpam
 from baseline import Baseline
-a = bendpam.presets.be_pam(); law = bendpam.MomentLaw(a); bl = Baseline(a)
+a = bendpam.physics.presets.be_pam(); law = bendpam.MomentLaw(a); bl = Baseline(a)
 rng = np.random.default_rng(0)
 out = {{}}
 for n in (8192, 100000):
@@ -209,7 +209,7 @@ def cold_allocator(rec: Recorder, quick: bool) -> None:
 
 
 def dense_grid(rec: Recorder, quick: bool) -> None:
-    a = bendpam.presets.be_pam()
+    a = bendpam.physics.presets.be_pam()
     law = bendpam.MomentLaw.of(a)
     lim = law.limits
     Pg = np.linspace(70.0, P_MAX_KPA, 1000)
@@ -229,7 +229,7 @@ def dense_grid(rec: Recorder, quick: bool) -> None:
 
 def _free_case(rec: Recorder, name: str, model: str, n: int, reps: int) -> tuple[float, float, float]:
     """One actuator and model of :func:`free_bending`: exact solves/s and the baseline and fast |dk'|."""
-    a = bendpam.presets.get(name, model)
+    a = bendpam.physics.presets.get(name, model)
     law = bendpam.MomentLaw.of(a, model)
     tab = law.tabulated()
     br = law.free_branch()

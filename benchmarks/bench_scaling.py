@@ -46,7 +46,7 @@ def _table(rec: Recorder, dim: str, unit: str, sizes, make):
 
 
 def run(rec: Recorder, quick: bool) -> None:
-    a = bendpam.presets.be_pam()
+    a = bendpam.physics.presets.be_pam()
     law = bendpam.MomentLaw.of(a)
     tab = law.tabulated()
     lim = law.limits

@@ -48,7 +48,7 @@ def main() -> None:
     ap.add_argument("--top", type=int, default=8)
     n = ap.parse_args().top
     settle_allocator()
-    base = bendpam.presets.be_pam()
+    base = bendpam.physics.presets.be_pam()
     a0, t0 = np.meshgrid(np.linspace(60.0, 80.0, 64), np.linspace(1.5, 3.0, 4), indexing="ij")
     cases = {"alpha0_deg": a0.ravel(), "t0_mm": t0.ravel()}
     P16, P1000 = np.linspace(80.0, 250.0, 16), np.linspace(70.0, 300.0, 1000)

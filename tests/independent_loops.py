@@ -26,8 +26,8 @@ import math
 import numpy as np
 
 import bendpam
-from bendpam.fixture import PAPER_FIXTURE
 from bendpam.lab.processing import PressureResult, ProcessedSet, ProcessingOptions
+from bendpam.physics.fixture import PAPER_FIXTURE
 
 __all__ = ["BoucWen", "GeometricPI", "LoopTruth", "make_truth", "noisy_set"]
 

@@ -3,8 +3,8 @@ import math
 import pytest
 
 from bendpam import Actuator, ModelParams, presets
-from bendpam.actuator import NEUTRAL_ANGLE_DEG
 from bendpam.errors import InputError
+from bendpam.physics.actuator import NEUTRAL_ANGLE_DEG
 
 
 def base(**kw):

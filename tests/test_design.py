@@ -11,7 +11,6 @@ from hypothesis import strategies as st
 import bendpam
 import bendpam.cli as cli
 from bendpam import presets
-from bendpam.checks import UnitWarning
 from bendpam.design import (
     Finger,
     FingerLoads,
@@ -34,6 +33,7 @@ from bendpam.design import (
 )
 from bendpam.design.finger import G_N_PER_G
 from bendpam.errors import InputError
+from bendpam.validate import UnitWarning
 
 
 def _act(name, L0=130.0, model="energy"):
@@ -78,7 +78,7 @@ def test_stable_branch_fold_of_bc_pam():
 # ------------------------------------------------------------------------------------------------
 # finger statics
 # ------------------------------------------------------------------------------------------------
-@pytest.mark.filterwarnings("ignore::bendpam.checks.UnitWarning")  # hypothesis tries 0 < P < 5 kPa too
+@pytest.mark.filterwarnings("ignore::bendpam.validate.UnitWarning")  # hypothesis tries 0 < P < 5 kPa too
 @settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(name=st.sampled_from(["be-pam", "bc-pam"]), P_kpa=st.floats(0.0, 130.0), bend=st.sampled_from([1, -1]),
        base=st.floats(-180.0, 180.0), tip=st.floats(0.0, 20.0))

@@ -8,7 +8,7 @@ from numpy.testing import assert_allclose
 
 import bendpam
 from bendpam import MomentLaw, presets
-from bendpam.fast import MomentTable, moment_table
+from bendpam.physics.fast import MomentTable, moment_table
 from strategies import actuators as actuator_strategy
 
 TOL = 1e-6

@@ -15,7 +15,7 @@ import pytest
 from bendpam import presets
 from bendpam.cli import main
 from bendpam.errors import InputError
-from bendpam.plots import (
+from bendpam.present.figures import (
     DOUBLE_COLUMN_IN,
     SINGLE_COLUMN_IN,
     demo_figure,

@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 from scipy.optimize import brentq
 
-from bendpam.fixture import PAPER_FIXTURE, Fixture
+from bendpam.physics.fixture import PAPER_FIXTURE, Fixture
 
 
 def test_golden_values_by_hand():

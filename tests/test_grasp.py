@@ -11,7 +11,7 @@ from bendpam import presets
 from bendpam.design import Gripper, grasp_sweep, plot_grasp, solve_grasp
 from bendpam.design.grasp import DEFAULT_MU, DEFAULT_SPLAY_DEG, PullOut
 from bendpam.errors import InputError
-from bendpam.law import MomentLaw
+from bendpam.physics.law import MomentLaw
 
 
 def _act(name, L0=130.0, model="energy"):
@@ -254,7 +254,7 @@ def _fake_sweep():
 
 
 def test_plot_leaves_gaps_where_there_is_no_contact(tmp_path):
-    from bendpam.plots import SINGLE_COLUMN_IN, save_figure
+    from bendpam.present.figures import SINGLE_COLUMN_IN, save_figure
 
     fig = plot_grasp(_fake_sweep())
     ax = fig.axes[0]

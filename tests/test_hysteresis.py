@@ -10,11 +10,11 @@ from numpy.testing import assert_allclose
 import bendpam
 from bendpam import presets
 from bendpam.cli import main
-from bendpam.fixture import PAPER_FIXTURE
-from bendpam.hysteresis import DahlLaw, LoopModel, PrandtlIshlinskii, loop_branches, predict_cycle
-from bendpam.identify import fit
+from bendpam.identify.fitting import fit
 from bendpam.lab.processing import ProcessedSet, ProcessingOptions, process_series, write_processed
 from bendpam.lab.simulate import SimulationSettings, simulate_test
+from bendpam.physics.fixture import PAPER_FIXTURE
+from bendpam.physics.hysteresis import DahlLaw, LoopModel, PrandtlIshlinskii, loop_branches, predict_cycle
 
 
 def triangle(theta_max, n=300, cycles=3):
@@ -202,7 +202,7 @@ def test_figure7_draws_the_loop(tmp_path):
     st = SimulationSettings(hysteresis=0.05, hysteresis_angle_deg=10.0, seed=3)
     ps, _ = simulate_processed(base, [100, 150, 200], "energy", st)
     r = fit(ps, base, hysteresis="pi")
-    from bendpam.plots import figure7, save_figure
+    from bendpam.present.figures import figure7, save_figure
 
     fig = figure7(ps, r)
     from matplotlib.collections import LineCollection

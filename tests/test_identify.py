@@ -10,8 +10,8 @@ from numpy.testing import assert_allclose
 import bendpam
 from bendpam import presets
 from bendpam.cli import main
-from bendpam.fixture import PAPER_FIXTURE
-from bendpam.identify import fit, parse_free, score
+from bendpam.identify.fitting import fit, parse_free, score
+from bendpam.identify.tension import fit_tension, tension_from_test
 from bendpam.lab import read_test, write_test
 from bendpam.lab.processing import (
     PressureResult,
@@ -21,8 +21,8 @@ from bendpam.lab.processing import (
     write_processed,
 )
 from bendpam.lab.simulate import SimulationSettings, simulate_test
-from bendpam.material import MooneyRivlin
-from bendpam.tension import fit_tension, tension_from_test
+from bendpam.physics.fixture import PAPER_FIXTURE
+from bendpam.physics.material import MooneyRivlin
 
 CASES = {"be-pam": [100, 125, 150, 175, 200], "bc-pam": [40, 60, 80, 100, 120]}
 # known parameters different from the presets: alpha0 moved, the shear modulus 5 % up and an admissible

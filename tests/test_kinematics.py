@@ -8,8 +8,8 @@ from numpy.testing import assert_allclose
 from scipy.integrate import quad
 
 import bendpam
-from bendpam.braid import LOCK_FRACTION, gauss_nodes
 from bendpam.errors import InputError
+from bendpam.physics.braid import LOCK_FRACTION, gauss_nodes
 from strategies import actuators as actuator_strategy
 
 
@@ -149,7 +149,7 @@ def test_property_kinematics_finite_and_consistent(a, frac):
 # ------------------------------------------------------------------------------------------------
 @pytest.mark.parametrize("alpha0_deg", [12.0, 30.0, 45.0, 56.0, 69.7, 80.0, 88.0])
 def test_ibar_closed_form_equals_adaptive_quadrature(alpha0_deg):
-    from bendpam.braid import ibar_closed_form
+    from bendpam.physics.braid import ibar_closed_form
 
     c = math.cos(math.radians(alpha0_deg))
     u_lock = (1 / c - 1) / 2
@@ -176,14 +176,14 @@ def test_closed_form_models_equal_high_order_quadrature(preset_model, span):
 
 @pytest.mark.parametrize("alpha0_deg", [15.0, 40.0, 69.7, 85.0])
 def test_one_newton_step_from_the_uniform_table_reaches_rounding(alpha0_deg):
-    from bendpam.braid import _hermite_start, _inverse_table, _newton, solve_u
+    from bendpam.physics.braid import _hermite_start, _inverse_table, _newton, solve_u
 
     a0 = math.radians(alpha0_deg)
     c = math.cos(a0)
     u_lock = (1 / c - 1) / 2
     # 4200 points (>= _UNIFORM_MIN_POINTS): the uniform-table path
     u_true = np.concatenate([np.linspace(-0.49, 0, 2100), np.linspace(0, LOCK_FRACTION * u_lock, 2100)])
-    q = math.sin(a0) * u_true * bendpam.braid.circle_ibar(u_true, c)[0]
+    q = math.sin(a0) * u_true * bendpam.physics.braid.circle_ibar(u_true, c)[0]
     u, ib, dib = solve_u(q, a0)
     qt, ut, dt = _inverse_table(a0, 0)
     u_ref, ib_ref, dib_ref = _newton(q, a0, 0, _hermite_start(q, qt, ut, dt), (-0.5, u_lock))

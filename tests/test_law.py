@@ -14,7 +14,7 @@ from numpy.testing import assert_allclose
 import bendpam
 from bendpam import MomentLaw, presets
 from bendpam.errors import InputError
-from bendpam.models import get_model
+from bendpam.physics.models import get_model
 from bendpam.sweeps import build_cases
 from strategies import actuators as actuator_strategy
 
@@ -236,7 +236,7 @@ def test_table_agrees_with_the_exact_law_within_its_bound(preset_model):
 
 
 def test_fast_moment_table_is_the_laws_table(be):
-    from bendpam.fast import moment_table
+    from bendpam.physics.fast import moment_table
 
     assert moment_table(be, "energy") is MomentLaw.of(be, "energy").tabulated()
     with pytest.raises(InputError, match="tol"):
@@ -280,7 +280,7 @@ def test_stable_branch_with_friction_shifts_the_free_state(be):
 # ------------------------------------------------------------------------------------------------
 # a property over valid actuators: the free curvature is a root of the law
 # ------------------------------------------------------------------------------------------------
-@pytest.mark.filterwarnings("ignore::bendpam.checks.UnitWarning")  # pressures may be drawn in (0, 5) kPa
+@pytest.mark.filterwarnings("ignore::bendpam.validate.UnitWarning")  # pressures may be drawn in (0, 5) kPa
 @settings(max_examples=40, deadline=None)
 @given(a=actuator_strategy(), model=st.sampled_from(MODELS),
        P=st.lists(st.floats(0.0, 400.0), min_size=1, max_size=6))

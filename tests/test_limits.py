@@ -15,8 +15,8 @@ import bendpam
 from bendpam import Actuator, presets
 from bendpam.cli import main
 from bendpam.errors import InputError, NoEquilibrium
-from bendpam.limits import buckling_load, foundation_modulus, section_limits
-from bendpam.models import force_balance
+from bendpam.physics.limits import buckling_load, foundation_modulus, section_limits
+from bendpam.physics.models import force_balance
 
 MARGINS = ("frame_strength_margin", "buckling_margin", "lockup_margin", "bladder_stretch_margin")
 
@@ -120,7 +120,7 @@ def test_axial_forces_integrate_the_force_balance_stress_state(preset_model):
     """``axial_forces`` is the section integral of :func:`force_balance.stress_state` (eq 43-48), any curvature."""
     a, _ = preset_model
     p = a.params
-    phi, wbar = bendpam.braid.gauss_nodes(32)
+    phi, wbar = bendpam.physics.braid.gauss_nodes(32)
     for k in np.linspace(-0.8, 0.8, 5) * min(-bendpam.curvature_limits(a).k_min, bendpam.curvature_limits(a).k_max):
         for pa in (0.0, 0.05, 0.15):
             kin = bendpam.kinematics(a, k)
@@ -262,7 +262,7 @@ def test_sweep_kernel_on_a_shared_table_block():
 
 def test_case_kernel_without_u_interpolates_and_polishes_eq5():
     """Given only k', the kernel solves eq 5 for u = k'R: the same limits."""
-    from bendpam.limits import case_limits
+    from bendpam.physics.limits import case_limits
     from bendpam.sweeps import build_cases
 
     cs = build_cases(presets.be_pam(), {"alpha0_deg": np.array([64.0, 69.7, 75.0]), "t0_mm": np.array([2.0, 2.5, 3.0])})

@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from bendpam.material import MooneyRivlin
+from bendpam.physics.material import MooneyRivlin
 
 
 def test_energy_zero_and_stress_free_at_identity():

@@ -1,6 +1,6 @@
 """Admissible Mooney-Rivlin materials: shear modulus, shape and admissible shapes.
 
-The conditions are checked here independently of the closed forms in bendpam.material:
+The conditions are checked here independently of the closed forms in bendpam.physics.material:
 on a dense grid of deformations, with the class's own energy, uniaxial stress and Cauchy
 stress differences.
 """
@@ -13,7 +13,7 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from bendpam.errors import InputError
-from bendpam.material import MooneyRivlin, admissible_shape_range, shape_limits
+from bendpam.physics.material import MooneyRivlin, admissible_shape_range, shape_limits
 
 # the bladder's principal stretches in bending: a generous envelope.  At the paper's
 # test pressures (BE-PAM 100-200 kPa, BC-PAM 40-120 kPa) the free-bending states reach

@@ -11,7 +11,7 @@ from numpy.testing import assert_allclose
 import bendpam
 from bendpam import presets
 from bendpam.errors import InputError
-from bendpam.models import energy, get_model
+from bendpam.physics.models import energy, get_model
 from strategies import actuators as actuator_strategy
 
 
@@ -213,7 +213,7 @@ def test_bad_inputs(be):
 actuators = actuator_strategy()
 
 
-@pytest.mark.filterwarnings("ignore::bendpam.checks.UnitWarning")  # P may be drawn in (0, 5) kPa
+@pytest.mark.filterwarnings("ignore::bendpam.validate.UnitWarning")  # P may be drawn in (0, 5) kPa
 @settings(max_examples=60, deadline=None)
 @given(a=actuators, P=st.floats(0.0, 400.0), frac=st.floats(-0.95, 0.95),
        model=st.sampled_from(["energy", "force_balance"]))

@@ -18,9 +18,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import bendpam.outputs as outputs
+import bendpam.infra.outputs as outputs
 from bendpam.errors import InputError
-from bendpam.outputs import (
+from bendpam.infra.outputs import (
     Interrupted,
     OutputBusy,
     OutputFile,
@@ -30,11 +30,11 @@ from bendpam.outputs import (
     to_json,
 )
 
-PKG_DIR = Path(outputs.__file__).resolve().parent
+PKG_DIR = Path(outputs.__file__).resolve().parent.parent  # src/bendpam
 
-# The child processes load bendpam.outputs without running bendpam/__init__.py (which
+# The child processes load bendpam.infra.outputs without running bendpam/__init__.py (which
 # imports SciPy, xarray, ...: about a second per process); the module needs only
-# bendpam.errors and bendpam.atomic.
+# bendpam.errors and bendpam.infra.atomic.
 CHILD = r"""
 import sys, time, types
 pkg = types.ModuleType("bendpam")
@@ -42,7 +42,7 @@ pkg.__path__ = [sys.argv[1]]
 sys.modules["bendpam"] = pkg
 import signal
 from bendpam.errors import InputError
-from bendpam.outputs import Interrupted, OutputSet, interrupts
+from bendpam.infra.outputs import Interrupted, OutputSet, interrupts
 
 # a test run started in the background may inherit SIGINT ignored; a terminal has it on
 signal.signal(signal.SIGINT, signal.default_int_handler)

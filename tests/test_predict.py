@@ -131,7 +131,7 @@ actuators = actuator_strategy(a0=((25.0, 50.0), (60.0, 80.0)), R0=(4.0, 12.0), t
                               c10=(-300.0, 1500.0), c01=(0.0, 600.0), ps=(20.0, 20.0), E=(500.0, 20000.0))
 
 
-@pytest.mark.filterwarnings("ignore::bendpam.checks.UnitWarning")  # P may be drawn in (0, 5) kPa
+@pytest.mark.filterwarnings("ignore::bendpam.validate.UnitWarning")  # P may be drawn in (0, 5) kPa
 @settings(max_examples=40, deadline=None)
 @given(a=actuators, P=st.floats(0.0, 400.0), model=st.sampled_from(["energy", "force_balance"]))
 def test_property_free_curvature_root_or_explicit_no_equilibrium(a, P, model):

@@ -10,7 +10,6 @@ from numpy.testing import assert_allclose
 import bendpam
 from bendpam import presets
 from bendpam.cli import main
-from bendpam.fixture import PAPER_FIXTURE
 from bendpam.lab import read_test
 from bendpam.lab.processing import (
     ProcessingError,
@@ -23,6 +22,7 @@ from bendpam.lab.processing import (
     write_processed,
 )
 from bendpam.lab.simulate import SimulationSettings, simulate_test, simulate_tests
+from bendpam.physics.fixture import PAPER_FIXTURE
 
 FORMATS = ["csv", "testxpert", "bluehill", "mts"]
 CASES = {"be-pam": [100, 125, 150, 175, 200], "bc-pam": [40, 60, 80, 100, 120]}

@@ -1,4 +1,4 @@
-"""bendpam.progress.Progress: plain lines off a terminal, a rich bar on one, silence when quiet."""
+"""bendpam.infra.progress.Progress: plain lines off a terminal, a rich bar on one, silence when quiet."""
 
 import io
 import subprocess
@@ -8,7 +8,7 @@ import time
 
 import pytest
 
-from bendpam.progress import Progress, format_duration
+from bendpam.infra.progress import Progress, format_duration
 
 
 class FakeClock:
@@ -146,7 +146,7 @@ def test_terminal_draws_a_rich_bar():
 def test_terminal_bar_stops_on_interrupt():
     from rich.console import Console
 
-    from bendpam import progress
+    from bendpam.infra import progress
 
     console = Console(file=io.StringIO(), force_terminal=True, width=80)
     with pytest.raises(KeyboardInterrupt), Progress(10, "sweep", stream=console):
@@ -168,6 +168,6 @@ def test_format_duration():
 
 
 def test_import_is_light():
-    code = "import sys, bendpam.progress; print('rich' in sys.modules)"
+    code = "import sys, bendpam.infra.progress; print('rich' in sys.modules)"
     res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert res.stdout.strip() == "False"

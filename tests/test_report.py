@@ -22,11 +22,11 @@ import pytest
 import bendpam
 import bendpam.cli
 from bendpam import presets
-from bendpam.identify import HYST_PARAMETERS, PARAMETERS, fit
+from bendpam.identify.fitting import HYST_PARAMETERS, PARAMETERS, fit
 from bendpam.lab import read_test
 from bendpam.lab.processing import process_tests
 from bendpam.lab.simulate import SimulationSettings, simulate_tests
-from bendpam.report import Report, alpha0_profile, build_report, fmt_pct, fmt_value, table2_rows, table3_rows
+from bendpam.present.report import Report, alpha0_profile, build_report, fmt_pct, fmt_value, table2_rows, table3_rows
 
 CHROMIUM = Path("/usr/bin/chromium")
 CHROMIUM_ARGS = ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",

@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 
 from bendpam import presets
-from bendpam.identify import fit
+from bendpam.identify.fitting import fit
 from bendpam.lab.processing import process_tests
 from bendpam.lab.simulate import SimulationSettings, simulate_tests
-from bendpam.report import (
+from bendpam.present.report import (
     CORRELATION_LIMIT,
     NRMSE_CYCLES_LIMIT,
     SYMBOLS,
@@ -114,7 +114,7 @@ def test_symbols_with_units():
 
 
 def test_every_actuator_and_fit_field_has_a_display_name():
-    from bendpam.identify import HYST_PARAMETERS, PARAMETERS
+    from bendpam.identify.fitting import HYST_PARAMETERS, PARAMETERS
 
     act = presets.be_pam()
     names = [*act.to_dict(), *act.derived()]

@@ -125,15 +125,18 @@ def find_cycles(graph: dict[str, set[str]]) -> list[list[str]]:
 def test_the_checker_sees_imports_and_cycles():
     # the parser finds the imports it must (absolute and relative, from a package and from a module)
     graph = import_graph()
-    assert len(MODULES) > 20 and "bendpam.law" in MODULES and "bendpam.cli.app" in MODULES
-    assert {"bendpam.actuator", "bendpam.braid", "bendpam.models"} <= graph["bendpam.law"]
-    assert "bendpam.law" in graph["bendpam"] and "bendpam.cli.app" in graph["bendpam.cli.predict"]
-    tree = ast.parse("import bendpam.law\nfrom bendpam import braid\nfrom ..models import energy\n"
+    assert len(MODULES) > 20 and "bendpam.physics.law" in MODULES and "bendpam.cli.app" in MODULES
+    physics = {"bendpam.physics.actuator", "bendpam.physics.braid", "bendpam.physics.models"}
+    assert physics <= graph["bendpam.physics.law"]
+    assert "bendpam.physics.law" in graph["bendpam"] and "bendpam.cli.app" in graph["bendpam.cli.predict"]
+    tree = ast.parse("import bendpam.physics.law\nfrom bendpam.physics import braid\n"
+                     "from ..physics.models import energy\n"
                      "def f():\n    from . import plots\n"
                      "from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from ..sweeps import sweep\n"
-                     "try:\n    from ..fast import moment_table\nexcept ImportError:\n    pass\n")
+                     "try:\n    from ..physics.fast import moment_table\nexcept ImportError:\n    pass\n")
     got = {t for n in module_level_imports(tree) for t, _ in resolve("bendpam.lab.simulate", SRC / "lab" / "x.py", n)}
-    assert got == {"bendpam.law", "bendpam.braid", "bendpam.models.energy", "bendpam.fast"}
+    assert got == {"bendpam.physics.law", "bendpam.physics.braid", "bendpam.physics.models.energy",
+                   "bendpam.physics.fast"}
     # and the cycle finder finds a cycle
     assert find_cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c", "a"]]
     assert find_cycles({"a": {"b"}, "b": set(), "c": {"a", "b"}}) == []
@@ -175,12 +178,13 @@ def test_known_private_imports_are_gone():
 
 
 def test_the_private_import_check_sees_them():
-    tree = ast.parse("from ..material import MooneyRivlin, _within\nfrom .. import __version__\n"
-                     "from ..checks import pressure_kpa as _p\ndef f():\n    from ..law import _branch_table\n")
+    tree = ast.parse("from ..physics.material import MooneyRivlin, _within\nfrom .. import __version__\n"
+                     "from ..validate import pressure_kpa as _p\n"
+                     "def f():\n    from ..physics.law import _branch_table\n")
     found = sorted((t, i) for n in ast.walk(tree) if isinstance(n, ast.ImportFrom)
                    for t, i in resolve("bendpam.lab.x", SRC / "lab" / "x.py", n)
                    if i is not None and i.startswith("_") and i != "__version__")
-    assert found == [("bendpam.law", "_branch_table"), ("bendpam.material", "_within")]
+    assert found == [("bendpam.physics.law", "_branch_table"), ("bendpam.physics.material", "_within")]
 
 
 # ------------------------------------------------------------------------------------------------
@@ -199,7 +203,7 @@ def modules_after_import():
 
 @pytest.mark.parametrize("heavy", HEAVY)
 def test_import_bendpam_is_light(modules_after_import, heavy):
-    assert "bendpam" in modules_after_import and "bendpam.law" in modules_after_import
+    assert "bendpam" in modules_after_import and "bendpam.physics.law" in modules_after_import
     loaded = sorted(m for m in modules_after_import if m == heavy or m.startswith(heavy + "."))
     assert loaded == [], f"`import bendpam` imports {heavy}: {loaded[:5]}"
 
@@ -230,9 +234,10 @@ def test_bendpam_help_and_version_exit_0(flag, tmp_path):
 # ------------------------------------------------------------------------------------------------
 # the law is the only sampler of the models
 # ------------------------------------------------------------------------------------------------
-MODELS_PACKAGE = "bendpam.models"
+MODELS_PACKAGE = "bendpam.physics.models"
 SAMPLERS = {"coefficients", "basis"}
-ALLOWED = {"bendpam.law", "bendpam.braid"}
+_ALIAS_NAMES = {n for n, p in MODULES.items() if "alias_module(__name__" in p.read_text(encoding="utf-8")}
+ALLOWED = {"bendpam.physics.law", "bendpam.physics.braid"} | _ALIAS_NAMES
 
 
 def _is_models(target: str) -> bool:
@@ -242,8 +247,8 @@ def _is_models(target: str) -> bool:
 def direct_sampling_calls(name: str, path: Path, tree: ast.Module) -> list[str]:
     """Calls of the models' ``coefficients``/``basis`` in one module (imports anywhere count).
 
-    A *model expression* is a name bound to :mod:`bendpam.models`, ``bendpam.models.energy`` or
-    ``bendpam.models.force_balance`` (by import or by assignment from a model expression,
+    A *model expression* is a name bound to :mod:`bendpam.physics.models`, ``bendpam.physics.models.energy`` or
+    ``bendpam.physics.models.force_balance`` (by import or by assignment from a model expression,
     ``self._mod = energy``), a call of ``get_model``, or a conditional, ``or`` or dictionary
     look-up of those.  A call ``<model expression>.coefficients(...)`` or ``.basis(...)``, or of
     ``coefficients``/``basis`` imported from a model module, is a direct sampling call.
@@ -314,11 +319,13 @@ def test_the_sampler_check_finds_direct_calls():
                "def e(law, model, k):\n    model = normalise_model(model)\n"
                "    return MomentLaw.of(law, model).coefficients(k)\n"
                "def g(p):\n    mod = {'energy': en}[p]\n    return mod.basis(p, 0.0)\n")
-    found = direct_sampling_calls("bendpam.somewhere", SRC / "somewhere.py", ast.parse(snippet))
+    found = direct_sampling_calls("bendpam.physics.somewhere", SRC / "physics" / "somewhere.py",
+                                  ast.parse(snippet))
     assert [f.split(": ")[1] for f in found] == ["self._mod.coefficients(...)", "get_model('energy').coefficients(...)",
                                                 "m.basis(...)", "basis(...)", "mod.basis(...)"]
     # the law itself samples the models (it is the one allowed to)
-    assert direct_sampling_calls("bendpam.law", MODULES["bendpam.law"], parse(MODULES["bendpam.law"]))
+    law = "bendpam.physics.law"
+    assert direct_sampling_calls(law, MODULES[law], parse(MODULES[law]))
 
 
 def test_the_law_is_the_only_sampler():
@@ -330,5 +337,234 @@ def test_the_law_is_the_only_sampler():
         found += direct_sampling_calls(name, path, parse(path))
         text = path.read_text(encoding="utf-8")  # and a plain grep, whatever the names
         found += [f"{path.relative_to(ROOT)}: {m.group(0)}" for m in grep.finditer(text)]
-    assert found == [], ("only bendpam.law (and bendpam.models, bendpam.braid) may call the models' "
-                         "coefficients/basis; use bendpam.MomentLaw:\n" + "\n".join(found))
+    assert found == [], ("only bendpam.physics.law (and bendpam.physics.models, bendpam.physics.braid) may call "
+                         "the models' coefficients/basis; use bendpam.MomentLaw:\n" + "\n".join(found))
+
+
+# ------------------------------------------------------------------------------------------------
+# layers (issue 20): every import goes downward, function-level imports included
+# ------------------------------------------------------------------------------------------------
+#: Rank of each layer; a module may import only modules of its own rank or below (and no cycle).
+#: ``infra`` sits beside the layers: it imports only rank 0, so every layer may use it.
+RANKS = {
+    "bendpam.errors": 0, "bendpam.validate": 0, "bendpam.version": 0,
+    "bendpam.infra": 0.5,
+    "bendpam.physics": 1,
+    "bendpam.predict": 2, "bendpam.sweeps": 2,
+    "bendpam.lab": 3, "bendpam.identify": 3, "bendpam.design": 3,
+    "bendpam.present": 4,
+    "bendpam.cli": 5,
+    "bendpam": 6,  # the facade (bendpam/__init__.py) re-exports from every layer
+}
+
+
+def is_alias_module(path: Path) -> bool:
+    """A module kept for one release as an alias of its new home (``bendpam.law``)."""
+    return "alias_module(__name__" in path.read_text(encoding="utf-8")
+
+
+ALIASES = {name for name, path in MODULES.items() if is_alias_module(path)}
+LAYERED = {name: path for name, path in MODULES.items() if name not in ALIASES and name != "bendpam._compat"}
+
+
+def rank(module: str) -> float:
+    """The rank of a module: that of the longest layer prefix of its name."""
+    best = None
+    for layer in RANKS:
+        if module == layer or module.startswith(layer + "."):
+            if best is None or len(layer) > len(best):
+                best = layer
+    if best is None:
+        raise KeyError(module)
+    return RANKS[best]
+
+
+def all_imports(tree: ast.Module) -> list:
+    """Every import statement that runs at some time: module level and inside functions, but not the
+    ones under ``if TYPE_CHECKING:`` (annotations only)."""
+    skip = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.If) and _is_type_checking(node.test):
+            for inner in node.body:
+                skip.update(id(n) for n in ast.walk(inner))
+    return [n for n in ast.walk(tree) if isinstance(n, (ast.Import, ast.ImportFrom)) and id(n) not in skip]
+
+
+def string_imports(tree: ast.Module) -> list[tuple[int, str]]:
+    """``importlib.import_module("bendpam....")`` calls with a literal name."""
+    out = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Call) and ast.unparse(node.func).endswith("import_module") and node.args:
+            arg = node.args[0]
+            if isinstance(arg, ast.Constant) and isinstance(arg.value, str) and arg.value.startswith("bendpam"):
+                out.append((node.lineno, arg.value))
+    return out
+
+
+def full_graph() -> dict[str, set[str]]:
+    graph: dict[str, set[str]] = {}
+    for name, path in LAYERED.items():
+        edges = set()
+        for node in all_imports(parse(path)):
+            for target, _ in resolve(name, path, node):
+                if (target != name and target not in ("bendpam.version",)) or target == "bendpam.version":
+                    edges.add(target)
+        graph[name] = {e for e in edges if e != name}
+    return graph
+
+
+#: The one sanctioned lazy route upward: a result's ``.plot()`` asks the accessor registry by name.
+STRING_IMPORT_ALLOWED = {("bendpam.infra.accessors", "bendpam.present.figures")}
+
+
+def upward_imports() -> list[str]:
+    bad = []
+    for name, path in LAYERED.items():
+        tree = parse(path)
+        for node in all_imports(tree):
+            for target, _ in resolve(name, path, node):
+                if target == name or (target in ALIASES and False):
+                    continue
+                if target in ALIASES or target.split(".")[:2] == ["bendpam", "_compat"]:
+                    bad.append(f"{path.relative_to(ROOT).as_posix()}:{node.lineno}: imports the old path {target}")
+                    continue
+                if name != "bendpam" and target == "bendpam":
+                    bad.append(f"{path.relative_to(ROOT).as_posix()}:{node.lineno}: imports the facade `bendpam`")
+                elif rank(target) > rank(name):
+                    bad.append(f"{path.relative_to(ROOT).as_posix()}:{node.lineno}: {name} (rank {rank(name)}) "
+                               f"imports {target} (rank {rank(target)})")
+        for lineno, target in string_imports(tree):
+            if name == "bendpam":
+                continue  # the facade's lazy attributes
+            if rank(target) > rank(name) and (name, target) not in STRING_IMPORT_ALLOWED:
+                bad.append(f"{path.relative_to(ROOT).as_posix()}:{lineno}: {name} loads {target} by name")
+    return bad
+
+
+def test_rank_table_covers_every_module():
+    for name in LAYERED:
+        rank(name)  # raises KeyError for a module outside every layer
+
+
+def test_the_layer_check_sees_function_level_and_upward_imports():
+    tree = ast.parse("def f():\n    from bendpam.present.figures import figure4\n"
+                     "from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from bendpam.cli.app import main\n")
+    found = [t for n in all_imports(tree) for t, _ in resolve("bendpam.lab.x", SRC / "lab" / "x.py", n)]
+    assert found == ["bendpam.present.figures"]
+    assert rank("bendpam.present.figures") > rank("bendpam.lab.processing") > rank("bendpam.physics.law")
+    assert rank("bendpam.infra.outputs") < rank("bendpam.physics.law")
+    assert string_imports(ast.parse("importlib.import_module('bendpam.cli.app')")) == [(1, "bendpam.cli.app")]
+
+
+@pytest.mark.xfail(reason="issue 20: fixed layer by layer; the marker goes when they are", strict=False)
+def test_no_import_goes_up_a_layer():
+    bad = upward_imports()
+    assert bad == [], "imports that go up a layer (function-level ones included):\n" + "\n".join(bad)
+
+
+@pytest.mark.xfail(reason="issue 20: fixed layer by layer; the marker goes when they are", strict=False)
+def test_no_cycle_counting_function_level_imports():
+    cycles = find_cycles({k: {v for v in vs if v in LAYERED} for k, vs in full_graph().items()})
+    assert cycles == [], "import cycles (function-level imports included): " + "; ".join(" -> ".join(c) for c in cycles)
+
+
+def _all_of(path: Path) -> set[str] | None:
+    for node in parse(path).body:
+        if isinstance(node, ast.Assign) and any(getattr(t, "id", "") == "__all__" for t in node.targets):
+            return set(ast.literal_eval(node.value))
+    return None
+
+
+def names_used_outside_all() -> list[str]:
+    """``from bendpam.x import name`` across modules where ``name`` is not in ``bendpam.x.__all__``."""
+    bad = []
+    for name, path in LAYERED.items():
+        for node in all_imports(parse(path)):
+            if not isinstance(node, ast.ImportFrom):
+                continue
+            for target, imported in resolve(name, path, node):
+                if imported is None or target not in LAYERED or target == name or imported == "__version__":
+                    continue
+                exported = _all_of(LAYERED[target])
+                if exported is None or imported not in exported:
+                    bad.append(f"{path.relative_to(ROOT).as_posix()}:{node.lineno}: {imported} from {target}")
+    return sorted(set(bad))
+
+
+@pytest.mark.xfail(reason="issue 20: fixed layer by layer; the marker goes when they are", strict=False)
+def test_every_name_used_across_modules_is_in_its_modules_all():
+    bad = names_used_outside_all()
+    assert bad == [], "names imported from another module but missing from its __all__:\n" + "\n".join(bad)
+
+
+CLI_FLAG = re.compile(r"(?<![\w-])--[a-z][a-z0-9]*(?:-[a-z0-9]+)*")
+
+
+def library_messages_naming_flags() -> list[str]:
+    """Strings in ``raise``/``warnings.warn`` outside the command line that name a ``--flag``."""
+    bad = []
+    for name, path in LAYERED.items():
+        if name.startswith("bendpam.cli"):
+            continue
+        for node in ast.walk(parse(path)):
+            if isinstance(node, ast.Raise) and node.exc is not None:
+                msg = node.exc
+            elif isinstance(node, ast.Call) and ast.unparse(node.func) in ("warnings.warn", "warn"):
+                msg = node
+            else:
+                continue
+            for sub in ast.walk(msg):
+                if isinstance(sub, ast.Constant) and isinstance(sub.value, str) and CLI_FLAG.search(sub.value):
+                    flag = CLI_FLAG.search(sub.value).group(0)
+                    bad.append(f"{path.relative_to(ROOT).as_posix()}:{sub.lineno}: {flag}")
+    return bad
+
+
+@pytest.mark.xfail(reason="issue 20: fixed layer by layer; the marker goes when they are", strict=False)
+def test_no_library_message_names_a_cli_flag():
+    bad = library_messages_naming_flags()
+    assert bad == [], "library errors and warnings name CLI flags (errors.py: the CLI adds those):\n" + "\n".join(bad)
+
+
+def test_the_flag_check_sees_a_flag():
+    tree = ast.parse("def f():\n    raise InputError(f'x is bad; pass --out-dir or --force')\n")
+    assert CLI_FLAG.search(ast.unparse(tree)).group(0) == "--out-dir"
+
+
+# ------------------------------------------------------------------------------------------------
+# sizes (issue 20): no function over 80 lines, no file over 1000 lines
+# ------------------------------------------------------------------------------------------------
+MAX_FUNCTION_LINES = 80
+MAX_FILE_LINES = 1000
+
+
+def long_functions() -> list[str]:
+    out = []
+    for path in LAYERED.values():
+        for node in ast.walk(parse(path)):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                n = node.end_lineno - node.lineno + 1
+                if n > MAX_FUNCTION_LINES:
+                    out.append(f"{path.relative_to(ROOT).as_posix()}:{node.lineno}: {node.name} ({n} lines)")
+    return out
+
+
+def long_files() -> list[str]:
+    out = []
+    for path in MODULES.values():
+        n = len(path.read_text(encoding="utf-8").splitlines())
+        if n > MAX_FILE_LINES:
+            out.append(f"{path.relative_to(ROOT).as_posix()} ({n} lines)")
+    return out
+
+
+@pytest.mark.xfail(reason="issue 20: fixed layer by layer; the marker goes when they are", strict=False)
+def test_no_function_is_over_80_lines():
+    bad = long_functions()
+    assert bad == [], f"functions over {MAX_FUNCTION_LINES} lines (carve them along their steps):\n" + "\n".join(bad)
+
+
+@pytest.mark.xfail(reason="issue 20: fixed layer by layer; the marker goes when they are", strict=False)
+def test_no_file_is_over_1000_lines():
+    bad = long_files()
+    assert bad == [], f"files over {MAX_FILE_LINES} lines:\n" + "\n".join(bad)

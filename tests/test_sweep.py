@@ -47,7 +47,7 @@ def test_sweep_equals_direct_evaluation(name, model):
                 assert mp == pytest.approx(br.max_pressure_kpa, rel=1e-9)
             else:
                 assert mp == np.inf
-            # the limits are bendpam.limits of the same actuator (the margins: safety factors; a fold's
+            # the limits are bendpam.physics.limits of the same actuator (the margins: safety factors; a fold's
             # curvature, which sets the BC-PAM's lock-up margin, is found to about 1e-8 on a flat maximum)
             lim = bendpam.limits(act, P, model)
             for name in ("frame_axial_force_n", "frame_stress_mpa", "buckling_margin", "lockup_margin",
@@ -222,9 +222,9 @@ def test_sweep_figure_fixes_the_requested_slice():
     import numpy as np
 
     import bendpam
-    from bendpam.plots import sweep_figure
+    from bendpam.present.figures import sweep_figure
 
-    ds = bendpam.sweep(bendpam.presets.be_pam(), [100.0, 150.0, 200.0], alpha0_deg=np.linspace(60, 80, 4),
+    ds = bendpam.sweep(bendpam.physics.presets.be_pam(), [100.0, 150.0, 200.0], alpha0_deg=np.linspace(60, 80, 4),
                        t0_mm=[2.0, 2.5])
     fig = sweep_figure(ds, at={"pressure_kpa": 151.0})
     assert "pressure_kpa = 150" in fig.axes[0].get_title()

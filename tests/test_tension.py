@@ -1,4 +1,4 @@
-"""Tension-test fit with admissible constants (bendpam.tension): synthetic, Treloar."""
+"""Tension-test fit with admissible constants (bendpam.identify.tension): synthetic, Treloar."""
 
 import json
 import math
@@ -9,9 +9,9 @@ import pandas as pd
 import pytest
 
 from bendpam.errors import FitError, InputError, ProcessingError
+from bendpam.identify.tension import TensionFit, fit_tension, tension_from_test
 from bendpam.lab import RawTest
-from bendpam.material import MooneyRivlin, admissible_shape_range
-from bendpam.tension import TensionFit, fit_tension, tension_from_test
+from bendpam.physics.material import MooneyRivlin, admissible_shape_range
 
 TRELOAR = Path(__file__).parent / "data" / "treloar_1944_uniaxial.csv"
 

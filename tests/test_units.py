@@ -19,9 +19,9 @@ from numpy.testing import assert_allclose
 
 import bendpam
 from bendpam import Actuator, presets
-from bendpam.checks import UnitWarning
 from bendpam.cli import main
-from bendpam.hysteresis import LoopModel, predict_cycle
+from bendpam.physics.hysteresis import LoopModel, predict_cycle
+from bendpam.validate import UnitWarning
 
 P_KPA = 150.0
 
@@ -229,7 +229,7 @@ def test_api_does_not_warn_for_kpa_or_zero():
     pytest.param(["stresses", "--preset", "be-pam", "--pressure-kpa", "0.15", "--out", "s.nc"], id="stresses"),
     pytest.param(["sweep", "--preset", "be-pam", "--pressure-kpa", "0.15", "--out", "w.nc"], id="sweep"),
 ], ids=lambda a: a[0] if isinstance(a, list) else None)
-@pytest.mark.filterwarnings("ignore::bendpam.checks.UnitWarning")  # printed by the commands that do not refuse
+@pytest.mark.filterwarnings("ignore::bendpam.validate.UnitWarning")  # printed by the commands that do not refuse
 def test_cli_refuses_mpa(capsys, tmp_path, monkeypatch, args):
     monkeypatch.chdir(tmp_path)
     i = args.index("--pressure-kpa") + 1

@@ -7,7 +7,7 @@ curvature in 1/mm, angles in degrees; the name of an argument, field, column or 
 Quick start::
 
     import bendpam
-    a = bendpam.presets.be_pam()
+    a = bendpam.physics.presets.be_pam()
     bendpam.blocked_moment(a, 200.0)               # N*mm at 200 kPa
     bendpam.free_curvature(a, [100.0, 200.0]).angle_deg
     law = bendpam.MomentLaw.of(a, "energy")         # the moment law as one object
@@ -20,15 +20,15 @@ from __future__ import annotations
 
 from typing import Any
 
-from . import braid, errors, material, models, presets
-from .actuator import NEUTRAL_ANGLE_DEG, Actuator, ModelParams
-from .braid import CurvatureLimits, Kinematics, curvature_limits
-from .checks import UnitWarning
-from .errors import BendpamError, FileFormatError, FitError, InputError, NoEquilibrium, ProcessingError
-from .law import FreeBending, FreeBranch, MomentLaw, MomentTable, StableBranch
-from .limits import Limits, limits
-from .material import MooneyRivlin
-from .predict import (
+from bendpam import errors
+from bendpam.errors import BendpamError, FileFormatError, FitError, InputError, NoEquilibrium, ProcessingError
+from bendpam.physics import braid, material, models, presets
+from bendpam.physics.actuator import NEUTRAL_ANGLE_DEG, Actuator, ModelParams
+from bendpam.physics.braid import CurvatureLimits, Kinematics, curvature_limits
+from bendpam.physics.law import FreeBending, FreeBranch, MomentLaw, MomentTable, StableBranch
+from bendpam.physics.limits import Limits, limits
+from bendpam.physics.material import MooneyRivlin
+from bendpam.predict import (
     active_pressure_kpa,
     blocked_moment,
     free_branch,
@@ -40,8 +40,8 @@ from .predict import (
     prediction_table,
     tangent_stiffness,
 )
-
-__version__ = "0.3.0"
+from bendpam.validate import UnitWarning
+from bendpam.version import __version__ as __version__
 
 __all__ = [
     "NEUTRAL_ANGLE_DEG",
@@ -92,19 +92,22 @@ __all__ = [
 _LAZY = {
     "sweep": ("sweeps", "sweep"),
     "design_actuator": ("design.inverse", "design_actuator"),
-    "fit": ("identify", "fit"),
+    "fit": ("identify.fitting", "fit"),
     "read_test": ("lab.readers", "read_test"),
     "process_tests": ("lab.processing", "process_tests"),
     "simulate_test": ("lab.simulate", "simulate_test"),
-    "fast": ("fast", None),
+    "fast": ("physics.fast", None),
     "sweeps": ("sweeps", None),
     "identify": ("identify", None),
-    "hysteresis": ("hysteresis", None),
+    "hysteresis": ("physics.hysteresis", None),
     "design": ("design", None),
     "lab": ("lab", None),
-    "plots": ("plots", None),
-    "report": ("report", None),
-    "fixture": ("fixture", None),
+    "physics": ("physics", None),
+    "present": ("present", None),
+    "infra": ("infra", None),
+    "plots": ("present.figures", None),
+    "report": ("present.report", None),
+    "fixture": ("physics.fixture", None),
 }
 
 

@@ -29,7 +29,7 @@ class BendpamError(Exception):
     --------
     >>> import bendpam
     >>> try:
-    ...     bendpam.presets.get("xx-pam")
+    ...     bendpam.physics.presets.get("xx-pam")
     ... except bendpam.BendpamError as exc:
     ...     print(type(exc).__name__, "-", exc)
     InputError - unknown preset 'xx-pam'; choose one of: be-pam, bc-pam
@@ -42,7 +42,7 @@ class InputError(BendpamError, ValueError):
     Examples
     --------
     >>> import bendpam
-    >>> bendpam.blocked_moment(bendpam.presets.be_pam(), -10.0)
+    >>> bendpam.blocked_moment(bendpam.physics.presets.be_pam(), -10.0)
     Traceback (most recent call last):
     ...
     bendpam.errors.InputError: pressure_kpa = -10 kPa at index 0 is below zero; allowed range [0, inf) kPa (gauge)
@@ -87,7 +87,7 @@ class NoEquilibrium(BendpamError, ValueError):
     >>> import bendpam
     >>> from bendpam.design import Finger, linear_tip_compliance
     >>> try:
-    ...     linear_tip_compliance(Finger(bendpam.presets.bc_pam()), 150.0)
+    ...     linear_tip_compliance(Finger(bendpam.physics.presets.bc_pam()), 150.0)
     ... except bendpam.NoEquilibrium as exc:
     ...     print(exc)
     pressure_kpa = 150 kPa has no free-bending equilibrium: fold of the moment-curvature curve ...
@@ -100,7 +100,7 @@ class FitError(BendpamError, ValueError):
     Examples
     --------
     >>> import numpy as np
-    >>> from bendpam.tension import fit_tension
+    >>> from bendpam.identify.tension import fit_tension
     >>> stretch = np.linspace(1.0, 1.5, 10)
     >>> fit_tension(stretch, -100.0 * (stretch - 1.0))      # stress falling with stretch
     Traceback (most recent call last):

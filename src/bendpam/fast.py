@@ -1,29 +1,5 @@
-"""The fast path: evaluate the moment law from cached spline tables.
+"""Deprecated alias of :mod:`bendpam.physics.fast` (moved in 0.4; this alias is removed in 0.5)."""
 
-The table itself is :class:`bendpam.MomentTable`, owned by the law
-(:meth:`bendpam.MomentLaw.tabulated`): ``A(k')`` and ``B(k')/k'`` on Chebyshev-Lobatto knots on
-each side of ``k' = 0``, interpolated by a C2 cubic spline, with the interpolation error measured
-at build time against the exact path and the knots doubled until it is below ``tol``.  This
-module gives the shortcut :func:`moment_table` (the cached table of an actuator and model).
+from bendpam._compat import alias_module
 
->>> import bendpam
->>> from bendpam.fast import moment_table
->>> t = moment_table(bendpam.presets.be_pam())
->>> t.max_rel_error < 1e-6
-True
->>> round(float(t(200.0, 0.0)), 1)
-310.3
-"""
-
-from __future__ import annotations
-
-from .actuator import Actuator
-from .law import MomentLaw, MomentTable
-
-__all__ = ["MomentTable", "moment_table"]
-
-
-def moment_table(actuator: Actuator, model: str = "energy", *, eq19_factor: bool = True,
-                 tol: float = 1e-6) -> MomentTable:
-    """The cached :class:`MomentTable` of ``actuator`` and ``model`` (built on first use)."""
-    return MomentLaw.of(actuator, model, eq19_factor=eq19_factor).tabulated(tol)
+alias_module(__name__, "bendpam.physics.fast")

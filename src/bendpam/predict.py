@@ -6,7 +6,7 @@ the units a user types:
 * pressure ``pressure_kpa``: kPa (gauge), >= 0.  The active pressure is ``max(P - P_start, 0)``
   (eq 50): below the threshold the actuator gives only its passive (frame + bladder) response.
   A set of pressures whose every nonzero value is below 5 kPa raises a
-  :class:`~bendpam.checks.UnitWarning` (MPa passed as kPa?).
+  :class:`~bendpam.validate.UnitWarning` (MPa passed as kPa?).
 * curvature ``curvature_per_mm``: the frame curvature k', 1/mm, positive toward the frame.  BE-PAMs
   bend freely with k' > 0, BC-PAMs with k' < 0 (docs/paper-reading.md item 17).
 * moments: N*mm; stiffness dM/dk': N*mm^2.
@@ -21,13 +21,13 @@ from typing import Any
 
 import numpy as np
 
-from .actuator import Actuator
-from .braid import DEFAULT_ORDER, Kinematics
-from .braid import kinematics as _kinematics
-from .checks import pressure_kpa as _check_pressure
-from .errors import InputError
-from .law import FreeBending, FreeBranch, MomentLaw
-from .models import force_balance as _fb
+from bendpam.errors import InputError
+from bendpam.physics.actuator import Actuator
+from bendpam.physics.braid import DEFAULT_ORDER, Kinematics
+from bendpam.physics.braid import kinematics as _kinematics
+from bendpam.physics.law import FreeBending, FreeBranch, MomentLaw
+from bendpam.physics.models import force_balance as _fb
+from bendpam.validate import pressure_kpa as _check_pressure
 
 __all__ = [
     "active_pressure_kpa",
@@ -51,7 +51,7 @@ def active_pressure_kpa(actuator: Actuator, pressure_kpa) -> np.ndarray:
     """Active pressure ``max(P - P_start, 0)`` in kPa (eq 50).
 
     >>> import bendpam
-    >>> bendpam.active_pressure_kpa(bendpam.presets.be_pam(), [50, 200]).tolist()
+    >>> bendpam.active_pressure_kpa(bendpam.physics.presets.be_pam(), [50, 200]).tolist()
     [0.0, 132.0]
     """
     if not isinstance(actuator, Actuator):
@@ -60,10 +60,10 @@ def active_pressure_kpa(actuator: Actuator, pressure_kpa) -> np.ndarray:
 
 
 def kinematics(actuator: Actuator, curvature_per_mm, *, order: int = DEFAULT_ORDER) -> Kinematics:
-    """Braid kinematics at ``curvature_per_mm`` (1/mm): see :class:`bendpam.braid.Kinematics` (eq 1-5).
+    """Braid kinematics at ``curvature_per_mm`` (1/mm): see :class:`bendpam.physics.braid.Kinematics` (eq 1-5).
 
     >>> import bendpam
-    >>> kin = bendpam.kinematics(bendpam.presets.be_pam(), 0.01)
+    >>> kin = bendpam.kinematics(bendpam.physics.presets.be_pam(), 0.01)
     >>> round(float(kin.radius), 3), round(float(kin.eta), 4), round(float(kin.axis_curvature), 6)
     (9.949, 0.9851, 0.009095)
     """
@@ -98,7 +98,7 @@ def moment(actuator: Actuator, pressure_kpa, curvature_per_mm, model: str = "ene
     Examples
     --------
     >>> import numpy as np, bendpam
-    >>> be = bendpam.presets.be_pam()
+    >>> be = bendpam.physics.presets.be_pam()
     >>> bendpam.moment(be, [[100.0], [200.0]], [0.0, 0.01]).round(1).tolist()
     [[75.2, -130.1], [310.3, 63.2]]
     """
@@ -113,7 +113,7 @@ def moment_terms(actuator: Actuator, pressure_kpa, curvature_per_mm, model: str 
     Force-balance model: ``M_load, M_p, M_frame, M_bl, M_br`` (eq 23-28, 49).
 
     >>> import bendpam
-    >>> t = bendpam.moment_terms(bendpam.presets.be_pam(), 200.0, 0.01)
+    >>> t = bendpam.moment_terms(bendpam.physics.presets.be_pam(), 200.0, 0.01)
     >>> sorted(t)
     ['M_air', 'M_bl', 'M_f', 'M_load']
     """
@@ -128,7 +128,7 @@ def blocked_moment(actuator: Actuator, pressure_kpa, model: str = "energy", *, e
     (docs/paper-reading.md item 14); the result is negative for a BC-PAM.
 
     >>> import bendpam
-    >>> round(float(bendpam.blocked_moment(bendpam.presets.be_pam(), 200.0)), 1)
+    >>> round(float(bendpam.blocked_moment(bendpam.physics.presets.be_pam(), 200.0)), 1)
     310.3
     """
     return _law(actuator, model, eq19_factor, order).blocked_moment(pressure_kpa)
@@ -139,7 +139,7 @@ def tangent_stiffness(actuator: Actuator, pressure_kpa, curvature_per_mm, model:
     """Tangent stiffness ``dM/dk'`` in N*mm^2 (fourth-order central difference of A and B).
 
     >>> import bendpam
-    >>> bool(bendpam.tangent_stiffness(bendpam.presets.be_pam(), 150.0, 0.005) < 0)
+    >>> bool(bendpam.tangent_stiffness(bendpam.physics.presets.be_pam(), 150.0, 0.005) < 0)
     True
     """
     return _law(actuator, model, eq19_factor, order).tangent_stiffness(pressure_kpa, curvature_per_mm)
@@ -150,7 +150,7 @@ def free_branch(actuator: Actuator, model: str = "energy", *, eq19_factor: bool 
     """The free-bending branch of ``actuator``: fold or lock-up pressure and the sampled curve.
 
     >>> import bendpam
-    >>> br = bendpam.free_branch(bendpam.presets.bc_pam())
+    >>> br = bendpam.free_branch(bendpam.physics.presets.bc_pam())
     >>> br.kind, round(br.max_pressure_kpa, 1)
     ('fold', 134.2)
     """
@@ -168,7 +168,7 @@ def free_curvature(actuator: Actuator, pressure_kpa, model: str = "energy", *, e
     disconnected branch beyond a fold is never returned.
 
     >>> import bendpam
-    >>> fb = bendpam.free_curvature(bendpam.presets.bc_pam(), [100.0, 150.0])
+    >>> fb = bendpam.free_curvature(bendpam.physics.presets.bc_pam(), [100.0, 150.0])
     >>> fb.status.tolist(), round(fb.max_pressure_kpa, 1)
     (['ok', 'no-equilibrium'], 134.2)
     """
@@ -215,7 +215,7 @@ def internal_stresses(actuator: Actuator, pressure_kpa, curvature_per_mm, *, n_p
     Examples
     --------
     >>> import bendpam
-    >>> ds = bendpam.internal_stresses(bendpam.presets.bc_pam("force_balance"), 120.0, -0.006)
+    >>> ds = bendpam.internal_stresses(bendpam.physics.presets.bc_pam("force_balance"), 120.0, -0.006)
     >>> ds["P_e_kpa"].attrs["units"], ds["sigma_bl1_kpa"].dims
     ('kPa', ('phi_deg',))
     """
@@ -286,7 +286,7 @@ def prediction_table(actuator: Actuator, pressure_kpa, model: str = "energy", *,
     """Blocked moment, free bending and the structural limits at each pressure, as a :class:`pandas.DataFrame`.
 
     Columns: ``pressure_kpa``, ``blocked_moment_nmm``, ``free_curvature_per_mm``,
-    ``free_angle_deg``; the limits of :func:`bendpam.limits` (the worse of the blocked and free
+    ``free_angle_deg``; the limits of :func:`bendpam.physics.limits` (the worse of the blocked and free
     states): ``frame_axial_force_n``, ``frame_stress_mpa``, the safety factors
     ``frame_strength_margin``, ``buckling_margin``, ``lockup_margin``, ``bladder_stretch_margin``
     (>= 1 within the limit, inf without demand or limit), ``bladder_stretch_max`` and
@@ -295,12 +295,12 @@ def prediction_table(actuator: Actuator, pressure_kpa, model: str = "energy", *,
     Signs follow the paper: k' > 0 toward the frame, so BC-PAM values are negative.
 
     >>> import bendpam
-    >>> bendpam.prediction_table(bendpam.presets.be_pam(), [100, 200]).columns.tolist()[:3]
+    >>> bendpam.prediction_table(bendpam.physics.presets.be_pam(), [100, 200]).columns.tolist()[:3]
     ['pressure_kpa', 'blocked_moment_nmm', 'free_curvature_per_mm']
     """
     import pandas as pd
 
-    from .limits import OUTPUTS, limits
+    from bendpam.physics.limits import OUTPUTS, limits
 
     law = _law(actuator, model, eq19_factor, order)
     P = np.atleast_1d(_check_pressure(pressure_kpa))

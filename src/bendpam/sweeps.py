@@ -12,7 +12,7 @@ combination of the swept parameters (an "actuator case") at every pressure and r
 * ``max_pressure_kpa`` (case): the highest pressure with a free-bending equilibrium (the fold or
   lock-up pressure; ``inf`` if unbounded) and ``branch_end`` (0 lock-up, 1 fold, 2 unbounded,
   3 neutral);
-* the structural limits of :mod:`bendpam.limits` (case, pressure), each the worse of the blocked and
+* the structural limits of :mod:`bendpam.physics.limits` (case, pressure), each the worse of the blocked and
   free-bending states: ``frame_axial_force_n``, ``frame_stress_mpa`` (largest combined axial and
   bending stress), and the safety factors (capacity / demand, >= 1 within the limit, inf without
   demand or limit) ``frame_strength_margin``, ``buckling_margin`` (frame on the bladder as an
@@ -46,7 +46,7 @@ Files and progress
     :func:`to_table` turns a sweep into a tidy long table (one row per case and pressure,
     unit-named columns); :func:`write_sweep` writes it atomically as NetCDF, CSV or Parquet
     (Parquet needs ``pip install "bendpam[parquet]"``).  ``progress`` reports each finished block
-    (a :class:`bendpam.progress.Progress` on stderr, or a callback), in-process and on a cluster.
+    (a :class:`bendpam.infra.progress.Progress` on stderr, or a callback), in-process and on a cluster.
 """
 
 from __future__ import annotations
@@ -58,13 +58,13 @@ from typing import Any
 
 import numpy as np
 
-from .actuator import Actuator, ModelParams
-from .braid import DEFAULT_ORDER
-from .errors import InputError
-from .law import MomentLaw
-from .limits import OUTPUTS as _LIMIT_OUTPUTS
-from .limits import case_limits
-from .models import normalise_model
+from bendpam.errors import InputError
+from bendpam.physics.actuator import Actuator, ModelParams
+from bendpam.physics.braid import DEFAULT_ORDER
+from bendpam.physics.law import MomentLaw
+from bendpam.physics.limits import OUTPUTS as _LIMIT_OUTPUTS
+from bendpam.physics.limits import case_limits
+from bendpam.physics.models import normalise_model
 
 __all__ = ["SWEEP_FORMATS", "SWEEP_PARAMETERS", "build_cases", "evaluate_cases", "sweep", "sweep_format", "to_table",
            "write_sweep"]
@@ -82,7 +82,7 @@ _UNITS = {
     "blocked_moment_nmm": ("N*mm", "blocked moment M(P, 0)"),
     "free_curvature_per_mm": ("1/mm", "free-bending frame curvature k' (NaN: no equilibrium on the branch)"),
     "free_angle_deg": ("deg", "free-bending angle k' L0"),
-    **_LIMIT_OUTPUTS,  # frame force and stress, the margins (bendpam.limits)
+    **_LIMIT_OUTPUTS,  # frame force and stress, the margins (bendpam.physics.limits)
     "max_pressure_kpa": ("kPa", "highest pressure with a free-bending equilibrium (fold or lock-up)"),
     "branch_end": ("1", "end of the free-bending branch: 0 lock-up, 1 fold, 2 unbounded, 3 neutral"),
 }
@@ -206,7 +206,7 @@ def sweep(base_actuator: Actuator, pressure_kpa, model: str = "energy", *, chunk
     scheduler : address of a Dask distributed scheduler (e.g. ``"tcp://127.0.0.1:8786"``).
     workers : start a ``LocalCluster`` with this many worker processes (loopback only).
     compute : return computed (NumPy-backed) data; ``False`` keeps a lazy Dask-backed dataset.
-    progress : ``True``: report progress on stderr with :class:`bendpam.progress.Progress` (a bar
+    progress : ``True``: report progress on stderr with :class:`bendpam.infra.progress.Progress` (a bar
         on a terminal, periodic lines otherwise); a callable: called as ``progress(n)`` with the
         number of cases of each block when it is done (from worker threads on the Dask
         threaded scheduler, so it must be thread-safe; ``Progress.advance`` is); ``False``: no
@@ -217,7 +217,7 @@ def sweep(base_actuator: Actuator, pressure_kpa, model: str = "energy", *, chunk
     Examples
     --------
     >>> import bendpam
-    >>> ds = bendpam.sweep(bendpam.presets.be_pam(), pressure_kpa=[150.0, 200.0], alpha0_deg=[65.0, 70.0, 75.0])
+    >>> ds = bendpam.sweep(bendpam.physics.presets.be_pam(), pressure_kpa=[150.0, 200.0], alpha0_deg=[65.0, 70.0, 75.0])
     >>> list(ds.dims), ds["blocked_moment_nmm"].attrs["units"]
     (['alpha0_deg', 'pressure_kpa'], 'N*mm')
     >>> ds["free_angle_deg"].round(1).values.tolist()      # rows: braid angle, columns: pressure
@@ -256,7 +256,7 @@ def sweep(base_actuator: Actuator, pressure_kpa, model: str = "energy", *, chunk
         if callable(show):
             report = show
         elif show and compute:
-            from .progress import Progress
+            from bendpam.infra.progress import Progress
 
             report = stack.enter_context(Progress(n_cases, "sweep")).advance
         else:
@@ -449,7 +449,7 @@ def to_table(ds) -> Any:
     --------
     >>> import bendpam
     >>> from bendpam.sweeps import sweep, to_table
-    >>> ds = sweep(bendpam.presets.get("be-pam"), [100, 200], alpha0_deg=[70, 72, 74])
+    >>> ds = sweep(bendpam.physics.presets.get("be-pam"), [100, 200], alpha0_deg=[70, 72, 74])
     >>> t = to_table(ds)
     >>> t.shape[0], list(t.columns[:3])
     (6, ['alpha0_deg', 'pressure_kpa', 'blocked_moment_nmm'])
@@ -518,7 +518,7 @@ def write_sweep(ds, path, format: str | None = None) -> Any:
     Examples
     --------
     >>> import tempfile, pathlib, pandas as pd, bendpam
-    >>> ds = sweep(bendpam.presets.get("be-pam"), [150], alpha0_deg=[70, 74])
+    >>> ds = sweep(bendpam.physics.presets.get("be-pam"), [150], alpha0_deg=[70, 74])
     >>> with tempfile.TemporaryDirectory() as d:
     ...     p = write_sweep(ds, pathlib.Path(d) / "s.csv")
     ...     len(pd.read_csv(p))
@@ -526,7 +526,7 @@ def write_sweep(ds, path, format: str | None = None) -> Any:
     """
     from pathlib import Path
 
-    from .atomic import atomic_path
+    from bendpam.infra.atomic import atomic_path
 
     fmt = sweep_format(path, format)
     if fmt == "parquet":

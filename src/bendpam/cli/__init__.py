@@ -13,8 +13,8 @@
 
 from __future__ import annotations
 
-from . import design, identify, inverse, lab, predict, report, sweep  # noqa: F401  (registers the commands)
-from .app import app, main
+from bendpam.cli import design, identify, inverse, lab, predict, report, sweep  # noqa: F401  (registers the commands)
+from bendpam.cli.app import app, main
 
 report.register(app)
 design.register(app)

@@ -35,7 +35,7 @@ def _version(value: bool) -> None:
         try:
             v = version("bendpam")
         except PackageNotFoundError:  # pragma: no cover - running from a source tree
-            from .. import __version__ as v
+            from bendpam.version import __version__ as v
         typer.echo(f"bendpam {v}")
         raise typer.Exit(0)
 
@@ -68,13 +68,13 @@ def main(argv: list[str] | None = None) -> int:
     >>> main(["predict", "--preset", "xx-pam", "--pressure-kpa", "100"])   # one line on stderr
     2
     """
-    from ..errors import BendpamError
+    from bendpam.errors import BendpamError
 
     args = list(sys.argv[1:] if argv is None else argv)
     if not args:
         args = ["--help"]
     debug = "--debug" in args
-    from ..outputs import Interrupted, interrupts
+    from bendpam.infra.outputs import Interrupted, interrupts
 
     try:
         with interrupts():

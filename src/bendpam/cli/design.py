@@ -19,7 +19,7 @@ from typing import Annotated, Optional
 
 import typer
 
-from .options import fmt_num as _fmt
+from bendpam.cli.options import fmt_num as _fmt
 
 __all__ = ["register"]
 
@@ -32,7 +32,7 @@ def _num(x):
 
 
 def _pair(text: str, name: str, unit: str) -> tuple[float, float]:
-    from .options import UserError
+    from bendpam.cli.options import UserError
 
     parts = [p for p in str(text).replace(";", ",").split(",") if p.strip()]
     try:
@@ -46,7 +46,7 @@ def _pair(text: str, name: str, unit: str) -> tuple[float, float]:
 
 def _plot_target(plot: Optional[Path], fmt=None):
     """Check --plot and --format (png, pdf or svg; from the suffix if --format is not given); returns --plot."""
-    from .options import UserError, figure_format
+    from bendpam.cli.options import UserError, figure_format
 
     if plot is None:
         if fmt is not None:
@@ -58,8 +58,8 @@ def _plot_target(plot: Optional[Path], fmt=None):
 
 def _save_plot(draw, plot: Path, fmt=None, aspect: float = 0.8) -> None:
     """Draw ``draw(ax)`` on a single-column journal figure and write it to --plot (format as checked above)."""
-    from ..plots import save_figure, styled_figure
-    from .options import figure_format
+    from bendpam.cli.options import figure_format
+    from bendpam.present.figures import save_figure, styled_figure
 
     save_figure(styled_figure(draw, "single", aspect), plot, format=figure_format(plot, fmt, "--plot"))
 
@@ -70,14 +70,14 @@ MAX_DESIGN_POINTS = 10_000
 
 def _budget(n: int, what: str) -> None:
     """Refuse a design grid of more than :data:`MAX_DESIGN_POINTS` points before computing it."""
-    from .options import UserError
+    from bendpam.cli.options import UserError
 
     if n > MAX_DESIGN_POINTS:
         raise UserError(f"{what} = {n} points; at most {MAX_DESIGN_POINTS} (about 10 ms each): give fewer values")
 
 
 def _length(act, l0_mm):
-    from .options import UserError
+    from bendpam.cli.options import UserError
 
     if l0_mm is None:
         return act
@@ -88,7 +88,7 @@ def _length(act, l0_mm):
 
 def register(app: typer.Typer) -> typer.Typer:
     """Add the ``finger``, ``grasp`` and ``wrist`` commands to ``app`` (once; returns ``app``)."""
-    from .options import (
+    from bendpam.cli.options import (
         ActuatorOpt,
         FigureFormatOpt,
         Model,
@@ -135,8 +135,8 @@ def register(app: typer.Typer) -> typer.Typer:
         fig_format: FigureFormatOpt = None,
     ):
         """Equilibrium shape and tip pose of a finger under tip force, tip mass and self-weight."""
-        from ..design.finger import Finger, FingerLoads, blocked_tip_force, finger_sweep
-        from .options import UserError, load_actuator, model_name, pressures_kpa
+        from bendpam.cli.options import UserError, load_actuator, model_name, pressures_kpa
+        from bendpam.design.finger import Finger, FingerLoads, blocked_tip_force, finger_sweep
 
         act = _length(load_actuator(preset, actuator, model), l0_mm)
         P = pressures_kpa(pressure_kpa)
@@ -156,7 +156,7 @@ def register(app: typer.Typer) -> typer.Typer:
         lims = [sh.limits() if sh.equilibrium else None for sh in shapes]  # worst section along the finger
         bforce = [blocked_tip_force(finger, p, loads=loads) for p in P] if blocked else None
         if plot is not None:
-            from ..design.finger import plot_finger_shapes
+            from bendpam.design.finger import plot_finger_shapes
 
             _save_plot(lambda ax: plot_finger_shapes(shapes, ax=ax, title=f"{act.name or act.kind}, "
                                                      f"L0 = {act.L0_mm:g} mm"), plot, fig_format, aspect=0.9)
@@ -257,7 +257,8 @@ def register(app: typer.Typer) -> typer.Typer:
         statics with their moment law, Coulomb stick/slip at the contacts); the grip force is the
         peak lifting load before the sphere escapes.
         """
-        from ..design.grasp import (
+        from bendpam.cli.options import UserError, load_actuator, model_name, parse_values, pressures_kpa
+        from bendpam.design.grasp import (
             DEFAULT_BASE_RADIUS_MM,
             DEFAULT_FINGERTIP_MM,
             DEFAULT_MU,
@@ -265,7 +266,6 @@ def register(app: typer.Typer) -> typer.Typer:
             Gripper,
             grasp_sweep,
         )
-        from .options import UserError, load_actuator, model_name, parse_values, pressures_kpa
 
         act = _length(load_actuator(preset, actuator, model), l0_mm)
         D = parse_values(diameter_mm, "--diameter-mm")
@@ -285,7 +285,7 @@ def register(app: typer.Typer) -> typer.Typer:
                      splay_deg=DEFAULT_SPLAY_DEG if splay_deg is None else splay_deg)
         ds = grasp_sweep(gr, D, P)
         if plot is not None:
-            from ..design.grasp import plot_grasp
+            from bendpam.design.grasp import plot_grasp
 
             _save_plot(lambda ax: plot_grasp(ds, ax=ax), plot, fig_format)
         rows = []
@@ -359,8 +359,8 @@ def register(app: typer.Typer) -> typer.Typer:
         quiet: QuietOpt = False,
     ):
         """Bending angle of a four-actuator wrist per direction, and the load it holds horizontally."""
-        from ..design.wrist import Wrist, wrist_hold, wrist_sweep
-        from .options import load_actuator, model_name, parse_values, pressures_kpa
+        from bendpam.cli.options import load_actuator, model_name, parse_values, pressures_kpa
+        from bendpam.design.wrist import Wrist, wrist_hold, wrist_sweep
 
         act = load_actuator(preset, actuator, model)
         P = pressures_kpa(pressure_kpa)
@@ -372,7 +372,7 @@ def register(app: typer.Typer) -> typer.Typer:
                   column_stiffness_nmm2=column_stiffness)
         import pandas as pd
 
-        from ..progress import Progress
+        from bendpam.infra.progress import Progress
 
         # one step per direction (each is independent of the others) and per holding pressure
         with Progress(len(dirs) + len(P), "wrist", quiet=quiet) as bar:
@@ -387,7 +387,7 @@ def register(app: typer.Typer) -> typer.Typer:
                                         hand_lever_mm=hand_lever_mm))
                 bar.advance()
         if plot is not None:
-            from ..design.wrist import plot_wrist
+            from bendpam.design.wrist import plot_wrist
 
             _save_plot(lambda ax: plot_wrist(table, holds, ax=ax, positions_deg=w.positions_deg,
                                              title=f"wrist of four {act.kind}s, L = {w.length_mm:g} mm"),

@@ -8,8 +8,8 @@ from typing import Annotated, Optional
 
 import typer
 
-from .app import app
-from .options import (
+from bendpam.cli.app import app
+from bendpam.cli.options import (
     ActuatorOpt,
     FigureFormatOpt,
     Model,
@@ -35,8 +35,8 @@ RangeOpt = Optional[tuple[float, float]]
 def tension_fit(path: Path, gauge_length_mm, area_mm2, width_mm, thickness_mm, stretch_range=None,
                 admissible_range=(0.6, 1.6)):
     """Read and fit a tension test from the command-line options: ``(TensionFit, TensionData)``."""
-    from ..lab import read_test
-    from ..tension import fit_tension, tension_data
+    from bendpam.identify.tension import fit_tension, tension_data
+    from bendpam.lab import read_test
 
     positive("--gauge-length-mm", gauge_length_mm, "mm")
     positive("--area-mm2", area_mm2, "mm^2")
@@ -87,9 +87,9 @@ def fit(
     figure: Annotated[bool, typer.Option("--figure/--no-figure", help="Draw figure7 (default).")] = True,
 ):
     """Identify model parameters (alpha0, C10, C01, ...) from processed cyclic tests (section 3.4)."""
-    from ..identify import fit as run_fit
-    from ..lab.processing import load_processed
-    from ..progress import Progress
+    from bendpam.identify.fitting import fit as run_fit
+    from bendpam.infra.progress import Progress
+    from bendpam.lab.processing import load_processed
 
     if out is None:
         raise UserError("give an output folder with --out OUTDIR")
@@ -112,7 +112,7 @@ def fit(
                 obj["tension"] = tfit.to_dict()
                 o.write_json("fit.json", obj)
             if figure:  # matplotlib is imported only when a figure is drawn
-                from ..plots import figure7, save_figure
+                from bendpam.present.figures import figure7, save_figure
 
                 save_figure(figure7(data, res), o.path(fig_name))
         bar.advance(0, description="fit")

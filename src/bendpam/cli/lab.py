@@ -7,8 +7,8 @@ from typing import Annotated, Optional
 
 import typer
 
-from .app import app
-from .options import (
+from bendpam.cli.app import app
+from bendpam.cli.options import (
     ActuatorOpt,
     FigureFormatOpt,
     Format,
@@ -51,8 +51,8 @@ def inspect(
     """What the reader understood of each file (format, encoding, channels, units, values), before processing."""
     import json
 
-    from ..lab import format_inspection, inspect_file
-    from ..outputs import json_safe
+    from bendpam.infra.outputs import json_safe
+    from bendpam.lab import format_inspection, inspect_file
 
     paths = collect_raw_files(files)
     infos = [inspect_file(p, pressure_kpa=pressure_kpa, columns=columns, rate_hz=rate_hz, repair=repair)
@@ -96,9 +96,9 @@ def process(
     quiet: QuietOpt = False,
 ):
     """Process raw four-point-bending cyclic tests into moment-curvature curves and Table 2 values."""
-    from ..fixture import Fixture
-    from ..lab import read_test
-    from ..lab.processing import ProcessingOptions, process_tests
+    from bendpam.lab import read_test
+    from bendpam.lab.processing import ProcessingOptions, process_tests
+    from bendpam.physics.fixture import Fixture
 
     if out is None:
         raise UserError("give an output folder with --out OUTDIR")
@@ -126,14 +126,14 @@ def process(
                             repair=repair)
             bar.advance()
 
-    from ..progress import Progress
+    from bendpam.infra.progress import Progress
 
     with output_set(out, inputs) as o, Progress(len(files) + 1, "process", quiet=quiet) as bar:
         processed = process_tests(tests(bar), fixture=fx, options=opts)
         bar.advance(0, description="process: writing")
         processed.save(o.staging, figure=False)
         if figure:
-            from ..plots import save_figure
+            from bendpam.present.figures import save_figure
 
             save_figure(processed.plot(), o.path(fig_name))
         bar.advance()
@@ -189,8 +189,8 @@ def simulate_test_cmd(
     seed: Annotated[Optional[int], typer.Option("--seed", help="Random seed.")] = None,
 ):
     """Write the raw files a testing machine would record for a model actuator (a virtual test)."""
-    from ..fixture import Fixture
-    from ..lab.simulate import SimulationSettings, simulate_tests
+    from bendpam.lab.simulate import SimulationSettings, simulate_tests
+    from bendpam.physics.fixture import Fixture
 
     if out is None:
         raise UserError("give an output folder with --out DIR")

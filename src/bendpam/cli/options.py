@@ -15,11 +15,11 @@ from typing import TYPE_CHECKING, Annotated, Optional
 import typer
 from typer.core import TyperCommand
 
-from ..checks import file_format
-from ..errors import InputError
+from bendpam.errors import InputError
+from bendpam.validate import file_format
 
 if TYPE_CHECKING:
-    from ..actuator import Actuator
+    from bendpam.physics.actuator import Actuator
 
 __all__ = [
     "FIGURE_FORMATS",
@@ -175,7 +175,7 @@ def pressures_kpa(first: list[str] | None, more: list[str] | None = None, name: 
 
 
 def model_name(model: Model) -> str:
-    from ..models import normalise_model
+    from bendpam.physics.models import normalise_model
 
     return normalise_model(model.value)
 
@@ -185,8 +185,8 @@ def load_actuator(preset: Preset | None, actuator: Path | None, model: Model) ->
         raise UserError("give either --preset or --actuator, not both")
     if preset is None and actuator is None:
         raise UserError("give an actuator: --preset be-pam|bc-pam or --actuator FILE.toml")
-    from .. import presets
-    from ..actuator import Actuator
+    from bendpam.physics import presets
+    from bendpam.physics.actuator import Actuator
 
     if preset is not None:
         return presets.get(preset.value, model_name(model))
@@ -220,7 +220,7 @@ def format_prediction_table(df, title: str) -> str:
 
 def collect_raw_files(paths: list[Path]) -> list[Path]:
     """Expand folders into their raw test files (see :func:`bendpam.lab.files.collect_raw_files`)."""
-    from ..lab.files import collect_raw_files as collect
+    from bendpam.lab.files import collect_raw_files as collect
 
     return collect(paths)
 
@@ -233,15 +233,15 @@ def command_line() -> list[str]:
 
 
 def output_set(out: Path, inputs=()):
-    """An :class:`~bendpam.outputs.OutputSet` for a command's output folder (whole set or nothing)."""
-    from ..outputs import OutputSet
+    """An :class:`~bendpam.infra.outputs.OutputSet` for a command's output folder (whole set or nothing)."""
+    from bendpam.infra.outputs import OutputSet
 
     return OutputSet(out, inputs=[p for p in inputs if p is not None], command=command_line())
 
 
 def output_file(out: Path, inputs=()):
-    """An :class:`~bendpam.outputs.OutputFile` for a command's single output file."""
-    from ..outputs import OutputFile
+    """An :class:`~bendpam.infra.outputs.OutputFile` for a command's single output file."""
+    from bendpam.infra.outputs import OutputFile
 
     if not out.parent.is_dir():
         raise UserError(f"--out {str(out)!r}: the folder {str(out.parent)!r} does not exist")
@@ -276,7 +276,7 @@ QuietOpt = Annotated[
 
 def output_format(path: Path | None, fmt: str | Enum | None, formats: tuple[str, ...], *, option: str = "--out",
                   default: str | None = None) -> str | None:
-    """The format of an output file from ``--format`` or the suffix of ``path`` (:func:`bendpam.checks.file_format`).
+    """The format of an output file from ``--format`` or the suffix of ``path`` (:func:`bendpam.validate.file_format`).
 
     Returns None when ``path`` is None.
     """

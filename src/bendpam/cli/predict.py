@@ -11,9 +11,8 @@ from typing import Annotated, Optional
 import numpy as np
 import typer
 
-from ..limits import OUTPUTS as LIMIT_OUTPUTS
-from .app import app
-from .options import (
+from bendpam.cli.app import app
+from bendpam.cli.options import (
     FIGURE_FORMATS,
     ActuatorOpt,
     FigureFormatOpt,
@@ -32,7 +31,8 @@ from .options import (
     output_format,
     pressures_kpa,
 )
-from .options import pressure_kpa as checked_pressure
+from bendpam.cli.options import pressure_kpa as checked_pressure
+from bendpam.physics.limits import OUTPUTS as LIMIT_OUTPUTS
 
 
 def _data_or_figure(out: Path, fmt, data_formats: tuple[str, ...]) -> str:
@@ -62,9 +62,9 @@ def predict(
     loop_angle_deg: Annotated[Optional[float], typer.Option("--loop-angle-deg", help="Loop angle (deg).")] = None,
 ):
     """Blocked moment and free bending curvature/angle at each pressure (and, with --cycle, the loop)."""
-    from ..atomic import json_safe
-    from ..law import MomentLaw
-    from ..predict import prediction_table
+    from bendpam.infra.atomic import json_safe
+    from bendpam.physics.law import MomentLaw
+    from bendpam.predict import prediction_table
 
     act = load_actuator(preset, actuator, model)
     P = pressures_kpa(pressure_kpa)
@@ -74,7 +74,7 @@ def predict(
     loop = _loop_model(actuator, loop_law, loop_a0_nmm, loop_a1_nmm_per_kpa, loop_angle_deg) if cycle else None
     cycles = None
     if loop is not None:
-        from ..hysteresis import predict_cycles
+        from bendpam.physics.hysteresis import predict_cycles
 
         # the same computation as the loss ratios and loop metrics of `bendpam fit` (one function)
         cycles = predict_cycles(act, loop, P, mname)
@@ -120,7 +120,7 @@ def predict(
 
 def _loop_model(actuator_file, law, a0, a1_per_kpa, angle):
     """Loop parameters for --cycle: the actuator file's [hysteresis] table, overridden by --loop-* options."""
-    from ..hysteresis import LoopModel
+    from bendpam.physics.hysteresis import LoopModel
 
     base = LoopModel.from_toml(actuator_file) if actuator_file is not None else None
     given = {k: v for k, v in (("law", law), ("a0_nmm", a0), ("theta_h_deg", angle),
@@ -139,7 +139,7 @@ def _margin(x, width: int) -> str:
 
 
 def _limits_table(df) -> list[str]:
-    """The margins of the prediction table (:func:`bendpam.limits`), one line per pressure."""
+    """The margins of the prediction table (:func:`bendpam.physics.limits`), one line per pressure."""
     lines = ["limits (safety factors, >= 1 within the limit; inf: no demand or no limit given)",
              f"{'P (kPa)':>8}  {'N_frame (N)':>11}  {'σ_frame (MPa)':>13}  {'strength':>8}  {'buckling':>8}  "
              f"{'lock-up':>8}  {'stretch':>7}  {'(max)':>6}  {'min':>6}"]
@@ -195,7 +195,7 @@ def curve(
     if P.size * points > 10_000_000:
         raise UserError(f"--pressure-kpa x --points = {P.size * points} curve points; at most 10000000")
     mname = model_name(model)
-    from ..plots import moment_curvature_figure, moment_curves, save_figure
+    from bendpam.present.figures import moment_curvature_figure, moment_curves, save_figure
 
     with output_file(out, [actuator]) as f:
         if kind == "csv":
@@ -219,7 +219,7 @@ def stresses(
     fig_format: FigureFormatOpt = None,
 ):
     """Force-balance internal stresses around the cross-section (eq 37-48)."""
-    from ..predict import internal_stresses
+    from bendpam.predict import internal_stresses
 
     act = load_actuator(preset, actuator, Model.force_balance)
     pressure_kpa = checked_pressure(pressure_kpa)
@@ -228,7 +228,7 @@ def stresses(
     kind = _data_or_figure(out, fig_format, ("nc", "csv"))
     with output_file(out, [actuator]) as f:
         if kind in FIGURE_FORMATS:
-            from ..plots import plot_internal_stresses, save_figure
+            from bendpam.present.figures import plot_internal_stresses, save_figure
 
             save_figure(plot_internal_stresses(act, pressure_kpa, curvature), f.path, format=kind)
         elif kind == "nc":
@@ -246,7 +246,7 @@ def actuator_cmd(
     out: Annotated[Optional[Path], typer.Option("--out", help="Write the actuator as TOML here.")] = None,
 ):
     """Show an actuator (TOML, derived values, lock-up limits) or save it as an editable TOML file."""
-    from ..braid import curvature_limits
+    from bendpam.physics.braid import curvature_limits
 
     act = load_actuator(preset, actuator, model)
     text = act.to_toml()
@@ -271,10 +271,10 @@ def demo(
     fig_format: FigureFormatOpt = None,
 ):
     """Predictions for the paper's BE-PAM and BC-PAM with both models, and a moment-curvature figure."""
-    from .. import presets
-    from ..law import MomentLaw
-    from ..plots import demo_figure, save_figure
-    from ..predict import prediction_table
+    from bendpam.physics import presets
+    from bendpam.physics.law import MomentLaw
+    from bendpam.predict import prediction_table
+    from bendpam.present.figures import demo_figure, save_figure
 
     if out is None:
         out = Path(f"bendpam-demo/moment-curvature.{fig_format.value if fig_format is not None else 'png'}")

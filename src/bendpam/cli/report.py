@@ -1,7 +1,7 @@
 """The ``bendpam report`` command: raw test files -> one self-contained HTML report.
 
 ``register(app)`` adds the command to the ``bendpam`` Typer app.  Like the other commands it only
-parses and prints; the work is :func:`bendpam.report.build_report`.
+parses and prints; the work is :func:`bendpam.present.report.build_report`.
 
 (No ``from __future__ import annotations`` here: the command is defined inside ``register`` and
 Typer reads its annotations as objects.)
@@ -19,7 +19,7 @@ def register(app: typer.Typer) -> None:
     """Add the ``report`` command to ``app`` (does nothing if it has one already)."""
     if any(getattr(c, "name", None) == "report" for c in app.registered_commands):
         return
-    from .options import ActuatorOpt, PresetOpt, QuietOpt
+    from bendpam.cli.options import ActuatorOpt, PresetOpt, QuietOpt
 
     @app.command("report")
     def report(
@@ -58,9 +58,9 @@ def register(app: typer.Typer) -> None:
 
 
 def _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, model, progress) -> None:
-    from ..fixture import Fixture
-    from ..report import build_report, fmt_value
-    from .options import Model, UserError, collect_raw_files, load_actuator, output_file, parse_values
+    from bendpam.cli.options import Model, UserError, collect_raw_files, load_actuator, output_file, parse_values
+    from bendpam.physics.fixture import Fixture
+    from bendpam.present.report import build_report, fmt_value
 
     if out is None:
         raise UserError("give the report to write with --out report.html")

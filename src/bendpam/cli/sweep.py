@@ -9,8 +9,8 @@ from typing import Annotated, Any, Optional
 import numpy as np
 import typer
 
-from .app import app
-from .options import (
+from bendpam.cli.app import app
+from bendpam.cli.options import (
     RANGE_HELP,
     ActuatorOpt,
     Model,
@@ -123,7 +123,7 @@ def sweep_cmd(
                                            help="Same as --quiet (--no-progress).")] = True,
 ):
     """Design sweep: actuator parameters crossed with pressures (in-process or on Dask)."""
-    from ..sweeps import SWEEP_PARAMETERS, sweep
+    from bendpam.sweeps import SWEEP_PARAMETERS, sweep
 
     if out is None and plot is None:
         raise UserError("give --out FILE.nc|.csv|.parquet and/or --plot FILE.png|.pdf|.svg")
@@ -168,13 +168,13 @@ def sweep_cmd(
                         f"{max(MAX_BLOCK_POINTS // len(P), 1)} or fewer, or fewer pressures")
     # typed Any: mypy would check the arrays against sweep()'s other keyword parameters
     grids: dict[str, Any] = {k: np.asarray(v) for k, v in params.items()}
-    from ..progress import Progress
+    from bendpam.infra.progress import Progress
 
     with Progress(n_cases, "sweep", quiet=quiet or not progress) as bar:
         ds = sweep(act, P, model_name(model), chunk_cases=chunk_cases, scheduler=scheduler, workers=workers,
                    progress=bar.advance, **grids)
     if out is not None:
-        from ..sweeps import write_sweep
+        from bendpam.sweeps import write_sweep
 
         with output_file(out, [actuator]) as f:
             write_sweep(ds, f.path, data_fmt)
@@ -182,7 +182,7 @@ def sweep_cmd(
         rows = f", {int(np.prod(list(ds.sizes.values())))} rows" if data_fmt != "nc" else ""
         typer.echo(f"wrote {out} ({shape}{rows})")
     if plot is not None:
-        from ..plots import save_figure, sweep_figure
+        from bendpam.present.figures import save_figure, sweep_figure
 
         with output_file(plot, [actuator]) as f:
             save_figure(sweep_figure(ds, plot_var, plot_x, plot_y, at=fixed_at), f.path, format=fig_fmt)

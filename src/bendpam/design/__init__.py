@@ -16,8 +16,7 @@ below 5 kPa) warns with :class:`bendpam.UnitWarning`.  The moment law is the act
 :class:`bendpam.MomentLaw`; :class:`StableBranch` is :class:`bendpam.StableBranch`.
 """
 
-from ..law import StableBranch
-from .finger import (
+from bendpam.design.finger import (
     BlockedTipForce,
     Finger,
     FingerLoads,
@@ -32,9 +31,9 @@ from .finger import (
     stable_branch,
     tip_stiffness,
 )
-from .grasp import Grasp, Gripper, grasp_sweep, plot_grasp, solve_grasp
-from .inverse import DesignResult, Target, Variable, design_actuator
-from .wrist import (
+from bendpam.design.grasp import Grasp, Gripper, grasp_sweep, plot_grasp, solve_grasp
+from bendpam.design.inverse import DesignResult, Target, Variable, design_actuator
+from bendpam.design.wrist import (
     Wrist,
     WristHold,
     WristState,
@@ -45,6 +44,7 @@ from .wrist import (
     wrist_pressures,
     wrist_sweep,
 )
+from bendpam.physics.law import StableBranch
 
 __all__ = [
     "BlockedTipForce",

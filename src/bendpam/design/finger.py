@@ -74,15 +74,15 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..actuator import Actuator
-from ..checks import UnitWarning, number
-from ..checks import pressure_kpa as _check_pressures
-from ..errors import InputError, NoEquilibrium
-from ..law import MomentLaw, StableBranch
-from ..models import normalise_model
+from bendpam.errors import InputError, NoEquilibrium
+from bendpam.physics.actuator import Actuator
+from bendpam.physics.law import MomentLaw, StableBranch
+from bendpam.physics.models import normalise_model
+from bendpam.validate import UnitWarning, number
+from bendpam.validate import pressure_kpa as _check_pressures
 
 if TYPE_CHECKING:
-    from ..hysteresis import LoopModel
+    from bendpam.physics.hysteresis import LoopModel
 
 __all__ = [
     "G_N_PER_G",
@@ -138,9 +138,9 @@ def _user_stacklevel() -> int:
 
 
 def _numeric_pressures(value, name: str) -> np.ndarray:
-    """:func:`bendpam.checks.pressure_kpa`, refusing strings and bools inside a list too ([100, "150"]).
+    """:func:`bendpam.validate.pressure_kpa`, refusing strings and bools inside a list too ([100, "150"]).
 
-    Its :class:`~bendpam.checks.UnitWarning` is reported at the user's call, not inside bendpam.design.
+    Its :class:`~bendpam.validate.UnitWarning` is reported at the user's call, not inside bendpam.design.
     """
     try:
         kind = np.asarray(value).dtype.kind
@@ -159,10 +159,10 @@ def _numeric_pressures(value, name: str) -> np.ndarray:
 
 
 def checked_pressure_kpa(value, name: str = "pressure_kpa") -> float:
-    """One gauge pressure in kPa as a float (:func:`bendpam.checks.pressure_kpa`, and a single value).
+    """One gauge pressure in kPa as a float (:func:`bendpam.validate.pressure_kpa`, and a single value).
 
     A negative, non-finite or non-numeric value raises :class:`~bendpam.errors.InputError`; a
-    nonzero value below 5 kPa warns with :class:`~bendpam.checks.UnitWarning` (MPa passed as kPa?).
+    nonzero value below 5 kPa warns with :class:`~bendpam.validate.UnitWarning` (MPa passed as kPa?).
     """
     p = _numeric_pressures(value, name)
     if p.size != 1:
@@ -184,7 +184,7 @@ def pressures_checked() -> Iterator[None]:
 
     The entry point validates (and warns about a suspected MPa value) once; inside, the law is
     evaluated many times at the same pressures and must not repeat the
-    :class:`~bendpam.checks.UnitWarning`.
+    :class:`~bendpam.validate.UnitWarning`.
     """
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UnitWarning)
@@ -206,7 +206,7 @@ def stable_branch(actuator: Actuator, pressure_kpa, model: str = "energy",
     Examples
     --------
     >>> import bendpam
-    >>> sb = stable_branch(bendpam.presets.be_pam(), 150.0)
+    >>> sb = stable_branch(bendpam.physics.presets.be_pam(), 150.0)
     >>> round(sb.k_hi, 5), sb.end_hi, round(sb.free_curvature, 5)     # 1/mm
     (0.03371, 'fold', 0.00816)
     """
@@ -244,7 +244,7 @@ class Finger:
         Lateral offset of the fingertip point toward the bending side, mm.
     nodes : int
         Collocation nodes along the active length, in [11, 1001] (default 81).
-    loop : bendpam.hysteresis.LoopModel, optional
+    loop : bendpam.physics.hysteresis.LoopModel, optional
         A fitted hysteresis loop (``bendpam fit --hysteresis``).  With it the moment law is shifted
         by the saturated friction moment ``A(P)`` against the motion: ``motion="unloading"`` (the
         finger opening toward its free shape, the lower branch) or ``"loading"`` (being pushed
@@ -255,7 +255,7 @@ class Finger:
     Examples
     --------
     >>> import bendpam
-    >>> finger = Finger(bendpam.presets.be_pam(), base_angle_deg=-90.0)   # hanging, curling counterclockwise
+    >>> finger = Finger(bendpam.physics.presets.be_pam(), base_angle_deg=-90.0)   # hanging, curling counterclockwise
     >>> shape = solve_finger(finger, 150.0)
     >>> [round(v, 2) for v in shape.tip_xy]                   # mm
     [76.22, -113.47]
@@ -300,7 +300,7 @@ class Finger:
         if self.motion not in ("unloading", "loading"):
             raise InputError(f"motion = {self.motion!r}; choose 'unloading' or 'loading'")
         if self.loop is not None and not hasattr(self.loop, "amplitude_nmm"):
-            raise TypeError("loop must be a bendpam.hysteresis.LoopModel")
+            raise TypeError("loop must be a bendpam.physics.hysteresis.LoopModel")
 
     def friction_nmm(self, pressure_kpa) -> float:
         """Signed saturated friction moment ``A(P) z`` (N*mm) at ``pressure_kpa`` (kPa); 0 without a loop.
@@ -373,7 +373,7 @@ class FingerLoads:
     --------
     >>> import bendpam
     >>> loads = FingerLoads(tip_force_n=(0.0, -0.5), tip_mass_g=20.0)   # 0.5 N down and a 20 g mass
-    >>> shape = solve_finger(Finger(bendpam.presets.be_pam()), 150.0, loads)
+    >>> shape = solve_finger(Finger(bendpam.physics.presets.be_pam()), 150.0, loads)
     >>> shape.equilibrium, shape.loads.tip_mass_g
     (True, 20.0)
     """
@@ -447,7 +447,7 @@ class FingerShape:
     Examples
     --------
     >>> import numpy as np, bendpam
-    >>> shape = solve_finger(Finger(bendpam.presets.be_pam()), 150.0)     # unloaded: a circular arc
+    >>> shape = solve_finger(Finger(bendpam.physics.presets.be_pam()), 150.0)     # unloaded: a circular arc
     >>> float(shape.s[-1]), round(float(np.degrees(shape.tip_angle)), 2)  # mm, deg
     (145.0, 67.78)
     >>> bool(np.allclose(shape.curvature, shape.curvature[0])), shape.equilibrium
@@ -742,7 +742,7 @@ def solve_finger(finger: Finger, pressure_kpa, loads: FingerLoads | None = None)
     Examples
     --------
     >>> import numpy as np, bendpam
-    >>> finger = Finger(bendpam.presets.be_pam())
+    >>> finger = Finger(bendpam.physics.presets.be_pam())
     >>> free = solve_finger(finger, 150.0)
     >>> loaded = solve_finger(finger, 150.0, FingerLoads(tip_force_n=(0.0, -0.5)))
     >>> [round(v, 2) for v in free.tip_xy], [round(v, 2) for v in loaded.tip_xy]    # mm
@@ -826,7 +826,7 @@ def finger_sweep(finger: Finger, pressures_kpa, loads: FingerLoads | None = None
     Examples
     --------
     >>> import bendpam
-    >>> table, shapes = finger_sweep(Finger(bendpam.presets.be_pam()), [100.0, 150.0])
+    >>> table, shapes = finger_sweep(Finger(bendpam.physics.presets.be_pam()), [100.0, 150.0])
     >>> table[["pressure_kpa", "tip_x_mm", "tip_y_mm", "bend_angle_deg"]].round(2).values.tolist()
     [[100.0, 140.34, 31.49, 25.29], [150.0, 113.47, 76.22, 67.78]]
     """
@@ -851,7 +851,7 @@ def finger_sweep(finger: Finger, pressures_kpa, loads: FingerLoads | None = None
 
 @dataclass(frozen=True)
 class FingerLimits:
-    """The structural limits along a solved finger: :mod:`bendpam.limits` at every section.
+    """The structural limits along a solved finger: :mod:`bendpam.physics.limits` at every section.
 
     Each section is checked at its own curvature ``k'(s)`` with the axial force the loads beyond it
     put on the frame line (a section's compression is assumed along the whole frame for buckling:
@@ -864,7 +864,7 @@ class FingerLimits:
     pressure_kpa : kPa.  s_mm : (nodes,) arc length.
     sections : per-section arrays (``axial_force_n``, ``stress_mpa``, ``buckling_margin``,
         ``lockup_margin``, ``bladder_stretch``, ``stretch_margin``, ``external_axial_force_n`` ...,
-        see :func:`bendpam.limits.section_limits`).
+        see :func:`bendpam.physics.limits.section_limits`).
     frame_axial_force_n : the section force with the largest ``|N|`` (N, tension > 0).
     frame_stress_mpa, bladder_stretch_max : largest along the finger.
     frame_strength_margin, buckling_margin, lockup_margin, bladder_stretch_margin, min_margin : smallest.
@@ -875,7 +875,7 @@ class FingerLimits:
     --------
     >>> import bendpam
     >>> from bendpam.design import Finger, FingerLoads, solve_finger
-    >>> sh = solve_finger(Finger(bendpam.presets.bc_pam()), 100.0, FingerLoads(tip_force_n=(0.0, -2.0)))
+    >>> sh = solve_finger(Finger(bendpam.physics.presets.bc_pam()), 100.0, FingerLoads(tip_force_n=(0.0, -2.0)))
     >>> lim = sh.limits()
     >>> round(lim.min_margin, 2), lim.worst_s_mm, lim.violations
     (1.67, 145.0, ())
@@ -903,11 +903,11 @@ def finger_limits(shape: FingerShape) -> FingerLimits:
 
     >>> import bendpam
     >>> from bendpam.design import Finger, solve_finger
-    >>> lim = finger_limits(solve_finger(Finger(bendpam.presets.be_pam()), 150.0))
+    >>> lim = finger_limits(solve_finger(Finger(bendpam.physics.presets.be_pam()), 150.0))
     >>> round(lim.lockup_margin, 1), lim.buckling_margin
     (4.1, inf)
     """
-    from ..limits import MARGINS, section_limits
+    from bendpam.physics.limits import MARGINS, section_limits
 
     if not isinstance(shape, FingerShape):
         raise TypeError(f"shape must be a FingerShape, got {type(shape).__name__}")
@@ -958,7 +958,7 @@ def free_tip_trajectory(finger: Finger, pressures_kpa):
     Examples
     --------
     >>> import bendpam
-    >>> t = free_tip_trajectory(Finger(bendpam.presets.be_pam()), [100.0, 150.0, 200.0])
+    >>> t = free_tip_trajectory(Finger(bendpam.physics.presets.be_pam()), [100.0, 150.0, 200.0])
     >>> t[["tip_x_mm", "tip_y_mm", "bend_angle_deg"]].round(2).values.tolist()     # mm, mm, deg
     [[140.34, 31.49, 25.29], [113.47, 76.22, 67.78], [68.36, 102.07, 112.38]]
     """
@@ -1013,7 +1013,7 @@ class BlockedTipForce:
     Examples
     --------
     >>> import bendpam
-    >>> held = blocked_tip_force(Finger(bendpam.presets.be_pam()), 150.0)
+    >>> held = blocked_tip_force(Finger(bendpam.physics.presets.be_pam()), 150.0)
     >>> held.constraint, [round(f, 3) for f in held.force_n], held.equilibrium    # N
     ('roller', [0.0, -2.053], True)
     """
@@ -1069,7 +1069,7 @@ def blocked_tip_force(finger: Finger, pressure_kpa, target_xy_mm=None, direction
     The force a sensor at the straight tip position measures at 150 kPa:
 
     >>> import bendpam
-    >>> held = blocked_tip_force(Finger(bendpam.presets.be_pam()), 150.0)
+    >>> held = blocked_tip_force(Finger(bendpam.physics.presets.be_pam()), 150.0)
     >>> round(held.force_n[1], 3)                         # N, on the tip (the finger pushes up)
     -2.053
     """
@@ -1185,7 +1185,7 @@ class TipStiffness:
     Examples
     --------
     >>> import numpy as np, bendpam
-    >>> ts = tip_stiffness(Finger(bendpam.presets.be_pam()), 150.0)
+    >>> ts = tip_stiffness(Finger(bendpam.physics.presets.be_pam()), 150.0)
     >>> ts.matrix.shape, bool(np.allclose(ts.matrix @ ts.compliance, np.eye(3)))
     ((3, 3), True)
     """
@@ -1206,7 +1206,7 @@ def tip_stiffness(finger: Finger, pressure_kpa, loads: FingerLoads | None = None
     Unloaded, it agrees with linear beam theory (:func:`linear_tip_compliance`):
 
     >>> import numpy as np, bendpam
-    >>> finger = Finger(bendpam.presets.be_pam())
+    >>> finger = Finger(bendpam.physics.presets.be_pam())
     >>> ts = tip_stiffness(finger, 150.0)
     >>> bool(np.allclose(ts.compliance, linear_tip_compliance(finger, 150.0), rtol=1e-3, atol=1e-6))
     True
@@ -1263,7 +1263,7 @@ def linear_tip_compliance(finger: Finger, pressure_kpa) -> np.ndarray:
     Examples
     --------
     >>> import bendpam
-    >>> c = linear_tip_compliance(Finger(bendpam.presets.be_pam()), 150.0)
+    >>> c = linear_tip_compliance(Finger(bendpam.physics.presets.be_pam()), 150.0)
     >>> round(float(c[1, 1]), 2)                          # mm of tip travel per N of vertical tip force
     26.96
     """
@@ -1305,13 +1305,13 @@ def plot_finger_shapes(shapes, ax=None, title: str | None = None):
     --------
     >>> import bendpam
     >>> import matplotlib.pyplot as plt
-    >>> finger = Finger(bendpam.presets.be_pam())
+    >>> finger = Finger(bendpam.physics.presets.be_pam())
     >>> fig = plot_finger_shapes([solve_finger(finger, p) for p in (100.0, 150.0)])
     >>> len(fig.axes)                                     # fig.savefig("shapes.png") to keep it
     1
     >>> plt.close(fig)
     """
-    from .. import plots  # noqa: F401, I001  (first: selects the Agg backend unless the caller chose one)
+    from bendpam.present import figures as plots  # noqa: F401, I001  (first: selects the Agg backend unless the caller chose one)
     import matplotlib.pyplot as plt
 
     if ax is None:

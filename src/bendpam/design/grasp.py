@@ -78,12 +78,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..actuator import Actuator
-from ..checks import number
-from ..errors import InputError, NoEquilibrium
-from ..law import MomentLaw, StableBranch
-from ..models import normalise_model
-from .finger import (
+from bendpam.design.finger import (
     NEWTON_TOL,
     Finger,
     FingerLoads,
@@ -96,6 +91,11 @@ from .finger import (
     pressures_checked,
     solve_finger,
 )
+from bendpam.errors import InputError, NoEquilibrium
+from bendpam.physics.actuator import Actuator
+from bendpam.physics.law import MomentLaw, StableBranch
+from bendpam.physics.models import normalise_model
+from bendpam.validate import number
 
 __all__ = [
     "DEFAULT_BASE_RADIUS_MM",
@@ -163,7 +163,7 @@ class Gripper:
     The paper's gripper: three 130 mm BE-PAM fingers.
 
     >>> import bendpam
-    >>> gripper = Gripper(bendpam.presets.be_pam().replace(L0_mm=130.0))
+    >>> gripper = Gripper(bendpam.physics.presets.be_pam().replace(L0_mm=130.0))
     >>> gripper.fingers, gripper.base_radius_mm, gripper.mu
     (3, 100.0, 0.5)
     """
@@ -251,7 +251,7 @@ class Grasp:
     Examples
     --------
     >>> import bendpam
-    >>> gripper = Gripper(bendpam.presets.be_pam().replace(L0_mm=130.0))
+    >>> gripper = Gripper(bendpam.physics.presets.be_pam().replace(L0_mm=130.0))
     >>> grasp = solve_grasp(gripper, 180.0, 150.0)        # a 180 mm sphere at 150 kPa
     >>> grasp.contact, grasp.equilibrium, grasp.grip_force_n > 0
     ('tip', True, True)
@@ -607,7 +607,7 @@ def solve_grasp(gripper: Gripper, diameter_mm, pressure_kpa) -> Grasp:
     Examples
     --------
     >>> import bendpam
-    >>> gripper = Gripper(bendpam.presets.be_pam().replace(L0_mm=130.0))
+    >>> gripper = Gripper(bendpam.physics.presets.be_pam().replace(L0_mm=130.0))
     >>> solve_grasp(gripper, 180.0, 120.0).contact       # the fingers do not reach it yet
     'none'
     >>> g = solve_grasp(gripper, 180.0, 160.0)
@@ -1321,7 +1321,7 @@ def grasp_sweep(gripper: Gripper, diameters_mm, pressures_kpa):
     Examples
     --------
     >>> import bendpam
-    >>> gripper = Gripper(bendpam.presets.be_pam().replace(L0_mm=130.0))
+    >>> gripper = Gripper(bendpam.physics.presets.be_pam().replace(L0_mm=130.0))
     >>> ds = grasp_sweep(gripper, [180.0], [120.0, 160.0])
     >>> list(ds.dims), ds["contact"].values.tolist()
     (['diameter_mm', 'pressure_kpa'], [['none', 'tip']])
@@ -1382,20 +1382,20 @@ def plot_grasp(ds, ax=None, title: str | None = None):
 
     ``ds`` is a :func:`grasp_sweep` result.  Where the gripper has no contact or no equilibrium the
     line has a gap (no point, no line through it), never a 0 N point; each pressure has its own
-    marker and colour.  The figure is sized for a journal column (:func:`bendpam.plots.figure_size`).
+    marker and colour.  The figure is sized for a journal column (:func:`bendpam.present.figures.figure_size`).
     Returns the figure.
 
     Examples
     --------
     >>> import bendpam
     >>> import matplotlib.pyplot as plt
-    >>> gripper = Gripper(bendpam.presets.be_pam().replace(L0_mm=130.0))
+    >>> gripper = Gripper(bendpam.physics.presets.be_pam().replace(L0_mm=130.0))
     >>> fig = plot_grasp(grasp_sweep(gripper, [160.0, 200.0], [160.0]))
     >>> len(fig.axes)                                     # fig.savefig("grip.png") to keep it
     1
     >>> plt.close(fig)
     """
-    from .. import plots  # noqa: I001  (first: the Agg backend unless chosen)
+    from bendpam.present import figures as plots  # noqa: I001  (first: the Agg backend unless chosen)
     import matplotlib.pyplot as plt
 
     with plots.figure_style():

@@ -84,13 +84,13 @@ from typing import Any
 
 import numpy as np
 
-from ..actuator import NEUTRAL_ANGLE_DEG, Actuator
-from ..atomic import atomic_write_text
-from ..checks import did_you_mean
-from ..errors import BendpamError, InputError
-from ..law import MomentLaw
-from ..models import normalise_model
-from ..sweeps import SWEEP_PARAMETERS, build_cases, evaluate_cases
+from bendpam.errors import BendpamError, InputError
+from bendpam.infra.atomic import atomic_write_text
+from bendpam.physics.actuator import NEUTRAL_ANGLE_DEG, Actuator
+from bendpam.physics.law import MomentLaw
+from bendpam.physics.models import normalise_model
+from bendpam.sweeps import SWEEP_PARAMETERS, build_cases, evaluate_cases
+from bendpam.validate import did_you_mean
 
 __all__ = [
     "DESIGN_VARIABLES",
@@ -711,8 +711,8 @@ def _distinct(U: np.ndarray, order: np.ndarray, k: int, min_dist: float = 0.15) 
 
 
 def _progress(total: int, description: str, show: bool | None) -> Any:
-    """The shared progress bar (:class:`bendpam.progress.Progress`); silent unless ``show``."""
-    from ..progress import Progress
+    """The shared progress bar (:class:`bendpam.infra.progress.Progress`); silent unless ``show``."""
+    from bendpam.infra.progress import Progress
 
     return Progress(total, description, quiet=not show)
 
@@ -788,7 +788,7 @@ class DesignResult:
     Examples
     --------
     >>> import bendpam
-    >>> res = design_actuator(bendpam.presets.be_pam(), ["blocked_moment_nmm=400@200"],
+    >>> res = design_actuator(bendpam.physics.presets.be_pam(), ["blocked_moment_nmm=400@200"],
     ...                       ["alpha0_deg=60:80"], n_coarse=64, n_starts=1)
     >>> res.met.tolist(), res.binding, round(res.actuator.alpha0_deg, 2)
     ([True], (), 79.87)
@@ -819,7 +819,7 @@ class DesignResult:
 
     def to_dict(self) -> dict[str, Any]:
         """design.json's content (units in the key names; ``null`` = infinite or not defined)."""
-        from .. import __version__
+        from bendpam.version import __version__
 
         return {
             "bendpam_version": __version__,
@@ -851,14 +851,14 @@ class DesignResult:
         }
 
     def to_json(self) -> str:
-        from ..outputs import to_json
+        from bendpam.infra.outputs import to_json
 
         return to_json(self.to_dict())
 
     def save(self, out_dir, *, figures: bool = True) -> dict[str, str]:
         """Write design.json, design.toml, coarse_map.csv, pareto.csv and figures into ``out_dir``.
 
-        Each file is written atomically (for a whole set, use :class:`bendpam.outputs.OutputSet`,
+        Each file is written atomically (for a whole set, use :class:`bendpam.infra.outputs.OutputSet`,
         as ``bendpam design --out`` does).  Returns ``{file name: path}``.
         """
         out = Path(out_dir)
@@ -881,7 +881,7 @@ class DesignResult:
         if self.pareto is not None:
             put("pareto.csv", self.pareto.to_csv())
         if figures:
-            from ..plots import save_figure
+            from bendpam.present.figures import save_figure
 
             save_figure(plot_coarse_map(self), out / "coarse_map.png")
             files["coarse_map.png"] = str(out / "coarse_map.png")
@@ -954,7 +954,7 @@ def design_actuator(base: Actuator, targets: Iterable[Target | str], vary, *, mo
     Examples
     --------
     >>> import bendpam
-    >>> res = design_actuator(bendpam.presets.be_pam(), ["blocked_moment_nmm=400@200"],
+    >>> res = design_actuator(bendpam.physics.presets.be_pam(), ["blocked_moment_nmm=400@200"],
     ...                       ["alpha0_deg=60:80"], n_coarse=64, n_starts=1)
     >>> res.feasible, round(res.values["alpha0_deg"], 2), round(float(res.achieved[0]), 3)
     (True, 79.87, 400.0)
@@ -1073,7 +1073,7 @@ def _min_margin(mg: np.ndarray) -> np.ndarray:
 
 def _coarse_grid(prob: _Problem, n_coarse: int, scheduler: str, report):
     """The coarse map as a factorial grid computed by :func:`bendpam.sweep` on a Dask cluster."""
-    from ..sweeps import sweep
+    from bendpam.sweeps import sweep
 
     n = len(prob.variables)
     levels = max(2, round(n_coarse ** (1.0 / n)))
@@ -1093,7 +1093,7 @@ def _coarse_grid(prob: _Problem, n_coarse: int, scheduler: str, report):
 
 # ---- the finger's tip force ---------------------------------------------------------------------
 def _tip_exact(act: Actuator, model: str, P: float) -> float:
-    from .finger import Finger, blocked_tip_force
+    from bendpam.design.finger import Finger, blocked_tip_force
 
     try:
         res = blocked_tip_force(Finger(act, model), P)
@@ -1284,7 +1284,7 @@ def _pareto(prob: _Problem, U, Q, MG, seed: int = 0, rounds=(0.15, 0.05, 0.015),
 # ---- the result ---------------------------------------------------------------------------------
 def _achieved(prob: _Problem, act: Actuator) -> np.ndarray:
     """Each target's magnitude from the public prediction functions (independent of the search)."""
-    from .. import predict
+    from bendpam import predict
 
     out = np.empty(len(prob.targets))
     for i, t in enumerate(prob.targets):

@@ -50,13 +50,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import presets
-from ..actuator import Actuator
-from ..checks import number
-from ..errors import InputError
-from ..law import MomentLaw, StableBranch
-from ..models import normalise_model
-from .finger import G_N_PER_G, checked_pressure_kpa, checked_pressures_kpa, pressures_checked
+from bendpam.design.finger import G_N_PER_G, checked_pressure_kpa, checked_pressures_kpa, pressures_checked
+from bendpam.errors import InputError
+from bendpam.physics import presets
+from bendpam.physics.actuator import Actuator
+from bendpam.physics.law import MomentLaw, StableBranch
+from bendpam.physics.models import normalise_model
+from bendpam.validate import number
 
 __all__ = [
     "BOTTLE_G",
@@ -600,7 +600,7 @@ def plot_wrist(table, holds=(), ax=None, title: str | None = None, positions_deg
     True
     >>> plt.close(fig)
     """
-    from .. import plots  # noqa: I001  (first: the Agg backend unless chosen)
+    from bendpam.present import figures as plots  # noqa: I001  (first: the Agg backend unless chosen)
     import matplotlib.pyplot as plt
 
     own = ax is None

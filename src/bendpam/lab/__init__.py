@@ -14,7 +14,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from .readers import (
+    from bendpam.lab.readers import (
         COLUMNS,
         DIALECTS,
         FORMATS,
@@ -30,7 +30,7 @@ if TYPE_CHECKING:
         pressure_from_filename,
         read_test,
     )
-    from .writers import write_test
+    from bendpam.lab.writers import write_test
 
 __all__ = [
     "COLUMNS",

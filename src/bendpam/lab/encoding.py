@@ -17,7 +17,7 @@ import codecs
 import re
 import unicodedata
 
-from .channels import ColumnInfo, classify_column, split_name_unit
+from bendpam.lab.channels import ColumnInfo, classify_column, split_name_unit
 
 __all__ = [
     "LEGACY_ENCODINGS",

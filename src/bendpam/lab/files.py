@@ -5,7 +5,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from ..errors import InputError
+from bendpam.errors import InputError
 
 __all__ = ["RAW_SUFFIXES", "collect_raw_files"]
 

@@ -25,7 +25,7 @@ from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from itertools import islice
 
-from .channels import is_unit_token
+from bendpam.lab.channels import is_unit_token
 
 __all__ = [
     "DELIMITERS",

@@ -15,7 +15,7 @@ One raw test (time, stroke, force) at one pressure becomes:
    last cycle (one that does not come back to the blocked state) is dropped and reported.
 4. **Zero and conversion.**  The stroke is counted from the blocked state (the median stroke at
    the blocked turning points), then converted to beta, k' and M by eq 6-8
-   (:class:`bendpam.fixture.Fixture`), after an optional force tare for self-weight.
+   (:class:`bendpam.physics.fixture.Fixture`), after an optional force tare for self-weight.
 5. **Branches.**  Each cycle has an *unloading* branch (blocked -> free, the lower curve) and a
    *loading* branch (free -> blocked, the upper curve).  Each is resampled onto a common curvature
    grid (the range that every branch covers) and averaged over the cycles.  The hysteresis-free
@@ -44,8 +44,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..errors import InputError, ProcessingError
-from ..fixture import PAPER_FIXTURE, Fixture
+from bendpam.errors import InputError, ProcessingError
+from bendpam.physics.fixture import PAPER_FIXTURE, Fixture
 
 if TYPE_CHECKING:  # pandas and xarray are imported by the functions that use them (fast start-up of `fit`)
     import pandas as pd
@@ -538,8 +538,8 @@ class ProcessedSet:
         return ds
 
     def plot(self, title: str = ""):
-        """Figure 4 of the paper for this set (a matplotlib Figure; see :func:`bendpam.plots.figure4`)."""
-        from ..plots import figure4
+        """Figure 4 of the paper for this set (a matplotlib Figure; see :func:`bendpam.present.figures.figure4`)."""
+        from bendpam.present.figures import figure4
 
         return figure4(self, title)
 
@@ -551,7 +551,7 @@ class ProcessedSet:
         import json
         from pathlib import Path
 
-        from ..atomic import atomic_path, atomic_write_text, json_safe
+        from bendpam.infra.atomic import atomic_path, atomic_write_text, json_safe
 
         out = Path(out_dir)
         if out.exists() and not out.is_dir():
@@ -567,7 +567,7 @@ class ProcessedSet:
         atomic_write_text(out / "summary.json", json.dumps(json_safe(self.summary()), indent=2, allow_nan=False))
         written["summary.json"] = str(out / "summary.json")
         if figure:
-            from ..plots import save_figure
+            from bendpam.present.figures import save_figure
 
             save_figure(self.plot(), out / "figure4.png")
             written["figure4.png"] = str(out / "figure4.png")
@@ -614,7 +614,7 @@ def process_tests(tests, *, fixture: Fixture = PAPER_FIXTURE, options: Processin
     >>> import bendpam
     >>> from bendpam.lab import RawTest
     >>> from bendpam.lab.simulate import SimulationSettings, simulate_test
-    >>> be, settings = bendpam.presets.be_pam(), SimulationSettings(cycles=2, rate_hz=5.0, seed=1)
+    >>> be, settings = bendpam.physics.presets.be_pam(), SimulationSettings(cycles=2, rate_hz=5.0, seed=1)
     >>> raws = [RawTest(simulate_test(be, p, settings=settings)[0], Path(f"be_{p:g}kPa.csv"), "csv",
     ...                 pressure_kpa=p) for p in (100.0, 150.0, 200.0)]
     >>> processed = process_tests(raws, keep_series=False)
@@ -643,7 +643,7 @@ def process_tests(tests, *, fixture: Fixture = PAPER_FIXTURE, options: Processin
             res = process_series(d["time_s"].to_numpy(), d["stroke_mm"].to_numpy(), d["force_n"].to_numpy(),
                                  p, fixture=fixture, options=options, source=src, keep_series=keep_series)
         res.notes.extend(getattr(rt, "warnings", []) or [])
-        from .readers import check_cycle_count
+        from bendpam.lab.readers import check_cycle_count
 
         mismatch = check_cycle_count(rt, res.n_cycles)
         if mismatch:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from ..errors import FileFormatError
+from bendpam.errors import FileFormatError
 
 __all__ = ["ReadError", "one_line", "show"]
 

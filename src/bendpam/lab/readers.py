@@ -47,7 +47,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from .channels import (
+from bendpam.lab.channels import (
     ACCEPTED_NAMES,
     DEFAULT_UNIT,
     FORCE_UNITS,
@@ -67,9 +67,9 @@ from .channels import (
     unit_cell,
     unit_factor,
 )
-from .checks import find_spikes, time_problems
-from .encoding import container_kind, detect_encoding
-from .layout import (
+from bendpam.lab.checks import find_spikes, time_problems
+from bendpam.lab.encoding import container_kind, detect_encoding
+from bendpam.lab.layout import (
     DELIMITERS,
     LineReader,
     MetaItem,
@@ -83,7 +83,7 @@ from .layout import (
     parse_number,
     split_cells,
 )
-from .read_error import ReadError, show
+from bendpam.lab.read_error import ReadError, show
 
 __all__ = [
     "COLUMNS",
@@ -419,7 +419,7 @@ def parse_columns(columns: Mapping[str, str] | str | None) -> dict[str, str]:
     >>> parse_columns("time=Zeit,force=Kraft"), parse_columns({"Stroke": "Weg"})
     ({'time': 'Zeit', 'force': 'Kraft'}, {'stroke': 'Weg'})
     """
-    from ..errors import InputError
+    from bendpam.errors import InputError
 
     if columns is None:
         return {}
@@ -516,7 +516,7 @@ def _check_text_head(text: str, label: Path | str) -> None:
 
 
 def _open_excel(path: Path, kind: str) -> list[tuple[str, list[str]]]:
-    from .excel import EXCEL_EXTRA_HINT, ExcelUnavailable, workbook_sheets
+    from bendpam.lab.excel import EXCEL_EXTRA_HINT, ExcelUnavailable, workbook_sheets
 
     what = "an .xlsx workbook (ZIP container)" if kind == "zip" else "an .xls workbook (OLE2)"
     try:
@@ -1505,7 +1505,7 @@ def _assemble(parsed: _Parsed, *, pressure_kpa: float | None, dialect: str | Non
 
 def _check_options(pressure_kpa: float | None, dialect: str | None, rate_hz: float | None
                    ) -> tuple[float | None, float | None]:  # fmt: skip
-    from ..errors import InputError
+    from bendpam.errors import InputError
 
     if dialect is not None and dialect not in FORMATS:
         raise InputError(f"unknown dialect {dialect!r}; expected one of {', '.join(FORMATS)}")
@@ -1759,7 +1759,7 @@ def inspect_file(
     >>> sorted(bad)
     ['error', 'file']
     """
-    from ..errors import BendpamError
+    from bendpam.errors import BendpamError
 
     name = os.fspath(path)
     try:

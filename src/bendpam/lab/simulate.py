@@ -7,7 +7,7 @@ At each pressure the virtual machine
 2. runs ``cycles`` triangular cycles blocked -> free -> blocked at ``speed_mm_min``, sampled at
    ``rate_hz``, with an optional dwell at each end;
 3. computes the moment from the quasi-static model plus a smooth hysteresis loop
-   (:mod:`bendpam.hysteresis`: the Prandtl-Ishlinskii law by default, or Dahl's with
+   (:mod:`bendpam.physics.hysteresis`: the Prandtl-Ishlinskii law by default, or Dahl's with
    ``hysteresis_law="dahl"``): ``M = M_model(P, k') - A z``, with the amplitude
    ``A = hysteresis * |M_model(P, 0)| + hysteresis_offset_nmm``; the loop's energy-loss ratio is
    about ``4 A / |M_blocked|`` for a nearly linear curve, so ``hysteresis = 0.06`` gives the
@@ -32,14 +32,14 @@ import numpy as np
 import pandas as pd
 from scipy.optimize import brentq
 
-from ..atomic import atomic_write_text
-from ..braid import curvature_limits
-from ..checks import number
-from ..errors import InputError, NoEquilibrium
-from ..fixture import PAPER_FIXTURE, Fixture
-from ..hysteresis import LAWS, make_law
-from ..models import normalise_model
-from ..predict import blocked_moment, free_curvature, moment
+from bendpam.errors import InputError, NoEquilibrium
+from bendpam.infra.atomic import atomic_write_text
+from bendpam.physics.braid import curvature_limits
+from bendpam.physics.fixture import PAPER_FIXTURE, Fixture
+from bendpam.physics.hysteresis import LAWS, make_law
+from bendpam.physics.models import normalise_model
+from bendpam.predict import blocked_moment, free_curvature, moment
+from bendpam.validate import number
 
 __all__ = ["DIALECT_SUFFIX", "SimulationSettings", "simulate_test", "simulate_tests"]
 
@@ -113,7 +113,7 @@ def simulate_test(actuator, pressure_kpa: float, model: str = "energy", *, fixtu
     Examples
     --------
     >>> import bendpam
-    >>> data, truth = simulate_test(bendpam.presets.be_pam(), 150.0, settings=SimulationSettings(seed=1))
+    >>> data, truth = simulate_test(bendpam.physics.presets.be_pam(), 150.0, settings=SimulationSettings(seed=1))
     >>> data.columns.tolist(), len(data)
     (['time_s', 'stroke_mm', 'force_n'], 5250)
     >>> round(truth["blocked_moment_nmm"], 1), round(truth["free_curvature_per_mm"], 5)   # N*mm, 1/mm
@@ -248,7 +248,7 @@ def simulate_tests(actuator, pressures_kpa, out_dir, model: str = "energy", *, d
     ``Pressure`` metadata line.  Returns the truth dictionary that is also written to
     ``truth.json`` (atomically).
     """
-    from .writers import write_test
+    from bendpam.lab.writers import write_test
 
     st = settings or SimulationSettings()
     model = normalise_model(model)

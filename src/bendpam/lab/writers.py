@@ -27,8 +27,8 @@ import os
 import numpy as np
 import pandas as pd
 
-from ..atomic import atomic_write_bytes
-from .readers import COLUMNS, DIALECTS, FORCE_UNITS, is_pressure_key
+from bendpam.infra.atomic import atomic_write_bytes
+from bendpam.lab.readers import COLUMNS, DIALECTS, FORCE_UNITS, is_pressure_key
 
 __all__ = ["write_test"]
 

@@ -31,8 +31,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..braid import CLOSED_FORM, DEFAULT_ORDER, circle_ibar, gauss_nodes, radius_state, radius_terms
-from ..material import MooneyRivlin
+from bendpam.physics.braid import CLOSED_FORM, DEFAULT_ORDER, circle_ibar, gauss_nodes, radius_state, radius_terms
+from bendpam.physics.material import MooneyRivlin
 
 __all__ = ["basis", "bladder_energy", "coefficients", "terms"]
 
@@ -122,7 +122,7 @@ def basis(params, curvature, *, order: int = DEFAULT_ORDER, eq19_factor: bool = 
     Examples
     --------
     >>> import numpy as np, bendpam
-    >>> A, b10, b01 = basis(bendpam.presets.be_pam().params, np.array([0.0, 0.01]))
+    >>> A, b10, b01 = basis(bendpam.physics.presets.be_pam().params, np.array([0.0, 0.01]))
     >>> A.round(2).tolist(), b10.round(1).tolist(), b01.round(1).tolist()
     ([2350.98, 1932.5], [0.0, 1088.7], [0.0, 1038.9])
     """
@@ -142,7 +142,7 @@ def coefficients(params, curvature, *, order: int = DEFAULT_ORDER, eq19_factor: 
     The blocked moment at 200 kPa is ``P_active A(0)`` with ``P_active = 0.2 - 0.068`` MPa:
 
     >>> import numpy as np, bendpam
-    >>> A, B = coefficients(bendpam.presets.be_pam().params, np.array([0.0, 0.01]))
+    >>> A, B = coefficients(bendpam.physics.presets.be_pam().params, np.array([0.0, 0.01]))
     >>> A.round(2).tolist(), B.round(2).tolist(), round(0.132 * float(A[0]), 2)
     ([2350.98, 1932.5], [0.0, 191.91], 310.33)
     """
@@ -159,7 +159,7 @@ def terms(params, p_active, curvature, *, order: int = DEFAULT_ORDER, eq19_facto
     Examples
     --------
     >>> import numpy as np, bendpam
-    >>> t = terms(bendpam.presets.be_pam().params, 0.132, np.array([0.0, 0.01]))   # 200 kPa
+    >>> t = terms(bendpam.physics.presets.be_pam().params, 0.132, np.array([0.0, 0.01]))   # 200 kPa
     >>> {name: v.round(2).tolist() for name, v in t.items()}
     {'M_load': [310.33, 63.18], 'M_air': [310.33, 255.09], 'M_bl': [0.0, 188.37], 'M_f': [0.0, 3.54]}
     """
@@ -182,7 +182,7 @@ def bladder_energy(params, curvature, *, order: int = DEFAULT_ORDER):
     Examples
     --------
     >>> import numpy as np, bendpam
-    >>> bladder_energy(bendpam.presets.be_pam().params, np.array([0.0, 0.01])).round(4).tolist()
+    >>> bladder_energy(bendpam.physics.presets.be_pam().params, np.array([0.0, 0.01])).round(4).tolist()
     [0.0, 0.9774]
     """
     k = np.asarray(curvature, dtype=float)

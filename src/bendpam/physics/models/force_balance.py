@@ -39,7 +39,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..braid import CLOSED_FORM, DEFAULT_ORDER, case_column, circle_ibar, gauss_nodes, radius_state, radius_terms
+from bendpam.physics.braid import (
+    CLOSED_FORM,
+    DEFAULT_ORDER,
+    case_column,
+    circle_ibar,
+    gauss_nodes,
+    radius_state,
+    radius_terms,
+)
 
 __all__ = ["axial_forces", "basis", "coefficients", "stress_state", "terms"]
 
@@ -153,7 +161,7 @@ def basis(params, curvature, *, order: int = DEFAULT_ORDER):
     Examples
     --------
     >>> import numpy as np, bendpam
-    >>> A, b10, b01 = basis(bendpam.presets.be_pam("force_balance").params, np.array([0.0, 0.01]))
+    >>> A, b10, b01 = basis(bendpam.physics.presets.be_pam("force_balance").params, np.array([0.0, 0.01]))
     >>> A.round(2).tolist(), bool(abs(b10[0]) + abs(b01[0]) < 1e-9)    # no bladder terms when straight
     ([2350.98, 1919.94], True)
     """
@@ -166,7 +174,7 @@ def coefficients(params, curvature, *, order: int = DEFAULT_ORDER):
     """``(A, B)`` with ``M = P_active A - B`` (N*mm/MPa and N*mm), shape of ``curvature``.
 
     >>> import numpy as np, bendpam
-    >>> A, B = coefficients(bendpam.presets.be_pam("force_balance").params, np.array([0.0, 0.01]))
+    >>> A, B = coefficients(bendpam.physics.presets.be_pam("force_balance").params, np.array([0.0, 0.01]))
     >>> A.round(2).tolist(), B.round(2).tolist()
     ([2350.98, 1919.94], [0.0, 194.51])
     """
@@ -179,7 +187,7 @@ def terms(params, p_active, curvature, *, order: int = DEFAULT_ORDER):
     """The parts of eq 49 in N*mm: ``M_load``, ``M_p``, ``M_frame``, ``M_bl``, ``M_br``.
 
     >>> import numpy as np, bendpam
-    >>> t = terms(bendpam.presets.be_pam("force_balance").params, 0.132, np.array([0.0, 0.01]))
+    >>> t = terms(bendpam.physics.presets.be_pam("force_balance").params, 0.132, np.array([0.0, 0.01]))
     >>> {name: v.round(2).tolist() for name, v in t.items()}
     {'M_load': [310.33, 58.92], 'M_p': [427.26, 408.42], 'M_frame': [0.0, 3.54],
      'M_bl': [0.0, 207.22], 'M_br': [116.93, 138.74]}
@@ -219,7 +227,7 @@ def stress_state(params, p_active, curvature, phi, *, order: int = DEFAULT_ORDER
     the far side:
 
     >>> import numpy as np, bendpam
-    >>> st = stress_state(bendpam.presets.bc_pam().params, 0.088, -0.006, np.radians([0.0, 90.0, 180.0]))
+    >>> st = stress_state(bendpam.physics.presets.bc_pam().params, 0.088, -0.006, np.radians([0.0, 90.0, 180.0]))
     >>> st["sigma_bl1"].round(4).tolist(), round(float(st["P_e"]), 4)      # MPa
     ([-0.0649, -0.0959, -0.0508], 0.0375)
     """
@@ -282,7 +290,7 @@ def axial_forces(params, p_active, u, R, *, order: int = DEFAULT_ORDER):
     Straight at 200 kPa: ``N_frame R0`` is the blocked moment (310.33 N*mm):
 
     >>> import numpy as np, bendpam
-    >>> p = bendpam.presets.be_pam("force_balance").params
+    >>> p = bendpam.physics.presets.be_pam("force_balance").params
     >>> f = axial_forces(p, 0.132, np.array(0.0), np.array(p.R0_start))
     >>> round(float(f["N_frame"]), 3), round(float(f["N_frame"] * p.R0_start), 2)
     (30.726, 310.33)

@@ -6,7 +6,7 @@ from all pressures at once, by default together with the actuator's friction loo
 Data and model (hysteresis-aware by default)
     When the tests show a loop (median energy-loss ratio above :data:`LOOP_THRESHOLD`,
     :func:`has_loop`), both mean branches of every pressure are fitted with the loop model of
-    :mod:`bendpam.hysteresis`::
+    :mod:`bendpam.physics.hysteresis`::
 
         M = M_qs(P, k') - (a0 + a1 P_active) z                                   (N*mm)
 
@@ -27,8 +27,8 @@ Objective
 
 Admissible material by construction
     The bladder is parametrised by its initial shear modulus ``mu = 2 (C10 + C01) > 0`` and its
-    shape ``beta = C01 / (C10 + C01)`` (:mod:`bendpam.material`), confined to the admissible
-    interval ``[beta_lo, beta_hi]`` of :func:`~bendpam.material.admissible_shape_range`: strain
+    shape ``beta = C01 / (C10 + C01)`` (:mod:`bendpam.physics.material`), confined to the admissible
+    interval ``[beta_lo, beta_hi]`` of :func:`~bendpam.physics.material.admissible_shape_range`: strain
     energy >= 0, monotone uniaxial stress and Baker-Ericksen over the bladder's stretches at the
     tested curvatures (eq 17, with a 10 % margin), the tension test's if one is given, and
     ``admissible_range`` (the range it will be asked to predict; default 0.6 to 1.6).  With both
@@ -77,7 +77,7 @@ Joint fit with a tension test (``tension_data``)
     The bladder's uniaxial nominal stress ``2 C10 (l - l^-2) + 2 C01 (l - l^-2)/l`` is linear in
     the constants, so its points join the linear solve as more rows.  The two data sets are
     weighted by their own noise: each is first fitted alone (the bending curves by the stages
-    above, the tension test by :func:`bendpam.tension.fit_tension`), and the tension rows are
+    above, the tension test by :func:`bendpam.identify.tension.fit_tension`), and the tension rows are
     scaled by ``s_bend / s_tension`` (the residual standard deviations), so the objective is
     ``SSR_bend / s_bend^2 + SSR_tension / s_tension^2``: one Gaussian likelihood.
 
@@ -99,13 +99,13 @@ from pathlib import Path
 
 import numpy as np
 
-from .actuator import NEUTRAL_ANGLE_DEG, Actuator
-from .atomic import atomic_write_text, json_safe
-from .braid import DEFAULT_ORDER
-from .errors import FileFormatError, FitError, InputError
-from .law import MomentLaw
-from .material import admissible_shape_range
-from .models import normalise_model
+from bendpam.errors import FileFormatError, FitError, InputError
+from bendpam.infra.atomic import atomic_write_text, json_safe
+from bendpam.physics.actuator import NEUTRAL_ANGLE_DEG, Actuator
+from bendpam.physics.braid import DEFAULT_ORDER
+from bendpam.physics.law import MomentLaw
+from bendpam.physics.material import admissible_shape_range
+from bendpam.physics.models import normalise_model
 
 __all__ = [
     "HYST_PARAMETERS",
@@ -259,7 +259,7 @@ def _unit(name: str) -> str:
 
 @dataclass
 class MaterialFit:
-    """The bladder as identified: initial shear modulus and shape (kPa; see :mod:`bendpam.material`).
+    """The bladder as identified: initial shear modulus and shape (kPa; see :mod:`bendpam.physics.material`).
 
     Attributes
     ----------
@@ -486,11 +486,11 @@ def bladder_stretch_range(actuator: Actuator, curvature_per_mm) -> tuple[float, 
     Examples
     --------
     >>> import bendpam
-    >>> lo, hi = bladder_stretch_range(bendpam.presets.be_pam(), [0.0, 0.0135])
+    >>> lo, hi = bladder_stretch_range(bendpam.physics.presets.be_pam(), [0.0, 0.0135])
     >>> round(lo, 3), round(hi, 3)
     (0.979, 1.267)
     """
-    from .braid import radius_terms
+    from bendpam.physics.braid import radius_terms
 
     p = actuator.params
     k = (actuator.bend_sign or 1) * np.abs(np.atleast_1d(np.asarray(curvature_per_mm, dtype=float)))
@@ -735,7 +735,7 @@ class _Problem:
     def _z(self, theta_deg: float) -> np.ndarray:
         z = self._z_cache.get(theta_deg)
         if z is None:
-            from .hysteresis import make_law
+            from bendpam.physics.hysteresis import make_law
 
             if len(self._z_cache) > 256:
                 self._z_cache.clear()
@@ -816,7 +816,7 @@ class HysteresisFit:
     """The loop part of a fit: parameters, loss ratios, branch NRMSE, and the law's systematic shift.
 
     ``energy_loss_ratio`` holds, per test, the measured ratio and the one of the predicted free cycle
-    (:func:`bendpam.hysteresis.predict_cycles`, the computation of ``bendpam predict --cycle``).
+    (:func:`bendpam.physics.hysteresis.predict_cycles`, the computation of ``bendpam predict --cycle``).
     ``law_shift`` is the change of each model parameter when the other law is fitted instead
     (``{field: shift}``, empty when not computed), ``alternative_law`` that law.
     """
@@ -830,8 +830,8 @@ class HysteresisFit:
     law_shift: dict[str, float] = field(default_factory=dict)
 
     def loop(self):
-        """The fitted :class:`bendpam.hysteresis.LoopModel`."""
-        from .hysteresis import LoopModel
+        """The fitted :class:`bendpam.physics.hysteresis.LoopModel`."""
+        from bendpam.physics.hysteresis import LoopModel
 
         return LoopModel(law=self.law, amplitude=self.amplitude,
                          **{p.field: p.value for p in self.parameters.values()})
@@ -898,7 +898,7 @@ class FitResult:
 
     @property
     def loop(self):
-        """The fitted loop (:class:`bendpam.hysteresis.LoopModel`) or None."""
+        """The fitted loop (:class:`bendpam.physics.hysteresis.LoopModel`) or None."""
         return None if self.hysteresis is None else self.hysteresis.loop()
 
     def _warn_outside(self, pressure_kpa) -> np.ndarray:
@@ -941,7 +941,7 @@ class FitResult:
         is propagated to first order (central differences of the quantity in each varied
         parameter); NaN where the model or a perturbed one has no answer (above a fold).
         """
-        from .checks import pressure_kpa as check_pressure
+        from bendpam.validate import pressure_kpa as check_pressure
 
         P = np.atleast_1d(check_pressure(pressure_kpa)).astype(float).ravel()
         units = {"free_curvature": "1/mm", "blocked_moment": "N*mm", "moment": "N*mm"}
@@ -981,7 +981,7 @@ class FitResult:
 
     def plot(self, processed, title: str = ""):
         """Figure 7 (a matplotlib Figure): the fitted model against ``processed``."""
-        from .plots import figure7
+        from bendpam.present.figures import figure7
 
         return figure7(processed, self, title)
 
@@ -1127,7 +1127,7 @@ def score(
       mean curve (no ``loop``), or over both mean branches against the loop model on the test's own
       path, blocked state to its measured free curvature (``loop`` given);
     * eq 54: ``NRMSE_BM = RMSE_BM / max_i BM_i``: the model's blocked moment, with a loop the
-      largest moment of the predicted free cycle (:func:`bendpam.hysteresis.predict_cycles`);
+      largest moment of the predicted free cycle (:func:`bendpam.physics.hysteresis.predict_cycles`);
     * eq 55: ``NRMSE_FBC = RMSE_FBC / max_i FBC_i``: the model's free curvature, with a loop where
       the predicted cycle's unloading branch reaches zero moment; over the pressures where there is
       one (the others are listed in ``no_equilibrium_kpa``).
@@ -1144,7 +1144,7 @@ def score(
         bm_model = np.abs(law.blocked_moment(d.P))
         kf_model = np.abs(law.free_curvature_array(d.P))
     else:
-        from .hysteresis import loop_branches, predict_cycles
+        from bendpam.physics.hysteresis import loop_branches, predict_cycles
 
         res = processed.results
         k = np.concatenate([np.asarray(r.curvature_grid, float) for r in res])
@@ -1182,7 +1182,7 @@ def score(
 
 def _loop_law(hysteresis, hysteresis_law: str, processed) -> str | None:
     """The loop law a fit uses: None (mean curves) or a law name."""
-    from .hysteresis import LAWS
+    from bendpam.physics.hysteresis import LAWS
 
     if hysteresis is None or hysteresis is False:
         return None
@@ -1220,9 +1220,9 @@ def fit(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C
     free : names among alpha0, C10, C01, P_start, E_f, R0_start (aliases such as ``alpha0_deg`` work).
     bounds : overrides of the default bounds, ``{name: (lo, hi)}`` in the parameter's unit;
         ``"shape"`` narrows the admissible shapes C01/(C10 + C01).
-    tension : a :class:`~bendpam.tension.TensionFit`; its ``C10_kpa`` and ``C01_kpa`` replace the
+    tension : a :class:`~bendpam.identify.tension.TensionFit`; its ``C10_kpa`` and ``C01_kpa`` replace the
         actuator's before fitting (the values of constants held fixed).
-    tension_data : a :class:`~bendpam.tension.TensionData` (the bladder's tension test): fitted
+    tension_data : a :class:`~bendpam.identify.tension.TensionData` (the bladder's tension test): fitted
         together with the bending curves (module notes) when C10 or C01 is free.
     fit_range : without a loop model, ``"developed"`` (default) fits each mean curve where the loop
         is developed (:func:`developed_range`), ``"all"`` every point, as the paper did.
@@ -1256,7 +1256,7 @@ def fit(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C
     >>> import bendpam
     >>> from bendpam.lab import RawTest
     >>> from bendpam.lab.simulate import SimulationSettings, simulate_test
-    >>> be, settings = bendpam.presets.be_pam(), SimulationSettings(cycles=2, rate_hz=5.0, seed=1)
+    >>> be, settings = bendpam.physics.presets.be_pam(), SimulationSettings(cycles=2, rate_hz=5.0, seed=1)
     >>> raws = [RawTest(simulate_test(be, p, settings=settings)[0], Path(f"be_{p:g}kPa.csv"), "csv",
     ...                 pressure_kpa=p) for p in (100.0, 150.0, 200.0)]
     >>> result = fit(bendpam.process_tests(raws, keep_series=False), be)
@@ -1467,7 +1467,7 @@ def _fold_rule(prob: _Problem, args, bnd, nl, lin, p_max: float):
 
 def _joint_tension(prob: _Problem, args, bnd, nl, lin, tension_data):
     """Refit with the tension test's rows, each data set weighted by its own residual noise."""
-    from .tension import fit_tension
+    from bendpam.identify.tension import fit_tension
 
     lam = np.asarray(tension_data.stretch, dtype=float)
     stress = np.asarray(tension_data.nominal_stress_kpa, dtype=float)
@@ -1769,7 +1769,7 @@ def _result(processed, actuator, model, prob: _Problem, bnd, unc: _Uncertainty, 
     loop = None
     hyst = None
     if law is not None:
-        from .hysteresis import predict_cycles
+        from bendpam.physics.hysteresis import predict_cycles
 
         hp = {}
         for n in ("a0", "a1", "theta_h"):
@@ -1815,11 +1815,11 @@ def predicted_loss_ratios(processed, actuator: Actuator, loop, model: str = "ene
                           eq19_factor: bool = True) -> list[dict]:
     """Energy-loss ratio of each test, measured (processing) and predicted (the loop's free cycle).
 
-    The prediction is :func:`bendpam.hysteresis.predict_cycles`, exactly what ``bendpam predict
+    The prediction is :func:`bendpam.physics.hysteresis.predict_cycles`, exactly what ``bendpam predict
     --cycle`` prints: the cycle between the blocked state and the free state the model reaches on
     unloading.
     """
-    from .hysteresis import predict_cycles
+    from bendpam.physics.hysteresis import predict_cycles
 
     cycles = predict_cycles(actuator, loop, [r.pressure_kpa for r in processed.results], model, order=order,
                             eq19_factor=eq19_factor)

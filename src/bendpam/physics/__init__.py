@@ -1,0 +1,17 @@
+"""The physics layer: the actuator, its materials and braid kinematics, the two moment models, the
+moment law that samples them, the limits and the hysteresis loop models.
+
+Modules here import only each other, :mod:`bendpam.errors`, :mod:`bendpam.validate` and
+:mod:`bendpam.infra` (a test checks it), never the lab, identification, design or presentation
+layers.
+
+* :mod:`~bendpam.physics.actuator`, :mod:`~bendpam.physics.presets`: the actuator's parameters.
+* :mod:`~bendpam.physics.material`: the bladder's Mooney-Rivlin law.
+* :mod:`~bendpam.physics.braid`: braid kinematics, eq 1-5.
+* :mod:`~bendpam.physics.fixture`: the four-point-bending fixture, eq 6-8.
+* :mod:`~bendpam.physics.models`: the energy (eq 9-21) and force-balance (eq 22-49) models.
+* :mod:`~bendpam.physics.law`: :class:`~bendpam.physics.law.MomentLaw`, the only sampler of the models.
+* :mod:`~bendpam.physics.fast`: the tabulated fast path.
+* :mod:`~bendpam.physics.limits`: frame stress, buckling, lock-up and bladder-stretch margins.
+* :mod:`~bendpam.physics.hysteresis`: loop models around the quasi-static law.
+"""
