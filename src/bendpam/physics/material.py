@@ -81,6 +81,7 @@ __all__ = [
     "ShapeLimit",
     "admissible_shape_range",
     "shape_limits",
+    "within",
 ]
 
 #: Relative slack when a shape is compared with its bounds (a fit may land on one).
@@ -422,6 +423,13 @@ def _span(stretch_min: Any, stretch_max: Any) -> tuple[float, float]:
 
 
 def within(beta: float, lo: float, hi: float) -> bool:
+    """``lo <= beta <= hi`` with a relative slack of 1e-9 at each bound (a fit may land on one).
+
+    Examples
+    --------
+    >>> within(1.0 + 1e-12, 0.0, 1.0), within(1.001, 0.0, 1.0)
+    (True, False)
+    """
     lo_ok = lo - _BOUND_TOL * max(1.0, abs(lo)) <= beta
     return lo_ok and beta <= hi + _BOUND_TOL * max(1.0, abs(hi))
 
