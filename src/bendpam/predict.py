@@ -27,6 +27,7 @@ from bendpam.physics.braid import DEFAULT_ORDER, Kinematics
 from bendpam.physics.braid import kinematics as _kinematics
 from bendpam.physics.law import FreeBending, FreeBranch, MomentLaw
 from bendpam.physics.models import force_balance as _fb
+from bendpam.validate import integer
 from bendpam.validate import pressure_kpa as _check_pressure
 
 __all__ = [
@@ -226,9 +227,7 @@ def internal_stresses(actuator: Actuator, pressure_kpa, curvature_per_mm, *, n_p
     k = law.check_curvature(curvature_per_mm)
     if P.ndim > 1 or k.ndim > 1:
         raise InputError("internal_stresses takes scalar or 1-D pressure_kpa and curvature_per_mm")
-    if isinstance(n_phi, bool) or not isinstance(n_phi, int | np.integer) or not 2 <= int(n_phi) <= 100_000:
-        raise InputError(f"n_phi = {n_phi!r} must be an integer in [2, 100000]")
-    phi = np.linspace(0.0, 2.0 * np.pi, int(n_phi))
+    phi = np.linspace(0.0, 2.0 * np.pi, integer("n_phi", n_phi, 2, 100_000))
     pa = law.active_pressure_kpa(P) * 1e-3  # MPa inside the numerics
     Pg = pa.reshape(pa.shape + (1,) * k.ndim)
     st = _fb.stress_state(law.params, Pg, k, phi, order=order)

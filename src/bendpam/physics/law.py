@@ -44,7 +44,6 @@ import numpy as np
 from bendpam.errors import InputError, NoEquilibrium
 from bendpam.physics.actuator import NEUTRAL_ANGLE_DEG, Actuator, ModelParams
 from bendpam.physics.braid import (
-    CLOSED_FORM,
     DEFAULT_ORDER,
     LOCK_FRACTION,
     MIN_FAR_STRETCH,
@@ -53,7 +52,7 @@ from bendpam.physics.braid import (
     radius_from_u,
 )
 from bendpam.physics.models import energy, force_balance, normalise_model
-from bendpam.validate import float_array
+from bendpam.validate import boolean, float_array, quadrature_order
 from bendpam.validate import pressure_kpa as _check_pressure
 
 __all__ = [
@@ -77,14 +76,6 @@ STABLE_BRANCH_TOL = 1e-8
 #: Codes of the end of a free-bending branch (as stored in sweeps).
 BRANCH_END = {"lock-up": 0, "fold": 1, "unbounded": 2, "neutral": 3}
 _END_NAME = {v: k for k, v in BRANCH_END.items()}
-
-
-def _order(order) -> int:
-    if isinstance(order, bool) or not isinstance(order, int | np.integer):
-        raise InputError(f"order = {order!r} must be an integer (Gauss-Legendre nodes on [0, pi])")
-    if int(order) != CLOSED_FORM and not 4 <= int(order) <= 1024:
-        raise InputError(f"order = {order} is outside the allowed range: 0 (closed form) or [4, 1024]")
-    return int(order)
 
 
 class MomentLaw:
@@ -129,10 +120,8 @@ class MomentLaw:
         else:
             raise TypeError(f"actuator must be a bendpam.Actuator, got {type(actuator).__name__}")
         self.model = normalise_model(model)
-        if not isinstance(eq19_factor, bool | np.bool_):
-            raise InputError(f"eq19_factor = {eq19_factor!r} must be True or False")
-        self.eq19_factor = bool(eq19_factor)
-        self.order = _order(order)
+        self.eq19_factor = boolean("eq19_factor", eq19_factor)
+        self.order = quadrature_order(order)
         self.is_cases = self.params.shape != ()
         self._mod = energy if self.model == "energy" else force_balance
         self._opts: dict[str, Any] = {"order": self.order}
@@ -145,9 +134,8 @@ class MomentLaw:
         """The shared (cached) law of ``actuator``: its branch and table are built once."""
         if not isinstance(actuator, Actuator):
             raise TypeError(f"actuator must be a bendpam.Actuator, got {type(actuator).__name__}")
-        if not isinstance(eq19_factor, bool | np.bool_):
-            raise InputError(f"eq19_factor = {eq19_factor!r} must be True or False")
-        return _cached_law(actuator, normalise_model(model), bool(eq19_factor), _order(order))
+        return _cached_law(actuator, normalise_model(model), boolean("eq19_factor", eq19_factor),
+                           quadrature_order(order))
 
     def __repr__(self) -> str:
         what = f"{self.params.shape} cases" if self.is_cases else (self.actuator.name or self.actuator.kind
