@@ -14,4 +14,5 @@ layers.
 * :mod:`~bendpam.physics.fast`: the tabulated fast path.
 * :mod:`~bendpam.physics.limits`: frame stress, buckling, lock-up and bladder-stretch margins.
 * :mod:`~bendpam.physics.hysteresis`: loop models around the quasi-static law.
+* :mod:`~bendpam.physics.roots`: the vectorised root finders (bracketed Newton, Illinois) they share.
 """

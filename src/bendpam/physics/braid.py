@@ -64,6 +64,7 @@ from typing import Any
 import numpy as np
 
 from bendpam.errors import InputError
+from bendpam.physics.roots import bracketed_newton
 
 __all__ = [
     "CLOSED_FORM",
@@ -277,21 +278,13 @@ def _newton(q, alpha0, order: int, u0, u_bounds):
     hi = np.where(q >= 0.0, u_bounds[1], 0.0)
     eps = 1e-9 * (hi - lo)
     u = np.where(q == 0.0, 0.0, np.clip(u0, lo + eps, hi - eps))
-    for _ in range(_NEWTON_MAXITER):
+
+    def f_and_slope(u):  # q(u) - q is increasing in u
         ib, dib = circle_ibar(u, c, order)
-        f = s * u * ib - q
-        # maintain the bracket (q is increasing in u)
-        lo = np.where(f < 0.0, u, lo)
-        hi = np.where(f > 0.0, u, hi)
-        step = f / (s * (ib + u * dib))
-        un = u - step
-        outside = ~((un >= lo) & (un <= hi))
-        un = np.where(outside, 0.5 * (lo + hi), un)
-        # Newton converges quadratically: a step below 1e-8 |u| leaves an error near 1e-16 |u|
-        done = ((np.abs(un - u) <= 1e-8 * np.abs(u)) & ~outside) | (f == 0.0)
-        u = np.where(f == 0.0, u, un)
-        if np.all(done):
-            break
+        return s * u * ib - q, s * (ib + u * dib)
+
+    # Newton converges quadratically: a step below 1e-8 |u| leaves an error near 1e-16 |u|
+    u = bracketed_newton(f_and_slope, u, lo, hi, maxiter=_NEWTON_MAXITER, rtol=1e-8)
     ib, dib = circle_ibar(u, c, order)
     return u, ib, dib
 

@@ -52,6 +52,7 @@ from bendpam.physics.braid import (
     radius_from_u,
 )
 from bendpam.physics.models import energy, force_balance, normalise_model
+from bendpam.physics.roots import bracketed_newton, illinois
 from bendpam.validate import boolean, float_array, quadrature_order
 from bendpam.validate import pressure_kpa as _check_pressure
 
@@ -63,7 +64,6 @@ __all__ = [
     "MomentLaw",
     "MomentTable",
     "StableBranch",
-    "illinois",
 ]
 
 _PER_KPA = 1e-3  # MPa per kPa: the models' A is per MPa
@@ -663,48 +663,6 @@ def _branch_table(law: MomentLaw, samples: int) -> BranchTable:
                        path=ev)
 
 
-def illinois(F, a, b, tol, maxiter: int = 100):
-    """Vectorised Illinois (modified regula falsi) root finder on brackets with ``F(a) >= 0 >= F(b)``.
-
-    ``F(x, idx)`` evaluates the function at points ``x`` for the flat indices ``idx`` of the
-    problem, so only unconverged points are evaluated.  A point stops when its bracket or its last
-    step is below ``tol`` (scalar or per point), or ``F`` hits zero.  Returns the roots (shape of
-    ``a``).
-    """
-    shape = np.shape(a)
-    a = np.array(a, dtype=float).ravel()
-    b = np.array(b, dtype=float).ravel()
-    tol = np.broadcast_to(np.asarray(tol, dtype=float), shape).ravel()
-    every = np.arange(a.size)
-    fa, fb = F(a, every), F(b, every)
-    x = np.where(fa == 0.0, a, np.where(fb == 0.0, b, 0.5 * (a + b)))
-    side = np.zeros(a.size)
-    act = np.flatnonzero((fa != 0.0) & (fb != 0.0))
-    for _ in range(maxiter):
-        if act.size == 0:
-            break
-        aa, bb, fa_, fb_ = a[act], b[act], fa[act], fb[act]
-        xs = (aa * fb_ - bb * fa_) / (fb_ - fa_)
-        inside = (xs > np.minimum(aa, bb)) & (xs < np.maximum(aa, bb))
-        xs = np.where(inside, xs, 0.5 * (aa + bb))
-        step = np.abs(xs - x[act])
-        x[act] = xs
-        fx = F(xs, act)
-        pos = fx > 0.0
-        sd = side[act]
-        # Illinois: halve the function value kept at the end that did not move twice in a row
-        fb_ = np.where(pos & (sd == 1), 0.5 * fb_, fb_)
-        fa_ = np.where(~pos & (sd == -1), 0.5 * fa_, fa_)
-        a[act] = np.where(pos, xs, aa)
-        fa[act] = np.where(pos, fx, fa_)
-        b[act] = np.where(pos, bb, xs)
-        fb[act] = np.where(pos, fb_, fx)
-        side[act] = np.where(pos, 1.0, -1.0)
-        done = (fx == 0.0) | (np.abs(b[act] - a[act]) <= tol[act]) | (step <= tol[act])
-        act = act[~done]
-    return x.reshape(shape)
-
-
 def _solve_free(law: MomentLaw, tab: BranchTable, pa: np.ndarray, xtol: float) -> tuple[np.ndarray, np.ndarray]:
     """Roots ``(k', u = k'R)`` of ``M = 0`` at active pressures ``pa`` (cases, pressures) (kPa); NaN above the end."""
     k = np.zeros(pa.shape)
@@ -1095,17 +1053,12 @@ class MomentTable:
             x = np.interp(q, pt[finite], kt[finite])
             j = np.clip(np.searchsorted(pt, q), 1, kt.size - 1)
             lo, hi = np.minimum(kt[j - 1], kt[j]), np.maximum(kt[j - 1], kt[j])
-            for _ in range(newton_steps):
+
+            def f_and_slope(x):  # -M: the moment falls with k' along the branch (either direction)
                 A, B, dA, dB = self.derivatives(x)
-                f = q * A - B
-                ahead = d * f > 0  # before the root along the branch
-                if d > 0:
-                    lo, hi = np.where(ahead, x, lo), np.where(~ahead, x, hi)
-                else:
-                    hi, lo = np.where(ahead, x, hi), np.where(~ahead, x, lo)
-                xn = x - f / (q * dA - dB)
-                x = np.where((xn >= lo) & (xn <= hi), xn, 0.5 * (lo + hi))
-            k[want] = x
+                return -(q * A - B), -(q * dA - dB)
+
+            k[want] = bracketed_newton(f_and_slope, x, lo, hi, maxiter=newton_steps)
         return _assemble_free(law, P, k.reshape(P.shape), br)
 
 
@@ -1167,9 +1120,13 @@ class StableBranch:
         kk = np.concatenate([[self.k_lo], kj[lo:hi], [self.k_hi]])
         mm, _ = self.moment(kk)
         k = np.interp(-m, -mm, kk)
-        for _ in range(4):  # Newton polish on the spline law
+
+        def f_and_slope(k):  # m - M: M falls with k' on the branch
             f, d = self.moment(k)
-            k = np.clip(k - (f - m) / d, self.k_lo, self.k_hi)
+            return -(f - m), -d
+
+        # Newton polish on the spline law
+        k = bracketed_newton(f_and_slope, k, np.full(k.shape, self.k_lo), np.full(k.shape, self.k_hi), maxiter=4)
         return np.where((m <= self.moment_max) & (m >= self.moment_min), k, np.nan)
 
     def describe_end(self, side: int) -> str:
