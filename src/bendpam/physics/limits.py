@@ -118,7 +118,8 @@ import numpy as np
 from bendpam.errors import InputError
 from bendpam.physics.actuator import Actuator, ModelParams
 from bendpam.physics.braid import DEFAULT_ORDER, curvature_limits, radius_state, solve_u
-from bendpam.physics.law import BRANCH_END, BranchTable, MomentLaw
+from bendpam.physics.branch import BRANCH_END, BranchTable
+from bendpam.physics.law import MomentLaw
 from bendpam.physics.models.force_balance import axial_forces
 from bendpam.validate import float_array, number
 from bendpam.validate import pressure_kpa as _check_pressure
@@ -335,7 +336,7 @@ def case_limits(law: MomentLaw, pressure_kpa, free_curvature, table: BranchTable
     free_curvature : (cases, p) or (p,) 1/mm
         The free-bending curvature from :meth:`MomentLaw.free_curvature_array` with ``table``
         (NaN past the end of the branch).
-    table : the :class:`~bendpam.physics.law.BranchTable` the curvatures came from (default: the law's).
+    table : the :class:`~bendpam.physics.branch.BranchTable` the curvatures came from (default: the law's).
     free_u : (cases, p) or (p,), optional
         ``u = k'R`` at the free curvatures (:meth:`MomentLaw.free_state_array`), so that ``R = u/k'``
         needs no solve of eq 5.  Without it ``u`` comes from :func:`bendpam.physics.braid.solve_u`.
