@@ -194,6 +194,22 @@ _STRESS_NAMES = {
 }
 
 
+#: Unit, meaning and scale from the model's units (MPa, N/mm, rad, mm) of each variable of the stress state.
+_STRESS_UNITS = {
+    "sigma_bl1": ("kPa", "bladder axial stress (eq 43)", 1e3),
+    "sigma_bl2": ("kPa", "bladder hoop stress (eq 44)", 1e3),
+    "sigma_bl3": ("kPa", "bladder radial stress, -P_active (eq 37)", 1e3),
+    "P_e": ("kPa", "interfacial pressure bladder-braid (eq 45)", 1e3),
+    "N_br1": ("N/mm", "braid axial line tension sigma_br1 * t_br (eq 48)", 1.0),
+    "N_br2": ("N/mm", "braid hoop line tension P_e R (eq 31)", 1.0),
+    "sigma_br1": ("kPa", "braid nominal axial stress (eq 48)", 1e3),
+    "sigma_br2": ("kPa", "braid nominal hoop stress (eq 31)", 1e3),
+    "braid_angle": ("deg", "local braid angle alpha(Phi)", 1.0),
+    "t_bar": ("mm", "mean bladder thickness (eq 40)", 1.0),
+    "R": ("mm", "deformed radius (eq 5)", 1.0),
+}
+
+
 def internal_stresses(actuator: Actuator, pressure_kpa, curvature_per_mm, *, n_phi: int = 181,
                       order: int = DEFAULT_ORDER) -> Any:
     """Internal state of the force-balance model (eq 37-48) around the cross-section.
@@ -220,8 +236,6 @@ def internal_stresses(actuator: Actuator, pressure_kpa, curvature_per_mm, *, n_p
     >>> ds["P_e_kpa"].attrs["units"], ds["sigma_bl1_kpa"].dims
     ('kPa', ('phi_deg',))
     """
-    import xarray as xr
-
     law = _law(actuator, "force_balance", True, order)
     P = _check_pressure(pressure_kpa)
     k = law.check_curvature(curvature_per_mm)
@@ -231,28 +245,22 @@ def internal_stresses(actuator: Actuator, pressure_kpa, curvature_per_mm, *, n_p
     pa = law.active_pressure_kpa(P) * 1e-3  # MPa inside the numerics
     Pg = pa.reshape(pa.shape + (1,) * k.ndim)
     st = _fb.stress_state(law.params, Pg, k, phi, order=order)
+    return _stress_dataset(actuator, st, P, k, phi, np.broadcast_shapes(Pg.shape, k.shape))
+
+
+def _stress_dataset(actuator: Actuator, st: dict, P: np.ndarray, k: np.ndarray, phi: np.ndarray,
+                    S: tuple[int, ...]) -> Any:
+    """The :func:`internal_stresses` dataset from the force-balance stress state ``st`` (model units) of shape ``S``."""
+    import xarray as xr
+
     dims = (["pressure_kpa"] if P.ndim else []) + (["curvature_per_mm"] if k.ndim else [])
-    units = {
-        "sigma_bl1": ("kPa", "bladder axial stress (eq 43)", 1e3),
-        "sigma_bl2": ("kPa", "bladder hoop stress (eq 44)", 1e3),
-        "sigma_bl3": ("kPa", "bladder radial stress, -P_active (eq 37)", 1e3),
-        "P_e": ("kPa", "interfacial pressure bladder-braid (eq 45)", 1e3),
-        "N_br1": ("N/mm", "braid axial line tension sigma_br1 * t_br (eq 48)", 1.0),
-        "N_br2": ("N/mm", "braid hoop line tension P_e R (eq 31)", 1.0),
-        "sigma_br1": ("kPa", "braid nominal axial stress (eq 48)", 1e3),
-        "sigma_br2": ("kPa", "braid nominal hoop stress (eq 31)", 1e3),
-        "braid_angle": ("deg", "local braid angle alpha(Phi)", 1.0),
-        "t_bar": ("mm", "mean bladder thickness (eq 40)", 1.0),
-        "R": ("mm", "deformed radius (eq 5)", 1.0),
-    }
-    S = np.broadcast_shapes(Pg.shape, k.shape)
     data = {}
     for name, arr in st.items():
         arr = np.asarray(arr)
         per_angle = arr.ndim == len(S) + 1
         full = np.broadcast_to(arr, S + ((phi.size,) if per_angle else ()))
         d = dims + (["phi_deg"] if per_angle else [])
-        unit, long_name, scale = units[name]
+        unit, long_name, scale = _STRESS_UNITS[name]
         if name == "braid_angle":
             full, name = np.degrees(full), "braid_angle_deg"
         else:

@@ -233,7 +233,6 @@ def sweep(base_actuator: Actuator, pressure_kpa, model: str = "energy", *, chunk
     names = list(grids_d)
     grids = [grids_d[n] for n in names]
     shape = tuple(g.size for g in grids)
-    n_cases = int(np.prod(shape)) if shape else 1
     chunk_cases = int(chunk_cases)
     if chunk_cases < 1:
         raise InputError(f"chunk_cases = {chunk_cases} must be >= 1")
@@ -241,9 +240,19 @@ def sweep(base_actuator: Actuator, pressure_kpa, model: str = "energy", *, chunk
     # parameters that constrain each other, each other parameter on its own
     _prevalidate(base_actuator, names, grids)
     chunks = _natural_chunks(shape, chunk_cases)
+    fn = _block_fn(base_actuator, model, names, grids, P, order, eq19_factor)
+    data = _run_blocks(fn, shape, chunks, P.size, scheduler=scheduler, workers=workers, compute=compute,
+                       progress=progress)
+    return _dataset(data, names, grids, shape, P, base_actuator, model, order)
+
+
+def _run_blocks(fn, shape: tuple[int, ...], chunks, n_pressures: int, *, scheduler: str | None, workers: int | None,
+                compute: bool, progress: bool | Callable[[int], Any] | None) -> Any:
+    """The sweep's data (cases..., pressures, outputs): the blocks of ``fn`` in a loop without Dask, else a
+    dask array, computed in-process or on a cluster, or left lazy; progress as :func:`sweep` describes."""
+    n_cases = int(np.prod(shape)) if shape else 1
     n_blocks = int(np.prod([len(c) for c in chunks])) if shape else 1
     show = progress if progress is not None else (n_blocks >= 20 and sys.stderr.isatty())
-    fn = _block_fn(base_actuator, model, names, grids, P, order, eq19_factor)
     da: Any
     try:
         import dask.array as da
@@ -263,16 +272,14 @@ def sweep(base_actuator: Actuator, pressure_kpa, model: str = "energy", *, chunk
             report = None
         remote = bool(scheduler or workers)
         if da is None:
-            data = _loop_blocks(_Counted(fn, report), shape, chunks)
-        else:
-            idx = da.arange(n_cases, chunks=n_cases).reshape(shape or (1,)).rechunk(chunks or ((1,),))
-            nd = idx.ndim
-            # in-process the kernel reports each block itself; on a cluster the futures do
-            kernel = fn if remote or not compute or report is None else _Counted(fn, report)
-            arr = idx.map_blocks(kernel, dtype=float, new_axis=[nd, nd + 1],
-                                 chunks=(*idx.chunks, (P.size,), (len(_OUTPUTS),)), meta=np.empty((0,) * (nd + 2)))
-            data = _compute(arr, scheduler, workers, report, idx.chunks) if compute else arr
-    return _dataset(data, names, grids, shape, P, base_actuator, model, order)
+            return _loop_blocks(_Counted(fn, report), shape, chunks)
+        idx = da.arange(n_cases, chunks=n_cases).reshape(shape or (1,)).rechunk(chunks or ((1,),))
+        nd = idx.ndim
+        # in-process the kernel reports each block itself; on a cluster the futures do
+        kernel = fn if remote or not compute or report is None else _Counted(fn, report)
+        arr = idx.map_blocks(kernel, dtype=float, new_axis=[nd, nd + 1],
+                             chunks=(*idx.chunks, (n_pressures,), (len(_OUTPUTS),)), meta=np.empty((0,) * (nd + 2)))
+        return _compute(arr, scheduler, workers, report, idx.chunks) if compute else arr
 
 
 def _natural_chunks(shape: tuple[int, ...], chunk_cases: int) -> tuple[tuple[int, ...], ...]:

@@ -405,12 +405,20 @@ def predict_cycles(actuator, loop: LoopModel, pressures_kpa, model: str = "energ
     >>> [round(100 * x.energy_loss_ratio, 1) for x in c]
     [15.9, 17.0]
     """
-    from bendpam.physics.braid import curvature_limits
     from bendpam.physics.law import MomentLaw
     from bendpam.validate import pressure_kpa as check_pressure
 
     P = np.atleast_1d(np.asarray(check_pressure(pressures_kpa), dtype=float)).ravel()
     law = MomentLaw.of(actuator, model, order=order, eq19_factor=eq19_factor)
+    kf, flat = _free_states(actuator, loop, law, P)
+    return _cycles(actuator, loop, law, P, kf, flat, int(n))
+
+
+def _free_states(actuator, loop: LoopModel, law, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(k_free, flat)``: where each pressure's unloading branch reaches zero moment (magnitudes, 1/mm; NaN
+    if never), by the fixed-point iteration of :func:`predict_cycles`, and where it collapsed onto ``k' = 0``."""
+    from bendpam.physics.braid import curvature_limits
+
     lim = curvature_limits(actuator)
     sgn = actuator.bend_sign or 1
     k_lim = abs(lim.k_max if sgn > 0 else lim.k_min) * 0.999
@@ -443,12 +451,17 @@ def predict_cycles(actuator, loop: LoopModel, pressures_kpa, model: str = "energ
         active[ii[done]] = False
     flat = np.isfinite(kf) & (kf <= 1e-9 * k_lim)  # the fixed point collapsed onto the straight state
     kf[flat] = math.nan
+    return kf, flat
+
+
+def _cycles(actuator, loop: LoopModel, law, P: np.ndarray, kf: np.ndarray, flat: np.ndarray, n: int) -> list[Cycle]:
+    """The :class:`Cycle` of each pressure from its free curvature ``kf`` (NaN: an empty cycle with a note)."""
     ok = np.isfinite(kf)
     out: list[Cycle] = []
     if ok.any():
-        k = np.linspace(0.0, 1.0, int(n))[None, :] * kf[ok, None]
+        k = np.linspace(0.0, 1.0, n)[None, :] * kf[ok, None]
         up, low = _cycle_branches(actuator, loop, law, P[ok, None], kf[ok, None], k)
-        th = k * L0
+        th = k * actuator.L0_mm
         loss = np.trapezoid(up - low, th, axis=-1)
         stored = np.trapezoid(0.5 * (up + low), th, axis=-1)
         with np.errstate(divide="ignore", invalid="ignore"):
