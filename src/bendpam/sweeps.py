@@ -94,6 +94,17 @@ def build_cases(base: Actuator, values: dict[str, np.ndarray]) -> ModelParams:
     Every value is validated as :class:`~bendpam.Actuator` would (one line naming the parameter
     and the allowed range).  When ``R0_mm`` is swept without ``R0_start_mm``, ``R0_start_mm``
     keeps the base ratio ``R0_start / R0``; eq 51-52 are applied by :meth:`ModelParams.build`.
+
+    Examples
+    --------
+    >>> import numpy as np, bendpam
+    >>> cases = build_cases(bendpam.physics.presets.be_pam(), {"alpha0_deg": np.array([65.0, 70.0])})
+    >>> cases.shape, np.degrees(cases.alpha0).round(1).tolist()
+    ((2,), [65.0, 70.0])
+    >>> build_cases(bendpam.physics.presets.be_pam(), {"t0_mm": np.array([2.0, 9.0])})
+    Traceback (most recent call last):
+    ...
+    bendpam.errors.InputError: t0_mm = 9 mm is outside the allowed range (0, R0_mm) mm
     """
     n = np.broadcast_shapes(*(np.shape(v) for v in values.values())) if values else ()
     get = {f: np.broadcast_to(np.asarray(values.get(f, getattr(base, f)), dtype=float), n)
@@ -136,6 +147,14 @@ def evaluate_cases(base: Actuator, model: str, values: dict[str, np.ndarray], pr
     """The sweep kernel: all outputs for the cases in ``values`` (1-D arrays) at ``pressure_kpa``.
 
     Returns arrays of shape (cases, pressures) and (cases,) keyed by the names in the module doc.
+
+    Examples
+    --------
+    >>> import numpy as np, bendpam
+    >>> out = evaluate_cases(bendpam.physics.presets.be_pam(), "energy", {"alpha0_deg": np.array([65.0, 70.0])},
+    ...                      np.array([150.0, 200.0]))
+    >>> out["free_angle_deg"].round(1).tolist(), out["branch_end"].tolist()
+    ([[50.1, 77.8], [68.7, 114.2]], [2.0, 2.0])
     """
     cs = build_cases(base, values)
     law = MomentLaw(cs, model, eq19_factor=eq19_factor, order=order)
