@@ -27,6 +27,7 @@ from bendpam.physics.braid import DEFAULT_ORDER, Kinematics
 from bendpam.physics.braid import kinematics as _kinematics
 from bendpam.physics.law import FreeBending, FreeBranch, MomentLaw
 from bendpam.physics.models import force_balance as _fb
+from bendpam.validate import integer
 from bendpam.validate import pressure_kpa as _check_pressure
 
 __all__ = [
@@ -193,6 +194,22 @@ _STRESS_NAMES = {
 }
 
 
+#: Unit, meaning and scale from the model's units (MPa, N/mm, rad, mm) of each variable of the stress state.
+_STRESS_UNITS = {
+    "sigma_bl1": ("kPa", "bladder axial stress (eq 43)", 1e3),
+    "sigma_bl2": ("kPa", "bladder hoop stress (eq 44)", 1e3),
+    "sigma_bl3": ("kPa", "bladder radial stress, -P_active (eq 37)", 1e3),
+    "P_e": ("kPa", "interfacial pressure bladder-braid (eq 45)", 1e3),
+    "N_br1": ("N/mm", "braid axial line tension sigma_br1 * t_br (eq 48)", 1.0),
+    "N_br2": ("N/mm", "braid hoop line tension P_e R (eq 31)", 1.0),
+    "sigma_br1": ("kPa", "braid nominal axial stress (eq 48)", 1e3),
+    "sigma_br2": ("kPa", "braid nominal hoop stress (eq 31)", 1e3),
+    "braid_angle": ("deg", "local braid angle alpha(Phi)", 1.0),
+    "t_bar": ("mm", "mean bladder thickness (eq 40)", 1.0),
+    "R": ("mm", "deformed radius (eq 5)", 1.0),
+}
+
+
 def internal_stresses(actuator: Actuator, pressure_kpa, curvature_per_mm, *, n_phi: int = 181,
                       order: int = DEFAULT_ORDER) -> Any:
     """Internal state of the force-balance model (eq 37-48) around the cross-section.
@@ -219,41 +236,31 @@ def internal_stresses(actuator: Actuator, pressure_kpa, curvature_per_mm, *, n_p
     >>> ds["P_e_kpa"].attrs["units"], ds["sigma_bl1_kpa"].dims
     ('kPa', ('phi_deg',))
     """
-    import xarray as xr
-
     law = _law(actuator, "force_balance", True, order)
     P = _check_pressure(pressure_kpa)
     k = law.check_curvature(curvature_per_mm)
     if P.ndim > 1 or k.ndim > 1:
         raise InputError("internal_stresses takes scalar or 1-D pressure_kpa and curvature_per_mm")
-    if isinstance(n_phi, bool) or not isinstance(n_phi, int | np.integer) or not 2 <= int(n_phi) <= 100_000:
-        raise InputError(f"n_phi = {n_phi!r} must be an integer in [2, 100000]")
-    phi = np.linspace(0.0, 2.0 * np.pi, int(n_phi))
+    phi = np.linspace(0.0, 2.0 * np.pi, integer("n_phi", n_phi, 2, 100_000))
     pa = law.active_pressure_kpa(P) * 1e-3  # MPa inside the numerics
     Pg = pa.reshape(pa.shape + (1,) * k.ndim)
     st = _fb.stress_state(law.params, Pg, k, phi, order=order)
+    return _stress_dataset(actuator, st, P, k, phi, np.broadcast_shapes(Pg.shape, k.shape))
+
+
+def _stress_dataset(actuator: Actuator, st: dict, P: np.ndarray, k: np.ndarray, phi: np.ndarray,
+                    S: tuple[int, ...]) -> Any:
+    """The :func:`internal_stresses` dataset from the force-balance stress state ``st`` (model units) of shape ``S``."""
+    import xarray as xr
+
     dims = (["pressure_kpa"] if P.ndim else []) + (["curvature_per_mm"] if k.ndim else [])
-    units = {
-        "sigma_bl1": ("kPa", "bladder axial stress (eq 43)", 1e3),
-        "sigma_bl2": ("kPa", "bladder hoop stress (eq 44)", 1e3),
-        "sigma_bl3": ("kPa", "bladder radial stress, -P_active (eq 37)", 1e3),
-        "P_e": ("kPa", "interfacial pressure bladder-braid (eq 45)", 1e3),
-        "N_br1": ("N/mm", "braid axial line tension sigma_br1 * t_br (eq 48)", 1.0),
-        "N_br2": ("N/mm", "braid hoop line tension P_e R (eq 31)", 1.0),
-        "sigma_br1": ("kPa", "braid nominal axial stress (eq 48)", 1e3),
-        "sigma_br2": ("kPa", "braid nominal hoop stress (eq 31)", 1e3),
-        "braid_angle": ("deg", "local braid angle alpha(Phi)", 1.0),
-        "t_bar": ("mm", "mean bladder thickness (eq 40)", 1.0),
-        "R": ("mm", "deformed radius (eq 5)", 1.0),
-    }
-    S = np.broadcast_shapes(Pg.shape, k.shape)
     data = {}
     for name, arr in st.items():
         arr = np.asarray(arr)
         per_angle = arr.ndim == len(S) + 1
         full = np.broadcast_to(arr, S + ((phi.size,) if per_angle else ()))
         d = dims + (["phi_deg"] if per_angle else [])
-        unit, long_name, scale = units[name]
+        unit, long_name, scale = _STRESS_UNITS[name]
         if name == "braid_angle":
             full, name = np.degrees(full), "braid_angle_deg"
         else:

@@ -94,6 +94,17 @@ def build_cases(base: Actuator, values: dict[str, np.ndarray]) -> ModelParams:
     Every value is validated as :class:`~bendpam.Actuator` would (one line naming the parameter
     and the allowed range).  When ``R0_mm`` is swept without ``R0_start_mm``, ``R0_start_mm``
     keeps the base ratio ``R0_start / R0``; eq 51-52 are applied by :meth:`ModelParams.build`.
+
+    Examples
+    --------
+    >>> import numpy as np, bendpam
+    >>> cases = build_cases(bendpam.physics.presets.be_pam(), {"alpha0_deg": np.array([65.0, 70.0])})
+    >>> cases.shape, np.degrees(cases.alpha0).round(1).tolist()
+    ((2,), [65.0, 70.0])
+    >>> build_cases(bendpam.physics.presets.be_pam(), {"t0_mm": np.array([2.0, 9.0])})
+    Traceback (most recent call last):
+    ...
+    bendpam.errors.InputError: t0_mm = 9 mm is outside the allowed range (0, R0_mm) mm
     """
     n = np.broadcast_shapes(*(np.shape(v) for v in values.values())) if values else ()
     get = {f: np.broadcast_to(np.asarray(values.get(f, getattr(base, f)), dtype=float), n)
@@ -136,6 +147,14 @@ def evaluate_cases(base: Actuator, model: str, values: dict[str, np.ndarray], pr
     """The sweep kernel: all outputs for the cases in ``values`` (1-D arrays) at ``pressure_kpa``.
 
     Returns arrays of shape (cases, pressures) and (cases,) keyed by the names in the module doc.
+
+    Examples
+    --------
+    >>> import numpy as np, bendpam
+    >>> out = evaluate_cases(bendpam.physics.presets.be_pam(), "energy", {"alpha0_deg": np.array([65.0, 70.0])},
+    ...                      np.array([150.0, 200.0]))
+    >>> out["free_angle_deg"].round(1).tolist(), out["branch_end"].tolist()
+    ([[50.1, 77.8], [68.7, 114.2]], [2.0, 2.0])
     """
     cs = build_cases(base, values)
     law = MomentLaw(cs, model, eq19_factor=eq19_factor, order=order)
@@ -233,7 +252,6 @@ def sweep(base_actuator: Actuator, pressure_kpa, model: str = "energy", *, chunk
     names = list(grids_d)
     grids = [grids_d[n] for n in names]
     shape = tuple(g.size for g in grids)
-    n_cases = int(np.prod(shape)) if shape else 1
     chunk_cases = int(chunk_cases)
     if chunk_cases < 1:
         raise InputError(f"chunk_cases = {chunk_cases} must be >= 1")
@@ -241,9 +259,19 @@ def sweep(base_actuator: Actuator, pressure_kpa, model: str = "energy", *, chunk
     # parameters that constrain each other, each other parameter on its own
     _prevalidate(base_actuator, names, grids)
     chunks = _natural_chunks(shape, chunk_cases)
+    fn = _block_fn(base_actuator, model, names, grids, P, order, eq19_factor)
+    data = _run_blocks(fn, shape, chunks, P.size, scheduler=scheduler, workers=workers, compute=compute,
+                       progress=progress)
+    return _dataset(data, names, grids, shape, P, base_actuator, model, order)
+
+
+def _run_blocks(fn, shape: tuple[int, ...], chunks, n_pressures: int, *, scheduler: str | None, workers: int | None,
+                compute: bool, progress: bool | Callable[[int], Any] | None) -> Any:
+    """The sweep's data (cases..., pressures, outputs): the blocks of ``fn`` in a loop without Dask, else a
+    dask array, computed in-process or on a cluster, or left lazy; progress as :func:`sweep` describes."""
+    n_cases = int(np.prod(shape)) if shape else 1
     n_blocks = int(np.prod([len(c) for c in chunks])) if shape else 1
     show = progress if progress is not None else (n_blocks >= 20 and sys.stderr.isatty())
-    fn = _block_fn(base_actuator, model, names, grids, P, order, eq19_factor)
     da: Any
     try:
         import dask.array as da
@@ -263,16 +291,14 @@ def sweep(base_actuator: Actuator, pressure_kpa, model: str = "energy", *, chunk
             report = None
         remote = bool(scheduler or workers)
         if da is None:
-            data = _loop_blocks(_Counted(fn, report), shape, chunks)
-        else:
-            idx = da.arange(n_cases, chunks=n_cases).reshape(shape or (1,)).rechunk(chunks or ((1,),))
-            nd = idx.ndim
-            # in-process the kernel reports each block itself; on a cluster the futures do
-            kernel = fn if remote or not compute or report is None else _Counted(fn, report)
-            arr = idx.map_blocks(kernel, dtype=float, new_axis=[nd, nd + 1],
-                                 chunks=(*idx.chunks, (P.size,), (len(_OUTPUTS),)), meta=np.empty((0,) * (nd + 2)))
-            data = _compute(arr, scheduler, workers, report, idx.chunks) if compute else arr
-    return _dataset(data, names, grids, shape, P, base_actuator, model, order)
+            return _loop_blocks(_Counted(fn, report), shape, chunks)
+        idx = da.arange(n_cases, chunks=n_cases).reshape(shape or (1,)).rechunk(chunks or ((1,),))
+        nd = idx.ndim
+        # in-process the kernel reports each block itself; on a cluster the futures do
+        kernel = fn if remote or not compute or report is None else _Counted(fn, report)
+        arr = idx.map_blocks(kernel, dtype=float, new_axis=[nd, nd + 1],
+                             chunks=(*idx.chunks, (n_pressures,), (len(_OUTPUTS),)), meta=np.empty((0,) * (nd + 2)))
+        return _compute(arr, scheduler, workers, report, idx.chunks) if compute else arr
 
 
 def _natural_chunks(shape: tuple[int, ...], chunk_cases: int) -> tuple[tuple[int, ...], ...]:

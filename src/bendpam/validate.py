@@ -22,8 +22,8 @@ import numpy as np
 from bendpam.errors import InputError
 
 __all__ = [
-    "KNOWN_SUFFIXES", "MPA_SUSPECT_KPA", "UnitWarning", "did_you_mean", "file_format", "float_array", "number",
-    "pressure_kpa",
+    "KNOWN_SUFFIXES", "MPA_SUSPECT_KPA", "UnitWarning", "boolean", "did_you_mean", "file_format", "finite_number",
+    "float_array", "integer", "number", "pressure_kpa", "quadrature_order",
 ]
 
 #: Below this (kPa), a set of pressures is suspected to be in MPa.
@@ -71,8 +71,96 @@ def number(name: str, value: Any, lo: float | None = None, hi: float | None = No
     return v
 
 
+def finite_number(name: str, value: Any, unit: str = "") -> float:
+    """``value`` as a finite float (anything :class:`float` takes but a bool or a string), else a one-line
+    :class:`InputError`.
+
+    Examples
+    --------
+    >>> finite_number("mu", 0.6, "MPa")
+    0.6
+    >>> finite_number("shape", float("nan"))
+    Traceback (most recent call last):
+    ...
+    bendpam.errors.InputError: shape = nan is not finite
+    """
+    u = f" {unit}" if unit else ""
+    if isinstance(value, bool | str | bytes):
+        raise InputError(f"{name} = {value!r} is not a number")
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} = {value!r} is not a number") from None
+    if not math.isfinite(v):
+        raise InputError(f"{name} = {value!r}{u} is not finite")
+    return v
+
+
+def integer(name: str, value: Any, lo: int, hi: int) -> int:
+    """``value`` as an int in ``[lo, hi]`` (a Python or NumPy integer, not a bool), else a one-line :class:`InputError`.
+
+    Examples
+    --------
+    >>> integer("n_phi", 181, 2, 100_000)
+    181
+    >>> integer("n_phi", 1.5, 2, 100_000)
+    Traceback (most recent call last):
+    ...
+    bendpam.errors.InputError: n_phi = 1.5 must be an integer in [2, 100000]
+    """
+    if isinstance(value, bool) or not isinstance(value, int | np.integer) or not lo <= int(value) <= hi:
+        raise InputError(f"{name} = {value!r} must be an integer in [{lo}, {hi}]")
+    return int(value)
+
+
+def boolean(name: str, value: Any) -> bool:
+    """``value`` as a bool (Python or NumPy), else a one-line :class:`InputError`; 0 and 1 are not booleans.
+
+    Examples
+    --------
+    >>> boolean("eq19_factor", True)
+    True
+    >>> boolean("eq19_factor", "yes")
+    Traceback (most recent call last):
+    ...
+    bendpam.errors.InputError: eq19_factor = 'yes' must be True or False
+    """
+    if not isinstance(value, bool | np.bool_):
+        raise InputError(f"{name} = {value!r} must be True or False")
+    return bool(value)
+
+
+def quadrature_order(order: Any) -> int:
+    """The order of the section integrals: 0 (closed form) or N in [4, 1024] Gauss-Legendre nodes on [0, pi].
+
+    Examples
+    --------
+    >>> quadrature_order(0), quadrature_order(32)
+    (0, 32)
+    >>> quadrature_order(2)
+    Traceback (most recent call last):
+    ...
+    bendpam.errors.InputError: order = 2 is outside the allowed range: 0 (closed form) or [4, 1024]
+    """
+    if isinstance(order, bool) or not isinstance(order, int | np.integer):
+        raise InputError(f"order = {order!r} must be an integer (Gauss-Legendre nodes on [0, pi])")
+    if int(order) != 0 and not 4 <= int(order) <= 1024:  # 0: bendpam.physics.braid.CLOSED_FORM
+        raise InputError(f"order = {order} is outside the allowed range: 0 (closed form) or [4, 1024]")
+    return int(order)
+
+
 def float_array(name: str, value: Any, unit: str) -> np.ndarray:
-    """``value`` as a float array, or a one-line :class:`InputError` (a bool or a string is not a number)."""
+    """``value`` as a float array, or a one-line :class:`InputError` (a bool or a string is not a number).
+
+    Examples
+    --------
+    >>> float_array("curvature_per_mm", [0, 0.01], "1/mm").tolist()
+    [0.0, 0.01]
+    >>> float_array("curvature_per_mm", "0.01", "1/mm")
+    Traceback (most recent call last):
+    ...
+    bendpam.errors.InputError: curvature_per_mm = '0.01' is not a number (1/mm expected)
+    """
     if isinstance(value, bool | str | bytes):
         raise InputError(f"{name} = {value!r} is not a number ({unit} expected)")
     try:

@@ -111,7 +111,7 @@ def process(
     for v in pressures:
         if v < 0:
             raise UserError(f"--pressure-kpa: {v:g} kPa is below zero")
-    fx = Fixture.from_string(fixture, L0_mm=l0_mm)
+    fx = Fixture.from_string(fixture, L0_mm=l0_mm, name="--fixture")
     opts = ProcessingOptions(cutoff_hz=cutoff_hz, reversal_fraction=reversal_fraction, grid_points=grid_points,
                              tare_n=tare_n)
     fig_name = f"figure4.{fig_format.value if fig_format is not None else 'png'}"
@@ -201,7 +201,7 @@ def simulate_test_cmd(
                             hysteresis_angle_deg=hysteresis_angle_deg, hysteresis_law=hysteresis_law,
                             hysteresis_offset_nmm=hysteresis_offset_nmm, dwell_s=dwell_s,
                             stroke_offset_mm=stroke_offset_mm, seed=seed)
-    fx = Fixture.from_string(fixture, L0_mm=act.L0_mm)
+    fx = Fixture.from_string(fixture, L0_mm=act.L0_mm, name="--fixture")
     with output_set(out, [actuator]) as o:
         truth = simulate_tests(act, P, o.staging, model_name(model), dialect=fmt.value, fixture=fx, settings=st)
     for t in truth["pressures"]:

@@ -123,51 +123,15 @@ def sweep_cmd(
                                            help="Same as --quiet (--no-progress).")] = True,
 ):
     """Design sweep: actuator parameters crossed with pressures (in-process or on Dask)."""
-    from bendpam.sweeps import SWEEP_PARAMETERS, sweep
+    from bendpam.sweeps import sweep
 
     if out is None and plot is None:
         raise UserError("give --out FILE.nc|.csv|.parquet and/or --plot FILE.png|.pdf|.svg")
-    fixed_at = {}
-    for item in at or []:
-        name, sep, value = item.partition("=")
-        vals = parse_values([value], f"--at {name}") if sep else []
-        if len(vals) != 1:
-            raise UserError(f"--at {item!r}: expected NAME=VALUE, e.g. pressure_kpa=150")
-        fixed_at[name.strip()] = vals[0]
+    fixed_at = parse_at(at)
     data_fmt, fig_fmt = sweep_formats(out, plot, fmt)
-    if data_fmt == "parquet":
-        try:
-            import pyarrow  # noqa: F401
-        except ImportError:
-            raise UserError(f'--out {str(out)!r}: writing Parquet needs pyarrow: pip install "bendpam[parquet]"') \
-                from None
-    if scheduler and workers:
-        raise UserError("give either --scheduler or --workers, not both")
-    if workers is not None and workers < 1:
-        raise UserError(f"--workers {workers}: give at least 1 worker process")
-    if workers is not None and workers > max_local_workers():
-        raise UserError(f"--workers {workers}: at most {max_local_workers()} local processes (4 per CPU); "
-                        "use --scheduler for a larger cluster")
+    check_run(out, data_fmt, scheduler, workers)
     act = load_actuator(preset, actuator, model)
-    params = dict(parse_param(p) for p in (param or []))
-    for name in params:
-        if name not in SWEEP_PARAMETERS:
-            raise UserError(f"--param {name}: cannot sweep it; choose from {', '.join(SWEEP_PARAMETERS)}")
-    if not pressure_kpa:
-        raise UserError("give the pressures with --pressure-kpa, e.g. 100:250:16")
-    P = pressures_kpa(pressure_kpa)
-    n_points = len(P) * int(np.prod([len(v) for v in params.values()] or [1]))
-    if n_points > max_points:
-        raise UserError(f"the sweep has {n_points} (case, pressure) points, more than --max-points {max_points}; "
-                        "raise --max-points to run it")
-    n_cases = n_points // len(P)
-    block = min(chunk_cases, n_cases) * len(P)
-    if block > MAX_BLOCK_POINTS:
-        raise UserError(f"--chunk-cases {chunk_cases} with {len(P)} pressures gives {block} (case, pressure) points "
-                        f"per block, more than {MAX_BLOCK_POINTS} (about 2 kB of memory each); use --chunk-cases "
-                        f"{max(MAX_BLOCK_POINTS // len(P), 1)} or fewer, or fewer pressures")
-    # typed Any: mypy would check the arrays against sweep()'s other keyword parameters
-    grids: dict[str, Any] = {k: np.asarray(v) for k, v in params.items()}
+    grids, P, n_cases = sweep_grid(param, pressure_kpa, max_points, chunk_cases)
     from bendpam.infra.progress import Progress
 
     with Progress(n_cases, "sweep", quiet=quiet or not progress) as bar:
@@ -187,3 +151,59 @@ def sweep_cmd(
         with output_file(plot, [actuator]) as f:
             save_figure(sweep_figure(ds, plot_var, plot_x, plot_y, at=fixed_at), f.path, format=fig_fmt)
         typer.echo(f"wrote {plot}")
+
+
+def parse_at(at: list[str] | None) -> dict[str, float]:
+    """The ``--at NAME=VALUE`` items as ``{name: value}``."""
+    fixed_at = {}
+    for item in at or []:
+        name, sep, value = item.partition("=")
+        vals = parse_values([value], f"--at {name}") if sep else []
+        if len(vals) != 1:
+            raise UserError(f"--at {item!r}: expected NAME=VALUE, e.g. pressure_kpa=150")
+        fixed_at[name.strip()] = vals[0]
+    return fixed_at
+
+
+def check_run(out: Path | None, data_fmt: str | None, scheduler: str | None, workers: int | None) -> None:
+    """Refuse, before any work, a Parquet --out without pyarrow and a --scheduler/--workers request that cannot run."""
+    if data_fmt == "parquet":
+        try:
+            import pyarrow  # noqa: F401
+        except ImportError:
+            raise UserError(f'--out {str(out)!r}: writing Parquet needs pyarrow: pip install "bendpam[parquet]"') \
+                from None
+    if scheduler and workers:
+        raise UserError("give either --scheduler or --workers, not both")
+    if workers is not None and workers < 1:
+        raise UserError(f"--workers {workers}: give at least 1 worker process")
+    if workers is not None and workers > max_local_workers():
+        raise UserError(f"--workers {workers}: at most {max_local_workers()} local processes (4 per CPU); "
+                        "use --scheduler for a larger cluster")
+
+
+def sweep_grid(param: list[str] | None, pressure_kpa: list[str] | None, max_points: int,
+               chunk_cases: int) -> tuple[dict[str, Any], list[float], int]:
+    """``(grids, pressures, n_cases)`` from --param and --pressure-kpa, within --max-points and the block size."""
+    from bendpam.sweeps import SWEEP_PARAMETERS
+
+    params = dict(parse_param(p) for p in (param or []))
+    for name in params:
+        if name not in SWEEP_PARAMETERS:
+            raise UserError(f"--param {name}: cannot sweep it; choose from {', '.join(SWEEP_PARAMETERS)}")
+    if not pressure_kpa:
+        raise UserError("give the pressures with --pressure-kpa, e.g. 100:250:16")
+    P = pressures_kpa(pressure_kpa)
+    n_points = len(P) * int(np.prod([len(v) for v in params.values()] or [1]))
+    if n_points > max_points:
+        raise UserError(f"the sweep has {n_points} (case, pressure) points, more than --max-points {max_points}; "
+                        "raise --max-points to run it")
+    n_cases = n_points // len(P)
+    block = min(chunk_cases, n_cases) * len(P)
+    if block > MAX_BLOCK_POINTS:
+        raise UserError(f"--chunk-cases {chunk_cases} with {len(P)} pressures gives {block} (case, pressure) points "
+                        f"per block, more than {MAX_BLOCK_POINTS} (about 2 kB of memory each); use --chunk-cases "
+                        f"{max(MAX_BLOCK_POINTS // len(P), 1)} or fewer, or fewer pressures")
+    # typed Any: mypy would check the arrays against sweep()'s other keyword parameters
+    grids: dict[str, Any] = {k: np.asarray(v) for k, v in params.items()}
+    return grids, P, n_cases

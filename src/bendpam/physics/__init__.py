@@ -10,8 +10,11 @@ layers.
 * :mod:`~bendpam.physics.braid`: braid kinematics, eq 1-5.
 * :mod:`~bendpam.physics.fixture`: the four-point-bending fixture, eq 6-8.
 * :mod:`~bendpam.physics.models`: the energy (eq 9-21) and force-balance (eq 22-49) models.
-* :mod:`~bendpam.physics.law`: :class:`~bendpam.physics.law.MomentLaw`, the only sampler of the models.
+* :mod:`~bendpam.physics.law`: :class:`~bendpam.physics.law.MomentLaw`, the only sampler of the models,
+  and its spline table; the free-bending branch (:mod:`~bendpam.physics.branch`), the law along
+  ``u = k'R`` (:mod:`~bendpam.physics.sections`) and the stable branch (:mod:`~bendpam.physics.stable`).
 * :mod:`~bendpam.physics.fast`: the tabulated fast path.
 * :mod:`~bendpam.physics.limits`: frame stress, buckling, lock-up and bladder-stretch margins.
 * :mod:`~bendpam.physics.hysteresis`: loop models around the quasi-static law.
+* :mod:`~bendpam.physics.roots`: the vectorised root finders (bracketed Newton, Illinois) they share.
 """

@@ -34,10 +34,6 @@ __all__ = ["NEUTRAL_ANGLE_DEG", "Actuator", "ModelParams", "bladder_area_mm2", "
 NEUTRAL_ANGLE_DEG = math.degrees(math.atan(math.sqrt(2.0)))
 
 
-def _check(name: str, value: Any, lo: float | None, hi: float | None, *, lo_open=True, hi_open=True, unit=""):
-    return number(name, value, lo, hi, lo_open=lo_open, hi_open=hi_open, unit=unit)
-
-
 def t0_start_mm(R0_mm, t0_mm, R0_start_mm):
     """Bladder wall thickness at P_start (mm), eq 52: constant wall area (eq 51); scalars or arrays.
 
@@ -244,31 +240,31 @@ class Actuator:
 
     def __post_init__(self) -> None:
         s = object.__setattr__
-        s(self, "alpha0_deg", _check("alpha0_deg", self.alpha0_deg, 0.0, 90.0, unit="deg"))
-        s(self, "R0_mm", _check("R0_mm", self.R0_mm, 0.0, None, unit="mm"))
-        s(self, "t0_mm", _check("t0_mm", self.t0_mm, 0.0, self.R0_mm, unit="mm"))
-        s(self, "L0_mm", _check("L0_mm", self.L0_mm, 0.0, None, unit="mm"))
-        s(self, "frame_thickness_mm", _check("frame_thickness_mm", self.frame_thickness_mm, 0.0, None, unit="mm"))
-        s(self, "frame_width_mm", _check("frame_width_mm", self.frame_width_mm, 0.0, None, unit="mm"))
-        s(self, "frame_modulus_mpa", _check("frame_modulus_mpa", self.frame_modulus_mpa, 0.0, None, unit="MPa"))
-        s(self, "C10_kpa", _check("C10_kpa", self.C10_kpa, None, None, unit="kPa"))
-        s(self, "C01_kpa", _check("C01_kpa", self.C01_kpa, None, None, unit="kPa"))
+        s(self, "alpha0_deg", number("alpha0_deg", self.alpha0_deg, 0.0, 90.0, lo_open=True, hi_open=True,
+                                     unit="deg"))
+        s(self, "R0_mm", number("R0_mm", self.R0_mm, 0.0, lo_open=True, unit="mm"))
+        s(self, "t0_mm", number("t0_mm", self.t0_mm, 0.0, self.R0_mm, lo_open=True, hi_open=True, unit="mm"))
+        s(self, "L0_mm", number("L0_mm", self.L0_mm, 0.0, lo_open=True, unit="mm"))
+        s(self, "frame_thickness_mm", number("frame_thickness_mm", self.frame_thickness_mm, 0.0, lo_open=True,
+                                             unit="mm"))
+        s(self, "frame_width_mm", number("frame_width_mm", self.frame_width_mm, 0.0, lo_open=True, unit="mm"))
+        s(self, "frame_modulus_mpa", number("frame_modulus_mpa", self.frame_modulus_mpa, 0.0, lo_open=True,
+                                            unit="MPa"))
+        s(self, "C10_kpa", number("C10_kpa", self.C10_kpa, unit="kPa"))
+        s(self, "C01_kpa", number("C01_kpa", self.C01_kpa, unit="kPa"))
         if self.C10_kpa + self.C01_kpa <= 0.0:
             raise InputError(
                 f"C10_kpa + C01_kpa = {self.C10_kpa + self.C01_kpa:g} kPa must be > 0 "
                 "(the bladder's initial shear modulus 2(C10 + C01) must be positive); "
                 f"got C10_kpa = {self.C10_kpa:g}, C01_kpa = {self.C01_kpa:g}"
             )
-        s(self, "P_start_kpa", _check("P_start_kpa", self.P_start_kpa, 0.0, None, lo_open=False, unit="kPa"))
+        s(self, "P_start_kpa", number("P_start_kpa", self.P_start_kpa, 0.0, unit="kPa"))
         if self.R0_start_mm is None:
             s(self, "R0_start_mm", self.R0_mm)
         else:
-            s(
-                self,
-                "R0_start_mm",
-                _check("R0_start_mm", self.R0_start_mm, self.R0_mm, None, lo_open=False, unit="mm"),
-            )
-        s(self, "braid_thickness_mm", _check("braid_thickness_mm", self.braid_thickness_mm, 0.0, None, unit="mm"))
+            s(self, "R0_start_mm", number("R0_start_mm", self.R0_start_mm, self.R0_mm, unit="mm"))
+        s(self, "braid_thickness_mm", number("braid_thickness_mm", self.braid_thickness_mm, 0.0, lo_open=True,
+                                             unit="mm"))
         if self.model not in ("", "energy", "force_balance"):
             raise InputError(f"model = {self.model!r}: the model the constants were identified with must be "
                              "'energy', 'force_balance' or '' (unknown)")
@@ -276,10 +272,10 @@ class Actuator:
             raise InputError(f"name = {self.name!r} must be a string")
         if self.frame_strength_mpa is not None:
             s(self, "frame_strength_mpa",
-              _check("frame_strength_mpa", self.frame_strength_mpa, 0.0, None, unit="MPa"))
+              number("frame_strength_mpa", self.frame_strength_mpa, 0.0, lo_open=True, unit="MPa"))
         if self.bladder_stretch_limit is not None:
             s(self, "bladder_stretch_limit",
-              _check("bladder_stretch_limit", self.bladder_stretch_limit, 1.0, None))  # a stretch: no unit
+              number("bladder_stretch_limit", self.bladder_stretch_limit, 1.0, lo_open=True))  # a stretch: no unit
         s(self, "_material", MooneyRivlin(self.C10_kpa * 1e-3, self.C01_kpa * 1e-3))
         s(self, "_params", ModelParams.build(**{f: getattr(self, f) for f in self.field_names()
                                                      if f not in _NOT_MODEL_PARAMS}))

@@ -64,6 +64,8 @@ from typing import Any
 import numpy as np
 
 from bendpam.errors import InputError
+from bendpam.physics.roots import bracketed_newton
+from bendpam.validate import quadrature_order
 
 __all__ = [
     "CLOSED_FORM",
@@ -73,12 +75,16 @@ __all__ = [
     "NODE_ORDER",
     "CurvatureLimits",
     "Kinematics",
+    "case_column",
     "circle_ibar",
     "curvature_limits",
     "gauss_nodes",
     "ibar_closed_form",
     "kinematics",
     "limits",
+    "radius_from_u",
+    "radius_state",
+    "radius_terms",
     "solve_u",
 ]
 
@@ -100,13 +106,18 @@ def gauss_nodes(order: int = DEFAULT_ORDER) -> tuple[np.ndarray, np.ndarray]:
 
         (1 / 2pi) \\int_0^{2pi} f dPhi = sum(wbar * f(phi))
 
-    Returns read-only arrays ``(phi, wbar)`` of length ``order``.
+    Returns read-only arrays ``(phi, wbar)`` of length ``order`` (``order = 0``: :data:`NODE_ORDER`).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> phi, wbar = gauss_nodes(8)
+    >>> phi.size, round(float(wbar.sum()), 12), round(float(wbar @ np.cos(phi) ** 2), 12)   # mean of cos^2 = 1/2
+    (8, 1.0, 0.5)
     """
-    order = int(order)
+    order = quadrature_order(int(order))
     if order == CLOSED_FORM:
         order = NODE_ORDER
-    if order < 4 or order > 1024:
-        raise InputError(f"quadrature order = {order} is outside the allowed range 0 (closed form) or [4, 1024]")
     x, w = np.polynomial.legendre.leggauss(order)
     phi = (x + 1.0) * (np.pi / 2.0)
     wbar = w / 2.0  # (pi/2 * w) / pi
@@ -116,7 +127,17 @@ def gauss_nodes(order: int = DEFAULT_ORDER) -> tuple[np.ndarray, np.ndarray]:
 
 
 def case_column(x):
-    """A scalar as is; an array parameter gets a trailing axis to broadcast against the nodes."""
+    """A scalar as is; an array parameter gets a trailing axis to broadcast against the nodes.
+
+    Per-case parameters (a block of actuator cases) meet per-node arrays of the section's
+    quadrature angles on the last axis.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> case_column(0.5), case_column(np.array([0.5, 0.6])).shape
+    (0.5, (2, 1))
+    """
     return x[..., None] if np.ndim(x) else x
 
 
@@ -263,21 +284,13 @@ def _newton(q, alpha0, order: int, u0, u_bounds):
     hi = np.where(q >= 0.0, u_bounds[1], 0.0)
     eps = 1e-9 * (hi - lo)
     u = np.where(q == 0.0, 0.0, np.clip(u0, lo + eps, hi - eps))
-    for _ in range(_NEWTON_MAXITER):
+
+    def f_and_slope(u):  # q(u) - q is increasing in u
         ib, dib = circle_ibar(u, c, order)
-        f = s * u * ib - q
-        # maintain the bracket (q is increasing in u)
-        lo = np.where(f < 0.0, u, lo)
-        hi = np.where(f > 0.0, u, hi)
-        step = f / (s * (ib + u * dib))
-        un = u - step
-        outside = ~((un >= lo) & (un <= hi))
-        un = np.where(outside, 0.5 * (lo + hi), un)
-        # Newton converges quadratically: a step below 1e-8 |u| leaves an error near 1e-16 |u|
-        done = ((np.abs(un - u) <= 1e-8 * np.abs(u)) & ~outside) | (f == 0.0)
-        u = np.where(f == 0.0, u, un)
-        if np.all(done):
-            break
+        return s * u * ib - q, s * (ib + u * dib)
+
+    # Newton converges quadratically: a step below 1e-8 |u| leaves an error near 1e-16 |u|
+    u = bracketed_newton(f_and_slope, u, lo, hi, maxiter=_NEWTON_MAXITER, rtol=1e-8)
     ib, dib = circle_ibar(u, c, order)
     return u, ib, dib
 
@@ -617,7 +630,17 @@ def radius_from_u(u, ib, dib, alpha0, R0, k=None):
     """``R, dR/dk', k'`` from ``u = k'R`` and the circle means ``Ibar(u)``, ``dIbar/du`` (eq 5).
 
     ``R = R0 xi(u)`` with ``xi = 1 / (s Ibar)``; ``dR/dk' = R0 xi' R / (1 - R0 xi' k')`` (implicit
-    differentiation).  ``k'`` is ``u / R`` unless given.  Scalars or arrays that broadcast.
+    differentiation).  ``k'`` is ``u / R`` unless given.  Scalars or arrays that broadcast;
+    ``alpha0`` in rad, ``R0`` (the prestrain-corrected ``R0_start``) in mm.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> a0 = np.radians(69.7)
+    >>> ib, dib = circle_ibar(np.array([0.0, 0.05]), np.cos(a0))
+    >>> R, dR, k = radius_from_u(np.array([0.0, 0.05]), ib, dib, a0, 10.1)
+    >>> R.round(4).tolist(), k.round(6).tolist()      # mm, 1/mm
+    ([10.1, 10.0277], [0.0, 0.004986])
     """
     s = np.sin(alpha0)
     # eta(0) = 1 and xi'(0) = -cot^2 alpha0 hold exactly; don't let quadrature rounding blur them
@@ -632,7 +655,17 @@ def radius_from_u(u, ib, dib, alpha0, R0, k=None):
 
 
 def radius_state(kprime, alpha0, R0, order: int = DEFAULT_ORDER):
-    """Eq 5 at ``kprime``: ``u, R, dR/dk', Ibar, dIbar/du`` (no limit checks)."""
+    """Eq 5 at ``kprime``: ``u, R, dR/dk', Ibar, dIbar/du`` (no limit checks).
+
+    ``kprime`` in 1/mm, ``alpha0`` in rad, ``R0`` (``R0_start``) in mm; ``R`` in mm, ``dR/dk'`` in mm^2.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> u, R, dR, ib, dib = radius_state([0.0, 0.01], np.radians(69.7), 10.1)
+    >>> u.round(6).tolist(), R.round(4).tolist()
+    ([0.0, 0.099494], [10.1, 9.9494])
+    """
     k = np.asarray(kprime, dtype=float)
     u, ib, dib = solve_u(k * R0, alpha0, order)
     R, dR, _ = radius_from_u(u, ib, dib, alpha0, R0, k)
@@ -640,7 +673,17 @@ def radius_state(kprime, alpha0, R0, order: int = DEFAULT_ORDER):
 
 
 def radius_terms(kprime, alpha0: float, R0: float, order: int = DEFAULT_ORDER):
-    """Core of eq 5 for the models: ``u, R, dR/dk'`` at ``kprime`` (no limit checks)."""
+    """Core of eq 5 for the models: ``u, R, dR/dk'`` at ``kprime`` (no limit checks).
+
+    The first three results of :func:`radius_state` (same units).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> u, R, dR = radius_terms(0.01, np.radians(69.7), 10.1)
+    >>> round(float(R), 4), round(float(dR), 2)       # mm, mm^2
+    (9.9494, -16.17)
+    """
     u, R, dR, _, _ = radius_state(kprime, alpha0, R0, order)
     return u, R, dR
 

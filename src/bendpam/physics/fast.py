@@ -25,5 +25,13 @@ __all__ = ["MomentTable", "moment_table"]
 
 def moment_table(actuator: Actuator, model: str = "energy", *, eq19_factor: bool = True,
                  tol: float = 1e-6) -> MomentTable:
-    """The cached :class:`MomentTable` of ``actuator`` and ``model`` (built on first use)."""
+    """The cached :class:`MomentTable` of ``actuator`` and ``model`` (built on first use).
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> table = moment_table(bendpam.physics.presets.bc_pam(), "force_balance")
+    >>> table is moment_table(bendpam.physics.presets.bc_pam(), "force_balance"), table.max_rel_error < 1e-6
+    (True, True)
+    """
     return MomentLaw.of(actuator, model, eq19_factor=eq19_factor).tabulated(tol)

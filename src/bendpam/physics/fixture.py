@@ -43,6 +43,13 @@ class Fixture:
     r_mm : loading roller radius (paper: 2.5 mm).
     t_mm : connecting plate thickness (paper: 4 mm).
     L0_mm : active length of the actuator, for k' = 2 beta / L0 (paper: 145 mm).
+
+    Examples
+    --------
+    >>> fx = Fixture()                                   # the paper's fixture
+    >>> beta, k, M = fx.convert(10.0, 5.0)               # stroke 10 mm, force 5 N
+    >>> round(float(beta), 4), round(float(k), 6), round(float(M), 2)   # rad, 1/mm, N*mm
+    (0.2694, 0.003716, 100.61)
     """
 
     d_mm: float = 35.0
@@ -69,15 +76,25 @@ class Fixture:
         return self.t_mm + 2.0 * self.r_mm
 
     @classmethod
-    def from_string(cls, text: str, L0_mm: float = 145.0) -> Fixture:
-        """Parse ``"d,r,t"`` (mm), as given to ``--fixture``."""
+    def from_string(cls, text: str, L0_mm: float = 145.0, *, name: str = "fixture") -> Fixture:
+        """Parse ``"d,r,t"`` (mm); ``name`` names the value in the error message (the CLI gives its option).
+
+        Examples
+        --------
+        >>> Fixture.from_string("35, 2.5, 4")
+        Fixture(d_mm=35.0, r_mm=2.5, t_mm=4.0, L0_mm=145.0)
+        >>> Fixture.from_string("35,2.5")
+        Traceback (most recent call last):
+        ...
+        bendpam.errors.InputError: fixture '35,2.5': expected three numbers d,r,t in mm, e.g. 35,2.5,4
+        """
         parts = [p for p in str(text).replace(";", ",").split(",") if p.strip()]
         if len(parts) != 3:
-            raise InputError(f"--fixture {text!r}: expected three numbers d,r,t in mm, e.g. 35,2.5,4")
+            raise InputError(f"{name} {text!r}: expected three numbers d,r,t in mm, e.g. 35,2.5,4")
         try:
             d, r, t = (float(p) for p in parts)
         except ValueError:
-            raise InputError(f"--fixture {text!r}: expected three numbers d,r,t in mm, e.g. 35,2.5,4") from None
+            raise InputError(f"{name} {text!r}: expected three numbers d,r,t in mm, e.g. 35,2.5,4") from None
         return cls(d, r, t, L0_mm)
 
     # ---- eq 6 ---------------------------------------------------------------------------------

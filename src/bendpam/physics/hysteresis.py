@@ -77,7 +77,15 @@ def _segments(theta: np.ndarray):
 
 @dataclass(frozen=True)
 class DahlLaw:
-    """Rate-independent Dahl law with characteristic angle ``theta_c_rad`` (> 0)."""
+    """Rate-independent Dahl law with characteristic angle ``theta_c_rad`` (> 0).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> law = DahlLaw(np.radians(5.0))
+    >>> law.z_path(np.radians([0.0, 5.0, 20.0, 15.0])).round(3).tolist()   # away, then back
+    [0.0, 0.632, 0.982, -0.271]
+    """
 
     theta_c_rad: float = math.radians(5.0)
 
@@ -127,7 +135,15 @@ class DahlLaw:
 
 @dataclass(frozen=True)
 class PrandtlIshlinskii:
-    """Prandtl-Ishlinskii (Iwan) law: ``n`` stop operators, saturation angle ``theta_h_rad``."""
+    """Prandtl-Ishlinskii (Iwan) law: ``n`` stop operators, saturation angle ``theta_h_rad``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> law = PrandtlIshlinskii(np.radians(10.0))
+    >>> law.z_path(np.radians([0.0, 5.0, 20.0, 15.0])).round(3).tolist()   # virgin: saturates after 5 deg
+    [0.0, 1.0, 1.0, -0.5]
+    """
 
     theta_h_rad: float = math.radians(10.0)
     n: int = 32
@@ -212,7 +228,15 @@ class PrandtlIshlinskii:
 
 
 def make_law(name: str, angle_deg: float):
-    """A law by name (``"pi"`` or ``"dahl"``) with its angle parameter in degrees."""
+    """A law by name (``"pi"`` or ``"dahl"``) with its angle parameter in degrees.
+
+    Examples
+    --------
+    >>> make_law("dahl", 5.0)
+    DahlLaw(theta_c_rad=0.08726646259971647)
+    >>> make_law("pi", 10.0).n
+    32
+    """
     key = str(name).strip().lower().replace("-", "_")
     if key in ("pi", "prandtl_ishlinskii", "iwan"):
         return PrandtlIshlinskii(math.radians(float(angle_deg)))
@@ -233,6 +257,15 @@ class LoopModel:
     theta_h_deg : saturation angle (PI) or characteristic angle (Dahl), degrees, > 0.
     amplitude : ``"linear"`` (``A = a0 + a1 P_active``) or ``"interfacial"``
         (``A = a0 + a1 P_e``, force-balance interfacial pressure, eq 45).
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> loop = LoopModel(a0_nmm=2.0, a1_nmm_per_kpa=0.1, theta_h_deg=8.0)
+    >>> float(loop.amplitude_nmm(bendpam.physics.presets.be_pam(), 168.0))     # 2 + 0.1 x 100 kPa active
+    12.0
+    >>> LoopModel.from_dict({"law": "dahl", "theta_h_deg": 5.0}).z_law.name
+    'dahl'
     """
 
     law: str = "pi"
@@ -316,6 +349,14 @@ def loss_ratio(k_mag, upper, lower, L0_mm: float) -> tuple[float, float, float]:
 
     Loss = loop area in M-theta, stored = area under the mean of the branches (Table 2's
     definition, as in :mod:`bendpam.lab.processing`).  Returns ``(ratio, loss, stored)``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> k = np.linspace(0.0, 0.01, 11)                   # 1/mm
+    >>> ratio, loss, stored = loss_ratio(k, 110.0 - 10000.0 * k, 90.0 - 10000.0 * k, 145.0)
+    >>> round(ratio, 3), round(loss, 2), round(stored, 2)   # loss and stored energy in N*mm
+    (0.4, 29.0, 72.5)
     """
     th = np.asarray(k_mag, dtype=float) * L0_mm
     loss = float(np.trapezoid(np.asarray(upper) - np.asarray(lower), th))
@@ -342,6 +383,15 @@ def loop_branches(actuator, loop: LoopModel, pressure_kpa, k_free, k, model: str
     Returns ``(loading, unloading)``: the upper and the lower branch (N*mm, magnitudes) at the
     curvature magnitudes ``k``.  ``pressure_kpa`` and ``k_free`` may be arrays that broadcast
     against ``k`` (one row per test).
+
+    Examples
+    --------
+    >>> import numpy as np, bendpam
+    >>> a = bendpam.physics.presets.be_pam()
+    >>> loop = LoopModel(a1_nmm_per_kpa=0.1, theta_h_deg=8.0)
+    >>> up, low = loop_branches(a, loop, 150.0, 0.007, np.array([0.0, 0.0035, 0.007]))
+    >>> up.round(1).tolist(), low.round(1).tolist()      # N*mm: the loop closes at both ends
+    ([201.0, 108.5, 14.5], [201.0, 92.1, 14.5])
     """
     from bendpam.physics.law import MomentLaw
 
@@ -352,7 +402,16 @@ def loop_branches(actuator, loop: LoopModel, pressure_kpa, k_free, k, model: str
 
 @dataclass(frozen=True)
 class Cycle:
-    """A predicted steady loop between the blocked state and the free state reached on unloading."""
+    """A predicted steady loop between the blocked state and the free state reached on unloading.
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> a = bendpam.physics.presets.be_pam()
+    >>> c = predict_cycle(a, LoopModel(a1_nmm_per_kpa=0.1, theta_h_deg=8.0), 200.0)
+    >>> round(c.blocked_moment_nmm, 1), round(c.free_curvature_per_mm, 5), c.curvature_per_mm.shape
+    (323.5, 0.01274, (201,))
+    """
 
     pressure_kpa: float
     free_curvature_per_mm: float  # magnitude, where the unloading branch reaches M = 0 (NaN if never)
@@ -405,12 +464,20 @@ def predict_cycles(actuator, loop: LoopModel, pressures_kpa, model: str = "energ
     >>> [round(100 * x.energy_loss_ratio, 1) for x in c]
     [15.9, 17.0]
     """
-    from bendpam.physics.braid import curvature_limits
     from bendpam.physics.law import MomentLaw
     from bendpam.validate import pressure_kpa as check_pressure
 
     P = np.atleast_1d(np.asarray(check_pressure(pressures_kpa), dtype=float)).ravel()
     law = MomentLaw.of(actuator, model, order=order, eq19_factor=eq19_factor)
+    kf, flat = _free_states(actuator, loop, law, P)
+    return _cycles(actuator, loop, law, P, kf, flat, int(n))
+
+
+def _free_states(actuator, loop: LoopModel, law, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(k_free, flat)``: where each pressure's unloading branch reaches zero moment (magnitudes, 1/mm; NaN
+    if never), by the fixed-point iteration of :func:`predict_cycles`, and where it collapsed onto ``k' = 0``."""
+    from bendpam.physics.braid import curvature_limits
+
     lim = curvature_limits(actuator)
     sgn = actuator.bend_sign or 1
     k_lim = abs(lim.k_max if sgn > 0 else lim.k_min) * 0.999
@@ -443,12 +510,17 @@ def predict_cycles(actuator, loop: LoopModel, pressures_kpa, model: str = "energ
         active[ii[done]] = False
     flat = np.isfinite(kf) & (kf <= 1e-9 * k_lim)  # the fixed point collapsed onto the straight state
     kf[flat] = math.nan
+    return kf, flat
+
+
+def _cycles(actuator, loop: LoopModel, law, P: np.ndarray, kf: np.ndarray, flat: np.ndarray, n: int) -> list[Cycle]:
+    """The :class:`Cycle` of each pressure from its free curvature ``kf`` (NaN: an empty cycle with a note)."""
     ok = np.isfinite(kf)
     out: list[Cycle] = []
     if ok.any():
-        k = np.linspace(0.0, 1.0, int(n))[None, :] * kf[ok, None]
+        k = np.linspace(0.0, 1.0, n)[None, :] * kf[ok, None]
         up, low = _cycle_branches(actuator, loop, law, P[ok, None], kf[ok, None], k)
-        th = k * L0
+        th = k * actuator.L0_mm
         loss = np.trapezoid(up - low, th, axis=-1)
         stored = np.trapezoid(0.5 * (up + low), th, axis=-1)
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -466,5 +538,13 @@ def predict_cycles(actuator, loop: LoopModel, pressures_kpa, model: str = "energ
 
 def predict_cycle(actuator, loop: LoopModel, pressure_kpa: float, model: str = "energy", *, n: int = 201,
                   order: int = DEFAULT_ORDER, eq19_factor: bool = True) -> Cycle:
-    """The loop a free-bending cycle traces at ``pressure_kpa``: :func:`predict_cycles` at one pressure."""
+    """The loop a free-bending cycle traces at ``pressure_kpa``: :func:`predict_cycles` at one pressure.
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> a = bendpam.physics.presets.be_pam()
+    >>> round(100 * predict_cycle(a, LoopModel(a1_nmm_per_kpa=0.1, theta_h_deg=8.0), 150.0).energy_loss_ratio, 1)
+    15.9
+    """
     return predict_cycles(actuator, loop, [pressure_kpa], model, n=n, order=order, eq19_factor=eq19_factor)[0]

@@ -118,7 +118,8 @@ import numpy as np
 from bendpam.errors import InputError
 from bendpam.physics.actuator import Actuator, ModelParams
 from bendpam.physics.braid import DEFAULT_ORDER, curvature_limits, radius_state, solve_u
-from bendpam.physics.law import BRANCH_END, BranchTable, MomentLaw
+from bendpam.physics.branch import BRANCH_END, BranchTable
+from bendpam.physics.law import MomentLaw
 from bendpam.physics.models.force_balance import axial_forces
 from bendpam.validate import float_array, number
 from bendpam.validate import pressure_kpa as _check_pressure
@@ -335,7 +336,7 @@ def case_limits(law: MomentLaw, pressure_kpa, free_curvature, table: BranchTable
     free_curvature : (cases, p) or (p,) 1/mm
         The free-bending curvature from :meth:`MomentLaw.free_curvature_array` with ``table``
         (NaN past the end of the branch).
-    table : the :class:`~bendpam.physics.law.BranchTable` the curvatures came from (default: the law's).
+    table : the :class:`~bendpam.physics.branch.BranchTable` the curvatures came from (default: the law's).
     free_u : (cases, p) or (p,), optional
         ``u = k'R`` at the free curvatures (:meth:`MomentLaw.free_state_array`), so that ``R = u/k'``
         needs no solve of eq 5.  Without it ``u`` comes from :func:`bendpam.physics.braid.solve_u`.
@@ -363,27 +364,8 @@ def case_limits(law: MomentLaw, pressure_kpa, free_curvature, table: BranchTable
     P = np.asarray(pressure_kpa, dtype=float).reshape(-1)
     k = np.asarray(free_curvature, dtype=float).reshape(m, P.size)
     pa_kpa = np.maximum(P[None, :] - cs.P_start_kpa[:, None], 0.0)
-    pa = pa_kpa * 1e-3
     opts = dict(strength=frame_strength_mpa, stretch_limit=bladder_stretch_limit, order=law.order)
-    col = cs.col()
-    zero = np.zeros((m, 1))
-    blocked = _section(col, pa, zero, zero, col.R0_start, **opts)
-    blocked = {key: np.broadcast_to(v, (m, P.size)).copy() for key, v in blocked.items()}
-    # free state: k' = 0 (deadband, neutral angle) is the blocked state; NaN past the branch end
-    free = {key: np.where(np.isnan(k), np.nan, v) for key, v in blocked.items()}
-    rows, cols = np.nonzero(np.isfinite(k) & (k != 0.0))
-    if rows.size:
-        kk = k[rows, cols]
-        sub = cs.take(rows)
-        if free_u is not None:
-            u = np.asarray(free_u, dtype=float).reshape(m, P.size)[rows, cols]
-        else:
-            u = solve_u(kk * sub.R0_start, sub.alpha0, law.order)[0]  # eq 5, per-case braid angles
-        st = _section(sub, pa[rows, cols], kk, u, u / kk, **opts)
-        for key in _STATE_KEYS:
-            free[key][rows, cols] = st[key]
-    free["curvature_per_mm"] = k
-    blocked["curvature_per_mm"] = np.zeros((m, P.size))
+    blocked, free = _states(cs, k, pa_kpa * 1e-3, free_u, opts)
     # lock-up: the branch's end curvature (the lock-up limit, or the fold) over |k'|; past it P_a,end / P_a
     k_cap = np.abs(np.where(tab.kind == BRANCH_END["fold"], tab.k_end, tab.k_lim))[:, None]
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -391,6 +373,43 @@ def case_limits(law: MomentLaw, pressure_kpa, free_curvature, table: BranchTable
         on = np.where(k != 0.0, k_cap / np.abs(k), np.inf)
     free["lockup_margin"] = np.where(np.isnan(k), past, on)
     blocked["lockup_margin"] = np.full((m, P.size), np.inf)
+    out = _worse(blocked, free)
+    out["blocked"], out["free"] = blocked, free
+    out["max_pressure_kpa"] = cs.P_start_kpa + tab.p_end
+    out["branch_end"] = tab.kind
+    return out
+
+
+def _states(cs: ModelParams, k: np.ndarray, pa: np.ndarray, free_u, opts: dict) -> tuple[dict, dict]:
+    """The per-state quantities (:func:`_section`) of the blocked and the free states, arrays (cases, p).
+
+    ``k`` is the free curvature (NaN past the branch end), ``pa`` the active pressure in MPa; a free
+    state at ``k' = 0`` (deadband, neutral angle) is the blocked state.
+    """
+    m, n = k.shape
+    col = cs.col()
+    zero = np.zeros((m, 1))
+    blocked = _section(col, pa, zero, zero, col.R0_start, **opts)
+    blocked = {key: np.broadcast_to(v, (m, n)).copy() for key, v in blocked.items()}
+    free = {key: np.where(np.isnan(k), np.nan, v) for key, v in blocked.items()}
+    rows, cols = np.nonzero(np.isfinite(k) & (k != 0.0))
+    if rows.size:
+        kk = k[rows, cols]
+        sub = cs.take(rows)
+        if free_u is not None:
+            u = np.asarray(free_u, dtype=float).reshape(m, n)[rows, cols]
+        else:
+            u = solve_u(kk * sub.R0_start, sub.alpha0, opts["order"])[0]  # eq 5, per-case braid angles
+        st = _section(sub, pa[rows, cols], kk, u, u / kk, **opts)
+        for key in _STATE_KEYS:
+            free[key][rows, cols] = st[key]
+    free["curvature_per_mm"] = k
+    blocked["curvature_per_mm"] = np.zeros((m, n))
+    return blocked, free
+
+
+def _worse(blocked: dict, free: dict) -> dict[str, Any]:
+    """The outputs of :data:`OUTPUTS`: at each pressure the worse of the blocked and free states."""
     larger = np.abs(free["axial_force_n"]) > np.abs(blocked["axial_force_n"])  # False where free is NaN
     out: dict[str, Any] = {
         "frame_axial_force_n": np.where(larger, free["axial_force_n"], blocked["axial_force_n"]),
@@ -402,9 +421,6 @@ def case_limits(law: MomentLaw, pressure_kpa, free_curvature, table: BranchTable
         "bladder_stretch_margin": np.fmin(blocked["stretch_margin"], free["stretch_margin"]),
     }
     out["min_margin"] = np.minimum.reduce([out[name] for name in MARGINS])
-    out["blocked"], out["free"] = blocked, free
-    out["max_pressure_kpa"] = cs.P_start_kpa + tab.p_end
-    out["branch_end"] = tab.kind
     return out
 
 

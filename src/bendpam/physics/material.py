@@ -74,6 +74,7 @@ from typing import Any
 import numpy as np
 
 from bendpam.errors import InputError
+from bendpam.validate import finite_number
 
 __all__ = [
     "BindingState",
@@ -81,6 +82,7 @@ __all__ = [
     "ShapeLimit",
     "admissible_shape_range",
     "shape_limits",
+    "within",
 ]
 
 #: Relative slack when a shape is compared with its bounds (a fit may land on one).
@@ -148,10 +150,10 @@ class MooneyRivlin:
         >>> round(m.C10, 12), round(m.C01, 12)
         (0.225, 0.075)
         """
-        mu_v = _finite_number("mu", mu, "MPa")
+        mu_v = finite_number("mu", mu, "MPa")
         if mu_v <= 0.0:
             raise InputError(f"mu = {mu_v:g} MPa is outside the allowed range (0, inf)")
-        beta = _finite_number("shape", shape, "")
+        beta = finite_number("shape", shape, "")
         return cls(C10=0.5 * mu_v * (1.0 - beta), C01=0.5 * mu_v * beta)
 
     @property
@@ -393,23 +395,10 @@ class ShapeLimit:
 _NOWHERE = BindingState((math.nan, math.nan, math.nan))
 
 
-def _finite_number(name: str, value: Any, unit: str) -> float:
-    u = f" {unit}" if unit else ""
-    if isinstance(value, bool | str | bytes):
-        raise InputError(f"{name} = {value!r} is not a number")
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise InputError(f"{name} = {value!r} is not a number") from None
-    if not math.isfinite(v):
-        raise InputError(f"{name} = {value!r}{u} is not finite")
-    return v
-
-
 def _span(stretch_min: Any, stretch_max: Any) -> tuple[float, float]:
     """The validated range, widened to contain 1."""
-    a = _finite_number("stretch_min", stretch_min, "")
-    b = _finite_number("stretch_max", stretch_max, "")
+    a = finite_number("stretch_min", stretch_min, "")
+    b = finite_number("stretch_max", stretch_max, "")
     for name, v in (("stretch_min", a), ("stretch_max", b)):
         if v <= 0.0:
             raise InputError(f"{name} = {v:g} is outside the allowed range (0, inf)")
@@ -422,6 +411,13 @@ def _span(stretch_min: Any, stretch_max: Any) -> tuple[float, float]:
 
 
 def within(beta: float, lo: float, hi: float) -> bool:
+    """``lo <= beta <= hi`` with a relative slack of 1e-9 at each bound (a fit may land on one).
+
+    Examples
+    --------
+    >>> within(1.0 + 1e-12, 0.0, 1.0), within(1.001, 0.0, 1.0)
+    (True, False)
+    """
     lo_ok = lo - _BOUND_TOL * max(1.0, abs(lo)) <= beta
     return lo_ok and beta <= hi + _BOUND_TOL * max(1.0, abs(hi))
 
