@@ -678,9 +678,17 @@ def mutated_cases(inp: dict[str, Path], folder: Path, seed: int, n_garble: int =
 
 def run_cases(tally: Tally, cases: Iterable[list[str]], cwd: Path, jobs: int = 2, timeout: float = TIMEOUT_S,
               label: str = "") -> list[tuple[list[str], str, str]]:
+    """Run ``cases`` ``jobs`` at a time, each in an empty folder of its own under ``cwd``.
+
+    Several cases name the same relative output (``--out p_x``); in one shared folder the outcome of
+    one would depend on which other case runs at the same time (``another bendpam run is writing``).
+    Their own folders keep every outcome independent of the scheduling (concurrent runs on one
+    output are :func:`concurrent_case`'s subject).
+    """
     cases = list(cases)
+    folders = [Path(tempfile.mkdtemp(prefix=f"case{i:03d}-", dir=cwd)) for i in range(len(cases))]
     with ThreadPoolExecutor(jobs) as ex:
-        runs = list(ex.map(lambda a: run(a, cwd, timeout), cases))
+        runs = list(ex.map(lambda a, d: run(a, d, timeout), cases, folders))
     out = []
     for args, r in zip(cases, runs, strict=True):
         kind, detail = classify(r)
