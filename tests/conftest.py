@@ -7,11 +7,6 @@ from bendpam import presets
 MODELS = ["energy", "force_balance"]
 
 
-def pytest_configure(config):
-    # registered here because pyproject.toml does not list it (``-m "not slow"`` deselects them)
-    config.addinivalue_line("markers", "slow: a test that takes more than about 5 s")
-
-
 @pytest.fixture(params=[(n, m) for n in ("be-pam", "bc-pam") for m in MODELS], ids=lambda p: f"{p[0]}-{p[1]}")
 def preset_model(request):
     """Each paper actuator with each model's Table 3 constants: (actuator, model)."""

@@ -4,7 +4,8 @@
   the modules ``bendpam`` exports) carries a ``>>>`` example, except the short list
   :data:`EXEMPT`, each with its reason.
 * The examples pass under ``pytest --doctest-modules`` (the README's test command collects them
-  from src/bendpam, pyproject.toml) and write no file into the folder they run in.
+  from src/bendpam, pyproject.toml) and write no file into the folder they run in (each runs in
+  an empty folder that must stay empty: the root conftest.py).
 * The tutorial (docs/tutorial.md) shows the commands of examples/walkthrough.sh in order; the CLI
   reference names every command and option of the app; the nav tolerates pages added later; the
   Markdown pages' own ``>>>`` examples pass.
@@ -98,19 +99,21 @@ def test_pytest_collects_the_docstring_examples():
     assert "--doctest-modules" in ini["addopts"].split()
 
 
-@pytest.mark.slow
-def test_docstring_examples_pass_and_write_nothing(tmp_path):
-    """All doctests of src/bendpam, run in an empty folder that must stay empty."""
-    cmd = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-c", str(ROOT / "pyproject.toml"),
-           "--rootdir", str(ROOT), str(ROOT / "src" / "bendpam")]
-    r = subprocess.run(cmd, cwd=tmp_path, capture_output=True, text=True, timeout=600,
-                       env={**os.environ, "MPLBACKEND": "Agg"})
-    assert r.returncode == 0, r.stdout[-4000:] + r.stderr[-2000:]
-    m = re.search(r"(\d+) passed", r.stdout)
-    assert m, r.stdout[-2000:]
-    with_examples = sum(has_example(obj) for obj in public_callables().values())
-    assert int(m.group(1)) >= with_examples
-    assert sorted(p.name for p in tmp_path.iterdir()) == []
+def test_doctests_run_in_an_empty_folder_that_must_stay_empty(tmp_path):
+    """The root conftest.py runs each docstring example in an empty folder and fails one that writes there.
+
+    (The examples themselves run once, collected by ``--doctest-modules``.)
+    """
+    (tmp_path / "writes.py").write_text('def f():\n    """\n    >>> open("left.txt", "w").write("x")\n    1\n    """\n')
+    (tmp_path / "clean.py").write_text('def g():\n    """\n    >>> 1 + 1\n    2\n    """\n')
+    cmd = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-p", "conftest", "--doctest-modules",
+           "-c", os.devnull, "--rootdir", str(tmp_path), "writes.py", "clean.py"]
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])}
+    r = subprocess.run(cmd, cwd=tmp_path, capture_output=True, text=True, timeout=120, env=env)
+    assert r.returncode == 1, r.stdout[-3000:] + r.stderr[-2000:]
+    assert "the example wrote into the folder it ran in: left.txt" in r.stdout
+    assert re.search(r"2 passed, 1 error", r.stdout), r.stdout[-2000:]
+    assert sorted(p.name for p in tmp_path.iterdir() if p.suffix != ".py" and p.name != "__pycache__") == []
 
 
 def test_markdown_pages_examples_pass():

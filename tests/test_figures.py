@@ -6,8 +6,13 @@ bounding boxes); the wrist figure tells its actuators apart.
 """
 
 import itertools
+import os
+import subprocess
+import sys
+from pathlib import Path
 
 import matplotlib
+import matplotlib.pyplot as plt  # closes the figures the design modules draw with pyplot
 import numpy as np
 import pandas as pd
 import pytest
@@ -90,7 +95,7 @@ def test_overlap_check_finds_an_overlap():
     with figure_style():
         fig = styled_figure(lambda ax: (ax.text(0.5, 0.5, "first label"), ax.text(0.5, 0.5, "second label")))
     assert ("first label", "second label") in overlapping_labels(fig)
-    matplotlib.pyplot.close(fig)
+    plt.close(fig)
 
 
 @pytest.mark.parametrize("name,pressure,curvature", [("be-pam", 200.0, 0.0), ("be-pam", 200.0, 0.008),
@@ -101,7 +106,7 @@ def test_internal_stress_labels_do_not_overlap(name, pressure, curvature):
     assert overlapping_labels(fig) == []
     assert outside_figure(fig) == []
     assert fig.get_size_inches()[0] == pytest.approx(DOUBLE_COLUMN_IN)
-    matplotlib.pyplot.close(fig)
+    plt.close(fig)
 
 
 def test_demo_and_curve_labels_do_not_overlap():
@@ -109,11 +114,36 @@ def test_demo_and_curve_labels_do_not_overlap():
              for n, P in (("be-pam", [100, 150, 200]), ("bc-pam", [40, 80, 120, 140])) for m in ("energy",)]
     fig = demo_figure(items)  # BC-PAM above its fold: the note is in the legend's title
     assert overlapping_labels(fig) == [] and outside_figure(fig) == []
-    matplotlib.pyplot.close(fig)
+    plt.close(fig)
     fig = moment_curvature_figure(presets.get("bc-pam"), [40, 60, 80, 100, 120, 140])
     assert overlapping_labels(fig) == [] and outside_figure(fig) == []
     assert fig.get_size_inches()[0] == pytest.approx(SINGLE_COLUMN_IN)
-    matplotlib.pyplot.close(fig)
+    plt.close(fig)
+
+
+# ------------------------------------------------------------------------------------------------
+# the backend is the caller's (issue 25)
+# ------------------------------------------------------------------------------------------------
+def _fresh_python(code):
+    """Run ``code`` in a fresh interpreter that imports this tree's bendpam, without MPLBACKEND."""
+    import bendpam
+
+    env = {k: v for k, v in os.environ.items() if k != "MPLBACKEND"}
+    env["PYTHONPATH"] = os.pathsep.join([str(Path(bendpam.__file__).parents[1]), env.get("PYTHONPATH", "")])
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=120)
+    assert r.returncode == 0, r.stderr
+    return r.stdout.split()
+
+
+def test_importing_the_figures_leaves_the_backend_and_pyplot_alone():
+    imports = "import bendpam.present.figures, bendpam.design, bendpam.identify"
+    # a backend chosen before the import stays chosen, and pyplot is not imported
+    assert _fresh_python(f"import sys, matplotlib\nmatplotlib.use('svg')\n{imports}\n"
+                         "print('matplotlib.pyplot' in sys.modules, matplotlib.get_backend())") == ["False", "svg"]
+    # without a choice, pyplot later picks the same backend as it would without bendpam
+    plain = _fresh_python("import matplotlib.pyplot, matplotlib\nprint(matplotlib.get_backend())")
+    assert _fresh_python(f"import sys\n{imports}\nprint('matplotlib.pyplot' in sys.modules)\n"
+                         "import matplotlib.pyplot, matplotlib\nprint(matplotlib.get_backend())") == ["False", *plain]
 
 
 # ------------------------------------------------------------------------------------------------
@@ -127,7 +157,7 @@ def test_style_is_local_and_fonts_fit_a_journal():
     assert min(sizes) >= 6.5 and max(sizes) <= 9.0, sizes
     widths = {line.get_linewidth() for ax in fig.axes for line in ax.get_lines()}
     assert max(widths) <= 1.5
-    matplotlib.pyplot.close(fig)
+    plt.close(fig)
 
 
 def test_sweep_figure_is_single_column():
@@ -137,7 +167,7 @@ def test_sweep_figure_is_single_column():
     fig = sweep_figure(ds)
     assert fig.get_size_inches()[0] == pytest.approx(SINGLE_COLUMN_IN)
     assert overlapping_labels(fig) == [] and outside_figure(fig) == []
-    matplotlib.pyplot.close(fig)
+    plt.close(fig)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -198,7 +228,7 @@ def test_wrist_symmetric_curves_are_drawn_once_and_say_so():
     assert "0+90°" in pair[0] and "toward 45°" in pair[0]
     assert single[1:] != pair[1:]  # colour, line style and marker differ
     assert overlapping_labels(fig) == [] and outside_figure(fig) == []
-    matplotlib.pyplot.close(fig)
+    plt.close(fig)
 
 
 def test_wrist_distinct_curves_are_told_apart():
@@ -211,7 +241,7 @@ def test_wrist_distinct_curves_are_told_apart():
     entries = legend_entries(fig)
     assert [e[0] for e in entries] == [f"actuator {d}° inflated (toward {d}°)" for d in (0, 90, 180, 270)]
     assert len({e[1] for e in entries}) == 4 and len({e[2] for e in entries}) == 4
-    matplotlib.pyplot.close(fig)
+    plt.close(fig)
 
 
 # ------------------------------------------------------------------------------------------------

@@ -63,10 +63,22 @@ def test_interval_from_the_environment(monkeypatch):
     assert Progress(1, "x", interval_s=2).interval_s == 2.0
 
 
+def wait_for_lines(out, n, timeout_s=60.0):
+    """Wait until ``out`` holds ``n`` lines (written by another thread); the timeout only guards a hang."""
+    deadline = time.monotonic() + timeout_s
+    while out.getvalue().count("\n") < n:
+        assert time.monotonic() < deadline, out.getvalue()
+        time.sleep(0.005)
+
+
 def test_timer_reports_a_long_single_step():
-    out = io.StringIO()
-    with Progress(None, "fit", stream=out, interval_s=0.05) as bar:
-        time.sleep(0.3)  # one long step without advance(): the background timer still reports
+    # the timer wakes every 0.05 s of real time but writes only when the (fake) clock has moved on by
+    # the interval: each line comes when the test moves the clock, however slowly the machine runs
+    out, clock = io.StringIO(), FakeClock()
+    with Progress(None, "fit", stream=out, interval_s=0.05, clock=clock) as bar:
+        for n in (1, 2):  # one long step without advance(): the background timer still reports
+            clock.t += 0.1  # more than the interval (0.05 s)
+            wait_for_lines(out, n)
         bar.advance()
     lines = out.getvalue().splitlines()
     assert len(lines) >= 3
@@ -83,6 +95,19 @@ def test_unknown_total_and_description_change():
         "bendpam: process a.csv: 3 done, 2 s elapsed",
         "bendpam: process a.csv: 3 done, finished in 2 s",
     ]
+
+
+@pytest.mark.parametrize("value", ["inf", "1e300"])
+def test_an_endless_interval_writes_no_line(monkeypatch, value):
+    """``BENDPAM_PROGRESS_INTERVAL_S=inf`` (or more than a timer can wait): no line, however long the work."""
+    monkeypatch.setenv("BENDPAM_PROGRESS_INTERVAL_S", value)
+    out, clock = io.StringIO(), FakeClock()
+    with Progress(10, "sweep", stream=out, clock=clock) as bar:
+        assert bar._timer is None
+        for _ in range(9):
+            clock.t += 1e6
+            bar.advance()
+    assert bar.completed == 9 and out.getvalue() == ""
 
 
 def test_quiet_writes_nothing_and_still_counts():

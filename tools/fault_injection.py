@@ -63,12 +63,22 @@ def cli(*args: object) -> list[str]:
     return [sys.executable, "-m", "bendpam_entry", *(str(a) for a in args)]
 
 
+def child_env() -> dict[str, str]:
+    """The environment of every command run here: no progress lines, however long a command takes.
+
+    Off a terminal a command writes a progress line every few seconds of work; a command that
+    fails after that would show two lines on stderr.  What the checks see must not depend on the
+    load of the machine, so the interval is infinite (``BENDPAM_PROGRESS_INTERVAL_S=inf``).
+    """
+    return {**os.environ, "BENDPAM_PROGRESS_INTERVAL_S": "inf"}
+
+
 def run(args: Sequence[object], cwd: Path, timeout: float = TIMEOUT_S) -> Run:
     argv = [str(a) for a in args]
     t0 = time.monotonic()
     try:
         p = subprocess.run(cli(*argv), cwd=cwd, capture_output=True, text=True, timeout=timeout,
-                           stdin=subprocess.DEVNULL)
+                           stdin=subprocess.DEVNULL, env=child_env())
     except subprocess.TimeoutExpired as exc:
         out = exc.stdout.decode(errors="replace") if isinstance(exc.stdout, bytes) else (exc.stdout or "")
         err = exc.stderr.decode(errors="replace") if isinstance(exc.stderr, bytes) else (exc.stderr or "")
@@ -277,12 +287,36 @@ def kill_args(command: str, inputs: dict[str, Path], out: Path) -> list[str]:
     return [a.format(raw=inputs["raw"], proc=inputs["proc"], out=out) for a in args]
 
 
+def catches(pid: int, signum: int) -> bool | None:
+    """Whether process ``pid`` has a handler for ``signum`` (Linux ``/proc``); None where that is unknown."""
+    try:
+        status = Path(f"/proc/{pid}/status").read_text()
+    except OSError:
+        return None
+    mask = next((line.split()[1] for line in status.splitlines() if line.startswith("SigCgt:")), None)
+    return None if mask is None else bool(int(mask, 16) >> (signum - 1) & 1)
+
+
+def wait_until(ready: Callable[[], bool], p: subprocess.Popen, timeout: float = TIMEOUT_S) -> bool:
+    """Poll ``ready()`` until it holds (True) or ``p`` has ended (False); the timeout only guards a hang."""
+    deadline = time.monotonic() + timeout
+    while p.poll() is None:
+        if ready():
+            return True
+        if time.monotonic() > deadline:
+            raise TimeoutError("the awaited state never came")
+        time.sleep(0.002)
+    return False
+
+
 def kill_case(tally: Tally, command: str, inputs: dict[str, Path], folder: Path, sig: int, delay: float,
-              fraction: float | None = None) -> None:
+              fraction: float | None = None, mid_work: bool = False) -> None:
     """Run ``command`` into a target holding a previous complete output; send ``sig`` after ``delay``.
 
     With ``fraction``, the signal is sent at that fraction of the baseline run's duration instead
-    (at least 0.3 s, after start-up), so that it lands mid-work however fast the command has become.
+    (at least 0.3 s, after start-up).  With ``mid_work``, it is sent as soon as the command holds
+    the lock on its output (``.<target>.bendpam-lock`` appears: the work under way), whatever the
+    time: the one way to land mid-work on a machine of any speed and load.
     """
     _, target_name = KILL_COMMANDS[command]
     folder.mkdir(parents=True, exist_ok=True)
@@ -298,9 +332,14 @@ def kill_case(tally: Tally, command: str, inputs: dict[str, Path], folder: Path,
     what = f"{command} killed by {signal.Signals(sig).name} after {delay:.2f} s"
     before = snapshot(target)
     t0 = time.monotonic()
+    lock = target.parent / f".{target.name}.bendpam-lock"
     p = subprocess.Popen(cli(*args), cwd=folder, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                         stdin=subprocess.DEVNULL)
-    time.sleep(max(0.0, delay - (time.monotonic() - t0)))
+                         stdin=subprocess.DEVNULL, env=child_env())
+    if mid_work:
+        wait_until(lock.exists, p)  # nothing fills its pipes meanwhile: no progress lines (child_env)
+        what = f"{command} killed by {signal.Signals(sig).name} once it held the lock"
+    else:
+        time.sleep(max(0.0, delay - (time.monotonic() - t0)))
     if p.poll() is None:
         p.send_signal(sig)
     try:
@@ -639,9 +678,17 @@ def mutated_cases(inp: dict[str, Path], folder: Path, seed: int, n_garble: int =
 
 def run_cases(tally: Tally, cases: Iterable[list[str]], cwd: Path, jobs: int = 2, timeout: float = TIMEOUT_S,
               label: str = "") -> list[tuple[list[str], str, str]]:
+    """Run ``cases`` ``jobs`` at a time, each in an empty folder of its own under ``cwd``.
+
+    Several cases name the same relative output (``--out p_x``); in one shared folder the outcome of
+    one would depend on which other case runs at the same time (``another bendpam run is writing``).
+    Their own folders keep every outcome independent of the scheduling (concurrent runs on one
+    output are :func:`concurrent_case`'s subject).
+    """
     cases = list(cases)
+    folders = [Path(tempfile.mkdtemp(prefix=f"case{i:03d}-", dir=cwd)) for i in range(len(cases))]
     with ThreadPoolExecutor(jobs) as ex:
-        runs = list(ex.map(lambda a: run(a, cwd, timeout), cases))
+        runs = list(ex.map(lambda a, d: run(a, d, timeout), cases, folders))
     out = []
     for args, r in zip(cases, runs, strict=True):
         kind, detail = classify(r)

@@ -10,7 +10,8 @@
   that ends within the first ``interval_s`` writes nothing: short commands stay silent, and a
   command that fails early still writes just its one-line error.  The default interval is 5 s;
   the environment variable ``BENDPAM_PROGRESS_INTERVAL_S`` changes it (``0``: a line at every
-  step, from the first).
+  step, from the first; ``inf``: no line at all, however long the work takes, which is how a
+  harness that checks a command's exact output on stderr keeps it independent of the time).
 * With ``quiet=True`` it writes nothing at all.
 
 :meth:`Progress.advance` is thread-safe, so it can be handed as a callback to code that reports
@@ -67,7 +68,10 @@ def format_duration(seconds: float) -> str:
 
 
 def _interval(interval_s: float | None) -> float:
-    """The interval between plain lines: the argument, else the environment variable, else 5 s."""
+    """The interval between plain lines: the argument, else the environment variable, else 5 s.
+
+    ``inf`` (never a line) is kept; NaN, a negative number or a word gives the default.
+    """
     if interval_s is None:
         text = os.environ.get(INTERVAL_ENV, "").strip()
         try:
@@ -75,7 +79,7 @@ def _interval(interval_s: float | None) -> float:
         except ValueError:
             interval_s = DEFAULT_INTERVAL_S
     value = float(interval_s)
-    return value if math.isfinite(value) and value >= 0 else DEFAULT_INTERVAL_S
+    return value if value >= 0 else DEFAULT_INTERVAL_S  # NaN >= 0 is False too
 
 
 class Progress:
@@ -97,7 +101,8 @@ class Progress:
     interval_s : float, optional
         Time between two plain progress lines, in s; the first comes ``interval_s`` after the
         start, the last at the end if any came before.  Default: the environment variable
-        ``BENDPAM_PROGRESS_INTERVAL_S``, else 5.  ``0``: a line at every :meth:`advance`.
+        ``BENDPAM_PROGRESS_INTERVAL_S``, else 5.  ``0``: a line at every :meth:`advance`;
+        ``math.inf``: no plain line at all.
     clock : callable, optional
         Returns the time in s (default :func:`time.monotonic`); for tests.
 
@@ -181,7 +186,7 @@ class Progress:
                 self._start_rich()
             else:
                 self._mode = "lines"
-                if self.interval_s > 0:
+                if 0 < self.interval_s < threading.TIMEOUT_MAX:  # longer: never a line, no timer
                     self._stop_timer.clear()
                     self._timer = threading.Thread(target=self._tick, name="bendpam-progress", daemon=True)
                     self._timer.start()
