@@ -28,7 +28,9 @@ import numpy as np
 import pandas as pd
 
 from bendpam.infra.atomic import atomic_write_bytes
-from bendpam.lab.readers import COLUMNS, DIALECTS, FORCE_UNITS, is_pressure_key
+from bendpam.lab.channels import FORCE_UNITS
+from bendpam.lab.pressure import is_pressure_key
+from bendpam.lab.rawtest import COLUMNS, DIALECTS
 
 __all__ = ["write_test"]
 
