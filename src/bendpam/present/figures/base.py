@@ -334,6 +334,7 @@ def demo_figure(items):
     return fig
 
 
+@register("save_figure")
 def save_figure(fig, path, format: str | None = None, dpi: int | None = None) -> Path:
     """Save ``fig`` atomically to ``path`` as PNG, PDF or SVG, close it, and return the path.
 
