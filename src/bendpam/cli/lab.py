@@ -104,7 +104,8 @@ def process(
 ):
     """Process raw four-point-bending cyclic tests into moment-curvature curves and Table 2 values."""
     from bendpam.lab import read_test
-    from bendpam.lab.processing import ProcessingOptions, process_tests
+    from bendpam.lab.processed import ProcessingOptions
+    from bendpam.lab.processing import process_tests
     from bendpam.physics.fixture import Fixture
 
     if out is None:
