@@ -11,16 +11,8 @@ import bendpam
 from bendpam import presets
 from bendpam.cli import main
 from bendpam.lab import read_test
-from bendpam.lab.processing import (
-    ProcessingError,
-    ProcessingOptions,
-    deadband_fit,
-    find_turning_points,
-    load_processed,
-    process_series,
-    process_tests,
-    write_processed,
-)
+from bendpam.lab.processed import ProcessingOptions, deadband_fit, load_processed, write_processed
+from bendpam.lab.processing import ProcessingError, find_turning_points, process_series, process_tests
 from bendpam.lab.simulate import SimulationSettings, simulate_test, simulate_tests
 from bendpam.physics.fixture import PAPER_FIXTURE
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from typing import Annotated, Optional
 
@@ -27,6 +28,7 @@ from bendpam.cli.options import (
     parse_values,
     pressures_kpa,
 )
+from bendpam.errors import InputError
 
 FixtureOpt = Annotated[str, typer.Option("--fixture", help="Fixture geometry d,r,t in mm.")]
 ColumnsOpt = Annotated[Optional[str], typer.Option(
@@ -37,6 +39,11 @@ RateOpt = Annotated[Optional[float], typer.Option(
     "--rate-hz", help="Sampling rate (Hz) for a file without a time column (default: from its metadata).")]
 RepairOpt = Annotated[bool, typer.Option(
     "--repair", help="Remove isolated spikes and non-increasing samples (reported) instead of refusing the file.")]
+
+#: SimulationSettings as named in the library's messages -> the options of ``simulate-test``.
+_FLAGS = {"rate_hz": "--rate-hz", "fewer cycles": "fewer --cycles", "dwell_s": "--dwell-s",
+          "speed_mm_min": "--speed-mm-min"}  # fmt: skip
+_SETTING_FLAGS = re.compile(r"(?<![\w-])(?:rate_hz|fewer cycles|dwell_s|speed_mm_min)(?![\w-])")
 
 
 @app.command()
@@ -97,20 +104,14 @@ def process(
 ):
     """Process raw four-point-bending cyclic tests into moment-curvature curves and Table 2 values."""
     from bendpam.lab import read_test
-    from bendpam.lab.processing import ProcessingOptions, process_tests
+    from bendpam.lab.processed import ProcessingOptions
+    from bendpam.lab.processing import process_tests
     from bendpam.physics.fixture import Fixture
 
     if out is None:
         raise UserError("give an output folder with --out OUTDIR")
     files = collect_raw_files(inputs)
-    pressures = parse_values(pressure_kpa, "--pressure-kpa") if pressure_kpa else []
-    if (pressures and len(pressures) not in (1, len(files))) or (len(pressures) == 1 and len(files) > 1):
-        raise UserError(
-            f"--pressure-kpa: got {len(pressures)} pressure(s) for {len(files)} file(s); give one per file, in order"
-        )
-    for v in pressures:
-        if v < 0:
-            raise UserError(f"--pressure-kpa: {v:g} kPa is below zero")
+    pressures = _file_pressures(pressure_kpa, files)
     fx = Fixture.from_string(fixture, L0_mm=l0_mm, name="--fixture")
     opts = ProcessingOptions(cutoff_hz=cutoff_hz, reversal_fraction=reversal_fraction, grid_points=grid_points,
                              tare_n=tare_n)
@@ -122,8 +123,12 @@ def process(
         # read lazily: process_tests takes each test in turn, so a file counts as done (read and
         # processed) when the next one is asked for
         for i, f in enumerate(files):
-            yield read_test(f, pressure_kpa=pressures[i] if pressures else None, columns=columns, rate_hz=rate_hz,
+            raw = read_test(f, pressure_kpa=pressures[i] if pressures else None, columns=columns, rate_hz=rate_hz,
                             repair=repair)
+            if raw.pressure_kpa is None:
+                raise UserError(f"{raw.path}: no pressure: give --pressure-kpa, a 'Pressure' metadata line, "
+                                "or a filename token like 200kPa")
+            yield raw
             bar.advance()
 
     from bendpam.infra.progress import Progress
@@ -140,7 +145,25 @@ def process(
     if as_json:
         typer.echo((out / "summary.json").read_text())
         return
-    summ = processed.summary()
+    _print_table2(processed.summary())
+    typer.echo(f"wrote {out}/ (curves.nc, curves.csv, summary.json{', ' + fig_name if figure else ''})")
+
+
+def _file_pressures(pressure_kpa: Optional[list[str]], files: list[Path]) -> list[float]:
+    """The ``--pressure-kpa`` values of ``process``: none, or one per file (in kPa, not below zero)."""
+    pressures = parse_values(pressure_kpa, "--pressure-kpa") if pressure_kpa else []
+    if (pressures and len(pressures) not in (1, len(files))) or (len(pressures) == 1 and len(files) > 1):
+        raise UserError(
+            f"--pressure-kpa: got {len(pressures)} pressure(s) for {len(files)} file(s); give one per file, in order"
+        )
+    for v in pressures:
+        if v < 0:
+            raise UserError(f"--pressure-kpa: {v:g} kPa is below zero")
+    return pressures
+
+
+def _print_table2(summ: dict) -> None:
+    """Table 2 of a processed set (its ``summary()``), one line per pressure, then the deadband."""
     typer.echo(f"{'P (kPa)':>8} {'cycles':>6} {'M_blocked (N·mm)':>18} {'k_free (1/mm)':>20} {'loss ratio':>10}")
     for r in summ["pressures"]:
         typer.echo(
@@ -151,7 +174,6 @@ def process(
         for note in r["notes"]:
             typer.echo(f"         note: {note}")
     typer.echo(f"deadband: {fmt_num(summ['deadband_kpa'], '.4g')} ± {fmt_num(summ['deadband_se_kpa'], '.2g')} kPa")
-    typer.echo(f"wrote {out}/ (curves.nc, curves.csv, summary.json{', ' + fig_name if figure else ''})")
 
 
 @app.command("simulate-test", cls=MultiValueCommand)
@@ -202,8 +224,11 @@ def simulate_test_cmd(
                             hysteresis_offset_nmm=hysteresis_offset_nmm, dwell_s=dwell_s,
                             stroke_offset_mm=stroke_offset_mm, seed=seed)
     fx = Fixture.from_string(fixture, L0_mm=act.L0_mm, name="--fixture")
-    with output_set(out, [actuator]) as o:
-        truth = simulate_tests(act, P, o.staging, model_name(model), dialect=fmt.value, fixture=fx, settings=st)
+    try:
+        with output_set(out, [actuator]) as o:
+            truth = simulate_tests(act, P, o.staging, model_name(model), dialect=fmt.value, fixture=fx, settings=st)
+    except InputError as exc:  # the library names the settings; this command's options say them as flags
+        raise UserError(_SETTING_FLAGS.sub(lambda m: _FLAGS[m.group(0)], str(exc))) from None
     for t in truth["pressures"]:
         typer.echo(
             f"{t['file']}: {t['samples']} samples, blocked {t['blocked_moment_nmm']:.2f} N·mm, "

@@ -14,22 +14,10 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from bendpam.lab.readers import (
-        COLUMNS,
-        DIALECTS,
-        FORMATS,
-        PRESSURE_RANGE_KPA,
-        RawTest,
-        ReadError,
-        check_cycle_count,
-        detect_dialect,
-        format_inspection,
-        inspect_file,
-        parse_columns,
-        parse_pressure,
-        pressure_from_filename,
-        read_test,
-    )
+    from bendpam.lab.pressure import PRESSURE_RANGE_KPA, parse_pressure, pressure_from_filename
+    from bendpam.lab.rawtest import COLUMNS, DIALECTS, FORMATS, RawTest, check_cycle_count
+    from bendpam.lab.read_error import ReadError
+    from bendpam.lab.readers import detect_dialect, format_inspection, inspect_file, parse_columns, read_test
     from bendpam.lab.writers import write_test
 
 __all__ = [
@@ -50,7 +38,14 @@ __all__ = [
     "write_test",
 ]
 
-_FROM = {name: "writers" if name == "write_test" else "readers" for name in __all__}
+#: Where each name lives (the readers module loads pandas; ``bendpam fit`` needs neither).
+_FROM = {
+    "COLUMNS": "rawtest", "DIALECTS": "rawtest", "FORMATS": "rawtest", "RawTest": "rawtest",
+    "check_cycle_count": "rawtest", "PRESSURE_RANGE_KPA": "pressure", "parse_pressure": "pressure",
+    "pressure_from_filename": "pressure", "ReadError": "read_error", "detect_dialect": "readers",
+    "format_inspection": "readers", "inspect_file": "readers", "parse_columns": "readers", "read_test": "readers",
+    "write_test": "writers",
+}  # fmt: skip
 
 
 def __getattr__(name: str):

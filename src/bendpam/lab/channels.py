@@ -234,8 +234,8 @@ _IN_UNIT = re.compile(r"(.+?)\s+(?:in|en|w|/)\s+(\S+)")
 def normalize_name(name: str) -> str:
     """Lower-case, NFKC-normalised name with punctuation runs turned into single spaces.
 
-    ``'_Time '`` -> ``'time'``, ``'Traverse abs.'`` -> ``'traverse abs'``,
-    ``'Position:Maximum (mm)'`` -> ``'position maximum mm'``.
+    >>> normalize_name("_Time "), normalize_name("Traverse abs."), normalize_name("Position:Maximum (mm)")
+    ('time', 'traverse abs', 'position maximum mm')
     """
     s = unicodedata.normalize("NFKC", str(name)).casefold().replace("\ufeff", "")
     return " ".join(_PUNCT.sub(" ", s).split())
@@ -244,9 +244,15 @@ def normalize_name(name: str) -> str:
 def split_name_unit(cell: str) -> tuple[str, str | None]:
     """Split a header cell into its name and its unit.
 
-    ``'Time (s)'`` -> ``('Time', 's')``, ``'Kraft [kN]'`` -> ``('Kraft', 'kN')``,
-    ``'force_kN'`` -> ``('force', 'kN')``, ``'Zeit in s'`` -> ``('Zeit', 's')``,
-    ``'Total Cycle Count(Linear Waveform)'`` -> the whole cell (the bracket is no unit).
+    >>> split_name_unit("Time (s)"), split_name_unit("Kraft [kN]"), split_name_unit("force_kN")
+    (('Time', 's'), ('Kraft', 'kN'), ('force', 'kN'))
+    >>> split_name_unit("Zeit in s"), split_name_unit("Load")
+    (('Zeit', 's'), ('Load', None))
+
+    A bracket that is no unit stays in the name:
+
+    >>> split_name_unit("Total Cycle Count(Linear Waveform)")
+    ('Total Cycle Count(Linear Waveform)', None)
     """
     s = cell.strip().strip('"').strip()
     m = _BRACKET_UNIT.fullmatch(s)
@@ -265,7 +271,11 @@ def split_name_unit(cell: str) -> tuple[str, str | None]:
 
 
 def unit_cell(cell: str) -> str:
-    """Unit text of a units-row cell: ``'(kN)'``, ``'[kN]'``, ``'in kN'`` -> ``'kN'``."""
+    """Unit text of a units-row cell: ``'(kN)'``, ``'[kN]'``, ``'in kN'`` -> ``'kN'``.
+
+    >>> unit_cell("(kN)"), unit_cell("[kN]"), unit_cell("in kN"), unit_cell("kN")
+    ('kN', 'kN', 'kN', 'kN')
+    """
     s = cell.strip().strip('"').strip()
     m = re.fullmatch(r"[(\[]\s*(.*?)\s*[)\]]", s)
     if m:
@@ -277,7 +287,11 @@ def unit_cell(cell: str) -> str:
 
 
 def is_unit_token(text: str) -> bool:
-    """Does ``text`` (a units-row cell or a bracket in a name) read as a unit?"""
+    """Does ``text`` (a units-row cell or a bracket in a name) read as a unit?
+
+    >>> is_unit_token("kN"), is_unit_token("(mm/min)"), is_unit_token("Linear Waveform")
+    (True, True, False)
+    """
     u = unit_cell(text).strip().lower().rstrip(".")
     if not u:
         return True
@@ -289,7 +303,11 @@ def is_unit_token(text: str) -> bool:
 
 
 def unit_factor(role: str, unit: str) -> float | None:
-    """Factor from ``unit`` to the library unit of ``role`` (s, mm, N), or None if unknown."""
+    """Factor from ``unit`` to the library unit of ``role`` (s, mm, N), or None if unknown.
+
+    >>> unit_factor("force", "kN"), unit_factor("time", "min"), unit_factor("stroke", "furlong")
+    (1000.0, 60.0, None)
+    """
     table = _UNIT_TABLES[role]
     u = unit.strip().strip('"').strip()
     f = table.get(u.lower())
@@ -305,7 +323,11 @@ _FORCE_SPELLING = {"n": "N", "kn": "kN", "mn": "mN", "dan": "daN", "newton": "N"
 
 
 def canonical_unit(role: str, unit: str) -> str:
-    """Unit as written, with the case fixed: ``'n'`` -> ``'N'``, ``'MM'`` -> ``'mm'``."""
+    """Unit as written, with the case fixed: ``'n'`` -> ``'N'``, ``'MM'`` -> ``'mm'``.
+
+    >>> canonical_unit("force", "kn"), canonical_unit("stroke", "MM")
+    ('kN', 'mm')
+    """
     u = unit.strip()
     if role == "force":
         return _FORCE_SPELLING.get(u.lower(), u)
@@ -349,6 +371,12 @@ class ColumnInfo:
         The unit (from the units row or the name), None if the file gives none.
     unit_line : int or None
         Line where the unit was written (units row or names row).
+
+    Examples
+    --------
+    >>> col = ColumnInfo(1, "Standardweg [mm]", *split_name_unit("Standardweg [mm]"), unit_line=12)
+    >>> col.name, col.unit
+    ('Standardweg', 'mm')
     """
 
     index: int
@@ -360,7 +388,12 @@ class ColumnInfo:
 
 @dataclass(frozen=True)
 class Candidate:
-    """A column that can play a role: rank (higher is better) and kind of channel."""
+    """A column that can play a role: rank (higher is better) and kind of channel.
+
+    >>> (candidate,) = classify_column(ColumnInfo(0, "Prüfzeit", "Prüfzeit", "s"))
+    >>> candidate.role, candidate.rank, candidate.kind, candidate.unit_ok
+    ('time', 3, 'test time', True)
+    """
 
     column: ColumnInfo
     role: str
@@ -382,6 +415,13 @@ def classify_column(col: ColumnInfo) -> list[Candidate]:
     list of Candidate
         Usually zero or one entry.  ``unit_ok`` is False when the name fits a role but the
         unit does not (``Extension (%)``).
+
+    Examples
+    --------
+    >>> [(c.role, c.kind) for c in classify_column(ColumnInfo(2, "Traverse abs.", "Traverse abs.", "mm"))]
+    [('stroke', 'crosshead position (absolute)')]
+    >>> [(c.role, c.kind) for c in classify_column(ColumnInfo(3, "Total Cycles", "Total Cycles", None))]
+    [('counter', 'cycle counter')]
     """
     name = normalize_name(col.name)
     unit = (col.unit or "").strip()
@@ -426,7 +466,11 @@ def classify_column(col: ColumnInfo) -> list[Candidate]:
 
 
 def looks_like_summary(columns: Sequence[ColumnInfo]) -> list[str]:
-    """Columns that mark a table as a summary (per cycle or per specimen), not a time series."""
+    """Columns that mark a table as a summary (per cycle or per specimen), not a time series.
+
+    >>> looks_like_summary([ColumnInfo(0, "Cycle", "Cycle", None), ColumnInfo(1, "Max Load (N)", "Max Load", "N")])
+    ['Max Load (N)']
+    """
     return [c.source for c in columns if c.source and _SUMMARY.search(normalize_name(c.source))]
 
 
@@ -446,6 +490,12 @@ class ChannelChoice:
         Roles without a column.
     bad_unit : dict
         role -> the best candidate whose unit does not fit (for the error message).
+
+    Examples
+    --------
+    >>> choice = choose_channels([ColumnInfo(0, "Time (s)", "Time", "s"), ColumnInfo(1, "Load (%)", "Load", "%")])
+    >>> sorted(choice.chosen), choice.missing, sorted(choice.bad_unit), choice.n_roles
+    (['time'], ['stroke', 'force'], ['force'], 2)
     """
 
     chosen: dict[str, ColumnInfo] = field(default_factory=dict)
@@ -456,6 +506,7 @@ class ChannelChoice:
 
     @property
     def n_roles(self) -> int:
+        """Roles a column was found for (chosen, or named right with a unit that does not fit)."""
         return len(self.chosen) + len(self.bad_unit)
 
 
@@ -496,6 +547,18 @@ def choose_channels(
     Returns
     -------
     ChannelChoice
+
+    Examples
+    --------
+    >>> names = ["Zeit (s)", "Standardweg (mm)", "Weg (mm)", "Standardkraft (N)"]
+    >>> cols = [ColumnInfo(i, cell, *split_name_unit(cell)) for i, cell in enumerate(names)]
+    >>> choice = choose_channels(cols)
+    >>> {role: col.source for role, col in choice.chosen.items()}
+    {'time': 'Zeit (s)', 'stroke': 'Standardweg (mm)', 'force': 'Standardkraft (N)'}
+    >>> print(choice.why["stroke"])
+    crosshead travel (relative) preferred over displacement 'Weg (mm)': eq 6 wants the crosshead stroke ...
+    >>> choose_channels(cols, {"stroke": "Weg"}).chosen["stroke"].source
+    'Weg (mm)'
     """
     choice = ChannelChoice()
     cands: dict[str, list[Candidate]] = {r: [] for r in (*ROLES, "counter")}

@@ -41,6 +41,16 @@ def find_spikes(x: np.ndarray) -> np.ndarray:
     -------
     numpy.ndarray
         Sorted indices (int64) of the spikes.
+
+    Examples
+    --------
+    A glitch such as ``2,451502E9`` in a force column of about 2.45 N:
+
+    >>> import numpy as np
+    >>> force_n = np.linspace(2.40, 2.50, 50)
+    >>> force_n[20] = 2.451502e9
+    >>> find_spikes(force_n).tolist()
+    [20]
     """
     n = x.size
     if n < 5:
@@ -72,6 +82,13 @@ class TimeProblems:
         Indices ``i`` with ``t[i] - t[i-1]`` a gap (see :data:`GAP_FACTOR`).
     median_step_s : float
         Median positive time step (s), NaN if none.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> problems = time_problems(np.array([0.0, 0.1, 0.2, 0.2, 0.3, 30.0, 30.1]))   # s
+    >>> problems.backwards.tolist(), problems.gaps.tolist(), problems.median_step_s
+    ([3], [5], 0.1)
     """
 
     backwards: np.ndarray
@@ -90,6 +107,13 @@ def time_problems(t: np.ndarray) -> TimeProblems:
     Returns
     -------
     TimeProblems
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> problems = time_problems(np.array([0.0, 0.05, 0.1, 0.08, 0.15]))     # s: one step back
+    >>> problems.backwards.tolist(), problems.gaps.tolist()
+    ([3], [])
     """
     if t.size < 2:
         e = np.empty(0, dtype=np.int64)

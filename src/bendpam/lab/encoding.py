@@ -48,6 +48,13 @@ def container_kind(head: bytes) -> str | None:
     str or None
         ``"zip"`` (``.xlsx``/``.ods``), ``"ole2"`` (``.xls``), ``"gzip"`` (Zwick ``.zs2``) or
         None for anything else.
+
+    Examples
+    --------
+    >>> container_kind(bytes([0x50, 0x4B, 3, 4, 20, 0])), container_kind(bytes([0x1F, 0x8B, 8]))
+    ('zip', 'gzip')
+    >>> container_kind(b"time_s,stroke_mm,force_n") is None
+    True
     """
     if head.startswith(b"PK\x03\x04"):
         return "zip"
@@ -87,6 +94,9 @@ def mojibake_score(text: str) -> int:
     """How garbled ``text`` looks: symbols glued to letters, Latin glued to CJK, controls.
 
     0 for clean text.  Used to compare decodings of the same bytes.
+
+    >>> mojibake_score("Obciążenie"), mojibake_score("Obciążenie".encode("cp1250").decode("cp1252"))
+    (0, 2)
     """
     bad = 0
     prev = " "
@@ -141,6 +151,13 @@ def detect_encoding(head: bytes, complete: bool = True) -> str:
     str
         A Python codec name: ``"utf-8-sig"``, ``"utf-16"``, ``"utf-16-le"``, ``"utf-8"``, or one
         of :data:`LEGACY_ENCODINGS`.
+
+    Examples
+    --------
+    >>> detect_encoding("Prüfzeit;Standardkraft".encode("utf-8"))
+    'utf-8'
+    >>> detect_encoding("Prüfzeit;Standardkraft".encode("cp1252")), detect_encoding("Czas;Obciążenie".encode("cp1250"))
+    ('cp1252', 'cp1250')
     """
     bom = _bom(head)
     if bom is not None:

@@ -21,12 +21,21 @@ EXCEL_EXTRA_HINT = "install the optional extra 'excel' (pip install 'bendpam[exc
 
 
 class ExcelUnavailable(ImportError):
-    """``python-calamine`` is not installed."""
+    """``python-calamine`` is not installed (an :class:`ImportError` whose message says how to install it).
+
+    >>> print(ExcelUnavailable(EXCEL_EXTRA_HINT))
+    install the optional extra 'excel' (pip install 'bendpam[excel]')
+    """
 
 
 @dataclass(frozen=True)
 class Sheet:
-    """One sheet of a workbook: its name and its rows as tab-separated lines."""
+    """One sheet of a workbook: its name and its rows as tab-separated lines.
+
+    >>> sheet = Sheet("Probe 1", ["Time\\tLoad", "0.5\\t11.8"])
+    >>> sheet.name, sheet.lines[1].split("\\t")
+    ('Probe 1', ['0.5', '11.8'])
+    """
 
     name: str
     lines: list[str]
@@ -71,6 +80,23 @@ def workbook_sheets(path: str | os.PathLike) -> list[Sheet]:
         If ``python-calamine`` is not installed.
     ValueError
         If the file is not a readable workbook (the message says why).
+
+    Examples
+    --------
+    A file that is not a workbook is refused (and without ``python-calamine`` every file is,
+    with :class:`ExcelUnavailable`):
+
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = Path(folder) / "notes.xlsx"
+    ...     _ = path.write_text("not a workbook")
+    ...     try:
+    ...         workbook_sheets(path)
+    ...     except (ValueError, ExcelUnavailable) as exc:
+    ...         refused = exc
+    >>> isinstance(refused, (ValueError, ImportError))
+    True
     """
     try:
         from python_calamine import CalamineWorkbook

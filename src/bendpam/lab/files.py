@@ -18,6 +18,17 @@ def collect_raw_files(inputs) -> list[Path]:
 
     ``inputs`` is one path or a sequence of paths.  Raises ``ValueError`` (one line) for a missing
     path, a folder without raw files, or no input at all.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     for name in ("be_200kPa.csv", "be_100kPa.TXT", "notes.md"):
+    ...         _ = (Path(folder) / name).write_text("")
+    ...     found = [path.name for path in collect_raw_files(folder)]
+    >>> found
+    ['be_100kPa.TXT', 'be_200kPa.csv']
     """
     if isinstance(inputs, str | os.PathLike):
         inputs = [inputs]

@@ -72,7 +72,11 @@ _BLANK_CHARS = ' \t"\x1a\x0c\x0b\ufeff'
 
 
 def split_cells(line: str, sep: str | None) -> list[str]:
-    """Split one line at ``sep`` honouring double quotes; cells are stripped and unquoted."""
+    """Split one line at ``sep`` honouring double quotes; cells are stripped and unquoted.
+
+    >>> split_cells('"Time";"Load";0,5', ";")
+    ['Time', 'Load', '0,5']
+    """
     if sep is None:
         return [line.strip().strip('"').strip()]
     if '"' not in line:
@@ -85,23 +89,39 @@ def split_cells(line: str, sep: str | None) -> list[str]:
 
 
 def is_blank(line: str, sep: str | None = None) -> bool:
-    """Empty, or only separators, quotes and whitespace (``;;;`` rows from spreadsheets)."""
+    """Empty, or only separators, quotes and whitespace (``;;;`` rows from spreadsheets).
+
+    >>> is_blank(";;;", ";"), is_blank(' "" '), is_blank("0;1", ";")
+    (True, True, False)
+    """
     return not line.strip(_BLANK_CHARS + (sep or ""))
 
 
 def has_control_chars(line: str) -> bool:
-    """Does the line hold control characters (binary data)?"""
+    """Does the line hold control characters (binary data)?
+
+    >>> has_control_chars("0,1" + chr(1)), has_control_chars("0\\t1")
+    (True, False)
+    """
     return _CONTROL.search(line) is not None
 
 
 def is_number(cell: str) -> bool:
-    """A number with a decimal point or comma (or a non-finite token such as ``nan``)."""
+    """A number with a decimal point or comma (or a non-finite token such as ``nan``).
+
+    >>> is_number("1,5e-005"), is_number("nan"), is_number("Load")
+    (True, True, False)
+    """
     c = cell.strip()
     return _NUM_ANY.fullmatch(c) is not None or c.lower() in NONFINITE_TOKENS
 
 
 def numeric_cells(cells: list[str]) -> tuple[int, int]:
-    """``(numbers, non-empty cells)`` of a split line."""
+    """``(numbers, non-empty cells)`` of a split line.
+
+    >>> numeric_cells(["0,5", "11.8", "", "N"])
+    (2, 3)
+    """
     num = nonempty = 0
     for c in cells:
         if c:
@@ -117,6 +137,9 @@ class NumberParse:
 
     ``problem`` is ``"empty"``, ``"nonfinite"``, ``"thousands"`` (a digit grouping that collides
     with the decimal mark) or ``"text"``.
+
+    >>> NumberParse(11.8), NumberParse(None, "text").problem
+    (NumberParse(value=11.8, problem=None), 'text')
     """
 
     value: float | None
@@ -136,6 +159,13 @@ def parse_number(cell: str, decimal: str) -> NumberParse:
     Returns
     -------
     NumberParse
+
+    Examples
+    --------
+    >>> parse_number("6.8902e-005", ".").value, parse_number("1.000,5", ",").value
+    (6.8902e-05, 1000.5)
+    >>> parse_number("1,000,5", ",").problem, parse_number("n/a", ".").problem
+    ('thousands', 'nonfinite')
     """
     c = cell.strip().replace("\u2212", "-")
     if not c:
@@ -175,6 +205,9 @@ def infer_decimal(rows: Iterable[list[str]], sep: str) -> tuple[str | None, int,
     A cell like ``1,000.5`` counts for the point, ``1.000,5`` for the comma; ``1,000,292``
     (a grouping that collides with a decimal comma) counts for the comma, so that the reader
     refuses it with its line.  The majority wins; the minority cells fail later with their line.
+
+    >>> infer_decimal([["0,05", "0,027"], ["0,1", "11,54"]], ";")
+    (',', 4, 0)
     """
     comma = dot = 0
     for cells in rows:
@@ -200,7 +233,11 @@ def infer_decimal(rows: Iterable[list[str]], sep: str) -> tuple[str | None, int,
 
 @dataclass(frozen=True)
 class MetaItem:
-    """One metadata line: ``key``, ``value`` and ``unit`` (``""`` when none)."""
+    """One metadata line: ``key``, ``value`` and ``unit`` (``""`` when none).
+
+    >>> MetaItem("Pressure", "200", "kPa").shown
+    '200 kPa'
+    """
 
     key: str
     value: str
@@ -227,6 +264,13 @@ def parse_metadata_line(line: str) -> MetaItem | None:
 
     Lines without a value (section titles such as ``Bediener Information Ende``), ``$``
     comment lines and blank lines give None.
+
+    >>> parse_metadata_line('"Pressure"\\t200\\t"kPa"')
+    MetaItem(key='Pressure', value='200', unit='kPa')
+    >>> parse_metadata_line('General : Specimen label,"BE-3",')
+    MetaItem(key='Specimen label', value='BE-3', unit='')
+    >>> parse_metadata_line("# Pressure: 200 kPa"), parse_metadata_line("$testXpert II") is None
+    (MetaItem(key='Pressure', value='200 kPa', unit=''), True)
     """
     s = line.strip().lstrip("\ufeff")
     if s.startswith("#"):
@@ -296,6 +340,9 @@ class Mts793Header:
 
     Fields: program, application, language, version, delimiter code (2 = tab), decimal mark,
     date separator, time separator, ...
+
+    >>> Mts793Header("MTS793", "MPT", "DEU", "\\t", ",").decimal
+    ','
     """
 
     program: str
@@ -309,7 +356,13 @@ _MTS_DELIMITERS = {"2": "\t", "0": ",", "1": ";", "3": " "}
 
 
 def parse_mts793(line: str) -> Mts793Header | None:
-    """Parse the first line of an MTS 793 export, or None if ``line`` is not one."""
+    """Parse the first line of an MTS 793 export, or None if ``line`` is not one.
+
+    >>> parse_mts793("MTS793|MPT|DEU|1|2|,|.|:|49|1|1|A")
+    Mts793Header(program='MTS793', application='MPT', language='DEU', delimiter='\\t', decimal=',')
+    >>> parse_mts793("time_s,stroke_mm,force_n") is None
+    True
+    """
     s = line.strip().lstrip("\ufeff")
     if not s.upper().startswith("MTS") or s.count("|") < 6:
         return None
@@ -323,6 +376,13 @@ class LineReader:
 
     Line ends are ``\\r\\n``, ``\\r`` or ``\\n`` (the stream must be opened with universal
     newlines); the returned lines have no line end.
+
+    >>> reader = LineReader(["time_s,force_n\\n", "0,11.8\\n", "0.05,11.71\\n"])
+    >>> reader.next(), reader.take(2), reader.lineno
+    ('time_s,force_n', ['0,11.8', '0.05,11.71'], 3)
+    >>> reader.push_back(["0.05,11.71"])
+    >>> reader.lineno, reader.next(), reader.next()
+    (2, '0.05,11.71', None)
     """
 
     def __init__(self, lines: Iterable[str]) -> None:

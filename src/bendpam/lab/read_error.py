@@ -11,12 +11,20 @@ __all__ = ["ReadError", "one_line", "show"]
 
 
 def one_line(text: object) -> str:
-    """``text`` as one line: every line break collapsed to a space."""
+    """``text`` as one line: every line break collapsed to a space.
+
+    >>> one_line("unknown unit\\nin line 3")
+    'unknown unit in line 3'
+    """
     return " ".join(str(text).splitlines()) if text else ""
 
 
 def show(value: object, limit: int = 40) -> str:
-    """``repr`` of a cell value for a message, shortened to about ``limit`` characters."""
+    """``repr`` of a cell value for a message, shortened to about ``limit`` characters.
+
+    >>> show("11,80"), show("x" * 50, limit=10)
+    ("'11,80'", "'xxxxxxxxxx...'")
+    """
     s = str(value)
     if len(s) > limit:
         s = s[:limit] + "..."

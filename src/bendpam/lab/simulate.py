@@ -55,7 +55,27 @@ MAX_SAMPLES = 10_000_000
 
 @dataclass(frozen=True)
 class SimulationSettings:
-    """Settings of the virtual testing machine (units in the names)."""
+    """Settings of the virtual testing machine (units in the names).
+
+    cycles : triangular cycles blocked -> free -> blocked per pressure.
+    speed_mm_min : crosshead speed (mm/min).  rate_hz : sampling rate (Hz).
+    noise_n, noise_stroke_mm : standard deviations of the Gaussian force (N) and stroke (mm) noise.
+    hysteresis : pressure part of the loop amplitude, a fraction of the blocked moment.
+    hysteresis_offset_nmm : constant part of the loop amplitude (N*mm).
+    hysteresis_angle_deg, hysteresis_law : the loop law (``"pi"`` Prandtl-Ishlinskii or ``"dahl"``)
+    and its angle (deg).  detection_load_n : force at which the machine finds the free state (N).
+    dwell_s : dwell at each end of a stroke (s).  stroke_offset_mm : machine stroke at the blocked
+    state (mm).  seed : random seed of the noise (None: fresh noise each time).
+
+    Examples
+    --------
+    >>> SimulationSettings(cycles=2, rate_hz=5.0).speed_mm_min        # mm/min
+    30.0
+    >>> SimulationSettings(rate_hz=0.0)
+    Traceback (most recent call last):
+    ...
+    bendpam.errors.InputError: rate_hz = 0.0 is outside the allowed range [0.001, 1e+06]
+    """
 
     cycles: int = 3
     speed_mm_min: float = 30.0
@@ -124,7 +144,6 @@ def simulate_test(actuator, pressure_kpa: float, model: str = "energy", *, fixtu
     rng = rng if rng is not None else np.random.default_rng(st.seed)
     P = float(number("pressure_kpa", pressure_kpa, 0.0, unit="kPa"))
     sgn = _signed(actuator)
-    L0 = fixture.L0_mm
     Mb = abs(float(blocked_moment(actuator, P, model)))
     if Mb <= 0.0:
         raise InputError(
@@ -133,57 +152,12 @@ def simulate_test(actuator, pressure_kpa: float, model: str = "energy", *, fixtu
         )
     A = st.hysteresis * Mb + st.hysteresis_offset_nmm
     law = make_law(st.hysteresis_law, st.hysteresis_angle_deg)
-    lim = curvature_limits(actuator)
-    k_lim = 0.999 * (lim.k_max if sgn > 0 else -lim.k_min)
 
     def m_qs(k):  # model moment magnitude at curvature magnitude k
         return sgn * moment(actuator, P, sgn * np.asarray(k, dtype=float), model)
 
-    # 1. free position: unloading from the blocked state (z0 = -1) until F = detection load
-    def force_unloading(k):  # vectorised over k
-        # z on the unloading branch from the saturated state after a loading (an unbounded span)
-        z, _ = law.steady_branches(np.asarray(k, dtype=float) * L0, np.inf)
-        beta = fixture.curvature_to_beta(k)
-        return (m_qs(k) - A * z) / fixture.lever(beta) - st.detection_load_n
-
-    k_hi = min(k_lim, float(fixture.beta_to_curvature(math.radians(MAX_BETA_DEG))))
-    grid = np.linspace(0.0, k_hi, 400)
-    fvals = force_unloading(grid)
-    cross = np.flatnonzero(fvals <= 0.0)
-    if fvals[0] <= 0.0 or cross.size == 0:
-        fb = free_curvature(actuator, P, model)
-        why = fb.reason.item() if fb.status.item() == "no-equilibrium" else "the unloading force never falls that low"
-        raise NoEquilibrium(
-            f"at {pressure_kpa:g} kPa there is no free state: the force does not fall to "
-            f"{st.detection_load_n:g} N before the lock-up limit or the fixture's {MAX_BETA_DEG:g} deg plate "
-            f"pitch ({why})"
-        )
-    j = cross[0]
-    k_f = brentq(lambda x: float(force_unloading(x)), grid[j - 1], grid[j], xtol=1e-14)
-    s_f = float(fixture.curvature_to_stroke(k_f))
-
-    # 2. triangular stroke path, sampled at rate_hz
-    t_ramp = s_f / (st.speed_mm_min / 60.0)
-    legs = []
-    for _ in range(st.cycles):
-        legs += [("ramp", 0.0, s_f), ("dwell", s_f, s_f), ("ramp", s_f, 0.0), ("dwell", 0.0, 0.0)]
-    knots_t, knots_s = [0.0], [0.0]
-    for kind, _a, b in legs:
-        dur = t_ramp if kind == "ramp" else st.dwell_s
-        if dur <= 0:
-            continue
-        knots_t.append(knots_t[-1] + dur)
-        knots_s.append(b)
-    T = knots_t[-1]
-    n_samples = math.floor(T * st.rate_hz + 0.5) + 1
-    if n_samples > MAX_SAMPLES:
-        raise InputError(
-            f"at {pressure_kpa:g} kPa the test would record {n_samples:,} samples ({st.rate_hz:g} Hz x {T:.4g} s), "
-            f"more than the limit of {MAX_SAMPLES:,} per test; use a lower --rate-hz, fewer --cycles, a shorter "
-            "--dwell-s or a higher --speed-mm-min"
-        )
-    t = np.arange(0.0, T + 0.5 / st.rate_hz, 1.0 / st.rate_hz)
-    s = np.interp(t, knots_t, knots_s)
+    k_f, s_f = _free_state(actuator, P, pressure_kpa, model, fixture, law, A, st, m_qs)
+    t, s, T = _stroke_path(s_f, st, pressure_kpa)
     force, _M, _k = _machine(actuator, P, model, fixture, law, A, s, m_qs)
     truth_cycles = _truth(actuator, P, model, fixture, law, A, s_f, st.cycles, m_qs)
     data = pd.DataFrame({
@@ -208,6 +182,69 @@ def simulate_test(actuator, pressure_kpa: float, model: str = "energy", *, fixtu
         "duration_s": float(T),
     }
     return data, truth
+
+
+def _free_state(actuator, P: float, pressure_kpa: float, model: str, fixture: Fixture, law, A: float,
+                st: SimulationSettings, m_qs) -> tuple[float, float]:
+    """Step 1: the free position, found as the machine finds it: ``(curvature 1/mm, stroke mm)``.
+
+    The actuator is released from the blocked state (z0 = -1) on the unloading branch until the
+    force falls to the detection load, before the lock-up limit and the fixture's plate pitch limit.
+    """
+    sgn = _signed(actuator)
+    L0 = fixture.L0_mm
+    lim = curvature_limits(actuator)
+    k_lim = 0.999 * (lim.k_max if sgn > 0 else -lim.k_min)
+
+    def force_unloading(k):  # vectorised over k
+        # z on the unloading branch from the saturated state after a loading (an unbounded span)
+        z, _ = law.steady_branches(np.asarray(k, dtype=float) * L0, np.inf)
+        beta = fixture.curvature_to_beta(k)
+        return (m_qs(k) - A * z) / fixture.lever(beta) - st.detection_load_n
+
+    k_hi = min(k_lim, float(fixture.beta_to_curvature(math.radians(MAX_BETA_DEG))))
+    grid = np.linspace(0.0, k_hi, 400)
+    fvals = force_unloading(grid)
+    cross = np.flatnonzero(fvals <= 0.0)
+    if fvals[0] <= 0.0 or cross.size == 0:
+        fb = free_curvature(actuator, P, model)
+        why = fb.reason.item() if fb.status.item() == "no-equilibrium" else "the unloading force never falls that low"
+        raise NoEquilibrium(
+            f"at {pressure_kpa:g} kPa there is no free state: the force does not fall to "
+            f"{st.detection_load_n:g} N before the lock-up limit or the fixture's {MAX_BETA_DEG:g} deg plate "
+            f"pitch ({why})"
+        )
+    j = cross[0]
+    k_f = brentq(lambda x: float(force_unloading(x)), grid[j - 1], grid[j], xtol=1e-14)
+    return k_f, float(fixture.curvature_to_stroke(k_f))
+
+
+def _stroke_path(s_f: float, st: SimulationSettings, pressure_kpa: float) -> tuple[np.ndarray, np.ndarray, float]:
+    """Step 2: the triangular stroke path, sampled at ``rate_hz``: ``(time s, stroke mm, duration s)``.
+
+    The sample count is checked against :data:`MAX_SAMPLES` before any array is made.
+    """
+    t_ramp = s_f / (st.speed_mm_min / 60.0)
+    legs = []
+    for _ in range(st.cycles):
+        legs += [("ramp", 0.0, s_f), ("dwell", s_f, s_f), ("ramp", s_f, 0.0), ("dwell", 0.0, 0.0)]
+    knots_t, knots_s = [0.0], [0.0]
+    for kind, _a, b in legs:
+        dur = t_ramp if kind == "ramp" else st.dwell_s
+        if dur <= 0:
+            continue
+        knots_t.append(knots_t[-1] + dur)
+        knots_s.append(b)
+    T = knots_t[-1]
+    n_samples = math.floor(T * st.rate_hz + 0.5) + 1
+    if n_samples > MAX_SAMPLES:
+        raise InputError(
+            f"at {pressure_kpa:g} kPa the test would record {n_samples:,} samples ({st.rate_hz:g} Hz x {T:.4g} s), "
+            f"more than the limit of {MAX_SAMPLES:,} per test; use a lower rate_hz, fewer cycles, a shorter "
+            "dwell_s or a higher speed_mm_min"
+        )
+    t = np.arange(0.0, T + 0.5 / st.rate_hz, 1.0 / st.rate_hz)
+    return t, np.interp(t, knots_t, knots_s), T
 
 
 def _machine(actuator, P, model, fixture, law, A, stroke, m_qs):
@@ -247,6 +284,20 @@ def simulate_tests(actuator, pressures_kpa, out_dir, model: str = "energy", *, d
     Files are named ``{prefix}_{P}kPa{suffix}`` with the dialect's usual suffix and carry a
     ``Pressure`` metadata line.  Returns the truth dictionary that is also written to
     ``truth.json`` (atomically).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> import bendpam
+    >>> from pathlib import Path
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     truth = simulate_tests(bendpam.physics.presets.be_pam(), [150.0], folder, dialect="testxpert",
+    ...                            settings=SimulationSettings(cycles=2, rate_hz=5.0, seed=1))
+    ...     written = sorted(path.name for path in Path(folder).iterdir())
+    >>> written
+    ['be-pam_150kPa.txt', 'truth.json']
+    >>> round(truth["pressures"][0]["blocked_moment_nmm"], 1)            # N*mm
+    204.3
     """
     from bendpam.lab.writers import write_test
 

@@ -28,7 +28,9 @@ import numpy as np
 import pandas as pd
 
 from bendpam.infra.atomic import atomic_write_bytes
-from bendpam.lab.readers import COLUMNS, DIALECTS, FORCE_UNITS, is_pressure_key
+from bendpam.lab.channels import FORCE_UNITS
+from bendpam.lab.pressure import is_pressure_key
+from bendpam.lab.rawtest import COLUMNS, DIALECTS
 
 __all__ = ["write_test"]
 
@@ -146,7 +148,46 @@ def write_test(
     fkey = str(force_unit).strip().lower()
     if fkey not in _FORCE_SPELLING:
         raise ValueError(f"unknown force unit {force_unit!r}; expected N, kN, mN or lbf")
-    funit = _FORCE_SPELLING[fkey]
+    arr = _numbers(data, fkey)
+    pressure_kpa, items = _metadata_items(metadata, pressure_kpa)
+    lang = language if dialect == "testxpert" else "en"
+    head, nl, sep, encoding = _header(dialect, lang, _FORCE_SPELLING[fkey], pressure_kpa, items)
+    text = nl.join(head) + nl + _rows(arr, dialect, sep, nl)
+    try:
+        raw = text.encode(encoding)
+    except UnicodeEncodeError:  # a metadata value outside cp1252: testXpert also reads UTF-8
+        raw = text.encode("utf-8")
+    atomic_write_bytes(path, raw)
+
+
+def _metadata_items(metadata: dict[str, str] | None, pressure_kpa: float | None
+                    ) -> tuple[float | None, list[tuple[str, str]]]:  # fmt: skip
+    """The pressure (checked finite) and the metadata lines to write (a given pressure replaces theirs)."""
+    if pressure_kpa is not None:
+        pressure_kpa = float(pressure_kpa)
+        if not math.isfinite(pressure_kpa):
+            raise ValueError(f"pressure_kpa must be finite, got {pressure_kpa!r}")
+    items = _check_metadata(metadata)
+    if pressure_kpa is not None:
+        items = [(k, v) for k, v in items if not is_pressure_key(k)[0]]
+    return pressure_kpa, items
+
+
+def _rows(arr: np.ndarray, dialect: str, sep: str, nl: str) -> str:
+    """The data rows in the dialect's style (quoted cells for Bluehill, decimal comma for testXpert)."""
+    decimal = "," if dialect == "testxpert" else "."
+    cell = f'"{_DIGITS}"' if dialect == "bluehill" else _DIGITS
+    row = sep.join([cell] * 3)
+    body = nl.join(map(row.__mod__, map(tuple, arr.tolist())))
+    if decimal == ",":
+        body = body.replace(".", ",")
+    if body:
+        body += nl
+    return body
+
+
+def _numbers(data: pd.DataFrame, fkey: str) -> np.ndarray:
+    """Time (s), stroke (mm) and force (in the unit ``fkey``) as an (n, 3) array, checked finite."""
     if hasattr(data, "data") and isinstance(data.data, pd.DataFrame):
         data = data.data  # a RawTest
     missing = [c for c in COLUMNS if c not in data.columns]
@@ -159,20 +200,15 @@ def write_test(
         bad_row = int(np.argwhere(~np.isfinite(arr))[0][0])
         raise ValueError(f"data row {bad_row} has a non-finite value; a readable export needs numbers")
     arr[:, 2] /= FORCE_UNITS[fkey]
-    if pressure_kpa is not None:
-        pressure_kpa = float(pressure_kpa)
-        if not math.isfinite(pressure_kpa):
-            raise ValueError(f"pressure_kpa must be finite, got {pressure_kpa!r}")
-    items = _check_metadata(metadata)
-    if pressure_kpa is not None:
-        items = [(k, v) for k, v in items if not is_pressure_key(k)[0]]
+    return arr
 
-    lang = language if dialect == "testxpert" else "en"
+
+def _header(dialect: str, lang: str, funit: str, pressure_kpa: float | None, items: list[tuple[str, str]]
+            ) -> tuple[list[str], str, str, str]:  # fmt: skip
+    """The dialect's header lines (metadata, names, units) and its line end, delimiter and encoding."""
     names = [n.format(unit=funit) for n in _NAMES[(dialect, lang)]]
     units = ["s", "mm", funit]
-    decimal = "," if dialect == "testxpert" else "."
     head: list[str] = []
-
     if dialect == "csv":
         nl, sep, encoding = "\n", ",", "utf-8"
         if pressure_kpa is not None:
@@ -200,17 +236,4 @@ def write_test(
             head.append(_csv_line(["Pressure", _fmt(pressure_kpa), "kPa"], sep))
         head += [_csv_line([k, v], sep) for k, v in items]
         head += ["", _csv_line(names, sep), _csv_line(["sec", "mm", funit], sep)]
-
-    cell = f'"{_DIGITS}"' if dialect == "bluehill" else _DIGITS
-    row = sep.join([cell] * 3)
-    body = nl.join(map(row.__mod__, map(tuple, arr.tolist())))
-    if decimal == ",":
-        body = body.replace(".", ",")
-    if body:
-        body += nl
-    text = nl.join(head) + nl + body
-    try:
-        raw = text.encode(encoding)
-    except UnicodeEncodeError:  # a metadata value outside cp1252: testXpert also reads UTF-8
-        raw = text.encode("utf-8")
-    atomic_write_bytes(path, raw)
+    return head, nl, sep, encoding

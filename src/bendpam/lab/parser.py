@@ -1,0 +1,824 @@
+"""The structure of an export, found in one pass over its lines: data blocks, metadata, numbers.
+
+:class:`Parser` reads the lines of a :class:`~bendpam.lab.source.Source` once.  Text lines are
+kept as metadata candidates; a line of numbers after text starts a data :class:`Block` (its
+names row, an optional units row, the delimiter, the channels chosen by
+:func:`bendpam.lab.channels.choose_channels`); the best block (time, stroke and force, or
+stroke and force with a sampling rate) is read into :class:`ColumnData`, in chunks of lines by
+the C parser of :func:`pandas.read_csv`, a chunk it cannot read line by line to find the
+offending line.  :func:`parse_source` and :func:`parse_path` run the pass and return the
+:class:`Parsed` result, or raise the :class:`~bendpam.lab.read_error.ReadError` that says why no
+block could be read.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from bendpam.lab.channels import (
+    ACCEPTED_NAMES,
+    ROLES,
+    UNIT_HINT,
+    ChannelChoice,
+    ColumnInfo,
+    choose_channels,
+    classify_column,
+    is_unit_token,
+    looks_like_summary,
+    normalize_name,
+    split_name_unit,
+    unit_cell,
+    unit_factor,
+)
+from bendpam.lab.layout import (
+    DELIMITERS,
+    LineReader,
+    MetaItem,
+    Mts793Header,
+    has_control_chars,
+    infer_decimal,
+    is_blank,
+    numeric_cells,
+    parse_metadata_line,
+    parse_mts793,
+    parse_number,
+    split_cells,
+)
+from bendpam.lab.read_error import ReadError, show
+from bendpam.lab.source import Source, open_source
+
+__all__ = ["Block", "ColumnData", "Parsed", "Parser", "parse_path", "parse_source"]
+
+_CHUNK_LINES = 100_000  # lines handed to the C parser at a time
+_PEEK_LINES = 200  # data rows inspected for the decimal mark
+_RATE_KEY = re.compile(
+    r"sampl|abtast|mess ?rate|data rate|acquisition rate|recording rate|aufzeichnungsrate|"
+    r"frequen|taux d.acquisition|échantillon|campionamento|muestreo|próbkowani|採樣|采样|"
+    r"サンプリング|データ取込|rate"
+)
+_INTERVAL_KEY = re.compile(r"interval|intervall|period|periode|abtastzeit|time step|zeitschritt")
+_RATE_UNITS = {"hz": 1.0, "khz": 1000.0, "1/s": 1.0, "/s": 1.0, "s-1": 1.0, "samples/s": 1.0,
+               "pts/s": 1.0, "points/s": 1.0, "punkte/s": 1.0}  # fmt: skip
+
+
+@dataclass
+class Block:
+    """One data block of an export: its names row, units row, delimiter, columns and rows.
+
+    Attributes
+    ----------
+    index : int
+        1-based number of the block in the file.
+    header_line : int
+        1-based line of the names row.
+    names : list of str
+        The names row's cells, as written.
+    units_line : int or None
+        Line of the units row, if there is one.
+    units : list of str or None
+        The units row's cells.
+    sep : str
+        Cell delimiter of the block.
+    first_line, first_row : int, str
+        The first data line and its text.
+    columns : list of ColumnInfo
+        The block's columns with their units.
+    choice : ChannelChoice or None
+        The columns chosen for time, stroke and force (None when a ``columns=`` name is missing).
+    override_missing : str or None
+        A column named in the ``columns=`` option that the block lacks.
+    summary : list of str
+        Columns that mark the block as a per-cycle or per-specimen summary.
+    n_rows, last_line : int
+        Data rows found and the last one's line.
+    read : bool
+        The block whose numbers were read.
+    decimal : str or None
+        Decimal mark of the block's numbers.
+
+    Examples
+    --------
+    >>> from bendpam.lab.channels import ColumnInfo
+    >>> cols = [ColumnInfo(0, "time_s", "time", "s"), ColumnInfo(1, "force_n", "force", "n")]
+    >>> block = Block(1, 3, ["time_s", "force_n"], None, None, ",", 4, "0,11.8", cols, n_rows=2)
+    >>> block.describe()
+    'line 3 (time_s, force_n; 2 rows)'
+    """
+
+    index: int
+    header_line: int
+    names: list[str]
+    units_line: int | None
+    units: list[str] | None
+    sep: str
+    first_line: int
+    first_row: str
+    columns: list[ColumnInfo]
+    choice: ChannelChoice | None = None
+    override_missing: str | None = None
+    summary: list[str] = field(default_factory=list)
+    n_rows: int = 0
+    last_line: int = 0
+    read: bool = False
+    decimal: str | None = None
+
+    def describe(self) -> str:
+        """Where the block is and what it holds, for a message."""
+        names = [n for n in self.names if n]
+        shown = ", ".join(names[:6]) + (", ..." if len(names) > 6 else "")
+        return f"line {self.header_line} ({shown}; {self.n_rows} rows)"
+
+
+@dataclass
+class ColumnData:
+    """The numbers read from the chosen block, in chunks, with their line numbers.
+
+    Attributes
+    ----------
+    cols : dict of str to list of numpy.ndarray
+        role (``"time"``, ``"stroke"``, ``"force"``, ``"counter"``) -> chunks of values in the
+        file's units.
+    lines : list of numpy.ndarray
+        1-based line number of every value, chunk by chunk.
+    dropped_nonfinite : list of int
+        Lines dropped for a non-finite or empty cell (``repair=True``).
+    counter_bad_line : int or None
+        First line whose cycle-counter cell is not a number.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> data = ColumnData()
+    >>> data.cols["force"] = [np.array([11.8, 11.71])]
+    >>> data.lines.append(np.array([2, 3]))
+    >>> np.concatenate(data.cols["force"]).tolist(), data.dropped_nonfinite
+    ([11.8, 11.71], [])
+    """
+
+    cols: dict[str, list[np.ndarray]] = field(default_factory=dict)
+    lines: list[np.ndarray] = field(default_factory=list)
+    dropped_nonfinite: list[int] = field(default_factory=list)
+    counter_bad_line: int | None = None
+
+
+def _role_hits(cells: list[str]) -> int:
+    roles = set()
+    for i, cell in enumerate(cells):
+        if not cell or len(cell) > 80:
+            continue
+        name, unit = split_name_unit(cell)
+        for c in classify_column(ColumnInfo(i, cell, name, unit)):
+            if c.role in ROLES:
+                roles.add(c.role)
+    return len(roles)
+
+
+def _is_units_row(cells: list[str], names: list[str]) -> bool:
+    nonempty = [c for c in cells if c]
+    if not nonempty or _role_hits(cells) > 0 or _role_hits(names) == 0:
+        return False
+    if numeric_cells(cells)[0] > 0:
+        return False
+    for c in nonempty:
+        u = unit_cell(c)
+        if not (is_unit_token(c) or (len(u) <= 12 and " " not in u.strip())):
+            return False
+    return len(nonempty) <= max(len(names), 1) + 1
+
+
+def _trim(cells: list[str]) -> list[str]:
+    out = list(cells)
+    while out and not out[-1]:
+        out.pop()
+    return out
+
+
+def _make_columns(
+    names: list[str], units: list[str] | None, header_line: int, units_line: int | None
+) -> list[ColumnInfo]:
+    cols = []
+    for i, cell in enumerate(names):
+        name, unit = split_name_unit(cell)
+        unit_line: int | None = header_line if unit else None
+        if units is not None and i < len(units) and units[i].strip():
+            unit, unit_line = unit_cell(units[i]).strip(), units_line
+        cols.append(ColumnInfo(i, cell, name, unit or None, unit_line))
+    return cols
+
+
+def _data_seps(line: str) -> list[str]:
+    out = []
+    for sep in DELIMITERS:
+        if sep in line:
+            num, nonempty = numeric_cells(split_cells(line, sep))
+            if num >= 2 and 2 * num >= nonempty:
+                out.append(sep)
+    return out
+
+
+class Parser:
+    """One pass over the lines of an export: blocks, metadata and the chosen block's numbers.
+
+    Parameters
+    ----------
+    reader : LineReader
+        The lines.
+    label : pathlib.Path or str
+        The file, as named in messages.
+    mts : Mts793Header or None
+        The first line of an MTS 793 export (its delimiter and decimal mark are honoured).
+    default_decimal : str or None
+        Decimal mark when the numbers do not show one.
+    overrides : dict of str to str
+        role -> column name (the ``columns=`` option).
+    rate_hz : float or None
+        Sampling rate for a block without a time column.
+    repair : bool
+        Drop rows with a non-finite or empty cell instead of refusing them.
+    want_data : bool
+        Read the chosen block's numbers (False: only find the blocks, as
+        :func:`~bendpam.lab.readers.detect_dialect` does).
+
+    Examples
+    --------
+    >>> from bendpam.lab.layout import LineReader
+    >>> lines = ["# Pressure: 150 kPa", "time_s,stroke_mm,force_n", "0,0,11.8", "0.05,0.027,11.71"]
+    >>> parser = Parser(LineReader(lines), "<text>", mts=None, default_decimal=None, overrides={},
+    ...                 rate_hz=None, repair=False)
+    >>> parser.run()
+    >>> parser.chosen.header_line, parser.chosen.n_rows, parser.chosen.decimal
+    (2, 2, '.')
+    >>> [(line, item.key, item.shown) for line, item in parser.meta_items()]
+    [(1, 'Pressure', '150 kPa')]
+    """
+
+    def __init__(
+        self,
+        reader: LineReader,
+        label: Path | str,
+        *,
+        mts: Mts793Header | None,
+        default_decimal: str | None,
+        overrides: dict[str, str],
+        rate_hz: float | None,
+        repair: bool,
+        want_data: bool = True,
+    ) -> None:
+        self.reader = reader
+        self.label = label
+        self.mts = mts
+        self.default_decimal = default_decimal
+        self.overrides = overrides
+        self.rate_hz = rate_hz
+        self.repair = repair
+        self.want_data = want_data
+        self.text: list[tuple[int, str]] = []  # text lines outside blocks
+        self.block_lines: set[int] = set()  # names and units rows
+        self.blocks: list[Block] = []
+        self.chosen: Block | None = None
+        self.data: ColumnData | None = None
+        self.first_orphan: int | None = None
+        self.dollar = False
+        self.warnings: list[str] = []
+        self.trailing: list[tuple[int, str]] = []
+
+    # -- metadata ----------------------------------------------------------------------------
+    def meta_items(self, before: int | None = None) -> list[tuple[int, MetaItem]]:
+        """``(line, item)`` of the metadata lines (before line ``before``, if given)."""
+        out = []
+        for ln, line in self.text:
+            if before is not None and ln >= before:
+                break
+            if ln in self.block_lines:
+                continue
+            if line.lstrip().startswith("$"):
+                continue
+            item = parse_metadata_line(line)
+            if item is not None:
+                out.append((ln, item))
+        return out
+
+    def rate_from_metadata(self, before: int | None = None) -> tuple[float, str] | None:
+        """``(rate in Hz, where it was found)`` from a sampling-rate or interval metadata line, or None."""
+        for _ln, item in self.meta_items(before):
+            key = normalize_name(item.key)
+            unit = item.unit.strip().lower()
+            value = item.value
+            m = re.fullmatch(r"\s*([+-]?\d+(?:[.,]\d+)?(?:[eE][+-]?\d+)?)\s*(\S*)\s*", value)
+            if m is None:
+                continue
+            number = float(m.group(1).replace(",", "."))
+            unit = unit or m.group(2).lower()
+            _kname, kunit = split_name_unit(item.key)
+            unit = unit or (kunit or "").lower()
+            if not (math.isfinite(number) and number > 0):
+                continue
+            if _RATE_KEY.search(key) and unit in _RATE_UNITS:
+                return number * _RATE_UNITS[unit], f"metadata {item.key!r}"
+            if _INTERVAL_KEY.search(key) and unit_factor("time", unit or "x") is not None:
+                dt = number * (unit_factor("time", unit) or 1.0)
+                return 1.0 / dt, f"metadata {item.key!r}"
+        return None
+
+    # -- main loop ---------------------------------------------------------------------------
+    def run(self) -> None:
+        """Read the lines: find the blocks, keep the text lines, read the best block's numbers."""
+        reader = self.reader
+        pre: list[tuple[int, str]] = []
+        while True:
+            line = reader.next()
+            if line is None:
+                break
+            ln = reader.lineno
+            if is_blank(line):
+                continue
+            if has_control_chars(line):
+                self._binary_line(ln)
+            if line.lstrip().startswith("$"):
+                self.dollar = True
+            seps = _data_seps(line)
+            if seps and pre:
+                blk = self._start_block(pre, line, ln, seps)
+                reader.push_back([line])
+                self._consume_block(blk)
+                pre = []
+                if self.chosen is not None and self.chosen.choice is not None and (
+                    "time" in self.chosen.choice.chosen and not self.want_data
+                ):
+                    return
+                continue
+            if seps:
+                if self.first_orphan is None:
+                    self.first_orphan = ln
+                continue
+            pre.append((ln, line))
+            self.text.append((ln, line))
+            if self.chosen is not None and self.chosen.read:
+                self.trailing.append((ln, line))
+
+    def _binary_line(self, ln: int) -> None:
+        raise ReadError(
+            "binary data (control characters); expected a text export (CSV/TXT)", self.label, ln
+        )
+
+    def _start_block(self, pre: list[tuple[int, str]], line: str, ln: int, seps: list[str]) -> Block:
+        order = list(seps)
+        if self.mts is not None and self.mts.delimiter in order:
+            order.remove(self.mts.delimiter)
+            order.insert(0, self.mts.delimiter)
+        best: tuple[tuple[int, int, int, int], Block] | None = None
+        p1 = pre[-1]
+        p2 = pre[-2] if len(pre) >= 2 else None
+        for k, sep in enumerate(order):
+            data_cells = split_cells(line, sep)
+            c1 = split_cells(p1[1], sep)
+            names_ln, names, units_ln, units = p1[0], c1, None, None
+            if p2 is not None:
+                c2 = split_cells(p2[1], sep)
+                if len(c2) >= 2 and _is_units_row(c1, c2):
+                    names_ln, names, units_ln, units = p2[0], c2, p1[0], c1
+            fit = int(len(_trim(names)) >= 2 and abs(len(_trim(names)) - len(_trim(data_cells))) <= 1)
+            score = (_role_hits(names), fit, len(names) >= 2, -k)
+            cols = _make_columns(names, units, names_ln, units_ln)
+            blk = Block(len(self.blocks) + 1, names_ln, names, units_ln, units, sep, ln, line, cols)
+            if best is None or score > best[0]:
+                best = (score, blk)
+        assert best is not None
+        blk = best[1]
+        self.blocks.append(blk)
+        self.block_lines.add(blk.header_line)
+        if blk.units_line is not None:
+            self.block_lines.add(blk.units_line)
+        try:
+            blk.choice = choose_channels(blk.columns, self.overrides)
+        except KeyError as exc:
+            blk.override_missing = str(exc.args[0])
+            blk.choice = None
+        blk.summary = looks_like_summary(blk.columns)
+        return blk
+
+    def _usable(self, blk: Block) -> int:
+        """2 = time, stroke and force; 1 = stroke and force with a rate; 0 = not usable."""
+        ch = blk.choice
+        if ch is None or ch.bad_unit:
+            return 0
+        if {"time", "stroke", "force"} <= set(ch.chosen):
+            return 2
+        if {"stroke", "force"} <= set(ch.chosen) and (
+            self.rate_hz is not None or self.rate_from_metadata(blk.header_line) is not None
+        ):
+            return 1
+        return 0
+
+    def _consume_block(self, blk: Block) -> None:
+        self.trailing = []
+        level = self._usable(blk)
+        current = 0 if self.chosen is None else self._usable(self.chosen)
+        if level > current:
+            self.chosen = blk
+            blk.read = True
+            self.trailing = []
+            if self.want_data:
+                self.data = ColumnData()
+                self._read_rows(blk, self.data)
+            else:
+                self._read_rows(blk, None)
+            for other in self.blocks:
+                if other is not blk:
+                    other.read = False
+        else:
+            self._read_rows(blk, None)
+
+    # -- rows --------------------------------------------------------------------------------
+    def _decimal_for(self, blk: Block) -> str:
+        reader = self.reader
+        peek = reader.take(_PEEK_LINES)
+        rows = []
+        for ln_text in peek:
+            if is_blank(ln_text):
+                continue
+            cells = split_cells(ln_text, blk.sep)
+            num, nonempty = numeric_cells(cells)
+            if num == 0 and nonempty:
+                break
+            rows.append(cells)
+        reader.push_back(peek)
+        mark, _comma, _dot = infer_decimal(rows, blk.sep)
+        if self.mts is not None and self.mts.decimal is not None:
+            return self.mts.decimal
+        if mark is not None:
+            return mark
+        return self.default_decimal or "."
+
+    def _needed(self, blk: Block) -> list[tuple[str, ColumnInfo]]:
+        ch = blk.choice
+        assert ch is not None
+        out = [(role, ch.chosen[role]) for role in ROLES if role in ch.chosen]
+        if ch.counter is not None:
+            out.append(("counter", ch.counter))
+        return out
+
+    def _read_rows(self, blk: Block, data: ColumnData | None) -> None:
+        reader = self.reader
+        dec = self._decimal_for(blk)
+        blk.decimal = dec
+        if data is None:
+            self._skip_rows(blk)
+            return
+        needed = self._needed(blk)
+        for role, _col in needed:
+            data.cols[role] = []
+        while True:
+            lines = reader.take(_CHUNK_LINES)
+            if not lines:
+                break
+            start = reader.lineno - len(lines) + 1
+            arrs = self._fast(lines, blk, needed, dec)
+            if arrs is None and needed[-1][0] == "counter":
+                # the optional counter alone may be what the C parser cannot read
+                arrs = self._fast(lines, blk, needed[:-1], dec)
+                if arrs is not None:
+                    arrs.append(np.full(len(lines), np.nan))
+                    if data.counter_bad_line is None:
+                        data.counter_bad_line = start
+            if arrs is not None:
+                for (role, _col), arr in zip(needed, arrs, strict=True):
+                    data.cols[role].append(arr)
+                data.lines.append(np.arange(start, start + len(lines), dtype=np.int32))
+                blk.n_rows += len(lines)
+                blk.last_line = start + len(lines) - 1
+                continue
+            end = self._slow(lines, start, blk, needed, dec, data)
+            if end is not None:
+                reader.push_back(lines[end:])
+                break
+
+    def _fast(self, lines: list[str], blk: Block, needed, dec: str) -> list[np.ndarray] | None:
+        if blk.sep == dec:
+            return None
+        idx = [col.index for _role, col in needed]
+        try:
+            df = pd.read_csv(
+                io.BytesIO("\n".join(lines).encode("utf-8", "surrogatepass")),
+                sep=blk.sep,
+                decimal=dec,
+                header=None,
+                usecols=sorted(set(idx)),
+                dtype=np.float64,
+                engine="c",
+                skip_blank_lines=False,
+                quotechar='"',
+                na_filter=False,
+                index_col=False,
+            )
+            arrs = [np.array(df[i].to_numpy(dtype=np.float64), copy=True) for i in idx]
+        except Exception:  # any parser trouble -> the slow path finds the line
+            return None
+        del df
+        if any(len(a) != len(lines) or not np.isfinite(a).all() for a in arrs):
+            return None
+        return arrs
+
+    def _row_problem(self, role: str, col: ColumnInfo, cell: str | None, dec: str, blk: Block,
+                     line: str) -> str:  # fmt: skip
+        roles = [r for r in ROLES if blk.choice is not None and r in blk.choice.chosen]
+        what = f"{len(roles)} numeric columns ({', '.join(roles)})"
+        name = col.source
+        if cell is None:
+            return (
+                f"expected {what}, got {show(line.strip())} with only "
+                f"{len(split_cells(line, blk.sep))} field(s) (column {name!r} missing)"
+            )
+        res = parse_number(cell, dec)
+        mark = "decimal comma" if dec == "," else "decimal point"
+        if res.problem == "empty":
+            return f"expected {what} with a {mark}, got an empty cell in column {name!r}"
+        if res.problem == "nonfinite":
+            return f"non-finite value {show(cell)} in column {name!r}; expected a finite number"
+        if res.problem == "thousands":
+            return (
+                f"number {show(cell)} in column {name!r} has a thousands separator that collides "
+                f"with the {mark}; expected numbers without digit grouping (export them plain)"
+            )
+        return f"expected {what} with a {mark}, got {show(cell)} in column {name!r}"
+
+    def _slow(self, lines: list[str], start: int, blk: Block, needed, dec: str,
+              data: ColumnData) -> int | None:  # fmt: skip
+        """Parse line by line; the index in ``lines`` where the block ends, or None."""
+        sep = blk.sep
+        rows: list[list[float]] = []
+        lnos: list[int] = []
+        blank_run: int | None = None
+        names_norm = [normalize_name(n) for n in blk.names]
+        end: int | None = None
+        for k, line in enumerate(lines):
+            ln = start + k
+            if is_blank(line, sep):
+                if blank_run is None:
+                    blank_run = k
+                continue
+            if has_control_chars(line):
+                self._binary_line(ln)
+            cells = split_cells(line, sep)
+            vals: list[float] = []
+            problem: tuple[str, ColumnInfo, str | None] | None = None
+            for role, col in needed:
+                cell = cells[col.index] if col.index < len(cells) else None
+                if cell is None:
+                    if role == "counter":
+                        vals.append(math.nan)
+                        continue
+                    problem = (role, col, None)
+                    break
+                res = parse_number(cell, dec)
+                if res.value is None:
+                    if role == "counter":
+                        vals.append(math.nan)
+                        if data.counter_bad_line is None:
+                            data.counter_bad_line = ln
+                        continue
+                    problem = (role, col, cell)
+                    break
+                vals.append(res.value)
+            if problem is None:
+                rows.append(vals)
+                lnos.append(ln)
+                blank_run = None
+                continue
+            num, nonempty = numeric_cells(cells)
+            datalike = num >= 2 and 2 * num >= nonempty
+            if not datalike:
+                repeated = [normalize_name(c) for c in cells] == names_norm
+                if blank_run is not None or repeated or _role_hits(cells) >= 2:
+                    end = blank_run if blank_run is not None else k
+                    break
+            role, col, cell = problem
+            if (
+                self.repair
+                and cell is not None
+                and parse_number(cell, dec).problem in ("nonfinite", "empty")
+                and datalike
+            ):
+                data.dropped_nonfinite.append(ln)
+                blank_run = None
+                continue
+            raise ReadError(self._row_problem(role, col, cell, dec, blk, line), self.label, ln,
+                            col.source)  # fmt: skip
+        if rows:
+            arr = np.asarray(rows, dtype=np.float64).reshape(-1, len(needed))
+            for j, (role, _col) in enumerate(needed):
+                data.cols[role].append(arr[:, j].copy())
+            data.lines.append(np.asarray(lnos, dtype=np.int32))
+            blk.n_rows += len(rows)
+            blk.last_line = lnos[-1]
+        if end is None and blank_run is not None:
+            return None  # trailing blank lines: the next chunk decides
+        return end
+
+    def _skip_rows(self, blk: Block) -> None:
+        reader = self.reader
+        sep = blk.sep
+        while True:
+            lines = reader.take(_CHUNK_LINES)
+            if not lines:
+                return
+            start = reader.lineno - len(lines) + 1
+            blank_run: int | None = None
+            for k, line in enumerate(lines):
+                if is_blank(line, sep):
+                    if blank_run is None:
+                        blank_run = k
+                    continue
+                cells = split_cells(line, sep)
+                num, nonempty = numeric_cells(cells)
+                if num >= 1 and 2 * num >= nonempty:
+                    blk.n_rows += 1
+                    blk.last_line = start + k
+                    blank_run = None
+                    continue
+                if has_control_chars(line):
+                    self._binary_line(start + k)
+                end = blank_run if blank_run is not None else k
+                reader.push_back(lines[end:])
+                return
+
+
+
+def _no_header_error(p: Parser) -> ReadError:
+    label = p.label
+    partial = [b for b in p.blocks if b.choice is not None and b.choice.n_roles >= 2]
+    summaries = [b for b in p.blocks if b.summary and (b.choice is None or b.choice.n_roles < 2)]
+    missing_override = [b for b in p.blocks if b.override_missing is not None]
+    if missing_override and p.overrides:
+        b = missing_override[0]
+        wanted = b.override_missing
+        cols = ", ".join(repr(n) for n in b.names if n)
+        return ReadError(
+            f"column {wanted!r} named in the columns option is not in the file; its columns "
+            f"are {cols}",
+            label,
+            b.header_line,
+        )
+    for b in partial:
+        assert b.choice is not None
+        for role, col in b.choice.bad_unit.items():
+            return ReadError(
+                f"unknown {role} unit {show(col.unit or '')} for column {col.source!r}; expected "
+                f"{UNIT_HINT[role]}",
+                label,
+                col.unit_line or b.header_line,
+                col.source,
+            )
+    if summaries and not partial:
+        b = summaries[0]
+        cols = ", ".join(repr(c) for c in b.summary[:4])
+        return ReadError(
+            f"a per-cycle or per-specimen summary, not a time series: columns such as {cols} "
+            "hold one value per cycle or specimen and no column is a time, stroke or force "
+            "sample; expected the raw data export (time, stroke and force samples)",
+            label,
+            b.header_line,
+        )
+    if partial:
+        b = partial[0]
+        assert b.choice is not None
+        ch = b.choice
+        found = ", ".join(f"{r} {ch.chosen[r].source!r}" for r in ROLES if r in ch.chosen)
+        missing = [r for r in ROLES if r not in ch.chosen]
+        if missing == ["time"]:
+            return ReadError(
+                f"header row has no time column (found {found}) and no sampling rate is known; "
+                "expected a time column, a sampling rate in the metadata (e.g. 'Sample rate: "
+                "100 Hz') or the rate_hz option",
+                label,
+                b.header_line,
+            )
+        return ReadError(
+            f"header row has no {' or '.join(missing)} column (found {found}); expected a "
+            f"column named after {' and '.join(missing)} (accepted names: {ACCEPTED_NAMES})",
+            label,
+            b.header_line,
+        )
+    # a header without data rows?
+    for ln, line in p.text:
+        for sep in DELIMITERS:
+            if sep in line and _role_hits(split_cells(line, sep)) >= 3:
+                return ReadError(
+                    "header row is followed by no data rows; expected at least 2", label, ln
+                )
+    first_data = p.blocks[0].first_line if p.blocks else p.first_orphan
+    if first_data is not None:
+        return ReadError(
+            "no header row naming time, stroke and force columns before the first data row; "
+            f"expected e.g. 'time_s,stroke_mm,force_n' (accepted names: {ACCEPTED_NAMES})",
+            label,
+            first_data,
+        )
+    return ReadError(
+        "no header row naming time, stroke and force columns; expected e.g. "
+        f"'time_s,stroke_mm,force_n' (accepted names: {ACCEPTED_NAMES})",
+        label,
+    )
+
+
+@dataclass
+class Parsed:
+    """What :func:`parse_source` found: the parser (metadata, blocks, numbers), its source and the block read.
+
+    Examples
+    --------
+    >>> from bendpam.lab.source import text_source
+    >>> (source,), _ = text_source(["time_s,stroke_mm,force_n", "0,0,11.8", "0.05,0.027,11.71"])
+    >>> parsed = parse_source(source, dialect=None, overrides={}, rate_hz=None, repair=False)
+    >>> parsed.block is parsed.parser.chosen, parsed.source.label
+    (True, '<text>')
+    """
+
+    parser: Parser
+    source: Source
+    block: Block
+
+
+def parse_source(source: Source, *, dialect: str | None, overrides: dict[str, str],
+                 rate_hz: float | None, repair: bool, want_data: bool = True) -> Parsed:  # fmt: skip
+    """Parse one source: its blocks and metadata, and the numbers of the block to read.
+
+    Parameters
+    ----------
+    source : Source
+        The lines (closed when read).
+    dialect : str or None
+        The format asked for; ``"testxpert"`` makes the decimal comma the default.
+    overrides, rate_hz, repair, want_data
+        As for :class:`Parser`.
+
+    Returns
+    -------
+    Parsed
+
+    Raises
+    ------
+    ReadError
+        If no block has time (or a rate), stroke and force, saying what was found instead.
+
+    Examples
+    --------
+    >>> from bendpam.lab.source import text_source
+    >>> (source,), _ = text_source("Zeit;Weg;Kraft\\ns;mm;kN\\n0;0,000;0,0118\\n0,05;0,027;0,01171\\n")
+    >>> parsed = parse_source(source, dialect=None, overrides={}, rate_hz=None, repair=False)
+    >>> block = parsed.block
+    >>> block.sep, block.decimal, block.units, block.n_rows
+    (';', ',', ['s', 'mm', 'kN'], 2)
+    >>> parsed.parser.data.cols["force"][0].tolist()          # kN, as written
+    [0.0118, 0.01171]
+    """
+    mts = parse_mts793(source.first_line)
+    default_decimal = "," if dialect == "testxpert" else None
+    reader = LineReader(source.lines)
+    p = Parser(reader, source.label, mts=mts, default_decimal=default_decimal,
+               overrides=overrides, rate_hz=rate_hz, repair=repair, want_data=want_data)  # fmt: skip
+    try:
+        p.run()
+    finally:
+        if source.close is not None:
+            source.close()
+    if p.chosen is None:
+        raise _no_header_error(p)
+    return Parsed(p, source, p.chosen)
+
+
+def parse_path(path: Path, **kw: Any) -> Parsed:
+    """Parse a file (the first readable sheet of a workbook); ``kw`` as for :func:`parse_source`.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = Path(folder) / "be_150kPa.csv"
+    ...     _ = path.write_text("time_s,stroke_mm,force_n\\n0,0,11.8\\n0.05,0.027,11.71\\n")
+    ...     parsed = parse_path(path, dialect=None, overrides={}, rate_hz=None, repair=False)
+    >>> parsed.block.header_line, parsed.block.n_rows, parsed.source.encoding
+    (1, 2, 'utf-8')
+    """
+    sources, _size = open_source(path)
+    first_error: ReadError | None = None
+    for src in sources:
+        try:
+            return parse_source(src, **kw)
+        except ReadError as exc:
+            if not src.is_excel:
+                raise
+            if first_error is None:
+                first_error = ReadError(f"sheet {src.sheet!r}: {exc.message}", path, exc.line,
+                                        exc.column)  # fmt: skip
+    assert first_error is not None
+    raise first_error

@@ -1,0 +1,234 @@
+"""The source of a raw test: a file's bytes (or a workbook's sheets, or text) as lines.
+
+:func:`open_source` opens a file: refuses what is not a text export or a workbook (empty
+files, directories, Zwick ``.zs2``, binary data), chooses the encoding
+(:func:`bendpam.lab.encoding.detect_encoding`) and hands out the lines lazily; a workbook gives
+one :class:`Source` per sheet (:mod:`bendpam.lab.excel`).  :func:`text_source` does the same for
+text already in memory.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+import re
+from collections.abc import Iterable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from bendpam.lab.encoding import container_kind, detect_encoding
+from bendpam.lab.read_error import ReadError
+
+__all__ = ["Source", "open_source", "text_source"]
+
+_HEAD_BYTES = 1 << 20  # bytes used to choose the encoding
+
+
+@dataclass
+class Source:
+    """Lines of one export (or one sheet of a workbook), ready for the parser.
+
+    Attributes
+    ----------
+    label : pathlib.Path or str
+        The file (``"<text>"`` for text in memory), as named in messages.
+    encoding : str
+        Codec the text is decoded with (``"xlsx"``/``"xls"`` for a workbook, ``"str"`` for text).
+    lines : iterable of str
+        The lines, read lazily from the file.
+    first_line : str
+        The first non-blank line (an MTS 793 export announces itself there).
+    is_excel : bool
+        A workbook sheet.
+    sheet : str or None
+        The sheet's name.
+    close : callable or None
+        Closes the file once the lines are read.
+
+    Examples
+    --------
+    >>> import io
+    >>> text = io.StringIO("time_s,stroke_mm,force_n\\n0,0,11.8\\n")
+    >>> source = Source("<text>", "str", text, "time_s,stroke_mm,force_n")
+    >>> next(iter(source.lines)).strip(), source.is_excel
+    ('time_s,stroke_mm,force_n', False)
+    """
+
+    label: Path | str
+    encoding: str
+    lines: Iterable[str]
+    first_line: str
+    is_excel: bool = False
+    sheet: str | None = None
+    close: Any = None
+
+
+def _read_head(path: Path) -> tuple[bytes, int]:
+    try:
+        size = path.stat().st_size
+        if path.is_dir():
+            raise IsADirectoryError
+        with open(path, "rb") as fh:
+            head = fh.read(_HEAD_BYTES)
+    except FileNotFoundError:
+        raise ReadError("file not found; expected an existing raw test export", path) from None
+    except IsADirectoryError:
+        raise ReadError("is a directory; expected a raw test export file", path) from None
+    except PermissionError:
+        raise ReadError("permission denied; cannot read the file", path) from None
+    except OSError as exc:
+        raise ReadError(f"cannot read the file ({exc.strerror or exc})", path) from None
+    return head, size
+
+
+def _binary_error(path: Path, head: bytes) -> None:
+    nul = head.find(b"\x00")
+    if nul >= 0:
+        raise ReadError(
+            "binary data (NUL byte); expected a text export (CSV/TXT) or an .xlsx/.xls "
+            "workbook, not a proprietary test file",
+            path,
+            head.count(b"\n", 0, nul) + 1,
+        )
+
+
+def _check_text_head(text: str, label: Path | str) -> None:
+    if "\x00" in text:
+        raise ReadError(
+            "binary data (NUL character); expected a text export (CSV/TXT)",
+            label,
+            text.count("\n", 0, text.index("\x00")) + 1,
+        )
+    head = text[:65536]
+    bad = re.findall(r"[\x00-\x08\x0e-\x19\x1b-\x1f\x7f]", head)
+    if len(bad) > max(2, len(head) // 100):
+        first = re.search(r"[\x00-\x08\x0e-\x19\x1b-\x1f\x7f]", head)
+        assert first is not None
+        raise ReadError(
+            "binary data (control characters); expected a text export (CSV/TXT)",
+            label,
+            head.count("\n", 0, first.start()) + 1,
+        )
+    if not text.strip():
+        raise ReadError("file contains only whitespace; expected a header row and data rows", label)
+
+
+def _open_excel(path: Path, kind: str) -> list[tuple[str, list[str]]]:
+    from bendpam.lab.excel import EXCEL_EXTRA_HINT, ExcelUnavailable, workbook_sheets
+
+    what = "an .xlsx workbook (ZIP container)" if kind == "zip" else "an .xls workbook (OLE2)"
+    try:
+        sheets = workbook_sheets(path)
+    except ExcelUnavailable:
+        raise ReadError(
+            f"binary file, {what}: reading workbooks needs python-calamine; "
+            f"{EXCEL_EXTRA_HINT}, or export CSV/TXT from the testing software",
+            path,
+            1,
+        ) from None
+    except ValueError as exc:
+        raise ReadError(
+            f"binary data that is not a readable workbook ({exc}); expected a text export "
+            "(CSV/TXT) or an .xlsx/.xls workbook",
+            path,
+            1,
+        ) from None
+    return [(s.name, s.lines) for s in sheets]
+
+
+def open_source(path: Path) -> tuple[list[Source], int]:
+    """Open an export: its sources (one, or one per workbook sheet) and its size in bytes.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The file.
+
+    Returns
+    -------
+    (list of Source, int)
+
+    Raises
+    ------
+    ReadError
+        For a file that is missing, empty, a directory, unreadable, binary or a native Zwick file.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = Path(folder) / "be_150kPa.csv"
+    ...     _ = path.write_text("time_s,stroke_mm,force_n\\n0,0,11.8\\n", encoding="utf-8")
+    ...     (source,), size = open_source(path)
+    ...     lines = [line.rstrip() for line in source.lines]
+    ...     source.close()
+    >>> source.encoding, size, lines
+    ('utf-8', 34, ['time_s,stroke_mm,force_n', '0,0,11.8'])
+    """
+    head, size = _read_head(path)
+    if size == 0 or not head:
+        raise ReadError("file is empty; expected a header row and data rows", path)
+    kind = container_kind(head)
+    if path.suffix.lower() in (".zs2", ".zp2") or (kind == "gzip"):
+        raise ReadError(
+            "native Zwick .zs2 (or gzip) file; export the test as ASCII (TXT/TRA) from "
+            "testXpert and read that",
+            path,
+        )
+    if kind in ("zip", "ole2"):
+        sheets = _open_excel(path, kind)
+        sources = []
+        for name, lines in sheets:
+            first = next((ln for ln in lines if ln.strip()), "")
+            sources.append(Source(path, "xlsx" if kind == "zip" else "xls", lines, first,
+                                   is_excel=True, sheet=name))  # fmt: skip
+        if not sources:
+            raise ReadError("workbook without sheets; expected a sheet of test data", path, 1)
+        return sources, size
+    encoding = detect_encoding(head, complete=size <= len(head))
+    if not encoding.startswith(("utf-16", "utf-32")):
+        _binary_error(path, head)
+    try:
+        head_text = head.decode(encoding, errors="replace")
+    except LookupError:  # pragma: no cover - codecs are fixed
+        head_text = head.decode("latin-1")
+    _check_text_head(head_text, path)
+    fh = open(path, encoding=encoding, errors="replace", newline=None)
+    first = head_text.lstrip("\ufeff").splitlines()[0] if head_text.strip() else ""
+    return [Source(path, encoding, fh, first, close=fh.close)], size
+
+
+
+def text_source(path_or_text_lines: Any) -> tuple[list[Source] | None, Path | None]:
+    """A path, or text given as a string with line breaks or as lines: ``(sources, None)`` or ``(None, path)``.
+
+    Examples
+    --------
+    >>> sources, path = text_source("be_150kPa.csv")
+    >>> sources is None, path.name
+    (True, 'be_150kPa.csv')
+    >>> (source,), _ = text_source(["time_s,stroke_mm,force_n", "0,0,11.8"])
+    >>> source.label, source.first_line
+    ('<text>', 'time_s,stroke_mm,force_n')
+    """
+    if isinstance(path_or_text_lines, os.PathLike) or (
+        isinstance(path_or_text_lines, str) and not re.search(r"[\r\n]", path_or_text_lines)
+    ):
+        return None, Path(path_or_text_lines)
+    if isinstance(path_or_text_lines, str):
+        text = path_or_text_lines
+    elif isinstance(path_or_text_lines, Iterable):
+        text = "\n".join(str(s).rstrip("\r\n") for s in path_or_text_lines)
+    else:
+        raise TypeError(
+            f"expected a path or an iterable of text lines, got {type(path_or_text_lines).__name__}"
+        )
+    label = "<text>"
+    if not text.strip():
+        raise ReadError("no text; expected a header row and data rows", label)
+    _check_text_head(text, label)
+    lines = io.StringIO(text, newline=None)
+    first = text.lstrip("\ufeff").splitlines()[0] if text.strip() else ""
+    return [Source(label, "str", lines, first)], None
