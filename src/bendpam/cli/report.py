@@ -16,7 +16,14 @@ __all__ = ["register"]
 
 
 def register(app: typer.Typer) -> None:
-    """Add the ``report`` command to ``app`` (does nothing if it has one already)."""
+    """Add the ``report`` command to ``app`` (does nothing if it has one already).
+
+    >>> app = typer.Typer()
+    >>> register(app)
+    >>> register(app)
+    >>> [c.name for c in app.registered_commands]
+    ['report']
+    """
     if any(getattr(c, "name", None) == "report" for c in app.registered_commands):
         return
     from bendpam.cli.options import ActuatorOpt, PresetOpt, QuietOpt

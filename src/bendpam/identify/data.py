@@ -142,8 +142,15 @@ def branch_data(processed, L0: float) -> FitData:
 def fit_data(processed, fit_range: str = "developed") -> FitData:
     """The mean curve of every pressure, where the loop is developed (``"developed"``) or whole (``"all"``).
 
-    Weights ``sqrt(K_i / sum K) / (M_max,i sqrt(n_i))`` make the sum of squares eq 53; the example
-    is :class:`FitData`'s.
+    Weights ``sqrt(K_i / sum K) / (M_max,i sqrt(n_i))`` make the sum of squares eq 53.
+
+    >>> from types import SimpleNamespace as NS
+    >>> k = np.linspace(0.0, 0.008, 5)
+    >>> test = NS(pressure_kpa=150.0, curvature_grid=k, mean_curve=200.0 * (1 - k / 0.008),
+    ...           blocked_moment=(200.0, 1.0), free_curvature=(0.008, 1e-4))
+    >>> d = fit_data(NS(results=[test]), "all")
+    >>> d.P.tolist(), d.Mc.tolist()
+    ([150.0], [200.0, 150.0, 100.0, 50.0, 0.0])
     """
     res = processed.results
     if not res:

@@ -207,8 +207,8 @@ def at_bound(p, fraction: float = LIMITS.bound_fraction) -> str | None:
     ``p`` has ``value``, ``min``, ``max`` and ``vary`` (a :class:`~bendpam.identify.result.Parameter`).
 
     >>> from types import SimpleNamespace as NS
-    >>> at_bound(NS(value=62.74, min=62.73, max=76.67, vary=True)), at_bound(NS(value=69.7, min=62.73, max=76.67,
-    ...                                                                          vary=True))
+    >>> near, inside = NS(value=62.74, min=62.73, max=76.67, vary=True), NS(value=69.7, min=62.73, max=76.67, vary=True)
+    >>> at_bound(near), at_bound(inside)
     ('lower', None)
     """
     if not p.vary or not (_finite(p.min) and _finite(p.max) and _finite(p.value)) or not p.max > p.min:

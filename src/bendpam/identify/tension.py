@@ -108,6 +108,13 @@ class TensionFit:
         tell (or: it sits at a bound).
     source : str
         Where the data came from (file name), may be empty.
+
+    Examples
+    --------
+    >>> lam = np.linspace(1.0, 2.0, 11)
+    >>> fit = fit_tension(lam, MooneyRivlin(0.2, 0.1).uniaxial_nominal_stress(lam) * 1e3)
+    >>> round(fit.shear_modulus_kpa, 6), round(fit.shape, 6), fit.n_points
+    (600.0, 0.333333, 11)
     """
 
     C10_kpa: float
@@ -378,6 +385,12 @@ class TensionData:
         Nominal stresses, kPa.
     source : str
         Where they came from (file name), may be empty.
+
+    Examples
+    --------
+    >>> td = TensionData(np.array([1.0, 1.5, 2.0]), np.array([0.0, 350.0, 600.0]), "t.csv")
+    >>> td.stretch.size, td.source
+    (3, 't.csv')
     """
 
     stretch: np.ndarray

@@ -54,6 +54,14 @@ class Report:
     hysteresis : ``{model: FitResult}`` of the fits with a loop model shown in the hysteresis section
         (empty when the tests show no loop).
     failed : ``{model: reason}`` of the models that could not be fitted.
+
+    Examples
+    --------
+    :func:`build_report` makes one; by hand (no page behind it):
+
+    >>> r = Report(Path("report.html"), [], [], None, {}, {}, [], [], [], None, [], "0.3.0", 0, False)
+    >>> r.html.name, r.warnings, r.failed
+    ('report.html', [], {})
     """
 
     html: Path

@@ -58,6 +58,12 @@ def alpha0_profile(res) -> dict | None:
     NRMSE², minimised over every other parameter at each α₀; and the reported interval), or a
     mapping with the same keys.  ``nrmse_percent`` is ``100 √objective`` (the NRMSE of the fitted
     curves) when the objective is on that scale, else None; ``interval_deg`` is None when absent.
+
+    >>> from types import SimpleNamespace as NS
+    >>> prof = alpha0_profile(NS(alpha0_profile={"alpha0_deg": [69.6, 69.7, 69.8], "objective": [4e-4, 1e-4, 9e-4],
+    ...                                          "interval_deg": (69.65, 69.75)}))
+    >>> prof["nrmse_percent"].round(1).tolist(), prof["interval_deg"]
+    ([2.0, 1.0, 3.0], (69.65, 69.75))
     """
     p = getattr(res, "alpha0_profile", None)
     if p is None:
@@ -122,6 +128,15 @@ def prediction_band(res, processed) -> dict | None:
     free-bending curvature from P_start to 1.5 times the
     highest, with ±2 standard errors.  Returns ``{"pressure_kpa", "series": [(quantity, unit,
     value, lower, upper)], "extrapolated"}`` or None when the fit has no band.
+
+    >>> from types import SimpleNamespace as NS
+    >>> from bendpam.identify.result import Band
+    >>> def band(P, quantity):   # a fit's band: 10 % either side
+    ...     v = 0.01 * P if quantity == "blocked_moment" else 1e-4 * P
+    ...     return Band(quantity, "", P, v, 0.9 * v, 1.1 * v, P > 260.0)
+    >>> b = prediction_band(NS(band=band, actuator=NS(P_start_kpa=50.0)), NS(pressures_kpa=np.array([100.0, 200.0])))
+    >>> b["pressure_kpa"][[0, -1]].tolist(), [s[0] for s in b["series"]], int(b["extrapolated"].sum())
+    ([50.0, 300.0], ['blocked_moment', 'free_curvature'], 10)
     """
     band = getattr(res, "band", None)
     if not callable(band):
