@@ -10,7 +10,8 @@ from numpy.testing import assert_allclose
 import bendpam
 from bendpam import presets
 from bendpam.cli import main
-from bendpam.identify.fitting import fit, parse_free, score
+from bendpam.identify.fitting import fit, parse_free
+from bendpam.identify.metrics import score
 from bendpam.identify.tension import fit_tension, tension_from_test
 from bendpam.lab import read_test, write_test
 from bendpam.lab.processing import (

@@ -20,7 +20,8 @@ import pytest
 import bendpam
 from bendpam import presets
 from bendpam.cli import main
-from bendpam.identify.fitting import ExtrapolationWarning, FitResult, _fold_rule, _Problem, fit
+from bendpam.identify.fitting import _fold_rule, _Problem, fit
+from bendpam.identify.result import ExtrapolationWarning, FitResult
 from bendpam.identify.tension import TensionData
 from bendpam.lab import write_test
 from bendpam.lab.processing import write_processed
@@ -227,6 +228,7 @@ def test_fold_rule_holds_the_shape_where_the_model_does_not_fold():
     # the bladder's stretches do not fold, so the rule is exercised on a problem allowed shapes down
     # to -4.2 and a tested range taken to 150 kPa: the best fit folds inside it and must be replaced.
     import bendpam.identify.fitting as ident
+    from bendpam.identify.data import fit_data
 
     base = presets.bc_pam("energy")
     S = 300.0
@@ -234,7 +236,7 @@ def test_fold_rule_holds_the_shape_where_the_model_does_not_fold():
     assert bendpam.MomentLaw.of(truth, "energy").free_branch().max_pressure_kpa == pytest.approx(141.5, abs=0.5)
     lt = make_truth(truth, [40, 60, 80, 100, 120], law=BoucWen(), frac=0.0, offset_nmm=0.0)
 
-    d = ident._data(noisy_set(lt, seed=1))
+    d = fit_data(noisy_set(lt, seed=1))
     bnd = ident._bounds(base, d, None)
     args = (base, d, "energy", ["alpha0", "C10", "C01"], bnd, 32, True, None, (-4.2, 1.0))
     prob = _Problem(*args)

@@ -22,7 +22,8 @@ import pytest
 import bendpam
 import bendpam.cli
 from bendpam import presets
-from bendpam.identify.fitting import HYST_PARAMETERS, PARAMETERS, fit
+from bendpam.identify.fitting import fit
+from bendpam.identify.result import HYST_PARAMETERS, PARAMETERS
 from bendpam.lab import read_test
 from bendpam.lab.processing import process_tests
 from bendpam.lab.simulate import SimulationSettings, simulate_tests

@@ -11,12 +11,12 @@ import numpy as np
 import pytest
 
 from bendpam import presets
+from bendpam.identify.compare import type_comparison
+from bendpam.identify.diagnose import CORRELATION_LIMIT, NRMSE_CYCLES_LIMIT
 from bendpam.identify.fitting import fit
 from bendpam.lab.processing import process_tests
 from bendpam.lab.simulate import SimulationSettings, simulate_tests
 from bendpam.present.report import (
-    CORRELATION_LIMIT,
-    NRMSE_CYCLES_LIMIT,
     SYMBOLS,
     describe_status,
     fmt_pct,
@@ -24,7 +24,6 @@ from bendpam.present.report import (
     report_warnings,
     symbol,
     table3_rows,
-    type_comparison,
 )
 
 NB = "\u202f"  # the narrow no-break space between digit groups
@@ -114,7 +113,7 @@ def test_symbols_with_units():
 
 
 def test_every_actuator_and_fit_field_has_a_display_name():
-    from bendpam.identify.fitting import HYST_PARAMETERS, PARAMETERS
+    from bendpam.identify.result import HYST_PARAMETERS, PARAMETERS
 
     act = presets.be_pam()
     names = [*act.to_dict(), *act.derived()]

@@ -16,7 +16,14 @@ __all__ = ["register"]
 
 
 def register(app: typer.Typer) -> None:
-    """Add the ``report`` command to ``app`` (does nothing if it has one already)."""
+    """Add the ``report`` command to ``app`` (does nothing if it has one already).
+
+    >>> app = typer.Typer()
+    >>> register(app)
+    >>> register(app)
+    >>> [c.name for c in app.registered_commands]
+    ['report']
+    """
     if any(getattr(c, "name", None) == "report" for c in app.registered_commands):
         return
     from bendpam.cli.options import ActuatorOpt, PresetOpt, QuietOpt
@@ -66,6 +73,8 @@ def _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, m
         raise UserError("give the report to write with --out report.html")
     if out.suffix.lower() not in {".html", ".htm"}:
         raise UserError(f"--out {str(out)!r}: the report is HTML; give a file name ending in .html")
+    if out.is_dir():
+        raise UserError(f"--out {str(out)!r} is a folder; give the HTML file to write, e.g. report.html")
     models = []
     for tok in model or ["energy", "force-balance"]:
         for part in tok.replace(",", " ").split():

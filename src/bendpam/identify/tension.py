@@ -43,6 +43,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from bendpam.errors import FitError, InputError, ProcessingError
+from bendpam.identify.diagnose import LIMITS, tension_identifiability
 from bendpam.infra.atomic import json_safe
 from bendpam.physics.material import MooneyRivlin, admissible_shape_range, within
 from bendpam.validate import number
@@ -61,10 +62,9 @@ __all__ = [
 DEFAULT_ADMISSIBLE_RANGE: tuple[float, float] = (0.6, 1.6)
 
 #: The shape is identified when its 95 % interval spans at most this fraction of the
-#: admissible width.
-SHAPE_RESOLVED_FRACTION = 0.5
+#: admissible width (``LIMITS.shape_resolved`` of :mod:`bendpam.identify.diagnose`).
+SHAPE_RESOLVED_FRACTION = LIMITS.shape_resolved
 
-_Z95 = 1.959963984540054
 _MIN_POINTS = 3  # informative points (stretch != 1) for two constants and a residual
 _MIN_TEST_POINTS = 5
 _MIN_TEST_STRETCH = 1.01
@@ -108,6 +108,13 @@ class TensionFit:
         tell (or: it sits at a bound).
     source : str
         Where the data came from (file name), may be empty.
+
+    Examples
+    --------
+    >>> lam = np.linspace(1.0, 2.0, 11)
+    >>> fit = fit_tension(lam, MooneyRivlin(0.2, 0.1).uniaxial_nominal_stress(lam) * 1e3)
+    >>> round(fit.shear_modulus_kpa, 6), round(fit.shape, 6), fit.n_points
+    (600.0, 0.333333, 11)
     """
 
     C10_kpa: float
@@ -249,31 +256,8 @@ def fit_tension(
     >>> round(fit.C10_kpa, 6), round(fit.C01_kpa, 6), fit.shape_at_bound
     (200.0, 100.0, False)
     """
-    lam = _column("stretch", stretch, "a stretch")
-    p_kpa = _column("nominal_stress_kpa", nominal_stress_kpa, "kPa")
-    if lam.size != p_kpa.size:
-        raise InputError(
-            f"stretch has {lam.size} values but nominal_stress_kpa has {p_kpa.size}"
-        )
-    if lam.size and float(lam.min()) <= 0.0:
-        i = int(np.argmin(lam))
-        raise InputError(f"stretch = {lam[i]:g} at index {i} is not > 0")
-    if stretch_range is not None:
-        lo, hi = _pair("stretch_range", stretch_range)
-        keep = (lam >= lo) & (lam <= hi)
-        lam, p_kpa = lam[keep], p_kpa[keep]
-    where = f" inside stretch_range {tuple(stretch_range)}" if stretch_range else ""
-    n_info = int(np.count_nonzero(np.abs(lam - 1.0) > 1e-6))
-    if n_info < _MIN_POINTS:
-        raise InputError(
-            f"{source or 'tension data'}: {n_info} point(s) with stretch != 1{where}; "
-            f"a fit of C10 and C01 needs at least {_MIN_POINTS}"
-        )
-    span = (float(lam.min()), float(lam.max()))
-    if admissible_range is not None:
-        a_lo, a_hi = _pair("admissible_range", admissible_range)
-        span = (min(span[0], a_lo), max(span[1], a_hi))
-    span = (min(span[0], 1.0), max(span[1], 1.0))
+    lam, p_kpa = _points(stretch, nominal_stress_kpa, stretch_range, source)
+    span = _bounds_span(lam, admissible_range)
     b_lo, b_hi = admissible_shape_range(*span)
 
     # basis for x = (mu, mu*beta) in kPa: P = x0 g1 + x1 g2
@@ -295,8 +279,8 @@ def fit_tension(
     se10, se01, corr, se_mu, se_beta = _uncertainty(lam, g1, rss, c10, c01)
     mu_free = float(x_free[0])
     beta_free = float(x_free[1]) / mu_free if mu_free != 0.0 else math.nan
-    sentence = _identifiable(mu, se_mu, beta, se_beta, corr, (b_lo, b_hi), span,
-                             at_bound, mu_free, beta_free)
+    sentence = tension_identifiability(mu, se_mu, beta, se_beta, corr, (b_lo, b_hi), span,
+                                       at_bound, mu_free, beta_free)
     return TensionFit(
         C10_kpa=c10, C01_kpa=c01, shear_modulus_kpa=mu, shape=beta,
         shape_bounds=(float(b_lo), float(b_hi)), shape_at_bound=at_bound,
@@ -306,6 +290,41 @@ def fit_tension(
         stretch_max=float(lam.max()),
         bounds_stretch_range=span, identifiable=sentence, source=source,
     )
+
+
+def _points(stretch: ArrayLike, nominal_stress_kpa: ArrayLike, stretch_range, source: str
+            ) -> tuple[np.ndarray, np.ndarray]:
+    """The validated points of :func:`fit_tension` inside ``stretch_range``: ``(stretch, stress in kPa)``."""
+    lam = _column("stretch", stretch, "a stretch")
+    p_kpa = _column("nominal_stress_kpa", nominal_stress_kpa, "kPa")
+    if lam.size != p_kpa.size:
+        raise InputError(
+            f"stretch has {lam.size} values but nominal_stress_kpa has {p_kpa.size}"
+        )
+    if lam.size and float(lam.min()) <= 0.0:
+        i = int(np.argmin(lam))
+        raise InputError(f"stretch = {lam[i]:g} at index {i} is not > 0")
+    if stretch_range is not None:
+        lo, hi = _pair("stretch_range", stretch_range)
+        keep = (lam >= lo) & (lam <= hi)
+        lam, p_kpa = lam[keep], p_kpa[keep]
+    where = f" inside stretch_range {tuple(stretch_range)}" if stretch_range else ""
+    n_info = int(np.count_nonzero(np.abs(lam - 1.0) > 1e-6))
+    if n_info < _MIN_POINTS:
+        raise InputError(
+            f"{source or 'tension data'}: {n_info} point(s) with stretch != 1{where}; "
+            f"a fit of C10 and C01 needs at least {_MIN_POINTS}"
+        )
+    return lam, p_kpa
+
+
+def _bounds_span(lam: np.ndarray, admissible_range) -> tuple[float, float]:
+    """The stretches the admissible shapes must hold over: the data's, ``admissible_range`` and 1."""
+    span = (float(lam.min()), float(lam.max()))
+    if admissible_range is not None:
+        a_lo, a_hi = _pair("admissible_range", admissible_range)
+        span = (min(span[0], a_lo), max(span[1], a_hi))
+    return (min(span[0], 1.0), max(span[1], 1.0))
 
 
 def _cone_lstsq(
@@ -354,40 +373,6 @@ def _uncertainty(
     return se10, se01, corr, se_mu, se_beta
 
 
-def _identifiable(
-    mu: float, se_mu: float, beta: float, se_beta: float, corr: float,
-    bounds: tuple[float, float], span: tuple[float, float], at_bound: bool,
-    mu_free: float, beta_free: float,
-) -> str:
-    """The plain-language identifiability sentence of :class:`TensionFit`."""
-    lo, hi = bounds
-    rel = se_mu / mu if mu > 0 else math.inf
-    if rel <= 0.1:
-        head = (f"The shear modulus mu = {mu:.4g} +- {se_mu:.2g} kPa is determined by "
-                "the data")
-    else:
-        head = (f"The shear modulus mu = {mu:.4g} +- {se_mu:.2g} kPa is only loosely "
-                f"determined ({100 * rel:.0f} %)")
-    adm = (f"the admissible [{lo:.4g}, {hi:.4g}] for stretches "
-           f"[{span[0]:g}, {span[1]:g}]")
-    if at_bound:
-        if not mu_free > 0.0:
-            why = f"the unconstrained fit has mu = {mu_free:.4g} kPa <= 0"
-        else:
-            why = f"the unconstrained fit wants beta = {beta_free:.4g}, outside {adm}"
-        return (f"{head}; the shape is not: {why}, so beta = C01/(C10 + C01) sits at "
-                f"the bound {beta:.4g}, set by the admissibility rule, not the data.")
-    width = hi - lo
-    frac = 2.0 * _Z95 * se_beta / width if width > 0 else math.inf
-    if frac <= SHAPE_RESOLVED_FRACTION:
-        return (f"{head}; so is the shape beta = C01/(C10 + C01) = {beta:.4g} +- "
-                f"{se_beta:.2g} (its 95 % interval covers {100 * frac:.0f} % of "
-                f"{adm}).")
-    return (f"{head}; the shape is not: beta = {beta:.4g} +- {se_beta:.2g}, whose 95 % "
-            f"interval covers {100 * frac:.0f} % of {adm}, so only C10 + C01 = mu/2 is "
-            f"reliable, not C10 and C01 apart (correlation {corr:+.3f}).")
-
-
 @dataclass(frozen=True)
 class TensionData:
     """The points of a uniaxial tension test the fits use (the loading branch, in the stretch range).
@@ -400,6 +385,12 @@ class TensionData:
         Nominal stresses, kPa.
     source : str
         Where they came from (file name), may be empty.
+
+    Examples
+    --------
+    >>> td = TensionData(np.array([1.0, 1.5, 2.0]), np.array([0.0, 350.0, 600.0]), "t.csv")
+    >>> td.stretch.size, td.source
+    (3, 't.csv')
     """
 
     stretch: np.ndarray
@@ -462,6 +453,24 @@ def tension_data(
     gauge = _positive("gauge_length_mm", gauge_length_mm, "mm")
     area = _positive("area_mm2", area_mm2, "mm^2")
     name = str(getattr(raw, "path", "") or "tension test")
+    ext, force = _loading_branch(raw, name)
+    lam = 1.0 + ext / gauge
+    if float(lam.max()) <= _MIN_TEST_STRETCH:
+        raise ProcessingError(
+            f"{name}: the largest stretch is {float(lam.max()):.5g} (stroke "
+            f"{float(ext.max()):.4g} mm on a {gauge:g} mm gauge); a tension fit needs "
+            f"a stretch above {_MIN_TEST_STRETCH:g}"
+        )
+    stress = force / area * 1e3
+    if stretch_range is not None:
+        lo, hi = _pair("stretch_range", stretch_range)
+        keep = (lam >= lo) & (lam <= hi)
+        lam, stress = lam[keep], stress[keep]
+    return TensionData(lam, stress, name)
+
+
+def _loading_branch(raw: Any, name: str) -> tuple[np.ndarray, np.ndarray]:
+    """Extension (mm, from the first sample) and force (N) up to the maximum extension, tension positive."""
     stroke = np.asarray(raw.data["stroke_mm"], dtype=float)
     force = np.asarray(raw.data["force_n"], dtype=float)
     if stroke.size == 0:
@@ -479,19 +488,7 @@ def tension_data(
             f"{name}: {ext.size} sample(s) up to the maximum stretch; a tension fit "
             f"needs at least {_MIN_TEST_POINTS} on the loading branch"
         )
-    lam = 1.0 + ext / gauge
-    if float(lam.max()) <= _MIN_TEST_STRETCH:
-        raise ProcessingError(
-            f"{name}: the largest stretch is {float(lam.max()):.5g} (stroke "
-            f"{float(ext.max()):.4g} mm on a {gauge:g} mm gauge); a tension fit needs "
-            f"a stretch above {_MIN_TEST_STRETCH:g}"
-        )
-    stress = force / area * 1e3
-    if stretch_range is not None:
-        lo, hi = _pair("stretch_range", stretch_range)
-        keep = (lam >= lo) & (lam <= hi)
-        lam, stress = lam[keep], stress[keep]
-    return TensionData(lam, stress, name)
+    return ext, force
 
 
 def tension_from_test(

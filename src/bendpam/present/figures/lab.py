@@ -206,7 +206,7 @@ def figure7(processed, fit_result, title: str = ""):
     Magnitudes, as in the paper.
 
     With a fitted loop every panel shows the model the fit used, the computations behind its
-    metrics (:func:`bendpam.identify.fitting.score`): (a) both branches on each test's own path, blocked
+    metrics (:func:`bendpam.identify.metrics.score`): (a) both branches on each test's own path, blocked
     state to its measured free curvature; (b) and (c) the predicted free cycle of
     :func:`bendpam.physics.hysteresis.predict_cycles` (its largest moment and the curvature where its
     unloading branch reaches zero, as ``bendpam predict --cycle``), the quasi-static model dashed.

@@ -1,0 +1,207 @@
+"""The processed tests as the identification sees them: curves, weights and the stretches they reach.
+
+:func:`fit_data` takes the mean curve of every pressure (where the loop is developed,
+:func:`developed_range`), :func:`branch_data` both mean branches (for fits with a loop model); both
+give a :class:`FitData` whose weights make the sum of squares the paper's cycle metric (eq 53).
+:func:`bladder_stretch_range` gives the bladder's stretches at the tested curvatures (eq 17).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from bendpam.errors import InputError
+from bendpam.physics.actuator import Actuator
+from bendpam.physics.braid import radius_terms
+
+__all__ = ["FitData", "bladder_stretch_range", "branch_data", "developed_range", "fit_data"]
+
+
+@dataclass
+class FitData:
+    """The curves a fit uses, concatenated, with the weights of eq 53 (magnitudes; kPa, 1/mm, N*mm).
+
+    Per test ``P``, ``k``, ``M`` (pressure, curvatures, mean curve), ``BM``/``BM_se`` and ``K``/``K_se``
+    (blocked moment, free curvature and their standard errors); per point ``kc``, ``Mc``, ``Pc``,
+    the weight ``w`` and the test ``seg``; with a loop ``branch`` (+1 loading, -1 unloading),
+    ``delta`` (bending angle from the branch's start, rad) and ``span`` (between the loop's ends).
+
+    Examples
+    --------
+    One virtual test of five points (a straight mean curve from the blocked to the free state):
+
+    >>> from types import SimpleNamespace as NS
+    >>> k = np.linspace(0.0, 0.008, 5)
+    >>> test = NS(pressure_kpa=150.0, curvature_grid=k, mean_curve=200.0 * (1 - k / 0.008),
+    ...           mean_loading=210.0 * (1 - k / 0.008), mean_unloading=190.0 * (1 - k / 0.008),
+    ...           blocked_moment=(200.0, 1.0), free_curvature=(0.008, 1e-4))
+    >>> d = fit_data(NS(results=[test]), "all")
+    >>> d.kc.size, float(d.w[0]), d.thin(2).kc.size
+    (5, 0.002236..., 3)
+    """
+
+    P: np.ndarray  # (n,) kPa
+    k: list[np.ndarray]  # magnitudes, 1/mm
+    M: list[np.ndarray]  # mean curves, N*mm
+    BM: np.ndarray  # blocked moments (data), N*mm
+    BM_se: np.ndarray
+    K: np.ndarray  # free curvatures (data), 1/mm
+    K_se: np.ndarray
+    w: np.ndarray  # per-point weights (concatenated)
+    kc: np.ndarray  # concatenated curvature magnitudes
+    Mc: np.ndarray  # concatenated data
+    Pc: np.ndarray  # concatenated pressures (kPa)
+    seg: np.ndarray  # curve index per point
+    branch: np.ndarray | None = None  # +1 loading (free -> blocked), -1 unloading (hysteresis fits)
+    delta: np.ndarray | None = None  # bending angle from the branch's starting end point (rad)
+    span: np.ndarray | None = None  # bending angle between the loop's end points (rad)
+
+    def thin(self, step: int) -> FitData:
+        """Every ``step``-th point (weights scaled so the objective keeps its scale): for the grid stage."""
+        keep = np.arange(self.kc.size) % step == 0
+        opt = {n: None if getattr(self, n) is None else getattr(self, n)[keep] for n in ("branch", "delta", "span")}
+        return FitData(self.P, self.k, self.M, self.BM, self.BM_se, self.K, self.K_se,
+                     self.w[keep] * math.sqrt(self.kc.size / keep.sum()), self.kc[keep], self.Mc[keep], self.Pc[keep],
+                     self.seg[keep], **opt)
+
+    @property
+    def group(self) -> np.ndarray:
+        """Residual groups of the uncertainty: one per curve (per branch with a loop)."""
+        return self.seg if self.branch is None else 2 * self.seg + (self.branch < 0)
+
+
+def developed_range(result, threshold: float = 0.8, negligible: float = 0.01) -> np.ndarray:
+    """Mask of the grid points where the hysteresis loop is developed.
+
+    Near each reversal a rounded loop closes: there both branches lie on the same side of the
+    hysteresis-free curve, and their average is biased by up to the loop's half-width.  Where the
+    half-width ``(loading - unloading) / 2`` is at least ``threshold`` times its median, the average
+    of the branches is a fair estimate of the quasi-static curve.  If the loop is negligible
+    (median half-width below ``negligible`` of the blocked moment) every point is kept.
+
+    >>> from types import SimpleNamespace as NS
+    >>> k = np.linspace(0.0, 0.008, 9)
+    >>> half_width = np.minimum(k, 0.008 - k) / 0.002      # a loop that closes at both reversals
+    >>> test = NS(mean_loading=50.0 + half_width, mean_unloading=50.0 - half_width, blocked_moment=(50.0, 1.0))
+    >>> developed_range(test).astype(int).tolist()
+    [0, 0, 1, 1, 1, 1, 1, 0, 0]
+    """
+    hw = 0.5 * (np.asarray(result.mean_loading) - np.asarray(result.mean_unloading))
+    med = float(np.median(hw))
+    if not np.isfinite(med) or med <= negligible * float(result.blocked_moment[0]):
+        return np.ones(hw.size, dtype=bool)
+    keep = hw >= threshold * med
+    if keep.sum() < max(5, hw.size // 5):
+        return np.ones(hw.size, dtype=bool)
+    # one contiguous range: from the first to the last developed point
+    idx = np.flatnonzero(keep)
+    mask = np.zeros(hw.size, dtype=bool)
+    mask[idx[0]: idx[-1] + 1] = True
+    return mask
+
+
+def branch_data(processed, L0: float) -> FitData:
+    """Both mean branches of every pressure (for fits with a hysteresis loop); ``L0`` the active length, mm.
+
+    >>> from types import SimpleNamespace as NS
+    >>> k = np.linspace(0.0, 0.008, 5)
+    >>> test = NS(pressure_kpa=150.0, curvature_grid=k, mean_curve=200.0 * (1 - k / 0.008),
+    ...           mean_loading=210.0 * (1 - k / 0.008), mean_unloading=190.0 * (1 - k / 0.008),
+    ...           blocked_moment=(200.0, 1.0), free_curvature=(0.008, 1e-4))
+    >>> d = branch_data(NS(results=[test]), 145.0)
+    >>> d.kc.size, d.branch.tolist()
+    (10, [1, 1, 1, 1, 1, -1, -1, -1, -1, -1])
+    """
+    res = processed.results
+    if not res:
+        raise InputError("no processed pressures to fit")
+    d = fit_data(processed, "all")
+    k, M, w, Pc, seg, br, delta, span = [], [], [], [], [], [], [], []
+    wK = d.K / d.K.sum()
+    for i, r in enumerate(res):
+        g = np.asarray(r.curvature_grid, float)
+        n = g.size
+        Kf = d.K[i]
+        for sign, curve, dist in ((1, r.mean_loading, (Kf - g) * L0), (-1, r.mean_unloading, g * L0)):
+            k.append(g)
+            M.append(np.asarray(curve, float))
+            w.append(np.full(n, math.sqrt(wK[i]) / (d.BM[i] * math.sqrt(2 * n))))
+            Pc.append(np.full(n, d.P[i]))
+            seg.append(np.full(n, i))
+            br.append(np.full(n, sign))
+            delta.append(np.maximum(dist, 0.0))
+            span.append(np.full(n, Kf * L0))
+    cat = np.concatenate
+    return FitData(d.P, d.k, d.M, d.BM, d.BM_se, d.K, d.K_se, cat(w), cat(k), cat(M), cat(Pc), cat(seg), cat(br),
+                 cat(delta), cat(span))
+
+
+def fit_data(processed, fit_range: str = "developed") -> FitData:
+    """The mean curve of every pressure, where the loop is developed (``"developed"``) or whole (``"all"``).
+
+    Weights ``sqrt(K_i / sum K) / (M_max,i sqrt(n_i))`` make the sum of squares eq 53.
+
+    >>> from types import SimpleNamespace as NS
+    >>> k = np.linspace(0.0, 0.008, 5)
+    >>> test = NS(pressure_kpa=150.0, curvature_grid=k, mean_curve=200.0 * (1 - k / 0.008),
+    ...           blocked_moment=(200.0, 1.0), free_curvature=(0.008, 1e-4))
+    >>> d = fit_data(NS(results=[test]), "all")
+    >>> d.P.tolist(), d.Mc.tolist()
+    ([150.0], [200.0, 150.0, 100.0, 50.0, 0.0])
+    """
+    res = processed.results
+    if not res:
+        raise InputError("no processed pressures to fit")
+    if fit_range not in ("developed", "all"):
+        raise InputError(f"fit_range = {fit_range!r}; choose 'developed' or 'all'")
+    P = np.array([r.pressure_kpa for r in res], dtype=float)
+    masks = [developed_range(r) if fit_range == "developed" else np.ones(r.curvature_grid.size, bool) for r in res]
+    k = [np.asarray(r.curvature_grid, float)[m] for r, m in zip(res, masks, strict=True)]
+    M = [np.asarray(r.mean_curve, float)[m] for r, m in zip(res, masks, strict=True)]
+    BM = np.array([r.blocked_moment[0] for r in res])
+    BMse = np.array([r.blocked_moment[1] for r in res])
+    K = np.array([r.free_curvature[0] for r in res])
+    Kse = np.array([r.free_curvature[1] for r in res])
+    if np.any(~np.isfinite(BM)) or np.any(BM <= 0) or np.any(~np.isfinite(K)) or np.any(K <= 0):
+        raise InputError("processed data need a positive blocked moment and free curvature at every pressure")
+    wK = K / K.sum()
+    w = np.concatenate([np.full(kk.size, math.sqrt(wK[i]) / (BM[i] * math.sqrt(kk.size))) for i, kk in enumerate(k)])
+    seg = np.concatenate([np.full(kk.size, i) for i, kk in enumerate(k)])
+    return FitData(P, k, M, BM, BMse, K, Kse, w, np.concatenate(k), np.concatenate(M),
+                 np.concatenate([np.full(kk.size, P[i]) for i, kk in enumerate(k)]), seg)
+
+
+def bladder_stretch_range(actuator: Actuator, curvature_per_mm) -> tuple[float, float]:
+    """Smallest and largest principal in-plane stretch of the bladder at curvatures (eq 17).
+
+    The axial stretch ``lambda1 = 1 + u (1 - cos Phi)`` (``u = k' R``) spans ``[1, 1 + 2u]`` around
+    the section, the hoop stretch is ``lambda2 = R / R0_start``; the range always contains 1.
+
+    Parameters
+    ----------
+    actuator : the actuator (its alpha0 and R0_start set the kinematics).
+    curvature_per_mm : curvature magnitudes along the bending direction, 1/mm.
+
+    Returns
+    -------
+    (float, float)
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> lo, hi = bladder_stretch_range(bendpam.physics.presets.be_pam(), [0.0, 0.0135])
+    >>> round(lo, 3), round(hi, 3)
+    (0.979, 1.267)
+    """
+    p = actuator.params
+    k = (actuator.bend_sign or 1) * np.abs(np.atleast_1d(np.asarray(curvature_per_mm, dtype=float)))
+    u, R, _ = radius_terms(k, float(p.alpha0), float(p.R0_start))
+    lam1 = 1.0 + 2.0 * u
+    lam2 = R / float(p.R0_start)
+    allv = np.concatenate([lam1, lam2, [1.0]])
+    return float(np.min(allv)), float(np.max(allv))
+
+

@@ -1,0 +1,178 @@
+"""Uncertainty of an identification: the sandwich covariance and what follows from it.
+
+The weights of the fit normalise each curve (eq 53); they are not inverse noise variances.  So
+:func:`sandwich_covariance` gives each residual group (a curve, a branch, the tension test) its own
+variance, inflated for the lag-1 autocorrelation of its residuals
+(:func:`lag1_autocorrelation`).  :class:`Uncertainty` holds the covariance of the varied
+parameters in their units, to which the loop law's systematic part is added; :func:`material_fit`
+propagates it to the bladder's shear modulus and shape.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from bendpam.errors import FitError
+from bendpam.identify.diagnose import shape_identified
+from bendpam.identify.result import MaterialFit
+from bendpam.physics.actuator import Actuator
+
+__all__ = ["Uncertainty", "lag1_autocorrelation", "material_fit", "sandwich_covariance"]
+
+
+class Uncertainty:
+    """Covariance of the varied parameters (user units) with flags; a systematic term can be added.
+
+    Parameters
+    ----------
+    values : every fitted value, by short name.
+    names : the varied parameters, in the order of ``cov``.
+    cov : their statistical covariance.
+    rho : mean lag-1 autocorrelation of the residuals.
+    nfev : model evaluations spent on it.
+    at_bound : the search's variables at a bound (:func:`bendpam.identify.diagnose.at_bounds`), by name.
+    ssr, m : weighted sum of squares and number of residuals.
+    corr_flag : |correlation| above which a pair is flagged.
+
+    Examples
+    --------
+    >>> unc = Uncertainty({"C10": 100.0, "C01": 300.0}, ["C10", "C01"], np.array([[4.0, -5.0], [-5.0, 9.0]]),
+    ...                   0.1, 0, {}, 1e-3, 40, 0.95)
+    >>> unc.sd.tolist(), round(float(unc.corr[0, 1]), 3)
+    ([2.0, 3.0], -0.833)
+    >>> unc.add_systematic({"C10": 6.0})   # a shift of 6 kPa: 6^2 / 3 kPa^2 more variance
+    >>> unc.sd.tolist()
+    [4.0, 3.0]
+    """
+
+    def __init__(self, values, names, cov, rho, nfev, at_bound, ssr, m, corr_flag):
+        self.corr_flag = corr_flag
+        self.values = values
+        self.names = names
+        self.cov_stat = cov
+        self.cov = cov.copy()
+        self.rho = rho
+        self.nfev = nfev
+        self.at_bound = at_bound
+        self.ssr = ssr
+        self.m = m
+
+    @property
+    def sd(self) -> np.ndarray:
+        """Standard errors of the varied parameters."""
+        return np.sqrt(np.clip(np.diag(self.cov), 0.0, None))
+
+    @property
+    def corr(self) -> np.ndarray:
+        """Their correlation matrix."""
+        sd = self.sd
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return self.cov / np.outer(sd, sd)
+
+    def add_systematic(self, shift: dict[str, float]) -> None:
+        """Add ``delta delta^T / 3`` for the parameter shifts (:mod:`bendpam.identify.fitting` notes)."""
+        dv = np.array([shift.get(n, 0.0) for n in self.names])
+        self.cov = self.cov_stat + np.outer(dv, dv) / 3.0
+
+
+def lag1_autocorrelation(resid: np.ndarray, seg: np.ndarray) -> float:
+    """Lag-1 autocorrelation of residuals, pooled over the segments ``seg`` (each about its own mean).
+
+    >>> lag1_autocorrelation(np.array([1.0, -1.0, 1.0, -1.0]), np.zeros(4, int))
+    -0.75
+    """
+    num = den = 0.0
+    for i in np.unique(seg):
+        r = resid[seg == i]
+        r = r - r.mean()
+        num += float(r[1:] @ r[:-1])
+        den += float(r @ r)
+    return num / den if den > 0 else 0.0
+
+
+def sandwich_covariance(J: np.ndarray, r: np.ndarray, groups: np.ndarray) -> tuple[np.ndarray, float]:
+    """``B^-1 (sum_g s_g^2 f_g J_g^T J_g) B^-1`` with ``B = J^T J``, and the mean autocorrelation.
+
+    Each residual group ``g`` has its own variance ``s_g^2`` (its residuals' mean square, for the
+    degrees of freedom left) and the inflation ``f_g = (1 + rho_g) / (1 - rho_g)`` for the lag-1
+    autocorrelation ``rho_g`` of its residuals (clipped to [0, 0.95]).
+
+    Parameters
+    ----------
+    J : Jacobian of the weighted residuals (rows: residuals, columns: parameters).
+    r : the weighted residuals at the optimum.
+    groups : the residual group of each row.
+
+    Returns
+    -------
+    (covariance, mean autocorrelation of the groups)
+
+    Raises
+    ------
+    FitError
+        The Jacobian is not finite: the data do not determine the parameters.
+
+    Examples
+    --------
+    A straight line through four points, one group:
+
+    >>> J = np.column_stack([np.ones(4), np.arange(4.0)])
+    >>> cov, rho = sandwich_covariance(J, np.array([0.1, -0.1, -0.1, 0.1]), np.zeros(4, int))
+    >>> cov.shape, rho
+    ((2, 2), 0.0)
+    """
+    m = r.size
+    B = J.T @ J
+    meat = np.zeros_like(B)
+    share = 1.0 - J.shape[1] / max(m, 1)
+    rhos = []
+    for g in np.unique(groups):
+        sel = groups == g
+        ri = r[sel]
+        var_i = float(ri @ ri) / max(share * ri.size, 1.0)
+        rho_i = min(max(lag1_autocorrelation(ri, np.zeros(ri.size, int)), 0.0), 0.95)
+        rhos.append(rho_i)
+        meat += (J[sel].T @ J[sel]) * var_i * (1.0 + rho_i) / (1.0 - rho_i)
+    rho = float(np.mean(rhos)) if rhos else 0.0
+    if not np.all(np.isfinite(B)):
+        raise FitError("the data do not determine the parameters (the Jacobian is not finite at the optimum); "
+                       "hold some of them fixed")
+    Binv = np.linalg.pinv(B, rcond=1e-13)
+    return Binv @ meat @ Binv, rho
+
+
+def material_fit(fitted: Actuator, unc: Uncertainty, shape_bounds, stretch, at_bound: bool, held: str,
+                 free: list[str]) -> MaterialFit | None:
+    """The bladder's shear modulus ``2 (C10 + C01)`` and shape ``C01 / (C10 + C01)`` with their standard errors.
+
+    By the delta method from ``unc``; None when neither constant is in ``free``.  ``shape_bounds``
+    and ``stretch`` are the admissible shapes and the stretches they hold over, ``at_bound`` whether
+    the shape sits on one of them, ``held`` why it was held fixed ("" if not).
+
+    >>> import bendpam
+    >>> act = bendpam.physics.presets.be_pam().replace(C10_kpa=100.0, C01_kpa=300.0)
+    >>> unc = Uncertainty({}, ["C10", "C01"], np.array([[4.0, -5.0], [-5.0, 9.0]]), 0.0, 0, {}, 0.0, 40, 0.95)
+    >>> mat = material_fit(act, unc, (-0.15, 1.07), (0.6, 1.6), False, "", ["C10", "C01"])
+    >>> mat.shear_modulus_kpa, round(mat.se_shear_modulus_kpa, 3), mat.shape, mat.shape_identified
+    (800.0, 3.464, 0.75, True)
+    """
+    if "C10" not in free and "C01" not in free:
+        return None
+    c10, c01 = fitted.C10_kpa, fitted.C01_kpa
+    S = c10 + c01
+    names = unc.names
+    g_mu = np.zeros(len(names))
+    g_b = np.zeros(len(names))
+    if "C10" in names:
+        g_mu[names.index("C10")] = 2.0
+        g_b[names.index("C10")] = -c01 / S**2
+    if "C01" in names:
+        g_mu[names.index("C01")] = 2.0
+        g_b[names.index("C01")] = c10 / S**2
+    se_mu = math.sqrt(max(float(g_mu @ unc.cov @ g_mu), 0.0))
+    se_b = math.sqrt(max(float(g_b @ unc.cov @ g_b), 0.0))
+    identified = shape_identified(se_b, shape_bounds, at_bound, held)
+    return MaterialFit(2.0 * S, se_mu, c01 / S, se_b, (float(shape_bounds[0]), float(shape_bounds[1])),
+                       (float(stretch[0]), float(stretch[1])), bool(at_bound), identified, held)
