@@ -136,7 +136,8 @@ def register(app: typer.Typer) -> typer.Typer:
     ):
         """Equilibrium shape and tip pose of a finger under tip force, tip mass and self-weight."""
         from bendpam.cli.options import UserError, load_actuator, model_name, pressures_kpa
-        from bendpam.design.finger import Finger, FingerLoads, blocked_tip_force, finger_sweep
+        from bendpam.design.finger import Finger, FingerLoads, finger_sweep
+        from bendpam.design.tip import blocked_tip_force
 
         act = _length(load_actuator(preset, actuator, model), l0_mm)
         P = pressures_kpa(pressure_kpa)

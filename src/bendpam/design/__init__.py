@@ -17,22 +17,18 @@ below 5 kPa) warns with :class:`bendpam.UnitWarning`.  The moment law is the act
 """
 
 from bendpam.design.finger import (
-    BlockedTipForce,
     Finger,
     FingerLoads,
     FingerShape,
-    TipStiffness,
-    blocked_tip_force,
     finger_sweep,
     free_tip_trajectory,
-    linear_tip_compliance,
     plot_finger_shapes,
     solve_finger,
     stable_branch,
-    tip_stiffness,
 )
 from bendpam.design.grasp import Grasp, Gripper, grasp_sweep, plot_grasp, solve_grasp
 from bendpam.design.inverse import DesignResult, Target, Variable, design_actuator
+from bendpam.design.tip import BlockedTipForce, TipStiffness, blocked_tip_force, linear_tip_compliance, tip_stiffness
 from bendpam.design.wrist import (
     Wrist,
     WristHold,

@@ -78,20 +78,11 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from bendpam.design.finger import (
-    NEWTON_TOL,
-    Finger,
-    FingerLoads,
-    FingerShape,
-    Rod,
-    checked_pressure_kpa,
-    checked_pressures_kpa,
-    cross,
-    newton,
-    pressures_checked,
-    solve_finger,
-)
+from bendpam.design.finger import Finger, FingerLoads, FingerShape, solve_finger
+from bendpam.design.parts import checked_pressure_kpa, checked_pressures_kpa, pressures_checked
+from bendpam.design.rod import NEWTON_TOL, Rod, cross, newton
 from bendpam.errors import InputError, NoEquilibrium
+from bendpam.infra.accessors import figure
 from bendpam.physics.actuator import Actuator
 from bendpam.physics.law import MomentLaw, StableBranch
 from bendpam.physics.models import normalise_model
@@ -1374,9 +1365,6 @@ def grasp_sweep(gripper: Gripper, diameters_mm, pressures_kpa):
     return ds
 
 
-_MARKERS = ("o", "s", "^", "D", "v", "P", "X", "*", "<", ">", "h", "p")
-
-
 def plot_grasp(ds, ax=None, title: str | None = None):
     """Grip (pull-out) force against sphere diameter, one line per pressure (cf. the paper's Figure 8(c, d)).
 
@@ -1395,27 +1383,4 @@ def plot_grasp(ds, ax=None, title: str | None = None):
     1
     >>> plt.close(fig)
     """
-    from bendpam.present import figures as plots  # noqa: I001  (first: the Agg backend unless chosen)
-    import matplotlib.pyplot as plt
-
-    with plots.figure_style():
-        if ax is None:
-            fig, ax = plt.subplots(figsize=plots.figure_size("single", 0.8))
-        else:
-            fig = ax.figure
-        P = ds["pressure_kpa"].values
-        D = ds["diameter_mm"].values
-        grip = np.array(ds["grip_force_n"].values, dtype=float)
-        hole = (ds["contact"].values == "none") | ~ds["equilibrium"].values.astype(bool) | ~np.isfinite(grip)
-        colors = plt.cm.viridis(np.linspace(0.0, 0.85, max(P.size, 1)))
-        for j, p in enumerate(P):
-            y = np.where(hole[:, j], np.nan, grip[:, j])
-            ax.plot(D, y, "-", marker=_MARKERS[j % len(_MARKERS)], color=colors[j], label=f"{p:g} kPa")
-        ax.set_xlabel("sphere diameter (mm)")
-        ax.set_ylabel("grip (pull-out) force (N)")
-        ax.set_ylim(bottom=0.0)
-        ax.grid(alpha=0.3)
-        ax.legend(title="gaps: no contact or\nno equilibrium", ncol=1 if P.size <= 5 else 2)
-        ax.set_title(title or f"{ds.attrs.get('fingers', '')}-finger gripper, {ds.attrs.get('actuator', '')}")
-        fig.tight_layout()
-    return fig
+    return figure("grasp")(ds, ax=ax, title=title)

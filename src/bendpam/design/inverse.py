@@ -1093,7 +1093,8 @@ def _coarse_grid(prob: _Problem, n_coarse: int, scheduler: str, report):
 
 # ---- the finger's tip force ---------------------------------------------------------------------
 def _tip_exact(act: Actuator, model: str, P: float) -> float:
-    from bendpam.design.finger import Finger, blocked_tip_force
+    from bendpam.design.finger import Finger
+    from bendpam.design.tip import blocked_tip_force
 
     try:
         res = blocked_tip_force(Finger(act, model), P)

@@ -50,8 +50,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from bendpam.design.finger import G_N_PER_G, checked_pressure_kpa, checked_pressures_kpa, pressures_checked
+from bendpam.design.parts import G_N_PER_G, checked_pressure_kpa, checked_pressures_kpa, pressures_checked
 from bendpam.errors import InputError
+from bendpam.infra.accessors import figure
 from bendpam.physics import presets
 from bendpam.physics.actuator import Actuator
 from bendpam.physics.law import MomentLaw, StableBranch
@@ -533,41 +534,6 @@ def wrist_sweep(wrist: Wrist, pressures_kpa, directions_deg=(0.0, 90.0, 180.0, 2
     return pd.DataFrame(rows)
 
 
-def _wrist_curve_groups(table, positions_deg) -> list[tuple[list[float], np.ndarray, np.ndarray, str]]:
-    """Free-bending curves of ``table`` grouped where they coincide: ``(directions, P, angle, label)``.
-
-    With identical actuators the curves of symmetric directions (each single actuator, or each
-    pair) are the same; such curves are drawn once and the label says which directions share it.
-    """
-    groups: list[tuple[list[float], np.ndarray, np.ndarray]] = []
-    for d, grp in table.groupby("direction_deg", sort=False):
-        grp = grp.sort_values("pressure_kpa")
-        P = grp["pressure_kpa"].to_numpy(dtype=float)
-        a = grp["angle_deg"].to_numpy(dtype=float)
-        for dirs, P0, a0 in groups:
-            scale = max(float(np.nanmax(np.abs(a0), initial=0.0)), 1.0)
-            if P0.shape == P.shape and np.array_equal(P0, P) and np.allclose(a0, a, rtol=0.0, atol=1e-6 * scale,
-                                                                           equal_nan=True):
-                dirs.append(float(d))
-                break
-        else:
-            groups.append(([float(d)], P, a))
-    out = []
-    for dirs, P, a in groups:
-        names = []
-        for d in dirs:
-            on = [p for p, v in zip(positions_deg, _wrist_pressures(d, 1.0, positions_deg), strict=True) if v > 0]
-            names.append("+".join(f"{p:g}" for p in on) + "°")
-        pair = len(names[0].split("+")) > 1
-        if len(dirs) == 1:
-            label = f"actuator{'s' if pair else ''} {names[0]} inflated (toward {dirs[0]:g}°)"
-        else:
-            label = (f"{'pairs' if pair else 'actuators'} {', '.join(names)}, {'each pair' if pair else 'one'} "
-                     "inflated:\nthe same curve by symmetry")
-        out.append((dirs, P, a, label))
-    return out
-
-
 def plot_wrist(table, holds=(), ax=None, title: str | None = None, positions_deg=(0.0, 90.0, 180.0, 270.0)):
     """Bending angle against pressure per inflated actuator (and the holding angles with the load, dashed).
 
@@ -600,37 +566,4 @@ def plot_wrist(table, holds=(), ax=None, title: str | None = None, positions_deg
     True
     >>> plt.close(fig)
     """
-    from bendpam.present import figures as plots  # noqa: I001  (first: the Agg backend unless chosen)
-    import matplotlib.pyplot as plt
-
-    own = ax is None
-    with plots.figure_style():
-        if ax is None:
-            fig, ax = plt.subplots(figsize=plots.figure_size("single", 1.15))
-        else:
-            fig = ax.figure
-        _draw_wrist(ax, table, holds, title, positions_deg)
-        if own:
-            fig.tight_layout()
-    return fig
-
-
-def _draw_wrist(ax, table, holds, title, positions_deg) -> None:
-    """The curves of :func:`plot_wrist` on ``ax``: a colour, line style and marker per distinct curve."""
-    styles = ("-", "--", "-.", ":")
-    markers = ("o", "s", "^", "D", "v", "P")
-    for i, (_, P, a, label) in enumerate(_wrist_curve_groups(table, positions_deg)):
-        ax.plot(P, a, linestyle=styles[i % len(styles)], marker=markers[i % len(markers)], color=f"C{i % 10}",
-                label=label)
-    holds = list(holds)
-    if holds:
-        ax.plot([h.pressure_kpa for h in holds], [h.angle_deg for h in holds], "s--", color="k", mfc="none",
-                label=f"holding {holds[0].load_g:g} g at {holds[0].lever_mm:g} mm")
-        ax.axhline(0.0, color="0.5", lw=0.8)
-    ax.axhline(30.0, color="tab:red", lw=0.8, ls=":", label="30°")
-    ax.set_xlabel("pressure (kPa)")
-    ax.set_ylabel("bending angle (deg)")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize="small", loc="upper center", bbox_to_anchor=(0.5, -0.2), borderaxespad=0.0)
-    if title:
-        ax.set_title(title)
+    return figure("wrist")(table, holds, ax=ax, title=title, positions_deg=positions_deg)
