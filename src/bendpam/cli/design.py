@@ -259,13 +259,13 @@ def register(app: typer.Typer) -> typer.Typer:
         peak lifting load before the sphere escapes.
         """
         from bendpam.cli.options import UserError, load_actuator, model_name, parse_values, pressures_kpa
-        from bendpam.design.grasp import (
+        from bendpam.design.grasp import grasp_sweep
+        from bendpam.design.gripper import (
             DEFAULT_BASE_RADIUS_MM,
             DEFAULT_FINGERTIP_MM,
             DEFAULT_MU,
             DEFAULT_SPLAY_DEG,
             Gripper,
-            grasp_sweep,
         )
 
         act = _length(load_actuator(preset, actuator, model), l0_mm)

@@ -26,7 +26,8 @@ from bendpam.design.finger import (
     solve_finger,
     stable_branch,
 )
-from bendpam.design.grasp import Grasp, Gripper, grasp_sweep, plot_grasp, solve_grasp
+from bendpam.design.grasp import grasp_sweep, plot_grasp, solve_grasp
+from bendpam.design.gripper import Grasp, Gripper
 from bendpam.design.inverse import DesignResult, Target, Variable, design_actuator
 from bendpam.design.tip import BlockedTipForce, TipStiffness, blocked_tip_force, linear_tip_compliance, tip_stiffness
 from bendpam.design.wrist import (
