@@ -201,7 +201,7 @@ def _complex_jacobians(fun, rows, u):
     return np.swapaxes(np.imag(R) / _EPS, 1, 2)
 
 
-def newton_batch(fun, u0, lo, hi, *, tol: float = NEWTON_TOL, maxit: int = MAX_NEWTON, jac=None):
+def newton_batch(fun, u0, lo, hi, *, tol: float = NEWTON_TOL, maxit: int = MAX_NEWTON, jac=None, admissible=None):
     """Damped Newton on a batch of independent systems ``fun(rows, U) = 0``, keeping ``lo < u < hi``.
 
     Parameters
@@ -221,6 +221,9 @@ def newton_batch(fun, u0, lo, hi, *, tol: float = NEWTON_TOL, maxit: int = MAX_N
         Newton steps at most.
     jac : callable ``jac(rows, u) -> (len(rows), m, m)``, optional
         The Jacobians at the states ``u`` (``len(rows)``, m); default: the exact complex step of ``fun``.
+    admissible : callable ``admissible(rows, u) -> (len(rows),) bool``, optional
+        Where the bounds are not a box: a trial state that is not admissible is refused by the
+        line search like one that does not decrease the residual (the wrist's stable branches).
 
     Returns
     -------
@@ -230,8 +233,9 @@ def newton_batch(fun, u0, lo, hi, *, tol: float = NEWTON_TOL, maxit: int = MAX_N
     -----
     Each step solves the Newton system (least squares where it is singular), shortens it to stay
     inside the bounds, then halves it (at most 30 times) until the squared residual decreases by
-    the Armijo factor ``1 - 1e-4 alpha``.  A system fails when the step is not finite, the line
-    search fails, or the step shrinks below ``1e-12``; its state stays the last accepted one.
+    the Armijo factor ``1 - 1e-4 alpha`` at an ``admissible`` state.  A system fails when the step
+    is not finite, the line search fails, or the step shrinks below ``1e-12``; its state stays the
+    last accepted one.
 
     Examples
     --------
@@ -266,7 +270,7 @@ def newton_batch(fun, u0, lo, hi, *, tol: float = NEWTON_TOL, maxit: int = MAX_N
         bad = ~np.all(np.isfinite(du), axis=1)
         du[bad] = 0.0
         alpha = _to_bounds(us, du, lo[sel], hi[sel])
-        acc, un, rn = _line_search(res, sel, us, rs, du, alpha, ~bad)
+        acc, un, rn = _line_search(res, sel, us, rs, du, alpha, ~bad, admissible)
         acc &= alpha >= 1e-12  # a vanishing step fails; the state stays the last accepted one
         u[sel[acc]] = un[acc]
         r[sel[acc]] = rn[acc]
@@ -293,7 +297,7 @@ def _to_bounds(u: np.ndarray, du: np.ndarray, lo: np.ndarray, hi: np.ndarray) ->
     return np.minimum(1.0, np.minimum(a_hi.min(axis=1), a_lo.min(axis=1)))
 
 
-def _line_search(res, sel, us, rs, du, alpha, pending):
+def _line_search(res, sel, us, rs, du, alpha, pending, admissible=None):
     """Backtracking (Armijo on the squared residual, 30 halvings at most); ``alpha`` is updated in place.
 
     Returns ``(accepted, u, r)`` per system of ``sel``.
@@ -309,6 +313,8 @@ def _line_search(res, sel, us, rs, du, alpha, pending):
         rt = res(sel[pend], trial)
         n2t = np.sum(rt * rt, axis=1)
         good = np.isfinite(n2t) & (n2t <= (1.0 - 1e-4 * alpha[pend]) * n2[pend])
+        if admissible is not None:
+            good &= admissible(sel[pend], trial)
         gi = pend[good]
         un[gi], rn[gi], acc[gi] = trial[good], rt[good], True
         pend = pend[~good]

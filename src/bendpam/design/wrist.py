@@ -51,6 +51,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from bendpam.design.parts import G_N_PER_G, checked_pressure_kpa, checked_pressures_kpa, pressures_checked
+from bendpam.design.rod import newton_batch
 from bendpam.errors import InputError
 from bendpam.infra.accessors import figure
 from bendpam.physics import presets
@@ -282,36 +283,10 @@ def _solve(wrist: Wrist, P: np.ndarray, load_fn=None, b0=None):
         step = min(step, 1.0 - t)
         tt = t + step
         law_t = _WristLaw(wrist, tuple(tt * P))
-        bb, ok = b.copy(), False
-        for _ in range(50):
-            m, J = law_t.moment(bb)
-            if load_fn is not None:
-                ml, Jl = load_fn(bb, tt)
-                m, J = m + ml, J + Jl
-            if np.max(np.abs(m)) < 1e-10 * scale:
-                ok = True
-                break
-            try:
-                db = -np.linalg.solve(J, m)
-            except np.linalg.LinAlgError:
-                break
-            alpha = 1.0
-            for _ in range(30):
-                cand = bb + alpha * db
-                if law_t.inside(cand)[0]:
-                    m2, _ = law_t.moment(cand)
-                    if load_fn is not None:
-                        m2 = m2 + load_fn(cand, tt)[0]
-                    if np.linalg.norm(m2) < (1 - 1e-4 * alpha) * np.linalg.norm(m):
-                        break
-                alpha *= 0.5
-            else:
-                break
-            bb = cand
+        total = _balance(law_t, load_fn, tt)
+        bb, ok = _equilibrium(law_t, total, b, scale)
         if ok:
-            m, J = law_t.moment(bb)
-            if load_fn is not None:
-                J = J + load_fn(bb, tt)[1]
+            J = total(bb)[1]
             ev = np.linalg.eigvals(0.5 * (J + J.T))
             ok = bool(np.all(ev.real < 0))
         if ok:
@@ -325,6 +300,36 @@ def _solve(wrist: Wrist, P: np.ndarray, load_fn=None, b0=None):
                         + (f" ({why})" if why else " (its combined moment law folds)"))
                 break
     return b, t, law, note
+
+
+def _balance(law: _WristLaw, load_fn, t: float):
+    """The wrist's moment plus the load's (N*mm) and its Jacobian (N*mm^2) at curvature b, path parameter ``t``."""
+
+    def total(b):
+        m, J = law.moment(b)
+        if load_fn is not None:
+            ml, Jl = load_fn(b, t)
+            m, J = m + ml, J + Jl
+        return m, J
+
+    return total
+
+
+def _equilibrium(law: _WristLaw, total, b: np.ndarray, scale: float) -> tuple[np.ndarray, bool]:
+    """Newton (:func:`bendpam.design.rod.newton_batch`) on ``total(b) = 0`` from ``b`` (moments over ``scale``),
+    every step on the actuators' stable branches; returns the last state and whether it converged."""
+
+    def fun(rows, U):
+        return np.array([[total(v)[0] / scale for v in row] for row in U])
+
+    def jac(rows, u):
+        return np.array([total(v)[1] / scale for v in u])
+
+    def inside(rows, u):
+        return np.array([law.inside(v)[0] for v in u])
+
+    u, ok, _ = newton_batch(fun, b[None, :], -np.inf, np.inf, maxit=50, jac=jac, admissible=inside)
+    return u[0], bool(ok[0])
 
 
 def _state(wrist: Wrist, P, b, t, law, note, load_moment=(0.0, 0.0)) -> WristState:
