@@ -28,7 +28,9 @@ from bendpam.design.finger import (
 )
 from bendpam.design.grasp import grasp_sweep, plot_grasp, solve_grasp
 from bendpam.design.gripper import Grasp, Gripper
-from bendpam.design.inverse import DesignResult, Target, Variable, design_actuator
+from bendpam.design.inverse import design_actuator
+from bendpam.design.result import DesignResult
+from bendpam.design.targets import Target, Variable
 from bendpam.design.tip import BlockedTipForce, TipStiffness, blocked_tip_force, linear_tip_compliance, tip_stiffness
 from bendpam.design.wrist import (
     Wrist,

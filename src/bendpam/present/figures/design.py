@@ -10,23 +10,39 @@ name                function
 ``finger_shapes``   :func:`plot_finger_shapes` (finger shapes at several pressures)
 ``grasp``           :func:`plot_grasp` (grip force against sphere diameter)
 ``wrist``           :func:`plot_wrist` (wrist bending angle against pressure)
+``coarse_map``      :func:`plot_coarse_map` (an inverse design's coarse map)
+``pareto``          :func:`plot_pareto` (an inverse design's Pareto front)
+``save_figure``     :func:`bendpam.present.figures.save_figure` (for ``DesignResult.save``)
 ==================  ====================================================================
 """
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.colors import LogNorm
 
+from bendpam.design.targets import NAN_MISS, TOL
 from bendpam.design.wrist import wrist_pressures
+from bendpam.errors import InputError
 from bendpam.infra.accessors import register
-from bendpam.present.figures.base import figure_size, figure_style
+from bendpam.present.figures.base import figure_size, figure_style, save_figure
+
+if TYPE_CHECKING:
+    from bendpam.design.result import DesignResult
 
 __all__ = [
+    "plot_coarse_map",
     "plot_finger_shapes",
     "plot_grasp",
+    "plot_pareto",
     "plot_wrist",
 ]
+
+# the design layer saves its figures through the accessor too (DesignResult.save)
+register("save_figure")(save_figure)
 
 _MARKERS = ("o", "s", "^", "D", "v", "P", "X", "*", "<", ">", "h", "p")
 
@@ -219,3 +235,76 @@ def _draw_wrist(ax, table, holds, title, positions_deg) -> None:
     ax.legend(fontsize="small", loc="upper center", bbox_to_anchor=(0.5, -0.2), borderaxespad=0.0)
     if title:
         ax.set_title(title)
+
+
+@register("coarse_map")
+def plot_coarse_map(result: DesignResult):
+    """The coarse map in the first two variables (colour: largest relative miss), the design starred.
+
+    Examples
+    --------
+    >>> import matplotlib.pyplot as plt
+    >>> from bendpam.physics.presets import be_pam
+    >>> from bendpam.design.inverse import design_actuator
+    >>> res = design_actuator(be_pam(), ["blocked_moment_nmm=400@200"], ["alpha0_deg=60:80"], n_coarse=16, n_starts=1)
+    >>> fig = plot_coarse_map(res)
+    >>> len(fig.axes)                                     # the map and its colour bar
+    2
+    >>> plt.close(fig)
+    """
+    c = result.coarse
+    names = [v.name for v in result.variables]
+    fig, ax = plt.subplots(figsize=(3.5, 2.9), layout="constrained")
+    v = np.clip(np.nan_to_num(c["violation"], nan=NAN_MISS), 1e-3, 3.0)
+    x = c["X"][:, 0]
+    y = c["X"][:, 1] if len(names) > 1 else v
+    sc = ax.scatter(x, y, c=v, s=5, cmap="viridis_r", norm=LogNorm(1e-3, 3.0), linewidths=0)
+    bx = result.values[names[0]]
+    by = result.values[names[1]] if len(names) > 1 else max(1e-3, float(np.max(np.abs(result.relative_error))))
+    ax.plot([bx], [by], marker="*", color="tab:red", ms=11, mec="k", mew=0.6, ls="none",
+            label="design" if result.feasible else "closest design")
+    ax.set_xlabel(names[0])
+    ax.set_ylabel(names[1] if len(names) > 1 else "largest relative miss")
+    if len(names) == 1:
+        ax.set_yscale("log")
+    cb = fig.colorbar(sc, ax=ax, pad=0.01)
+    cb.set_label("largest relative miss", fontsize=8)
+    ax.legend(fontsize=7, loc="best")
+    ax.set_title(f"coarse map ({len(x)} designs, {c['method']})", fontsize=8)
+    return fig
+
+
+@register("pareto")
+def plot_pareto(result: DesignResult):
+    """The Pareto front of the two targets over the coarse map's designs that meet every margin.
+
+    Examples
+    --------
+    >>> import matplotlib.pyplot as plt
+    >>> from bendpam.physics.presets import be_pam
+    >>> from bendpam.design.inverse import design_actuator
+    >>> res = design_actuator(be_pam(), ["blocked_moment_nmm>=300@150", "free_angle_deg>=60@150"],
+    ...                       ["alpha0_deg=60:80", "R0_mm=7:10"], n_coarse=16, n_starts=1)
+    >>> fig = plot_pareto(res)
+    >>> len(fig.axes)                                     # fig.savefig("pareto.png") to keep it
+    1
+    >>> plt.close(fig)
+    """
+    pf = result.pareto
+    if pf is None:
+        raise InputError("this design has no Pareto front (it needs exactly two targets)")
+    t1, t2 = pf.targets
+    fig, ax = plt.subplots(figsize=(3.5, 2.8), layout="constrained")
+    Q = result.coarse["quantities"]
+    ok = np.isfinite(result.coarse["min_margin"]) & (result.coarse["min_margin"] >= result.min_margin_required * (
+        1 - TOL)) if np.any(np.isfinite(result.coarse["min_margin"])) else np.ones(len(Q), bool)
+    ax.scatter(Q[ok, 0], Q[ok, 1], s=3, color="0.75", linewidths=0, label="designs (margins met)")
+    ax.plot(pf.quantities[:, 0], pf.quantities[:, 1], "-o", color="tab:blue", ms=3, lw=1.2, label="Pareto front")
+    ax.axvline(t1.value, color="k", ls="--", lw=0.7)
+    ax.axhline(t2.value, color="k", ls="--", lw=0.7)
+    ax.plot([result.achieved[0]], [result.achieved[1]], marker="*", color="tab:red", ms=11, mec="k", mew=0.6,
+            ls="none", label="design" if result.feasible else "closest design")
+    ax.set_xlabel(t1.label, fontsize=8)
+    ax.set_ylabel(t2.label, fontsize=8)
+    ax.legend(fontsize=6.5, loc="best")
+    return fig
