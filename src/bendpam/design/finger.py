@@ -70,11 +70,18 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from bendpam.design.parts import G_N_PER_G, checked_pair, checked_pressure_kpa, checked_pressures_kpa, pressures_checked
+from bendpam.design.parts import (
+    G_N_PER_G,
+    checked_pair,
+    checked_pressure_kpa,
+    checked_pressures_kpa,
+    json_number,
+    pressures_checked,
+)
 from bendpam.design.rod import NEWTON_TOL, Rod, complex_jacobian, continuation, newton, sinc
 from bendpam.errors import InputError, NoEquilibrium
 from bendpam.infra.accessors import figure
@@ -424,6 +431,22 @@ class FingerShape:
         """The structural limits along this shape, worst section (:func:`finger_limits`)."""
         return finger_limits(self)
 
+    def to_dict(self) -> dict[str, Any]:
+        """The tip pose, base moment and residual as a JSON-ready dict (units in the key names; null: not defined).
+
+        The arrays along the finger are in :meth:`to_dataframe`.
+
+        >>> import bendpam
+        >>> d = solve_finger(Finger(bendpam.physics.presets.be_pam()), 150.0).to_dict()
+        >>> round(d["tip_x_mm"], 2), round(d["bend_angle_deg"], 2), d["note"]
+        (113.47, 67.78, None)
+        """
+        return {"pressure_kpa": float(self.pressure_kpa), "tip_x_mm": json_number(self.tip_xy[0]),
+                "tip_y_mm": json_number(self.tip_xy[1]), "tip_angle_deg": json_number(self.tip_angle_deg),
+                "equilibrium": bool(self.equilibrium), "note": self.note or None,
+                "bend_angle_deg": json_number(self.bend_angle_deg), "base_moment_nmm": json_number(self.moment_ext[0]),
+                "residual_nmm": json_number(self.residual_nmm)}
+
     def to_dataframe(self):
         """The shape as a :class:`pandas.DataFrame` (units in the column names)."""
         import pandas as pd
@@ -654,6 +677,20 @@ class FingerLimits:
     worst_s_mm: float
     violations: tuple[str, ...]
     sections: dict[str, np.ndarray] = field(repr=False, compare=False)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The worst section's numbers as a JSON-ready dict (margins: null where infinite, no demand or no limit).
+
+        >>> import bendpam
+        >>> from bendpam.design import Finger, solve_finger
+        >>> d = solve_finger(Finger(bendpam.physics.presets.be_pam()), 150.0).limits().to_dict()
+        >>> round(d["lockup_margin"], 1), d["buckling_margin"], d["violations"]
+        (4.1, None, [])
+        """
+        return {k: json_number(getattr(self, k)) for k in (
+            "frame_axial_force_n", "frame_stress_mpa", "frame_strength_margin", "buckling_margin", "lockup_margin",
+            "bladder_stretch_max", "bladder_stretch_margin", "min_margin", "worst_s_mm")} | {
+            "violations": list(self.violations)}
 
 
 def finger_limits(shape: FingerShape) -> FingerLimits:

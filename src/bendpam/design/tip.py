@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from bendpam.design.finger import Finger, FingerLoads, FingerShape, check_finger, solve_finger
-from bendpam.design.parts import checked_pair, checked_pressure_kpa, pressures_checked
+from bendpam.design.parts import checked_pair, checked_pressure_kpa, json_number, pressures_checked
 from bendpam.design.rod import Rod, complex_jacobian, continuation, cross
 from bendpam.errors import NoEquilibrium
 from bendpam.validate import number
@@ -68,7 +68,20 @@ class BlockedTipForce:
 
     @property
     def magnitude_n(self) -> float:
+        """The holding force's magnitude, N."""
         return math.hypot(*self.force_n)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The holding force as a JSON-ready dict (``force_n`` null without an equilibrium).
+
+        >>> import bendpam
+        >>> blocked_tip_force(Finger(bendpam.physics.presets.be_pam()), 150.0).to_dict()["force_n"]
+        [0.0, -2.053...]
+        """
+        return {"force_n": [json_number(f) for f in self.force_n] if self.equilibrium else None,
+                "target_xy_mm": [json_number(v) for v in self.target_xy], "constraint": self.constraint,
+                "direction": None if self.direction is None else [float(v) for v in self.direction],
+                "equilibrium": bool(self.equilibrium), "note": self.note or None}
 
 
 def _straight_tip(finger: Finger) -> tuple[float, float]:

@@ -47,10 +47,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
-from bendpam.design.parts import G_N_PER_G, checked_pressure_kpa, checked_pressures_kpa, pressures_checked
+from bendpam.design.parts import G_N_PER_G, checked_pressure_kpa, checked_pressures_kpa, json_number, pressures_checked
 from bendpam.design.rod import newton_batch
 from bendpam.errors import InputError
 from bendpam.infra.accessors import figure
@@ -198,6 +199,20 @@ class WristState:
     load_moment_nmm: tuple
     equilibrium: bool
     note: str
+
+    def to_dict(self) -> dict[str, Any]:
+        """The state as a JSON-ready dict (units in the key names; null: not defined).
+
+        >>> d = wrist_bend(Wrist(), (0.0, 150.0, 0.0, 0.0)).to_dict()
+        >>> round(d["angle_deg"], 1), d["direction_deg"], d["pressures_kpa"]
+        (24.4, 90.0, [0.0, 150.0, 0.0, 0.0])
+        """
+        return {"pressures_kpa": [float(p) for p in self.pressures_kpa],
+                "curvature_per_mm": json_number(self.curvature), "direction_deg": json_number(self.direction_deg),
+                "angle_deg": json_number(self.angle_deg),
+                "actuator_curvatures_per_mm": [json_number(k) for k in self.actuator_curvatures],
+                "load_moment_nmm": [json_number(m) for m in self.load_moment_nmm],
+                "equilibrium": bool(self.equilibrium), "note": self.note or None}
 
 
 def wrist_pressures(direction_deg: float, pressure_kpa, positions_deg=(0.0, 90.0, 180.0, 270.0)) -> tuple:
@@ -440,6 +455,20 @@ class WristHold:
     load_moment_nmm: float
     equilibrium: bool
     note: str
+
+    def to_dict(self) -> dict[str, Any]:
+        """The load case and how the wrist holds it, as a JSON-ready dict (units in the key names; null: not defined).
+
+        >>> d = wrist_hold(Wrist(), 150.0).to_dict()
+        >>> d["holds_horizontal"], round(d["angle_deg"], 1), round(d["capacity_g"])
+        (True, 2.1, 367)
+        """
+        return {"pressure_kpa": float(self.pressure_kpa), "angle_deg": json_number(self.angle_deg),
+                "holds_horizontal": bool(self.holds_horizontal), "capacity_g": json_number(self.capacity_g),
+                "equilibrium": bool(self.equilibrium), "note": self.note or None, "load_g": float(self.load_g),
+                "lever_mm": float(self.lever_mm), "hand_mass_g": float(self.hand_mass_g),
+                "hand_lever_mm": float(self.hand_lever_mm), "load_moment_nmm": json_number(self.load_moment_nmm),
+                "pressure_needed_kpa": json_number(self.pressure_needed_kpa)}
 
 
 def _dz(kap, L, lever):
