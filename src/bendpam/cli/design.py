@@ -36,7 +36,7 @@ from bendpam.cli.options import (
 )
 from bendpam.cli.options import fmt_num as _fmt
 
-__all__ = ["MAX_DESIGN_POINTS", "finger_cmd", "grasp_cmd", "register", "wrist_cmd"]
+__all__ = ["register"]
 
 #: The most equilibrium solutions one design command may compute (each takes about 10 ms).
 MAX_DESIGN_POINTS = 10_000
@@ -157,11 +157,11 @@ def finger_cmd(
         _save_plot(lambda ax: plot_finger_shapes(shapes, ax=ax, title=f"{act.name or act.kind}, "
                                                  f"L0 = {act.L0_mm:g} mm"), plot, fig_format, aspect=0.9)
     rows = []
-    for i, sh in enumerate(shapes):
+    for i, (sh, lm) in enumerate(zip(shapes, lims, strict=True)):
         row = sh.to_dict()
         if held is not None:
             row["blocked_force_n"] = held[i].to_dict()["force_n"]
-        row["limits"] = None if lims[i] is None else lims[i].to_dict()
+        row["limits"] = None if lm is None else lm.to_dict()
         rows.append(row)
     if as_json:
         obj = {"model": mname, "actuator": act.name or act.kind, "L0_mm": act.L0_mm,
@@ -292,9 +292,17 @@ def grasp_cmd(
     if as_json:
         typer.echo(json.dumps({**gr.to_dict(), "units": _GRASP_UNITS, "results": rows}, indent=2))
         return
+    _print_grasps(gr, rows)
+    if plot is not None:
+        typer.echo(f"wrote {plot}")
+
+
+def _print_grasps(gr, rows: list[dict[str, Any]]) -> None:
+    """The table of ``bendpam grasp``: one row per sphere and pressure."""
+    act = gr.actuator
     typer.echo(f"{gr.fingers}-finger gripper, {act.name or act.kind}, L0 = {act.L0_mm:g} mm, base radius "
                f"{gr.base_radius_mm:g} mm, splay {gr.splay_deg:g}°, mu = {gr.mu:g} — "
-               f"{mname.replace('_', '-')} model; grip = peak load of the quasi-static pull-out "
+               f"{gr.model.replace('_', '-')} model; grip = peak load of the quasi-static pull-out "
                "(frozen = frozen-normal estimate, for comparison)")
     typer.echo(f"{'D (mm)':>7} {'P (kPa)':>8} {'grip (N)':>9} {'lift (mm)':>9} {'frozen (N)':>10} "
                f"{'N/finger':>9} {'contact':>8} {'β (deg)':>8}  note")
@@ -303,8 +311,6 @@ def grasp_cmd(
                    f"{_fmt(r['peak_lift_mm'], '9.2f')} {_fmt(r['frozen_grip_force_n'], '10.2f')} "
                    f"{_fmt(r['contact_force_n'], '9.2f')} {r['contact']:>8} {_fmt(r['contact_angle_deg'], '8.1f')}"
                    + (f"  {r['note']}" if r["note"] else ""))
-    if plot is not None:
-        typer.echo(f"wrote {plot}")
 
 
 # ---- wrist --------------------------------------------------------------------------------------
@@ -413,7 +419,13 @@ def _print_wrist(results, holding, holds, load_g, lever_mm, hand_mass_g, hand_le
 
 # ---- registration -------------------------------------------------------------------------------
 def register(app: typer.Typer) -> typer.Typer:
-    """Add the ``finger``, ``grasp`` and ``wrist`` commands to ``app`` (once; returns ``app``)."""
+    """Add the ``finger``, ``grasp`` and ``wrist`` commands to ``app`` (once; returns ``app``).
+
+    >>> import typer
+    >>> app = register(register(typer.Typer()))
+    >>> [c.name for c in app.registered_commands]
+    ['finger', 'grasp', 'wrist']
+    """
     names = {c.name or (c.callback.__name__ if c.callback else None) for c in app.registered_commands}
     if {"finger", "grasp", "wrist"} <= names:
         return app

@@ -467,7 +467,7 @@ class _Path:
         except NoEquilibrium as exc:
             return (Grasp.no_contact(D, P, depth, str(exc), equilibrium=False), None)
         if self.state is not None:
-            return self._tracked(P, br_P, fb.reason if not free_ok else "a limit point of the contact equilibrium")
+            return self._tracked(P, br_P, str(fb.reason) if not free_ok else "a limit point of the contact equilibrium")
         # the contact needs more curvature than the free branch has (beyond the fold): direct solve
         res = _direct(self.ctx, self.gripper, D, P, depth, br_P, self.kind, self.k_c, self.sig0)
         if res is None:
