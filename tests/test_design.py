@@ -31,7 +31,7 @@ from bendpam.design import (
     wrist_pressures,
     wrist_sweep,
 )
-from bendpam.design.finger import G_N_PER_G
+from bendpam.design.parts import G_N_PER_G
 from bendpam.errors import InputError
 from bendpam.validate import UnitWarning
 

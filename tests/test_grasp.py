@@ -9,7 +9,8 @@ import pytest
 import bendpam.cli as cli
 from bendpam import presets
 from bendpam.design import Gripper, grasp_sweep, plot_grasp, solve_grasp
-from bendpam.design.grasp import DEFAULT_MU, DEFAULT_SPLAY_DEG, PullOut
+from bendpam.design.gripper import DEFAULT_MU, DEFAULT_SPLAY_DEG
+from bendpam.design.pullout import PullOut
 from bendpam.errors import InputError
 from bendpam.physics.law import MomentLaw
 

@@ -15,7 +15,8 @@ import bendpam
 from bendpam import presets
 from bendpam.cli import main
 from bendpam.design import Finger, blocked_tip_force
-from bendpam.design.inverse import Target, Variable, design_actuator, parse_variables
+from bendpam.design.inverse import design_actuator
+from bendpam.design.targets import Target, Variable, parse_variables
 
 ISSUE_TARGETS = ["blocked_moment_nmm=400@200", "free_angle_deg=90@200"]
 ISSUE_VARY = ["alpha0_deg=60:80", "R0_mm=6:12", "t0_mm=1:3"]

@@ -70,7 +70,8 @@ def design_cmd(
     Example: bendpam design --preset be-pam --target blocked_moment_nmm=400@200 --target free_angle_deg=90@200
     --vary alpha0_deg=60:80 --vary R0_mm=6:12 --vary t0_mm=1:3 --max-pressure-kpa 250 --min-margin 1.5 --out design/
     """
-    from bendpam.design.inverse import design_actuator, parse_targets, parse_variables
+    from bendpam.design.inverse import design_actuator
+    from bendpam.design.targets import parse_targets, parse_variables
     from bendpam.infra.outputs import to_json
 
     if not target:

@@ -1,4 +1,8 @@
-r"""A bending-PAM finger under in-plane loads: equilibrium shape, tip pose, blocked force, stiffness.
+r"""A bending-PAM finger under in-plane loads: equilibrium shape, tip pose, structural limits.
+
+The fingertip held at a target (blocked force) and the tip stiffness are in
+:mod:`bendpam.design.tip`; the discretised rod and the Newton method all of them share are in
+:mod:`bendpam.design.rod`.
 
 Model
 -----
@@ -33,7 +37,8 @@ then bends the same geometric way as a BE-PAM finger with the same ``bend``.  Mi
 
 Numerics
 --------
-Collocation on ``n`` equally spaced nodes (default 81): the unknowns are the nodal curvatures;
+(:mod:`bendpam.design.rod`.)  Collocation on ``n`` equally spaced nodes (default 81): the unknowns
+are the nodal curvatures;
 ``phi`` is their trapezoidal integral and every segment is integrated exactly as a circular arc of
 linearly varying angle, so a constant-curvature (free) shape is exact.  The moment law is the
 actuator's shared :class:`bendpam.MomentLaw` (``MomentLaw.of(actuator, model)``); the solver uses
@@ -64,131 +69,44 @@ mistake (every nonzero value below 5 kPa) warns with :class:`bendpam.UnitWarning
 from __future__ import annotations
 
 import math
-import sys
-import warnings
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
-from types import FrameType
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from bendpam.design.parts import (
+    G_N_PER_G,
+    checked_pair,
+    checked_pressure_kpa,
+    checked_pressures_kpa,
+    json_number,
+    pressures_checked,
+)
+from bendpam.design.rod import NEWTON_TOL, Rod, complex_jacobian, continuation, newton, sinc
 from bendpam.errors import InputError, NoEquilibrium
+from bendpam.infra.accessors import figure
 from bendpam.physics.actuator import Actuator
 from bendpam.physics.law import MomentLaw, StableBranch
 from bendpam.physics.models import normalise_model
-from bendpam.validate import UnitWarning, number
-from bendpam.validate import pressure_kpa as _check_pressures
+from bendpam.validate import number
 
 if TYPE_CHECKING:
     from bendpam.physics.hysteresis import LoopModel
 
 __all__ = [
-    "G_N_PER_G",
-    "BlockedTipForce",
     "Finger",
     "FingerLimits",
     "FingerLoads",
     "FingerShape",
     "StableBranch",
-    "TipStiffness",
-    "blocked_tip_force",
+    "check_finger",
     "finger_limits",
     "finger_sweep",
     "free_tip_trajectory",
-    "linear_tip_compliance",
     "plot_finger_shapes",
     "solve_finger",
     "stable_branch",
-    "tip_stiffness",
 ]
-
-#: weight of one gram, N (standard gravity 9.80665 m/s^2)
-G_N_PER_G = 9.80665e-3
-
-NEWTON_TOL = 1e-10  # on the residual divided by the moment scale
-_MAX_NEWTON = 40
-_MIN_STEP = 1.0 / 2048
-_PACKAGE = __name__.rpartition(".")[0]  # "bendpam.design": warnings point at the first frame outside it
-
-
-# ------------------------------------------------------------------------------------------------
-# validation shared by the design modules (public within bendpam.design, not exported)
-# ------------------------------------------------------------------------------------------------
-def _pair(name: str, value, unit: str) -> tuple[float, float]:
-    if isinstance(value, str | bytes):
-        raise InputError(f"{name} = {value!r} must be two numbers ({unit})")
-    try:
-        a = np.asarray(value, dtype=float).ravel()
-    except (TypeError, ValueError):
-        raise InputError(f"{name} = {value!r} must be two numbers ({unit})") from None
-    if a.size != 2 or not np.all(np.isfinite(a)):
-        raise InputError(f"{name} = {value!r} must be two finite numbers ({unit})")
-    return float(a[0]), float(a[1])
-
-
-def _user_stacklevel() -> int:
-    """``stacklevel`` (for a ``warnings.warn`` in the caller) of the first frame outside bendpam.design."""
-    level = 1
-    frame: FrameType | None = sys._getframe(1)
-    while frame is not None and frame.f_globals.get("__name__", "").startswith(_PACKAGE):
-        frame, level = frame.f_back, level + 1
-    return level
-
-
-def _numeric_pressures(value, name: str) -> np.ndarray:
-    """:func:`bendpam.validate.pressure_kpa`, refusing strings and bools inside a list too ([100, "150"]).
-
-    Its :class:`~bendpam.validate.UnitWarning` is reported at the user's call, not inside bendpam.design.
-    """
-    try:
-        kind = np.asarray(value).dtype.kind
-    except (TypeError, ValueError):  # ragged: left to the check's own message
-        kind = "O"
-    if kind in "USb":
-        raise InputError(f"{name} = {value!r} is not numeric (kPa expected)")
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        p = _check_pressures(value, name)
-    if caught:
-        level = _user_stacklevel()
-        for w in caught:
-            warnings.warn(w.message, stacklevel=level)
-    return p
-
-
-def checked_pressure_kpa(value, name: str = "pressure_kpa") -> float:
-    """One gauge pressure in kPa as a float (:func:`bendpam.validate.pressure_kpa`, and a single value).
-
-    A negative, non-finite or non-numeric value raises :class:`~bendpam.errors.InputError`; a
-    nonzero value below 5 kPa warns with :class:`~bendpam.validate.UnitWarning` (MPa passed as kPa?).
-    """
-    p = _numeric_pressures(value, name)
-    if p.size != 1:
-        raise InputError(f"{name} has {p.size} values; give one pressure (kPa)")
-    return float(p.reshape(()))
-
-
-def checked_pressures_kpa(value, name: str = "pressures_kpa") -> np.ndarray:
-    """Gauge pressures in kPa as a 1-D float array (at least one), validated as :func:`checked_pressure_kpa`."""
-    p = np.atleast_1d(_numeric_pressures(value, name)).ravel()
-    if p.size == 0:
-        raise InputError(f"{name} is empty; give at least one pressure (kPa)")
-    return p
-
-
-@contextmanager
-def pressures_checked() -> Iterator[None]:
-    """Run the numerics of a public function whose pressures were already validated.
-
-    The entry point validates (and warns about a suspected MPa value) once; inside, the law is
-    evaluated many times at the same pressures and must not repeat the
-    :class:`~bendpam.validate.UnitWarning`.
-    """
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", UnitWarning)
-        yield
 
 
 # ------------------------------------------------------------------------------------------------
@@ -280,7 +198,7 @@ class Finger:
             raise InputError(f"alpha0_deg = {self.actuator.alpha0_deg:g} deg is the neutral braid angle: "
                              "the actuator does not bend, so it cannot be a finger")
         s(self, "model", normalise_model(self.model))
-        s(self, "base_xy_mm", _pair("base_xy_mm", self.base_xy_mm, "mm"))
+        s(self, "base_xy_mm", checked_pair("base_xy_mm", self.base_xy_mm, "mm"))
         s(self, "base_angle_deg", number("base_angle_deg", self.base_angle_deg, -720.0, 720.0, unit="deg"))
         b = self.bend
         if isinstance(b, str):
@@ -386,12 +304,12 @@ class FingerLoads:
 
     def __post_init__(self):
         s = object.__setattr__
-        s(self, "tip_force_n", _pair("tip_force_n", self.tip_force_n, "N"))
+        s(self, "tip_force_n", checked_pair("tip_force_n", self.tip_force_n, "N"))
         s(self, "tip_moment_nmm", number("tip_moment_nmm", self.tip_moment_nmm, unit="N*mm"))
         s(self, "tip_mass_g", number("tip_mass_g", self.tip_mass_g, 0.0, unit="g"))
         s(self, "mass_per_length_g_per_mm",
           number("mass_per_length_g_per_mm", self.mass_per_length_g_per_mm, 0.0, unit="g/mm"))
-        g = _pair("gravity", self.gravity, "direction")
+        g = checked_pair("gravity", self.gravity, "direction")
         ng = math.hypot(*g)
         if ng == 0.0:
             raise InputError("gravity = (0, 0) has no direction; give a non-zero vector, e.g. (0, -1)")
@@ -486,9 +404,48 @@ class FingerShape:
     def bend_angle_deg(self) -> float:
         return math.degrees(self.bend_angle)
 
+    @classmethod
+    def from_curvature(cls, rod: Rod, k, branch: StableBranch | None, P: float, loads: FingerLoads, *,
+                       lam: float = 1.0, equilibrium: bool = True, stable: bool = True, note: str = "",
+                       exact: bool = True) -> FingerShape:
+        """The shape of ``rod`` at the nodal curvatures ``k`` (1/mm) under ``lam`` times its loads (a solver's result).
+
+        ``residual_nmm`` is taken with the exact law (not the branch's table) unless ``exact`` is False (NaN).
+        """
+        f = rod.f
+        phi, x, y, xt, yt = rod.geometry(k)
+        m_act = -rod.c * rod.load_moment(x, y, xt, yt, lam)
+        res = float(np.max(np.abs(f.law.moment(P, k) - m_act))) if exact else math.nan
+        return cls(f, loads, P, rod.s.copy(), x, y, phi, np.asarray(k, float), m_act, (float(xt), float(yt)),
+                   float(phi[-1]), equilibrium, stable, res, lam, note, None, branch)
+
+    @classmethod
+    def failure(cls, rod: Rod, branch: StableBranch | None, P: float, loads: FingerLoads, note: str,
+                limit: FingerShape | None = None, lam: float = 0.0) -> FingerShape:
+        """A result without equilibrium: NaN arrays, the ``note`` why, the last equilibrium reached in ``limit``."""
+        nan = np.full(rod.n, np.nan)
+        return cls(rod.f, loads, P, rod.s.copy(), nan, nan.copy(), nan.copy(), nan.copy(), nan.copy(),
+                   (math.nan, math.nan), math.nan, False, False, math.nan, lam, note, limit, branch)
+
     def limits(self) -> FingerLimits:
         """The structural limits along this shape, worst section (:func:`finger_limits`)."""
         return finger_limits(self)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The tip pose, base moment and residual as a JSON-ready dict (units in the key names; null: not defined).
+
+        The arrays along the finger are in :meth:`to_dataframe`.
+
+        >>> import bendpam
+        >>> d = solve_finger(Finger(bendpam.physics.presets.be_pam()), 150.0).to_dict()
+        >>> round(d["tip_x_mm"], 2), round(d["bend_angle_deg"], 2), d["note"]
+        (113.47, 67.78, None)
+        """
+        return {"pressure_kpa": float(self.pressure_kpa), "tip_x_mm": json_number(self.tip_xy[0]),
+                "tip_y_mm": json_number(self.tip_xy[1]), "tip_angle_deg": json_number(self.tip_angle_deg),
+                "equilibrium": bool(self.equilibrium), "note": self.note or None,
+                "bend_angle_deg": json_number(self.bend_angle_deg), "base_moment_nmm": json_number(self.moment_ext[0]),
+                "residual_nmm": json_number(self.residual_nmm)}
 
     def to_dataframe(self):
         """The shape as a :class:`pandas.DataFrame` (units in the column names)."""
@@ -499,148 +456,8 @@ class FingerShape:
 
 
 # ------------------------------------------------------------------------------------------------
-# the discretised rod
+# the solver (the rod and its Newton method: bendpam.design.rod)
 # ------------------------------------------------------------------------------------------------
-def _sinc(x):
-    """sin(x)/x, analytic (complex-step safe)."""
-    small = np.abs(x) < 1e-3
-    xs = np.where(small, 1.0, x)
-    x2 = x * x
-    return np.where(small, 1.0 - x2 / 6.0 + x2 * x2 / 120.0, np.sin(xs) / xs)
-
-
-def cross(ax, ay, bx, by):
-    """z-component of the planar cross product ``a x b`` (batched; complex-step safe)."""
-    return ax * by - ay * bx
-
-
-class Rod:
-    """Geometry and load moments of the discretised finger (batched over leading axes).
-
-    Shared by :mod:`bendpam.design.grasp`; not part of the public API of :mod:`bendpam.design`.
-    """
-
-    def __init__(self, finger: Finger, loads: FingerLoads):
-        self.f = finger
-        n = finger.nodes
-        L = finger.length
-        self.n, self.L = n, L
-        self.s = np.linspace(0.0, L, n)
-        self.h = L / (n - 1)
-        self.w = np.full(n, self.h)
-        self.w[[0, -1]] *= 0.5
-        self.c = finger.frame_side
-        self.x0, self.y0 = finger.base_xy_mm
-        self.phi0 = finger.base_angle
-        self.ell, self.off = finger.fingertip_mm, finger.fingertip_offset_mm
-        self.loads = loads
-        self.F = loads.tip_resultant()
-        self.q = loads.distributed()
-        self.Mt = loads.tip_moment_nmm
-        self.rem = L - self.s  # length beyond each node
-
-    def geometry(self, k):
-        h = self.h
-        kap = self.c * k
-        inc = 0.5 * h * (kap[..., 1:] + kap[..., :-1])
-        zero = np.zeros((*k.shape[:-1], 1), dtype=k.dtype)
-        phi = self.phi0 + np.concatenate([zero, np.cumsum(inc, axis=-1)], axis=-1)
-        mid = 0.5 * (phi[..., 1:] + phi[..., :-1])
-        sc = h * _sinc(0.5 * inc)
-        x = self.x0 + np.concatenate([zero, np.cumsum(np.cos(mid) * sc, axis=-1)], axis=-1)
-        y = self.y0 + np.concatenate([zero, np.cumsum(np.sin(mid) * sc, axis=-1)], axis=-1)
-        pl = phi[..., -1]
-        b = self.f.bend
-        xt = x[..., -1] + self.ell * np.cos(pl) - b * self.off * np.sin(pl)
-        yt = y[..., -1] + self.ell * np.sin(pl) + b * self.off * np.cos(pl)
-        return phi, x, y, xt, yt
-
-    def point(self, phi, x, y, sc):
-        """Position and angle at arc length ``sc`` (batched scalar) on the arcs between nodes."""
-        h = self.h
-        jr = np.clip(np.floor(np.real(sc) / h).astype(int), 0, self.n - 2)
-        idx = jr[..., None]
-        p0 = np.take_along_axis(phi, idx, -1)[..., 0]
-        p1 = np.take_along_axis(phi, idx + 1, -1)[..., 0]
-        x0 = np.take_along_axis(x, idx, -1)[..., 0]
-        y0 = np.take_along_axis(y, idx, -1)[..., 0]
-        tau = sc - jr * h
-        dp = (p1 - p0) * tau / h
-        pm = p0 + 0.5 * dp
-        ln = tau * _sinc(0.5 * dp)
-        return x0 + ln * np.cos(pm), y0 + ln * np.sin(pm), p0 + dp
-
-    def load_moment(self, x, y, xt, yt, lam=1.0):
-        """Counterclockwise moment m(s_j) of the dead loads beyond each node, N*mm."""
-        Fx, Fy = self.F
-        m = lam * (self.Mt + cross(xt[..., None] - x, yt[..., None] - y, Fx, Fy))
-        qx, qy = self.q
-        if qx or qy:
-            w = self.h
-            # X_j = int_{s_j}^L x du by the trapezoidal rule
-            cx = np.cumsum(0.5 * w * (x[..., 1:] + x[..., :-1])[..., ::-1], axis=-1)[..., ::-1]
-            cy = np.cumsum(0.5 * w * (y[..., 1:] + y[..., :-1])[..., ::-1], axis=-1)[..., ::-1]
-            zero = np.zeros((*x.shape[:-1], 1), dtype=x.dtype)
-            X = np.concatenate([cx, zero], axis=-1)
-            Y = np.concatenate([cy, zero], axis=-1)
-            m = m + lam * cross(X - self.rem * x, Y - self.rem * y, qx, qy)
-        return m
-
-
-def _complex_jacobian(fun, u):
-    """Exact Jacobian of a real-analytic vector function by the complex step (one batched call)."""
-    m = u.size
-    eps = 1e-30
-    U = u[None, :] + 1j * eps * np.eye(m)
-    return (np.imag(fun(U)) / eps).T
-
-
-def newton(fun, u0, lo, hi, tol, maxit=_MAX_NEWTON):
-    """Damped Newton on ``fun(u) = 0`` keeping ``lo < u < hi``.  Returns ``(u, ok, |r|_inf)``."""
-    u = np.array(u0, dtype=float)
-    r = np.real(fun(u[None, :]))[0]
-    nr = float(np.max(np.abs(r)))
-    for _ in range(maxit):
-        if not np.isfinite(nr):
-            return u, False, nr
-        if nr < tol:
-            return u, True, nr
-        J = _complex_jacobian(fun, u)
-        try:
-            du = np.linalg.solve(J, -r)
-        except np.linalg.LinAlgError:
-            du = np.linalg.lstsq(J, -r, rcond=None)[0]
-        if not np.all(np.isfinite(du)):
-            return u, False, nr
-        # stay strictly inside the bounds (the stable branch): at most 90 % of the way to a bound
-        with np.errstate(divide="ignore", invalid="ignore"):
-            a_hi = np.where(du > 0, 0.9 * (hi - u) / du, np.inf)
-            a_lo = np.where(du < 0, 0.9 * (lo - u) / du, np.inf)
-        alpha = float(min(1.0, np.min(a_hi), np.min(a_lo)))
-        n2 = float(np.sum(r * r))
-        for _ in range(30):
-            un = u + alpha * du
-            rn = np.real(fun(un[None, :]))[0]
-            n2n = float(np.sum(rn * rn))
-            if np.isfinite(n2n) and n2n <= (1.0 - 1e-4 * alpha) * n2:
-                break
-            alpha *= 0.5
-        else:
-            return u, False, nr
-        if alpha < 1e-12:
-            return u, False, nr
-        u, r = un, rn
-        nr = float(np.max(np.abs(r)))
-    return u, nr < tol, nr
-
-
-def _moment_scale(branch: StableBranch, rod: Rod) -> float:
-    """Moment scale for the Newton tolerance: blocked moment, fold moments and load moments (not lock-up)."""
-    load = abs(rod.Mt) + math.hypot(*rod.F) * (rod.L + rod.ell) + math.hypot(*rod.q) * rod.L ** 2
-    folds = [abs(m) for m, e in ((branch.moment_max, branch.end_lo), (branch.moment_min, branch.end_hi)) if e == "fold"]
-    return max([abs(float(branch.moment(0.0)[0])), load, 1.0, *folds])
-
-
 def _k_bounds(branch: StableBranch, n: int):
     return np.full(n, branch.k_lo), np.full(n, branch.k_hi)
 
@@ -659,27 +476,12 @@ def _dead_load_system(rod: Rod, branch: StableBranch, scale: float):
 
 def _stability(fun, k, w):
     """Smallest eigenvalue of the symmetrised, weighted Hessian (relative to the largest)."""
-    J = _complex_jacobian(fun, k)
+    J = complex_jacobian(fun, k)
     sw = np.sqrt(w)
     H = -(sw[:, None] * J / sw[None, :])
     H = 0.5 * (H + H.T)
     ev = np.linalg.eigvalsh(H)
     return float(ev[0] / max(abs(ev[-1]), 1e-300))
-
-
-def _shape(rod: Rod, k, branch, P, loads, *, lam=1.0, equilibrium=True, stable=True, note="", exact=True):
-    f = rod.f
-    phi, x, y, xt, yt = rod.geometry(k)
-    m_act = -rod.c * rod.load_moment(x, y, xt, yt, lam)
-    res = float(np.max(np.abs(f.law.moment(P, k) - m_act))) if exact else math.nan
-    return FingerShape(f, loads, P, rod.s.copy(), x, y, phi, np.asarray(k, float), m_act, (float(xt), float(yt)),
-                       float(phi[-1]), equilibrium, stable, res, lam, note, None, branch)
-
-
-def _failed(rod: Rod, branch, P, loads, note, limit=None, lam=0.0):
-    nan = np.full(rod.n, np.nan)
-    return FingerShape(rod.f, loads, P, rod.s.copy(), nan, nan.copy(), nan.copy(), nan.copy(), nan.copy(),
-                       (math.nan, math.nan), math.nan, False, False, math.nan, lam, note, limit, branch)
 
 
 def _near_end_note(branch: StableBranch, k, s):
@@ -695,33 +497,13 @@ def _near_end_note(branch: StableBranch, k, s):
     return f"at s = {s[j_lo]:.3g} mm the section reaches {branch.describe_end(-1)}"
 
 
-def _continue(system, u0):
-    """Continuation in a path parameter t in [0, 1]: ``system(t) -> (fun, lo, hi)``.
+def check_finger(finger, loads) -> FingerLoads:
+    """Check that ``finger`` is a :class:`Finger`; ``loads`` as :class:`FingerLoads` (None: no load).
 
-    ``u0`` must be (close to) the solution at t = 0.  Adaptive steps (doubling on success, halving
-    on failure down to 1/2048).  Returns the last solution and the parameter reached (1.0 on
-    success; -1.0 if even the start does not converge).
+    >>> import bendpam
+    >>> check_finger(Finger(bendpam.physics.presets.be_pam()), None).is_zero
+    True
     """
-    fun, lo, hi = system(0.0)
-    u, ok, _ = newton(fun, np.asarray(u0, dtype=float), lo, hi, NEWTON_TOL)
-    if not ok:
-        return np.asarray(u0, dtype=float), -1.0
-    t, step = 0.0, 1.0
-    while t < 1.0:
-        step = min(step, 1.0 - t)
-        fun, lo, hi = system(t + step)
-        un, ok, _ = newton(fun, u, lo, hi, NEWTON_TOL)
-        if ok:
-            u, t = un, t + step
-            step *= 2.0
-        else:
-            step *= 0.5
-            if step < _MIN_STEP:
-                break
-    return u, t
-
-
-def _check_finger(finger, loads) -> FingerLoads:
     if not isinstance(finger, Finger):
         raise TypeError(f"finger must be a bendpam.design.Finger, got {type(finger).__name__}")
     loads = FingerLoads() if loads is None else loads
@@ -750,7 +532,7 @@ def solve_finger(finger: Finger, pressure_kpa, loads: FingerLoads | None = None)
     >>> loaded.equilibrium, loaded.residual_nmm < 1e-6
     (True, True)
     """
-    loads = _check_finger(finger, loads)
+    loads = check_finger(finger, loads)
     P = checked_pressure_kpa(pressure_kpa)
     with pressures_checked():
         return _solve_finger(finger, P, loads)
@@ -762,8 +544,8 @@ def _solve_finger(finger: Finger, P: float, loads: FingerLoads) -> FingerShape:
     try:
         br = finger.branch(P)
     except NoEquilibrium as exc:
-        return _failed(rod, None, P, loads, str(exc))
-    scale = _moment_scale(br, rod)
+        return FingerShape.failure(rod, None, P, loads, str(exc))
+    scale = rod.moment_scale(br)
     fun = _dead_load_system(rod, br, scale)
     lo, hi = _k_bounds(br, rod.n)
     kf = br.free_curvature
@@ -774,24 +556,25 @@ def _solve_finger(finger: Finger, P: float, loads: FingerLoads) -> FingerShape:
         kf = float(fb.curvature_per_mm)
     if loads.is_zero:
         if not free_ok:
-            return _failed(rod, br, P, loads, f"no free-bending equilibrium: {fb.reason or br.describe_end(+1)}")
-        return _shape(rod, np.full(rod.n, kf), br, P, loads)
+            why = fb.reason or br.describe_end(+1)
+            return FingerShape.failure(rod, br, P, loads, f"no free-bending equilibrium: {why}")
+        return FingerShape.from_curvature(rod, np.full(rod.n, kf), br, P, loads)
 
     def finish(k, lam_note=""):
         st = _stability(lambda U: fun(U, 1.0), k, rod.w)
         if st < -1e-7:
-            sh = _shape(rod, k, br, P, loads, stable=False)
-            return _failed(rod, br, P, loads, "unstable equilibrium (a structural limit or bifurcation: the "
-                           "finger buckles under these loads)" + lam_note, limit=sh, lam=1.0)
-        return _shape(rod, k, br, P, loads, note=lam_note)
+            sh = FingerShape.from_curvature(rod, k, br, P, loads, stable=False)
+            return FingerShape.failure(rod, br, P, loads, "unstable equilibrium (a structural limit or bifurcation: "
+                                       "the finger buckles under these loads)" + lam_note, limit=sh, lam=1.0)
+        return FingerShape.from_curvature(rod, k, br, P, loads, note=lam_note)
 
     if free_ok:
         # continuation in the load fraction from the free shape (exact at fraction 0)
-        k, lam = _continue(lambda t: ((lambda U: fun(U, t)), lo, hi), np.full(rod.n, kf))
+        k, lam = continuation(lambda t: ((lambda U: fun(U, t)), lo, hi), np.full(rod.n, kf))
         lam = max(lam, 0.0)
         if lam >= 1.0:
             return finish(k)
-        last = _shape(rod, k, br, P, loads, lam=lam, equilibrium=False)
+        last = FingerShape.from_curvature(rod, k, br, P, loads, lam=lam, equilibrium=False)
         where = _near_end_note(br, k, rod.s)
         if where:
             note = (f"no equilibrium: snap-through at load fraction {lam:.3g} ({where}); the loads need more "
@@ -799,7 +582,7 @@ def _solve_finger(finger: Finger, P: float, loads: FingerLoads) -> FingerShape:
         else:
             note = (f"no equilibrium: the load path reaches a structural limit point at load fraction {lam:.3g} "
                     "(the finger would snap to another configuration)")
-        return _failed(rod, br, P, loads, note, limit=last, lam=lam)
+        return FingerShape.failure(rod, br, P, loads, note, limit=last, lam=lam)
     # no free shape (pressure above the fold): look for a loaded equilibrium on the stable branch
     span = br.k_hi - br.k_lo
     sgn = finger.actuator.bend_sign
@@ -813,7 +596,7 @@ def _solve_finger(finger: Finger, P: float, loads: FingerLoads) -> FingerShape:
     note = (f"no equilibrium: at {P:.4g} kPa the stable branch supplies only M in [{br.moment_min:.4g}, "
             f"{br.moment_max:.4g}] N*mm, not M = 0 (above the fold: {br.describe_end(sgn)}); where the load moment is "
             "smaller (toward the tip) the finger snaps through")
-    return _failed(rod, br, P, loads, note)
+    return FingerShape.failure(rod, br, P, loads, note)
 
 
 def finger_sweep(finger: Finger, pressures_kpa, loads: FingerLoads | None = None):
@@ -832,7 +615,7 @@ def finger_sweep(finger: Finger, pressures_kpa, loads: FingerLoads | None = None
     """
     import pandas as pd
 
-    loads = _check_finger(finger, loads)
+    loads = check_finger(finger, loads)
     P = checked_pressures_kpa(pressures_kpa)
     with pressures_checked():
         shapes = [_solve_finger(finger, float(p), loads) for p in P]
@@ -894,6 +677,20 @@ class FingerLimits:
     worst_s_mm: float
     violations: tuple[str, ...]
     sections: dict[str, np.ndarray] = field(repr=False, compare=False)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The worst section's numbers as a JSON-ready dict (margins: null where infinite, no demand or no limit).
+
+        >>> import bendpam
+        >>> from bendpam.design import Finger, solve_finger
+        >>> d = solve_finger(Finger(bendpam.physics.presets.be_pam()), 150.0).limits().to_dict()
+        >>> round(d["lockup_margin"], 1), d["buckling_margin"], d["violations"]
+        (4.1, None, [])
+        """
+        return {k: json_number(getattr(self, k)) for k in (
+            "frame_axial_force_n", "frame_stress_mpa", "frame_strength_margin", "buckling_margin", "lockup_margin",
+            "bladder_stretch_max", "bladder_stretch_margin", "min_margin", "worst_s_mm")} | {
+            "violations": list(self.violations)}
 
 
 def finger_limits(shape: FingerShape) -> FingerLimits:
@@ -974,7 +771,7 @@ def free_tip_trajectory(finger: Finger, pressures_kpa):
     L = finger.length
     th = kap * L
     p0 = finger.base_angle
-    ln = L * _sinc(0.5 * th)
+    ln = L * sinc(0.5 * th)
     x0, y0 = finger.base_xy_mm
     pl = p0 + th
     b = finger.bend
@@ -994,312 +791,13 @@ def free_tip_trajectory(finger: Finger, pressures_kpa):
 
 
 # ------------------------------------------------------------------------------------------------
-# blocked tip force and tip stiffness
-# ------------------------------------------------------------------------------------------------
-@dataclass(frozen=True)
-class BlockedTipForce:
-    """The force that holds the fingertip point at a target.
-
-    Attributes
-    ----------
-    force_n : (Fx, Fy) applied to the tip by the holder, N (the finger pushes with the opposite).
-    target_xy : the target point, mm.
-    constraint : ``"roller"`` (only the tip's coordinate along ``direction`` is held, the force acts
-        along ``direction``) or ``"pin"`` (both coordinates held).
-    direction : unit vector of the roller (None for a pin).
-    shape : the held :class:`FingerShape` (its ``loads`` include the holding force).
-    equilibrium, note : as in :class:`FingerShape`.
-
-    Examples
-    --------
-    >>> import bendpam
-    >>> held = blocked_tip_force(Finger(bendpam.physics.presets.be_pam()), 150.0)
-    >>> held.constraint, [round(f, 3) for f in held.force_n], held.equilibrium    # N
-    ('roller', [0.0, -2.053], True)
-    """
-
-    force_n: tuple[float, float]
-    target_xy: tuple[float, float]
-    constraint: str
-    direction: tuple[float, float] | None
-    shape: FingerShape
-    equilibrium: bool
-    note: str
-
-    @property
-    def magnitude_n(self) -> float:
-        return math.hypot(*self.force_n)
-
-
-def _straight_tip(finger: Finger) -> tuple[float, float]:
-    p = finger.base_angle
-    x0, y0 = finger.base_xy_mm
-    L = finger.length + finger.fingertip_mm
-    o = finger.bend * finger.fingertip_offset_mm
-    return x0 + L * math.cos(p) - o * math.sin(p), y0 + L * math.sin(p) + o * math.cos(p)
-
-
-def blocked_tip_force(finger: Finger, pressure_kpa, target_xy_mm=None, direction_deg=None,
-                      loads: FingerLoads | None = None) -> BlockedTipForce:
-    """Force needed to hold the fingertip at a target point.
-
-    Parameters
-    ----------
-    finger : Finger
-    pressure_kpa : float, kPa.
-    target_xy_mm : (x, y), optional
-        Target point, mm.  Default: the straight (unpressurised) tip position, held by a roller
-        normal to the base direction, as a force sensor measures a blocked force (a pin there would
-        need an infinite force: an inextensible rod reaches distance L only when exactly straight).
-    direction_deg : float, optional
-        Hold only the tip coordinate along this direction (degrees counterclockwise from +x) with a
-        frictionless roller; the force acts along it.  Default with ``target_xy_mm``: a pin (both
-        coordinates held, any force direction).
-    loads : FingerLoads, optional
-        Further loads acting together with the holding force.
-
-    Notes
-    -----
-    The force components are extra unknowns and the held coordinates extra equations; the target
-    is reached by continuation from the free (or loaded) tip.  If the holder cannot be reached on
-    the stable branch (a fold: snap-through), ``equilibrium`` is False with a note.
-
-    Examples
-    --------
-    The force a sensor at the straight tip position measures at 150 kPa:
-
-    >>> import bendpam
-    >>> held = blocked_tip_force(Finger(bendpam.physics.presets.be_pam()), 150.0)
-    >>> round(held.force_n[1], 3)                         # N, on the tip (the finger pushes up)
-    -2.053
-    """
-    loads = _check_finger(finger, loads)
-    P = checked_pressure_kpa(pressure_kpa)
-    if target_xy_mm is None:
-        target = _straight_tip(finger)
-        if direction_deg is None:
-            p = finger.base_angle
-            direction = (-finger.bend * math.sin(p), finger.bend * math.cos(p))
-        else:
-            d = math.radians(number("direction_deg", direction_deg, unit="deg"))
-            direction = (math.cos(d), math.sin(d))
-    else:
-        target = _pair("target_xy_mm", target_xy_mm, "mm")
-        if direction_deg is None:
-            direction = None
-        else:
-            d = math.radians(number("direction_deg", direction_deg, unit="deg"))
-            direction = (math.cos(d), math.sin(d))
-    with pressures_checked():
-        return _blocked_tip_force(finger, P, target, direction, target_xy_mm is not None, loads)
-
-
-def _blocked_tip_force(finger: Finger, P: float, target, direction, given_target: bool,
-                       loads: FingerLoads) -> BlockedTipForce:
-    """:func:`blocked_tip_force` with validated arguments (P in kPa, ``direction`` a unit vector or None)."""
-    constraint = "pin" if direction is None else "roller"
-    start = _solve_finger(finger, P, loads)
-    rod = Rod(finger, loads)
-    try:
-        br = finger.branch(P)
-    except NoEquilibrium as exc:
-        return BlockedTipForce((math.nan, math.nan), target, constraint, direction, start, False, str(exc))
-    n = rod.n
-    c = rod.c
-    Lr = rod.L + rod.ell
-    scale = _moment_scale(br, rod)
-    fscale = max(scale / Lr, 1e-3)
-    nf = 2 if direction is None else 1
-
-    def make(P_t, tx, ty):
-        b = finger.branch(P_t)
-
-        def fun(U):
-            k = U[..., :n]
-            if direction is None:
-                gx, gy = U[..., n] * fscale, U[..., n + 1] * fscale
-            else:
-                gx, gy = U[..., n] * fscale * direction[0], U[..., n] * fscale * direction[1]
-            _phi, x, y, xt, yt = rod.geometry(k)
-            m = rod.load_moment(x, y, xt, yt) + cross(xt[..., None] - x, yt[..., None] - y,
-                                                      gx[..., None], gy[..., None])
-            M, _ = b.moment(k)
-            r1 = (M + c * m) / scale
-            if direction is None:
-                extra = [((xt - tx) / Lr)[..., None], ((yt - ty) / Lr)[..., None]]
-            else:
-                extra = [(((xt - tx) * direction[0] + (yt - ty) * direction[1]) / Lr)[..., None]]
-            return np.concatenate([r1, *extra], axis=-1)
-
-        lo = np.concatenate([np.full(n, b.k_lo), np.full(nf, -np.inf)])
-        hi = np.concatenate([np.full(n, b.k_hi), np.full(nf, np.inf)])
-        return fun, lo, hi
-
-    tgt = np.array(target)
-    straight = np.array(_straight_tip(finger))
-    P0 = min(P, finger.actuator.P_start_kpa)
-    paths: list[tuple[np.ndarray, Callable[[float], Any]]] = []
-    if given_target and start.equilibrium:
-        # move the holder from the free tip to the target at the working pressure
-        t0 = np.array(start.tip_xy)
-
-        def toward_target(t: float, t0: np.ndarray = t0):
-            return make(P, *(t0 + t * (tgt - t0)))
-
-        paths.append((np.concatenate([start.curvature, np.zeros(nf)]), toward_target))
-    # as a test rig does: hold the tip from the straight, unpressurised state while the pressure rises
-    # (first move the holder to the target at P0, then raise the pressure)
-    paths.append((np.zeros(n + nf),
-                  lambda t: make(P0, *(straight + min(2 * t, 1.0) * (tgt - straight))) if t <= 0.5
-                  else make(P0 + (2 * t - 1.0) * (P - P0), *tgt)))
-    t_best = 0.0
-    for u0, system in paths:
-        u, t_reached = _continue(system, u0)
-        t_best = max(t_best, t_reached)
-        if t_reached >= 1.0:
-            break
-    else:
-        what = "roller" if direction is not None else "pin"
-        why = "" if start.equilibrium else f" (no unloaded equilibrium: {start.note})"
-        note = (f"no equilibrium holds the tip with a {what} at ({target[0]:.4g}, {target[1]:.4g}) mm: the finger "
-                f"snaps through on the way (continuation stops at {t_best:.3g} of the path){why}")
-        sh = _failed(rod, br, P, loads, note, lam=t_best)
-        return BlockedTipForce((math.nan, math.nan), target, constraint, direction, sh, False, note)
-    if direction is None:
-        F = (float(u[n] * fscale), float(u[n + 1] * fscale))
-    else:
-        F = (float(u[n] * fscale * direction[0]), float(u[n] * fscale * direction[1]))
-    total = replace(loads, tip_force_n=(loads.tip_force_n[0] + F[0], loads.tip_force_n[1] + F[1]))
-    sh = _shape(Rod(finger, total), u[:n], br, P, total)
-    return BlockedTipForce(F, target, constraint, direction, sh, True, "")
-
-
-@dataclass(frozen=True)
-class TipStiffness:
-    """Tangent stiffness of the fingertip at an equilibrium.
-
-    ``matrix`` maps small changes of the tip load ``(dFx, dFy, dM)`` (N, N, N*mm) to the tip pose
-    ``(dx, dy, dphi)`` (mm, mm, rad) by ``compliance``; ``matrix = inv(compliance)``.  Both include the
-    geometric stiffness of the loads already acting; for dead loads they are symmetric.
-
-    Examples
-    --------
-    >>> import numpy as np, bendpam
-    >>> ts = tip_stiffness(Finger(bendpam.physics.presets.be_pam()), 150.0)
-    >>> ts.matrix.shape, bool(np.allclose(ts.matrix @ ts.compliance, np.eye(3)))
-    ((3, 3), True)
-    """
-
-    matrix: np.ndarray
-    compliance: np.ndarray
-    shape: FingerShape
-
-
-def tip_stiffness(finger: Finger, pressure_kpa, loads: FingerLoads | None = None) -> TipStiffness:
-    """Tip stiffness matrix (3x3) at the equilibrium at ``pressure_kpa`` (kPa) under ``loads``.
-
-    From the exact (complex-step) Jacobian.  Raises :class:`~bendpam.errors.NoEquilibrium` where the
-    finger has no stable equilibrium under these loads.
-
-    Examples
-    --------
-    Unloaded, it agrees with linear beam theory (:func:`linear_tip_compliance`):
-
-    >>> import numpy as np, bendpam
-    >>> finger = Finger(bendpam.physics.presets.be_pam())
-    >>> ts = tip_stiffness(finger, 150.0)
-    >>> bool(np.allclose(ts.compliance, linear_tip_compliance(finger, 150.0), rtol=1e-3, atol=1e-6))
-    True
-    """
-    loads = _check_finger(finger, loads)
-    P = checked_pressure_kpa(pressure_kpa)
-    with pressures_checked():
-        sh = _solve_finger(finger, P, loads)
-    if not sh.equilibrium:
-        raise NoEquilibrium(f"no equilibrium at pressure_kpa = {P:g} kPa under these loads: {sh.note}")
-    rod = Rod(finger, loads)
-    br = sh.branch
-    n = rod.n
-    c = rod.c
-    k = sh.curvature
-
-    def fun(U):  # unknowns k, then the load increment (dFx, dFy, dM)
-        kk = U[..., :n]
-        _phi, x, y, xt, yt = rod.geometry(kk)
-        dF = U[..., n:]
-        m = rod.load_moment(x, y, xt, yt) + dF[..., 2:3] + cross(xt[..., None] - x, yt[..., None] - y,
-                                                                  dF[..., 0:1], dF[..., 1:2])
-        M, _ = br.moment(kk)
-        return M + c * m
-
-    def pose(U):
-        phi, _x, _y, xt, yt = rod.geometry(U[..., :n])
-        return np.stack([xt, yt, phi[..., -1]], axis=-1)
-
-    u = np.concatenate([k, np.zeros(3)])
-    J = _complex_jacobian(fun, u)
-    Jk, JF = J[:, :n], J[:, n:]
-    try:
-        dk = -np.linalg.solve(Jk, JF)
-        Q = _complex_jacobian(pose, u)
-        C = Q[:, :n] @ dk
-        K = np.linalg.inv(C)
-    except np.linalg.LinAlgError:
-        raise NoEquilibrium(
-            f"pressure_kpa = {sh.pressure_kpa:g}: the tip compliance is singular (the finger is straight and "
-            "inextensible, so its tip stiffness along its axis is unbounded); use linear_tip_compliance or a "
-            "pressure that bends it") from None
-    return TipStiffness(K, C, sh)
-
-
-def linear_tip_compliance(finger: Finger, pressure_kpa) -> np.ndarray:
-    """Linear beam-theory compliance (3x3) of the free finger: reference for the nonlinear solver.
-
-    With the free (constant) curvature and the tangent stiffness ``K = dM/dk'`` there (negative), a
-    small tip load changes the curvature by ``dk' = dM_ext / K`` and the tip pose by the integral of
-    the rotations, with no geometric stiffness (the finger is unloaded).  Integrated on 1001 nodes.
-    Pressure in kPa; raises :class:`~bendpam.errors.NoEquilibrium` above the free branch.
-
-    Examples
-    --------
-    >>> import bendpam
-    >>> c = linear_tip_compliance(Finger(bendpam.physics.presets.be_pam()), 150.0)
-    >>> round(float(c[1, 1]), 2)                          # mm of tip travel per N of vertical tip force
-    26.96
-    """
-    _check_finger(finger, None)
-    P = checked_pressure_kpa(pressure_kpa)
-    law = finger.law
-    with pressures_checked():
-        fb = law.free_curvature(P)
-        if fb.status == "no-equilibrium":
-            raise NoEquilibrium(f"pressure_kpa = {P:g} kPa has no free-bending equilibrium: {fb.reason}")
-        k = float(fb.curvature_per_mm)
-        K = float(law.tangent_stiffness(P, k))
-    fine = replace(finger, nodes=1001)
-    rod = Rod(fine, FingerLoads())
-    _phi, x, y, xt, yt = rod.geometry(np.full((1, rod.n), k))
-    x, y, xt, yt = x[0], y[0], float(xt[0]), float(yt[0])
-    ax, ay = xt - x, yt - y  # lever from each section to the tip
-    # unit loads: Fx, Fy, M -> m(s) (counterclockwise moment) -> dkappa = c dk' = c (-c m)/K = -m/K
-    ms = [cross(ax, ay, 1.0, 0.0), cross(ax, ay, 0.0, 1.0), np.ones_like(ax)]
-    C = np.zeros((3, 3))
-    for j, m in enumerate(ms):
-        dkap = -m / K
-        w = rod.w
-        C[0, j] = np.sum(w * dkap * -ay)  # rotation about s moves the tip by dtheta * z x (tip - r)
-        C[1, j] = np.sum(w * dkap * ax)
-        C[2, j] = np.sum(w * dkap)
-    return C
-
-
-# ------------------------------------------------------------------------------------------------
-# figure
+# figure (drawn by bendpam.present.figures.design, reached by name)
 # ------------------------------------------------------------------------------------------------
 def plot_finger_shapes(shapes, ax=None, title: str | None = None):
     """Draw finger shapes (frame line, fingertip, tip point) on ``ax``; returns the figure.
 
     Shapes without equilibrium are drawn dashed from their last equilibrium (``limit``) if any.
+    The figure is :func:`bendpam.present.figures.design.plot_finger_shapes`, loaded on first use.
 
     Examples
     --------
@@ -1311,32 +809,4 @@ def plot_finger_shapes(shapes, ax=None, title: str | None = None):
     1
     >>> plt.close(fig)
     """
-    from bendpam.present import figures as plots  # noqa: F401, I001  (first: selects the Agg backend unless the caller chose one)
-    import matplotlib.pyplot as plt
-
-    if ax is None:
-        fig, ax = plt.subplots(figsize=(6.0, 5.0))
-    else:
-        fig = ax.figure
-    shapes = list(shapes)
-    colors = plt.cm.viridis(np.linspace(0.0, 0.9, max(len(shapes), 1)))
-    for sh, col in zip(shapes, colors, strict=False):
-        draw, style = (sh, "-") if sh.equilibrium else (sh.limit, "--")
-        label = f"{sh.pressure_kpa:g} kPa" + ("" if sh.equilibrium else " (no equilibrium)")
-        if draw is None:
-            ax.plot([], [], style, color=col, label=label)
-            continue
-        ax.plot(draw.x, draw.y, style, color=col, label=label)
-        ax.plot([draw.x[-1], draw.tip_xy[0]], [draw.y[-1], draw.tip_xy[1]], style, color=col, lw=3, alpha=0.6)
-        ax.plot(*draw.tip_xy, "o", color=col, ms=4)
-    if shapes:
-        x0, y0 = shapes[0].finger.base_xy_mm
-        ax.plot(x0, y0, "ks", ms=6)
-    ax.set_aspect("equal", adjustable="datalim")
-    ax.set_xlabel("x (mm)")
-    ax.set_ylabel("y (mm)")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
-    if title:
-        ax.set_title(title)
-    return fig
+    return figure("finger_shapes")(shapes, ax=ax, title=title)

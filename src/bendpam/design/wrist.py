@@ -47,11 +47,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
-from bendpam.design.finger import G_N_PER_G, checked_pressure_kpa, checked_pressures_kpa, pressures_checked
+from bendpam.design.parts import G_N_PER_G, checked_pressure_kpa, checked_pressures_kpa, json_number, pressures_checked
+from bendpam.design.rod import newton_batch
 from bendpam.errors import InputError
+from bendpam.infra.accessors import figure
 from bendpam.physics import presets
 from bendpam.physics.actuator import Actuator
 from bendpam.physics.law import MomentLaw, StableBranch
@@ -197,6 +200,20 @@ class WristState:
     equilibrium: bool
     note: str
 
+    def to_dict(self) -> dict[str, Any]:
+        """The state as a JSON-ready dict (units in the key names; null: not defined).
+
+        >>> d = wrist_bend(Wrist(), (0.0, 150.0, 0.0, 0.0)).to_dict()
+        >>> round(d["angle_deg"], 1), d["direction_deg"], d["pressures_kpa"]
+        (24.4, 90.0, [0.0, 150.0, 0.0, 0.0])
+        """
+        return {"pressures_kpa": [float(p) for p in self.pressures_kpa],
+                "curvature_per_mm": json_number(self.curvature), "direction_deg": json_number(self.direction_deg),
+                "angle_deg": json_number(self.angle_deg),
+                "actuator_curvatures_per_mm": [json_number(k) for k in self.actuator_curvatures],
+                "load_moment_nmm": [json_number(m) for m in self.load_moment_nmm],
+                "equilibrium": bool(self.equilibrium), "note": self.note or None}
+
 
 def wrist_pressures(direction_deg: float, pressure_kpa, positions_deg=(0.0, 90.0, 180.0, 270.0)) -> tuple:
     """The four pressures (kPa) that bend the wrist toward ``direction_deg``: the actuator there at
@@ -281,36 +298,10 @@ def _solve(wrist: Wrist, P: np.ndarray, load_fn=None, b0=None):
         step = min(step, 1.0 - t)
         tt = t + step
         law_t = _WristLaw(wrist, tuple(tt * P))
-        bb, ok = b.copy(), False
-        for _ in range(50):
-            m, J = law_t.moment(bb)
-            if load_fn is not None:
-                ml, Jl = load_fn(bb, tt)
-                m, J = m + ml, J + Jl
-            if np.max(np.abs(m)) < 1e-10 * scale:
-                ok = True
-                break
-            try:
-                db = -np.linalg.solve(J, m)
-            except np.linalg.LinAlgError:
-                break
-            alpha = 1.0
-            for _ in range(30):
-                cand = bb + alpha * db
-                if law_t.inside(cand)[0]:
-                    m2, _ = law_t.moment(cand)
-                    if load_fn is not None:
-                        m2 = m2 + load_fn(cand, tt)[0]
-                    if np.linalg.norm(m2) < (1 - 1e-4 * alpha) * np.linalg.norm(m):
-                        break
-                alpha *= 0.5
-            else:
-                break
-            bb = cand
+        total = _balance(law_t, load_fn, tt)
+        bb, ok = _equilibrium(law_t, total, b, scale)
         if ok:
-            m, J = law_t.moment(bb)
-            if load_fn is not None:
-                J = J + load_fn(bb, tt)[1]
+            J = total(bb)[1]
             ev = np.linalg.eigvals(0.5 * (J + J.T))
             ok = bool(np.all(ev.real < 0))
         if ok:
@@ -324,6 +315,36 @@ def _solve(wrist: Wrist, P: np.ndarray, load_fn=None, b0=None):
                         + (f" ({why})" if why else " (its combined moment law folds)"))
                 break
     return b, t, law, note
+
+
+def _balance(law: _WristLaw, load_fn, t: float):
+    """The wrist's moment plus the load's (N*mm) and its Jacobian (N*mm^2) at curvature b, path parameter ``t``."""
+
+    def total(b):
+        m, J = law.moment(b)
+        if load_fn is not None:
+            ml, Jl = load_fn(b, t)
+            m, J = m + ml, J + Jl
+        return m, J
+
+    return total
+
+
+def _equilibrium(law: _WristLaw, total, b: np.ndarray, scale: float) -> tuple[np.ndarray, bool]:
+    """Newton (:func:`bendpam.design.rod.newton_batch`) on ``total(b) = 0`` from ``b`` (moments over ``scale``),
+    every step on the actuators' stable branches; returns the last state and whether it converged."""
+
+    def fun(rows, U):
+        return np.array([[total(v)[0] / scale for v in row] for row in U])
+
+    def jac(rows, u):
+        return np.array([total(v)[1] / scale for v in u])
+
+    def inside(rows, u):
+        return np.array([law.inside(v)[0] for v in u])
+
+    u, ok, _ = newton_batch(fun, b[None, :], -np.inf, np.inf, maxit=50, jac=jac, admissible=inside)
+    return u[0], bool(ok[0])
 
 
 def _state(wrist: Wrist, P, b, t, law, note, load_moment=(0.0, 0.0)) -> WristState:
@@ -435,6 +456,20 @@ class WristHold:
     equilibrium: bool
     note: str
 
+    def to_dict(self) -> dict[str, Any]:
+        """The load case and how the wrist holds it, as a JSON-ready dict (units in the key names; null: not defined).
+
+        >>> d = wrist_hold(Wrist(), 150.0).to_dict()
+        >>> d["holds_horizontal"], round(d["angle_deg"], 1), round(d["capacity_g"])
+        (True, 2.1, 367)
+        """
+        return {"pressure_kpa": float(self.pressure_kpa), "angle_deg": json_number(self.angle_deg),
+                "holds_horizontal": bool(self.holds_horizontal), "capacity_g": json_number(self.capacity_g),
+                "equilibrium": bool(self.equilibrium), "note": self.note or None, "load_g": float(self.load_g),
+                "lever_mm": float(self.lever_mm), "hand_mass_g": float(self.hand_mass_g),
+                "hand_lever_mm": float(self.hand_lever_mm), "load_moment_nmm": json_number(self.load_moment_nmm),
+                "pressure_needed_kpa": json_number(self.pressure_needed_kpa)}
+
 
 def _dz(kap, L, lever):
     """d z / d kappa for the load point of a uniform arc (z = (1 - cos kL)/k + lever sin kL), and its derivative."""
@@ -533,41 +568,6 @@ def wrist_sweep(wrist: Wrist, pressures_kpa, directions_deg=(0.0, 90.0, 180.0, 2
     return pd.DataFrame(rows)
 
 
-def _wrist_curve_groups(table, positions_deg) -> list[tuple[list[float], np.ndarray, np.ndarray, str]]:
-    """Free-bending curves of ``table`` grouped where they coincide: ``(directions, P, angle, label)``.
-
-    With identical actuators the curves of symmetric directions (each single actuator, or each
-    pair) are the same; such curves are drawn once and the label says which directions share it.
-    """
-    groups: list[tuple[list[float], np.ndarray, np.ndarray]] = []
-    for d, grp in table.groupby("direction_deg", sort=False):
-        grp = grp.sort_values("pressure_kpa")
-        P = grp["pressure_kpa"].to_numpy(dtype=float)
-        a = grp["angle_deg"].to_numpy(dtype=float)
-        for dirs, P0, a0 in groups:
-            scale = max(float(np.nanmax(np.abs(a0), initial=0.0)), 1.0)
-            if P0.shape == P.shape and np.array_equal(P0, P) and np.allclose(a0, a, rtol=0.0, atol=1e-6 * scale,
-                                                                           equal_nan=True):
-                dirs.append(float(d))
-                break
-        else:
-            groups.append(([float(d)], P, a))
-    out = []
-    for dirs, P, a in groups:
-        names = []
-        for d in dirs:
-            on = [p for p, v in zip(positions_deg, _wrist_pressures(d, 1.0, positions_deg), strict=True) if v > 0]
-            names.append("+".join(f"{p:g}" for p in on) + "°")
-        pair = len(names[0].split("+")) > 1
-        if len(dirs) == 1:
-            label = f"actuator{'s' if pair else ''} {names[0]} inflated (toward {dirs[0]:g}°)"
-        else:
-            label = (f"{'pairs' if pair else 'actuators'} {', '.join(names)}, {'each pair' if pair else 'one'} "
-                     "inflated:\nthe same curve by symmetry")
-        out.append((dirs, P, a, label))
-    return out
-
-
 def plot_wrist(table, holds=(), ax=None, title: str | None = None, positions_deg=(0.0, 90.0, 180.0, 270.0)):
     """Bending angle against pressure per inflated actuator (and the holding angles with the load, dashed).
 
@@ -600,37 +600,4 @@ def plot_wrist(table, holds=(), ax=None, title: str | None = None, positions_deg
     True
     >>> plt.close(fig)
     """
-    from bendpam.present import figures as plots  # noqa: I001  (first: the Agg backend unless chosen)
-    import matplotlib.pyplot as plt
-
-    own = ax is None
-    with plots.figure_style():
-        if ax is None:
-            fig, ax = plt.subplots(figsize=plots.figure_size("single", 1.15))
-        else:
-            fig = ax.figure
-        _draw_wrist(ax, table, holds, title, positions_deg)
-        if own:
-            fig.tight_layout()
-    return fig
-
-
-def _draw_wrist(ax, table, holds, title, positions_deg) -> None:
-    """The curves of :func:`plot_wrist` on ``ax``: a colour, line style and marker per distinct curve."""
-    styles = ("-", "--", "-.", ":")
-    markers = ("o", "s", "^", "D", "v", "P")
-    for i, (_, P, a, label) in enumerate(_wrist_curve_groups(table, positions_deg)):
-        ax.plot(P, a, linestyle=styles[i % len(styles)], marker=markers[i % len(markers)], color=f"C{i % 10}",
-                label=label)
-    holds = list(holds)
-    if holds:
-        ax.plot([h.pressure_kpa for h in holds], [h.angle_deg for h in holds], "s--", color="k", mfc="none",
-                label=f"holding {holds[0].load_g:g} g at {holds[0].lever_mm:g} mm")
-        ax.axhline(0.0, color="0.5", lw=0.8)
-    ax.axhline(30.0, color="tab:red", lw=0.8, ls=":", label="30°")
-    ax.set_xlabel("pressure (kPa)")
-    ax.set_ylabel("bending angle (deg)")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize="small", loc="upper center", bbox_to_anchor=(0.5, -0.2), borderaxespad=0.0)
-    if title:
-        ax.set_title(title)
+    return figure("wrist")(table, holds, ax=ax, title=title, positions_deg=positions_deg)

@@ -54,3 +54,4 @@ __all__ = [
     "styled_figure",
     "sweep_figure",
 ]
+from bendpam.present.figures import design  # noqa: F401  (registers the design figures)

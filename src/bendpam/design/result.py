@@ -1,0 +1,234 @@
+"""The outcome of an inverse design: :class:`DesignResult` (JSON, files, summary) and its :class:`ParetoFront`."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from bendpam.design.targets import Target, Variable
+from bendpam.infra.accessors import figure
+from bendpam.infra.atomic import atomic_write_text
+from bendpam.infra.outputs import to_json
+from bendpam.physics.actuator import Actuator
+from bendpam.version import __version__
+
+__all__ = [
+    "DesignResult",
+    "ParetoFront",
+    "fmt_margin",
+]
+
+
+@dataclass
+class ParetoFront:
+    """Non-dominated designs in two target quantities (sorted by the first).
+
+    Attributes
+    ----------
+    targets : the two :class:`Target` objects (their quantities and pressures; the Pareto sense is
+        larger is better for ``>=``/``=``, smaller for ``<=``).
+    quantities : ``(K, 2)`` the two magnitudes of each design, in the targets' units.
+    X : ``(K, n)`` the variables of each design (:attr:`DesignResult.variables` order).
+    min_margin : ``(K,)`` the smallest safety margin of each design.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from bendpam.design.targets import Target
+    >>> pf = ParetoFront((Target.parse("blocked_moment_nmm>=300@150"), Target.parse("free_angle_deg>=60@150")),
+    ...                  np.array([[300.0, 80.0], [350.0, 70.0]]), np.array([[70.0], [75.0]]),
+    ...                  np.array([1.5, 1.2]), ("alpha0_deg",))
+    >>> print(pf.to_csv(), end="")
+    blocked_moment_nmm@150kpa,free_angle_deg@150kpa,alpha0_deg,min_margin
+    300,80,70,1.5
+    350,70,75,1.2
+    """
+
+    targets: tuple[Target, Target]
+    quantities: np.ndarray
+    X: np.ndarray
+    min_margin: np.ndarray
+    variable_names: tuple[str, ...]
+
+    def columns(self) -> dict[str, np.ndarray]:
+        out = {self.targets[0].key: self.quantities[:, 0], self.targets[1].key: self.quantities[:, 1]}
+        out.update({n: self.X[:, j] for j, n in enumerate(self.variable_names)})
+        out["min_margin"] = self.min_margin
+        return out
+
+    def to_csv(self) -> str:
+        cols = self.columns()
+        lines = [",".join(cols)]
+        for r in range(len(self.quantities)):
+            lines.append(",".join(f"{float(v[r]):.10g}" for v in cols.values()))
+        return "\n".join(lines) + "\n"
+
+
+@dataclass
+class DesignResult:
+    """The outcome of :func:`design_actuator`.
+
+    Attributes
+    ----------
+    actuator : the best design (the closest one when the targets cannot be met), an
+        :class:`~bendpam.Actuator` whose ``model`` field records the model.
+    model : the moment model.
+    targets, variables : the problem.
+    values : ``{variable: value}`` at the best design.
+    achieved : ``(n_targets,)`` the magnitudes predicted for the best design by the public
+        functions (:func:`bendpam.blocked_moment`, :func:`bendpam.free_curvature`,
+        :func:`bendpam.tangent_stiffness`, :func:`bendpam.free_branch`,
+        :func:`bendpam.design.blocked_tip_force`), independently of the search.
+    relative_error : ``achieved / value - 1`` per target; ``met`` whether each target is met (0.1 %).
+    feasible : every target met and every margin >= ``min_margin`` (to 0.1 %).
+    message : a plain-words account (why not, when not feasible).
+    binding : the targets (texts) or limits that prevent meeting the rest (empty when feasible).
+    active : the bounds and margins at their limit at the best design.
+    closest : the variables of the closest design (== ``values``) when not feasible, else None.
+    margins : ``{name: value}`` the smallest of each margin over the operating pressures.
+    margins_by_pressure : ``{pressure_kpa: {name: value}}`` at the target and operating pressures.
+    min_margin, min_margin_required, max_pressure_kpa : the smallest margin, the required one,
+        the operating pressure (kPa; None when no target has a pressure).
+    sensitivities : ``{target key: {variable: d ln(quantity) / d ln(variable)}}`` at the best
+        design (central differences; ``min_margin`` too when finite).
+    coarse : the coarse map: ``X`` (N, n), ``quantities`` (N, n_targets), ``violation`` (N,),
+        ``min_margin`` (N,), and ``method`` (``"sobol"`` or ``"grid"``).
+    pareto : the :class:`ParetoFront` (two targets) or None.
+    search : seed, sizes, evaluations and the elapsed time.
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> from bendpam.design.inverse import design_actuator
+    >>> res = design_actuator(bendpam.physics.presets.be_pam(), ["blocked_moment_nmm=400@200"],
+    ...                       ["alpha0_deg=60:80"], n_coarse=64, n_starts=1)
+    >>> res.met.tolist(), res.binding, round(res.actuator.alpha0_deg, 2)
+    ([True], (), 79.87)
+    """
+
+    actuator: Actuator
+    model: str
+    targets: tuple[Target, ...]
+    variables: tuple[Variable, ...]
+    values: dict[str, float]
+    achieved: np.ndarray
+    relative_error: np.ndarray
+    met: np.ndarray
+    feasible: bool
+    message: str
+    binding: tuple[str, ...]
+    active: tuple[str, ...]
+    closest: dict[str, float] | None
+    margins: dict[str, float]
+    margins_by_pressure: dict[float, dict[str, float]]
+    min_margin: float
+    min_margin_required: float
+    max_pressure_kpa: float | None
+    sensitivities: dict[str, dict[str, float]]
+    coarse: dict[str, Any] = field(repr=False)
+    pareto: ParetoFront | None = field(repr=False)
+    search: dict[str, Any] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, Any]:
+        """design.json's content (units in the key names; ``null`` = infinite or not defined)."""
+        return {
+            "bendpam_version": __version__,
+            "model": self.model,
+            "feasible": self.feasible,
+            "message": self.message,
+            "binding": list(self.binding),
+            "active": list(self.active),
+            "targets": [
+                {"target": t.text, "quantity": t.quantity, "unit": t.unit, "comparison": t.sense, "value": t.value,
+                 "pressure_kpa": t.pressure_kpa, "achieved": float(a), "relative_error": float(e), "met": bool(m),
+                 "compared": "magnitude"}
+                for t, a, e, m in zip(self.targets, self.achieved, self.relative_error, self.met, strict=True)],
+            "variables": [{"name": v.name, "low": v.low, "high": v.high, "value": self.values[v.name]}
+                          for v in self.variables],
+            "closest_design": self.closest,
+            "constraints": {"min_margin": self.min_margin_required, "max_pressure_kpa": self.max_pressure_kpa},
+            "margins": dict(self.margins),
+            "min_margin": self.min_margin,
+            "margins_by_pressure": [{"pressure_kpa": p, **m} for p, m in self.margins_by_pressure.items()],
+            "sensitivities": {"meaning": "d ln(quantity) / d ln(variable) at the design", **self.sensitivities},
+            "actuator": self.actuator.to_dict(),
+            "pareto": None if self.pareto is None else {
+                "quantities": [t.key for t in self.pareto.targets], "n_designs": len(self.pareto.quantities),
+                "better": ["larger" if t.larger_is_better else "smaller" for t in self.pareto.targets],
+                "file": "pareto.csv"},
+            "search": dict(self.search),
+            "null_means": "infinite (no demand, no limit, an unbounded free-bending branch) or not defined",
+        }
+
+    def to_json(self) -> str:
+        """design.json's text (:meth:`to_dict` as JSON)."""
+        return to_json(self.to_dict())
+
+    def save(self, out_dir, *, figures: bool = True) -> dict[str, str]:
+        """Write design.json, design.toml, coarse_map.csv, pareto.csv and figures into ``out_dir``.
+
+        Each file is written atomically (for a whole set, use :class:`bendpam.infra.outputs.OutputSet`,
+        as ``bendpam design --out`` does).  Returns ``{file name: path}``.
+        """
+        out = Path(out_dir)
+        out.mkdir(parents=True, exist_ok=True)
+        files: dict[str, str] = {}
+
+        def put(name: str, text: str) -> None:
+            atomic_write_text(out / name, text)
+            files[name] = str(out / name)
+
+        put("design.json", self.to_json())
+        put("design.toml", self.actuator.to_toml())
+        cols = {v.name: self.coarse["X"][:, j] for j, v in enumerate(self.variables)}
+        cols.update({t.key: self.coarse["quantities"][:, i] for i, t in enumerate(self.targets)})
+        cols["violation"] = self.coarse["violation"]
+        cols["min_margin"] = self.coarse["min_margin"]
+        lines = [",".join(cols)] + [",".join(f"{float(c[r]):.8g}" for c in cols.values())
+                                    for r in range(len(self.coarse["X"]))]
+        put("coarse_map.csv", "\n".join(lines) + "\n")
+        if self.pareto is not None:
+            put("pareto.csv", self.pareto.to_csv())
+        if figures:  # drawn and saved by bendpam.present.figures, reached by name
+            save_figure = figure("save_figure")
+            save_figure(figure("coarse_map")(self), out / "coarse_map.png")
+            files["coarse_map.png"] = str(out / "coarse_map.png")
+            if self.pareto is not None:
+                save_figure(figure("pareto")(self), out / "pareto.png")
+                files["pareto.png"] = str(out / "pareto.png")
+        return files
+
+    def summary(self) -> str:
+        """A short human summary: targets against achieved values, feasibility, margins."""
+        head = "feasible: every target met" if self.feasible else "NOT FEASIBLE: the targets cannot all be met"
+        lines = [f"design ({self.model.replace('_', '-')} model): {head}"]
+        w = max(len(t.text) for t in self.targets)
+        for t, a, e, m in zip(self.targets, self.achieved, self.relative_error, self.met, strict=True):
+            a_s = f"{a:.5g}" if np.isfinite(a) else ("inf" if a == np.inf else "none")
+            e_s = f"{100 * e:+.3f} %" if np.isfinite(e) else "—"
+            lines.append(f"  {t.text:<{w}}  achieved {a_s} {t.unit} ({e_s}) {'ok' if m else 'MISSED'}")
+        lines.append("  variables: " + ", ".join(f"{k} = {v:.5g}" for k, v in self.values.items()))
+        if self.margins:
+            ms = ", ".join(f"{k} {fmt_margin(v)}" for k, v in self.margins.items())
+            lines.append(f"  margins (>= {self.min_margin_required:g} required"
+                         + (f" up to {self.max_pressure_kpa:g} kPa" if self.max_pressure_kpa else "") + f"): {ms}")
+        if self.active:
+            lines.append(f"  at their limit: {', '.join(self.active)}")
+        lines.append(f"  {self.message}")
+        return "\n".join(lines)
+
+    def __str__(self) -> str:
+        return self.summary()
+
+
+def fmt_margin(v: float) -> str:
+    """A safety margin in words: ``inf`` (no demand or no limit), ``none`` (not defined) or 3 digits.
+
+    >>> fmt_margin(1.23456), fmt_margin(float("inf")), fmt_margin(float("nan"))
+    ('1.23', 'inf', 'none')
+    """
+    return "inf" if v == math.inf else ("none" if not np.isfinite(v) else f"{v:.3g}")
