@@ -7,10 +7,14 @@ Multi-valued numbers (``--pressure-kpa``, ``--param``) take separate tokens, com
 
 from __future__ import annotations
 
+import contextvars
 import math
+import os
+import sys
+from collections.abc import Iterable
 from enum import Enum
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Optional
+from typing import TYPE_CHECKING, Annotated, Any, Optional
 
 import typer
 from typer.core import TyperCommand
@@ -19,6 +23,7 @@ from bendpam.errors import InputError
 from bendpam.validate import file_format
 
 if TYPE_CHECKING:
+    from bendpam.infra.outputs import OutputFile, OutputSet
     from bendpam.physics.actuator import Actuator
 
 __all__ = [
@@ -35,15 +40,23 @@ __all__ = [
     "PresetOpt",
     "PressureOpt",
     "QuietOpt",
+    "RUN_ARGS",
+    "RUN_COMMAND",
+    "RUN_FORCE",
     "UserError",
     "collect_raw_files",
+    "as_given",
+    "command_line",
+    "command_inputs",
     "echo",
     "figure_format",
     "fmt_num",
     "format_prediction_table",
     "load_actuator",
     "model_name",
+    "output_file",
     "output_format",
+    "output_set",
     "parse_values",
     "pressures_kpa",
 ]
@@ -225,27 +238,104 @@ def collect_raw_files(paths: list[Path]) -> list[Path]:
     return collect(paths)
 
 
+#: The arguments of the running command line (set by :func:`bendpam.cli.app.main`).
+RUN_ARGS: contextvars.ContextVar[list[str] | None] = contextvars.ContextVar("bendpam_run_args", default=None)
+#: The name of the running command (``"process"``): the producer recorded in its output sets.
+RUN_COMMAND: contextvars.ContextVar[str | None] = contextvars.ContextVar("bendpam_run_command", default=None)
+#: ``bendpam --force``: replace outputs that bendpam did not write, moving them aside.
+RUN_FORCE: contextvars.ContextVar[bool] = contextvars.ContextVar("bendpam_run_force", default=False)
+#: Parameters of a command that name its outputs (every other path parameter is an input).
+OUTPUT_PARAMS = ("out", "plot")
+
+
 def command_line() -> list[str]:
-    """The command line, for the manifests of output sets."""
-    import sys
+    """The command line, for the manifests of output sets.
 
-    return ["bendpam", *sys.argv[1:]]
+    >>> command_line()[0]
+    'bendpam'
+    """
+    args = RUN_ARGS.get()
+    return ["bendpam", *(sys.argv[1:] if args is None else args)]
 
 
-def output_set(out: Path, inputs=()):
-    """An :class:`~bendpam.infra.outputs.OutputSet` for a command's output folder (whole set or nothing)."""
+def _click_context() -> Any:
+    """The running command's click context (Typer may vendor click), or None."""
+    base = next((c for c in typer.Context.__mro__[1:] if c.__name__ == "Context"), None)
+    core = sys.modules.get(base.__module__) if base is not None else None
+    push = getattr(core, "push_context", None)
+    get = getattr(sys.modules.get(getattr(push, "__module__", "") or ""), "get_current_context", None)
+    return get(silent=True) if callable(get) else None
+
+
+def command_inputs() -> list[Path]:
+    """The existing paths among the running command's parameters, outputs (``--out``, ``--plot``) aside.
+
+    Every output is checked against them: an output equal to, inside or containing an input
+    folder given on the command line is refused for every command, whatever inputs the
+    command itself passes.
+
+    >>> command_inputs()      # outside a command
+    []
+    """
+    ctx = _click_context()
+    if ctx is None:
+        return []
+    found: list[Path] = []
+    for name, value in (getattr(ctx, "params", None) or {}).items():
+        if name in OUTPUT_PARAMS:
+            continue
+        for v in value if isinstance(value, list | tuple) else [value]:
+            if isinstance(v, os.PathLike) and os.path.exists(v):
+                found.append(Path(v))
+    return found
+
+
+def _inputs(inputs: Iterable[Path | None]) -> list[Path]:
+    out: list[Path] = []
+    for p in [*inputs, *command_inputs()]:
+        if p is not None and Path(p) not in out:
+            out.append(Path(p))
+    return out
+
+
+def as_given(out: Path) -> Path | str:
+    """``out`` as typed: Typer's ``Path("./~")`` is ``Path("~")``; only a ``~`` typed first means home.
+
+    >>> str(as_given(Path("data")))
+    'data'
+    """
+    text = str(out)
+    if not text.startswith("~"):
+        return out
+    values = [a.split("=", 1)[1] if a.startswith("--") and "=" in a else a for a in RUN_ARGS.get() or []]
+    typed = [v for v in values if v and Path(v) == out]
+    if typed and not any(v.startswith("~") for v in typed):
+        return os.path.join(".", text)  # typed as ./~ : a folder named ~ here
+    return text
+
+
+def output_set(out: Path, inputs: Iterable[Path | None] = (), *, force: bool | None = None) -> OutputSet:
+    """An :class:`~bendpam.infra.outputs.OutputSet` for a command's output folder (whole set or nothing).
+
+    The producer recorded is the command's name; ``force`` defaults to ``bendpam --force``;
+    the inputs are ``inputs`` and every path parameter of the command but its outputs.
+    """
     from bendpam.infra.outputs import OutputSet
 
-    return OutputSet(out, inputs=[p for p in inputs if p is not None], command=command_line())
+    return OutputSet(as_given(out), inputs=_inputs(inputs), command=command_line(),
+                     force=RUN_FORCE.get() if force is None else force, producer=RUN_COMMAND.get())
 
 
-def output_file(out: Path, inputs=()):
+def output_file(out: Path, inputs: Iterable[Path | None] = (), *, force: bool | None = None) -> OutputFile:
     """An :class:`~bendpam.infra.outputs.OutputFile` for a command's single output file."""
     from bendpam.infra.outputs import OutputFile
 
-    if not out.parent.is_dir():
-        raise UserError(f"--out {str(out)!r}: the folder {str(out.parent)!r} does not exist")
-    return OutputFile(out, inputs=[p for p in inputs if p is not None], command=command_line())
+    typed = as_given(out)
+    given = Path(os.path.expanduser(typed) if isinstance(typed, str) and typed.startswith("~") else typed)
+    if not given.parent.is_dir():
+        raise UserError(f"--out {str(out)!r}: the folder {str(given.parent)!r} does not exist")
+    return OutputFile(typed, inputs=_inputs(inputs), command=command_line(),
+                      force=RUN_FORCE.get() if force is None else force)
 
 
 def positive(name: str, value: float | None, unit: str) -> float | None:

@@ -123,6 +123,7 @@ class _Output:
         self.target: Path = resolve_target(target, self._kind)
         """The absolute target path (``~`` expanded, symbolic links resolved)."""
         self._given = Path(target)
+        self._shown = os.fspath(target)
         if isinstance(inputs, str | os.PathLike):
             inputs = [inputs]
         self.inputs: list[Path] = [Path(p) for p in inputs]
@@ -141,7 +142,7 @@ class _Output:
     @property
     def shown(self) -> str:
         """The target as the user named it (for messages)."""
-        return str(self._given)
+        return self._shown
 
     # -- steps the subclasses provide --------------------------------------------------------
     def _prepare(self) -> None:
@@ -215,7 +216,7 @@ class _Output:
             fsops.remove_path(old)
         self._state = "done"
         self._lock.release()
-        record_written(self._given)
+        record_written(self._shown)
 
     def _abort(self, exc: BaseException | None) -> None:
         """Put the old version back if needed, remove what was staged, release the lock."""
@@ -416,11 +417,10 @@ class OutputSet(_Output):
         problem = ownership_problem(self.target, self.producer, self.shown)
         if problem is None:
             return
-        reason, _ = problem
+        reason = f"output folder {self.shown!r} not replaced: {problem[0]}"
         if not self.force:
-            raise OutputRefused(f"output folder {self.shown!r} not replaced: {reason}; choose another folder, or "
-                                "force the replacement (the old folder is then moved aside, not deleted)",
-                                forceable=True)
+            raise OutputRefused(f"{reason}; choose another folder, or force the replacement (the old folder is "
+                                "then moved aside, not deleted)", forceable=True, reason=reason)
         self._aside = _aside_name(self.target)
 
     def _prepare(self) -> None:
@@ -630,9 +630,9 @@ class OutputFile(_Output):
             except InputError:
                 in_set = False
             if in_set:
-                raise OutputRefused(f"output file {shown!r} would go into the bendpam output set "
-                                    f"{str(t.parent)!r}, which would then no longer match its {MANIFEST_NAME}; "
-                                    "choose another folder", forceable=True)
+                reason = (f"output file {shown!r} would go into the bendpam output set {str(t.parent)!r}, "
+                          f"which would then no longer match its {MANIFEST_NAME}")
+                raise OutputRefused(f"{reason}; choose another folder", forceable=True, reason=reason)
 
     def _open(self) -> None:
         for _, stale in fsops.stale_temporaries(self.target.parent, self.target.name):

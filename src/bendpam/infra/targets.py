@@ -32,6 +32,8 @@ class OutputRefused(InputError):
     forceable : bool
         True when forcing the replacement would be allowed (the old content is then moved
         aside, never deleted); false for refusals that nothing overrides.
+    reason : str
+        The message without its closing advice (a caller may give its own).
 
     Examples
     --------
@@ -40,9 +42,10 @@ class OutputRefused(InputError):
     (True, True)
     """
 
-    def __init__(self, message: str, *, forceable: bool = False) -> None:
+    def __init__(self, message: str, *, forceable: bool = False, reason: str | None = None) -> None:
         super().__init__(message)
         self.forceable = forceable
+        self.reason = message if reason is None else reason
 
 
 def _dangling_link(p: Path) -> Path | None:
