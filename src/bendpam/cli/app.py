@@ -123,7 +123,6 @@ def main(argv: list[str] | None = None) -> int:
     2
     """
     from bendpam.errors import BendpamError
-
     from bendpam.infra.signals import Interrupted, forget_written, interrupted_line, interrupts, quiet_logging
 
     args = list(sys.argv[1:] if argv is None else argv)
