@@ -130,7 +130,7 @@ def main(argv: list[str] | None = None) -> int:
         args = ["--help"]
     debug = "--debug" in args
     forget_written()
-    tokens = [RUN_ARGS.set(list(args)), RUN_COMMAND.set(None), RUN_FORCE.set(False)]
+    tokens = (RUN_ARGS.set(list(args)), RUN_COMMAND.set(None), RUN_FORCE.set(False))
     try:
         args = _lift_force(args)
         with interrupts(on_signal=quiet_logging):
@@ -170,6 +170,7 @@ def main(argv: list[str] | None = None) -> int:
         return 1
     finally:
         logging.disable(logging.NOTSET)  # (quiet_logging after a signal)
-        for var, token in zip((RUN_ARGS, RUN_COMMAND, RUN_FORCE), tokens, strict=True):
-            var.reset(token)
+        RUN_ARGS.reset(tokens[0])
+        RUN_COMMAND.reset(tokens[1])
+        RUN_FORCE.reset(tokens[2])
     return 0

@@ -29,6 +29,7 @@ if TYPE_CHECKING:
 __all__ = [
     "FIGURE_FORMATS",
     "MULTI_VALUE_OPTIONS",
+    "RANGE_HELP",
     "RUN_ARGS",
     "RUN_COMMAND",
     "RUN_FORCE",
@@ -58,6 +59,8 @@ __all__ = [
     "output_format",
     "output_set",
     "parse_values",
+    "positive",
+    "pressure_kpa",
     "pressures_kpa",
 ]
 
@@ -66,20 +69,42 @@ MAX_VALUES = 1_000_000
 
 
 class UserError(InputError):
-    """A command line that cannot be acted on (a missing option, inconsistent options)."""
+    """A command line that cannot be acted on (a missing option, inconsistent options).
+
+    >>> issubclass(UserError, InputError)
+    True
+    """
 
 
 class Model(str, Enum):
+    """The moment model of ``--model``.
+
+    >>> Model("force-balance").name
+    'force_balance'
+    """
+
     energy = "energy"
     force_balance = "force-balance"
 
 
 class Preset(str, Enum):
+    """The paper's actuators of ``--preset``.
+
+    >>> [p.value for p in Preset]
+    ['be-pam', 'bc-pam']
+    """
+
     be_pam = "be-pam"
     bc_pam = "bc-pam"
 
 
 class Format(str, Enum):
+    """The export dialects of ``simulate-test --format``.
+
+    >>> Format("mts").value
+    'mts'
+    """
+
     csv = "csv"
     testxpert = "testxpert"
     bluehill = "bluehill"
@@ -101,7 +126,11 @@ MULTI_VALUE_OPTIONS = ("--pressure-kpa", "--diameter-mm", "--direction-deg")
 
 
 class MultiValueCommand(TyperCommand):
-    """A command in which ``--opt a b c`` means ``--opt a --opt b --opt c`` for the options above."""
+    """A command in which ``--opt a b c`` means ``--opt a --opt b --opt c`` for the options above.
+
+    >>> "--pressure-kpa" in MultiValueCommand.multi_value_options
+    True
+    """
 
     multi_value_options = MULTI_VALUE_OPTIONS
 
@@ -131,11 +160,20 @@ class MultiValueCommand(TyperCommand):
 
 
 def echo(text: str = "", err: bool = False) -> None:
+    """Print one line (to stderr with ``err``).
+
+    >>> echo("wrote out/")
+    wrote out/
+    """
     typer.echo(text, err=err)
 
 
 def parse_values(tokens: list[str] | None, name: str, *, max_values: int = MAX_VALUES) -> list[float]:
-    """Parse numbers given as separate tokens, comma lists or ranges ``start:stop:count``."""
+    """Parse numbers given as separate tokens, comma lists or ranges ``start:stop:count``.
+
+    >>> parse_values(["100,150", "200:300:3"], "--pressure-kpa")
+    [100.0, 150.0, 200.0, 250.0, 300.0]
+    """
     out: list[float] = []
     for tok in tokens or []:
         for part in str(tok).replace(",", " ").split():
@@ -168,12 +206,24 @@ def parse_values(tokens: list[str] | None, name: str, *, max_values: int = MAX_V
 
 
 def pressure_kpa(value: float, name: str = "--pressure-kpa") -> float:
-    """One pressure option in kPa, with the same checks as :func:`pressures_kpa`."""
+    """One pressure option in kPa, with the same checks as :func:`pressures_kpa`.
+
+    >>> pressure_kpa(150)
+    150.0
+    """
     return pressures_kpa([repr(float(value))], None, name)[0]
 
 
 def pressures_kpa(first: list[str] | None, more: list[str] | None = None, name: str = "--pressure-kpa") -> list[float]:
-    """Pressures (kPa) from the option's values (``more``: values that followed it, if any)."""
+    """Pressures (kPa) from the option's values (``more``: values that followed it, if any).
+
+    >>> pressures_kpa(["100:200:3"])
+    [100.0, 150.0, 200.0]
+    >>> pressures_kpa(["0.2"])
+    Traceback (most recent call last):
+    ...
+    bendpam.cli.options.UserError: --pressure-kpa: every pressure is below 5 kPa (largest 0.2); ...
+    """
     values = parse_values((first or []) + (more or []), name)
     if not values:
         raise UserError(f"give at least one pressure with {name} (kPa), e.g. {name} 100 150 200")
@@ -188,12 +238,22 @@ def pressures_kpa(first: list[str] | None, more: list[str] | None = None, name: 
 
 
 def model_name(model: Model) -> str:
+    """The library's name of a ``--model`` choice.
+
+    >>> model_name(Model.force_balance)
+    'force_balance'
+    """
     from bendpam.physics.models import normalise_model
 
     return normalise_model(model.value)
 
 
 def load_actuator(preset: Preset | None, actuator: Path | None, model: Model) -> Actuator:
+    """The actuator of ``--preset`` or ``--actuator`` (exactly one of them).
+
+    >>> load_actuator(Preset.be_pam, None, Model.energy).alpha0_deg
+    69.7
+    """
     if preset is not None and actuator is not None:
         raise UserError("give either --preset or --actuator, not both")
     if preset is None and actuator is None:
@@ -212,7 +272,11 @@ def load_actuator(preset: Preset | None, actuator: Path | None, model: Model) ->
 
 
 def fmt_num(x, fmt: str) -> str:
-    """``format(x, fmt)``, or a dash of the same width for None/NaN/inf."""
+    """``format(x, fmt)``, or a dash of the same width for None/NaN/inf.
+
+    >>> fmt_num(1.23456, "6.2f"), fmt_num(float("nan"), "6.2f")
+    ('  1.23', '     —')
+    """
     width = fmt.split(".")[0]
     try:
         ok = x is not None and math.isfinite(float(x))
@@ -222,6 +286,14 @@ def fmt_num(x, fmt: str) -> str:
 
 
 def format_prediction_table(df, title: str) -> str:
+    """The text table of ``predict``.
+
+    >>> import pandas as pd
+    >>> row = dict(pressure_kpa=150.0, blocked_moment_nmm=200.0, free_curvature_per_mm=0.01, free_angle_deg=30.0,
+    ...            note="")
+    >>> print(format_prediction_table(pd.DataFrame([row]), "BE-PAM").splitlines()[-1])
+         150            200.00        0.01000         30.00
+    """
     lines = [title, f"{'P (kPa)':>8}  {'M_blocked (N·mm)':>16}  {'k_free (1/mm)':>13}  {'θ_free (deg)':>12}  note"]
     for r in df.itertuples():
         lines.append(
@@ -232,7 +304,13 @@ def format_prediction_table(df, title: str) -> str:
 
 
 def collect_raw_files(paths: list[Path]) -> list[Path]:
-    """Expand folders into their raw test files (see :func:`bendpam.lab.files.collect_raw_files`)."""
+    """Expand folders into their raw test files (see :func:`bendpam.lab.files.collect_raw_files`).
+
+    >>> collect_raw_files([Path("no-such-folder")])
+    Traceback (most recent call last):
+    ...
+    bendpam.errors.InputError: no-such-folder: no such file or folder
+    """
     from bendpam.lab.files import collect_raw_files as collect
 
     return collect(paths)
@@ -319,6 +397,13 @@ def output_set(out: Path, inputs: Iterable[Path | None] = (), *, force: bool | N
 
     The producer recorded is the command's name; ``force`` defaults to ``bendpam --force``;
     the inputs are ``inputs`` and every path parameter of the command but its outputs.
+
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     with output_set(Path(d) / "out") as o:
+    ...         _ = o.write_text("a.txt", "a")
+    ...     print(sorted(p.name for p in (Path(d) / "out").iterdir()))
+    ['a.txt', 'manifest.json']
     """
     from bendpam.infra.outputs import OutputSet
 
@@ -327,7 +412,13 @@ def output_set(out: Path, inputs: Iterable[Path | None] = (), *, force: bool | N
 
 
 def output_file(out: Path, inputs: Iterable[Path | None] = (), *, force: bool | None = None) -> OutputFile:
-    """An :class:`~bendpam.infra.outputs.OutputFile` for a command's single output file."""
+    """An :class:`~bendpam.infra.outputs.OutputFile` for a command's single output file.
+
+    >>> output_file(Path("no-such-folder") / "x.csv")
+    Traceback (most recent call last):
+    ...
+    bendpam.cli.options.UserError: --out 'no-such-folder/x.csv': the folder 'no-such-folder' does not exist
+    """
     from bendpam.infra.outputs import OutputFile
 
     typed = as_given(out)
@@ -339,7 +430,11 @@ def output_file(out: Path, inputs: Iterable[Path | None] = (), *, force: bool | 
 
 
 def positive(name: str, value: float | None, unit: str) -> float | None:
-    """A numeric option that must be > 0 (None passes)."""
+    """A numeric option that must be > 0 (None passes).
+
+    >>> positive("--width-mm", 2.0, "mm"), positive("--width-mm", None, "mm")
+    (2.0, None)
+    """
     if value is None:
         return None
     if not (math.isfinite(value) and value > 0):
@@ -349,6 +444,12 @@ def positive(name: str, value: float | None, unit: str) -> float | None:
 
 # ---- figure formats and progress (issue 16) -------------------------------------------------
 class FigureFormat(str, Enum):
+    """The figure formats of ``--format``.
+
+    >>> FIGURE_FORMATS
+    ('png', 'pdf', 'svg')
+    """
+
     png = "png"
     pdf = "pdf"
     svg = "svg"
@@ -369,6 +470,9 @@ def output_format(path: Path | None, fmt: str | Enum | None, formats: tuple[str,
     """The format of an output file from ``--format`` or the suffix of ``path`` (:func:`bendpam.validate.file_format`).
 
     Returns None when ``path`` is None.
+
+    >>> output_format(Path("sweep.csv"), None, ("nc", "csv"))
+    'csv'
     """
     if path is None:
         return None
@@ -376,5 +480,9 @@ def output_format(path: Path | None, fmt: str | Enum | None, formats: tuple[str,
 
 
 def figure_format(path: Path | None, fmt: str | Enum | None, option: str = "--out") -> str | None:
-    """:func:`output_format` for a figure (png, pdf or svg; png when neither the name nor --format says)."""
+    """:func:`output_format` for a figure (png, pdf or svg; png when neither the name nor --format says).
+
+    >>> figure_format(Path("fig.svg"), None), figure_format(Path("fig"), None)
+    ('svg', 'png')
+    """
     return output_format(path, fmt, FIGURE_FORMATS, option=option, default="png")
