@@ -364,3 +364,22 @@ def test_a_damaged_set_is_refused_when_read_back(capsys, lab, tmp_path):
     with pytest.raises(FileFormatError, match=r"no manifest\.json"):
         verify_set(tmp_path, required=True)
     assert verify_set(tmp_path) is None
+
+
+def test_commands_refuse_a_damaged_input_set(capsys, lab, tmp_path):
+    proc = tmp_path / "proc"
+    assert run(capsys, "process", lab / "raw", "--out", proc, "--no-figure")[0] == 0
+    summary = proc / "summary.json"
+    summary.write_text(summary.read_text().replace('"cycles"', '"cycles" ', 1))
+    code, _, err = run(capsys, "fit", proc, "--preset", "be-pam", "--out", tmp_path / "fit")
+    assert code == 2
+    assert one_error(err) == (f"bendpam: error: {summary}: does not match the manifest.json of its folder "
+                              "(size or sha256 differ: changed or damaged after bendpam wrote it)")
+    assert sorted(os.listdir(tmp_path)) == ["proc"]
+    # an input folder with another tool's manifest.json is not bendpam's to check
+    raw = tmp_path / "theirs"
+    raw.mkdir()
+    for f in (lab / "raw").glob("*.csv"):
+        (raw / f.name).write_bytes(f.read_bytes())
+    (raw / "manifest.json").write_text('{"instrument": "Zwick"}')
+    assert run(capsys, "process", raw, "--out", tmp_path / "p2", "--no-figure")[0] == 0

@@ -48,6 +48,7 @@ __all__ = [
     "read_manifest",
     "to_json",
     "verify_file",
+    "verify_input",
     "verify_set",
 ]
 
@@ -411,3 +412,35 @@ def ownership_problem(folder: Path, producer: str | None, shown: str | None = No
         new = f"'bendpam {producer}'" if producer else "this program"
         return f"it holds the output of {by}, which {new} would replace", False
     return None
+
+
+def verify_input(path: str | os.PathLike[str]) -> None:
+    """Check an input that is (or lies in) a bendpam output set against that set's manifest.
+
+    A folder is checked whole (:func:`verify_set`), a file against the manifest of its
+    folder (:func:`verify_file`).  A folder whose ``manifest.json`` is not bendpam's is
+    someone else's data and passes unchecked, as does anything without a manifest.
+
+    Raises
+    ------
+    FileFormatError
+        One line naming the file that differs from the manifest.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     _ = (Path(d) / "manifest.json").write_text('{"tool": "not bendpam"}')
+    ...     verify_input(d)                                        # someone else's: not checked
+    """
+    p = Path(path)
+    folder = p if p.is_dir() else p.parent
+    try:
+        if read_manifest(folder) is None:
+            return
+    except FileFormatError:
+        return
+    if p.is_dir():
+        verify_set(p)
+    else:
+        verify_file(p)

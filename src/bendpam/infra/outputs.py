@@ -49,7 +49,15 @@ from bendpam.errors import InputError
 from bendpam.infra import fsops
 from bendpam.infra.atomic import UMASK, json_safe
 from bendpam.infra.locks import OutputBusy, TargetLock
-from bendpam.infra.manifest import MANIFEST_NAME, build_manifest, now_utc, ownership_problem, read_manifest, to_json
+from bendpam.infra.manifest import (
+    MANIFEST_NAME,
+    build_manifest,
+    now_utc,
+    ownership_problem,
+    read_manifest,
+    to_json,
+    verify_input,
+)
 from bendpam.infra.signals import HeldSignals, Interrupted, interrupts, is_interruption, record_written
 from bendpam.infra.targets import (
     OutputRefused,
@@ -350,7 +358,9 @@ class OutputSet(_Output):
         The output folder (``~`` expanded).  Its parent folders are created if needed.
     inputs : iterable of paths, optional
         The files and folders the run reads.  The target may not be, lie inside or
-        contain one of them; every input must exist.  They are listed, with size and
+        contain one of them; every input must exist, and one that is (or lies in) a
+        bendpam set must match that set's manifest
+        (:func:`~bendpam.infra.manifest.verify_input`).  They are listed, with size and
         sha256, in the manifest.
     command : str or sequence of str, optional
         The command line to record (default ``sys.argv``).
@@ -428,6 +438,8 @@ class OutputSet(_Output):
         resolved = resolve_inputs(self.inputs)
         self._inputs_resolved = [r for _, r in resolved]
         check_against_inputs(self.target, self.shown, resolved, "folder")
+        for _, r in resolved:
+            verify_input(r)  # a set read back must match its manifest
         self._check_target()
         try:
             self.target.parent.mkdir(parents=True, exist_ok=True)
@@ -619,7 +631,10 @@ class OutputFile(_Output):
 
     def _prepare(self) -> None:
         t, shown = self.target, self.shown
-        check_against_inputs(t, shown, resolve_inputs(self.inputs), "file")
+        resolved = resolve_inputs(self.inputs)
+        check_against_inputs(t, shown, resolved, "file")
+        for _, r in resolved:
+            verify_input(r)  # a set read back must match its manifest
         if t.is_dir():
             raise OutputRefused(f"output file {shown!r} is an existing folder")
         if not t.parent.is_dir():
