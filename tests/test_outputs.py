@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import bendpam.infra.fsops as fsops
 import bendpam.infra.outputs as outputs
 from bendpam.errors import InputError
 from bendpam.infra.outputs import (
@@ -246,7 +247,7 @@ def test_set_is_replaced_whole(tmp_path):
 
 
 def test_fallback_swap_without_renameat2(tmp_path, monkeypatch):
-    monkeypatch.setattr(outputs, "_exchange", lambda a, b: False)
+    monkeypatch.setattr(fsops, "exchange", lambda a, b: False)
     target = tmp_path / "out"
     write_set(target, "old")
     write_set(target, "new", n=3)
@@ -255,14 +256,14 @@ def test_fallback_swap_without_renameat2(tmp_path, monkeypatch):
 
 
 def test_exchange_really_swaps(tmp_path):
-    if outputs._RENAMEAT2 is None:
+    if fsops.RENAMEAT2 is None:
         pytest.skip("no renameat2 here")
     a, b = tmp_path / "a", tmp_path / "b"
     a.mkdir()
     b.mkdir()
     (a / "x").write_text("a")
     (b / "y").write_text("b")
-    if not outputs._exchange(a, b):
+    if not fsops.exchange(a, b):
         pytest.skip("this file system refuses RENAME_EXCHANGE")
     assert os.listdir(a) == ["y"] and os.listdir(b) == ["x"]
 
@@ -315,7 +316,7 @@ def test_failure_during_commit_leaves_target_unchanged(tmp_path, monkeypatch):
     def broken(a, b):
         raise OSError(5, "simulated I/O error")
 
-    monkeypatch.setattr(outputs, "_exchange", broken)
+    monkeypatch.setattr(fsops, "exchange", broken)
     with pytest.raises(OSError, match="simulated"), OutputSet(target) as out:
         out.write_text("f0.txt", "new")
     assert snapshot(target) == before
@@ -427,7 +428,7 @@ def test_interrupts_maps_signals_and_restores_handlers(sig, code):
 def test_second_signal_during_cleanup_is_ignored(tmp_path, monkeypatch):
     target = tmp_path / "out"
     before = write_set(target, "old")
-    real_remove = outputs._remove
+    real_remove = fsops.remove_path
 
     def slow_remove(path):
         signal.raise_signal(signal.SIGTERM)  # the impatient second signal
@@ -436,7 +437,7 @@ def test_second_signal_during_cleanup_is_ignored(tmp_path, monkeypatch):
     with pytest.raises(Interrupted) as info, interrupts():
         with OutputSet(target) as out:
             out.write_text("f0.txt", "new")
-            monkeypatch.setattr(outputs, "_remove", slow_remove)
+            monkeypatch.setattr(fsops, "remove_path", slow_remove)
             signal.raise_signal(signal.SIGINT)
     assert info.value.exit_code == 130  # the first signal wins
     assert snapshot(target) == before
@@ -444,7 +445,7 @@ def test_second_signal_during_cleanup_is_ignored(tmp_path, monkeypatch):
 
 
 def test_signal_during_cleanup_of_an_error_is_delivered(tmp_path, monkeypatch):
-    real_remove = outputs._remove
+    real_remove = fsops.remove_path
 
     def remove_then_signal(path):
         signal.raise_signal(signal.SIGTERM)
@@ -453,7 +454,7 @@ def test_signal_during_cleanup_of_an_error_is_delivered(tmp_path, monkeypatch):
     with pytest.raises(Interrupted) as info, interrupts():
         with OutputSet(tmp_path / "out") as out:
             out.write_text("a.txt", "a")
-            monkeypatch.setattr(outputs, "_remove", remove_then_signal)
+            monkeypatch.setattr(fsops, "remove_path", remove_then_signal)
             raise ValueError("bad data")
     assert info.value.exit_code == 143
     assert isinstance(info.value.__context__, ValueError)
@@ -463,13 +464,13 @@ def test_signal_during_cleanup_of_an_error_is_delivered(tmp_path, monkeypatch):
 def test_signal_during_swap_is_held_until_the_set_is_in_place(tmp_path, monkeypatch):
     target = tmp_path / "out"
     write_set(target, "old")
-    real_exchange = outputs._exchange
+    real_exchange = fsops.exchange
 
     def exchange(a, b):
         signal.raise_signal(signal.SIGINT)
         return real_exchange(a, b)
 
-    monkeypatch.setattr(outputs, "_exchange", exchange)
+    monkeypatch.setattr(fsops, "exchange", exchange)
     with pytest.raises(Interrupted), interrupts():
         with OutputSet(target) as out:
             out.write_text("f0.txt", "new")
@@ -584,18 +585,22 @@ def test_foreign_folder_needs_force(tmp_path):
     target = tmp_path / "Documents"
     target.mkdir()
     (target / "thesis.tex").write_text("precious")
-    with pytest.raises(InputError, match=r"no manifest\.json"), OutputSet(target):
+    with pytest.raises(InputError, match=r"thesis\.tex', which bendpam did not write \(no bendpam manifest\.json"), \
+            OutputSet(target):
         pass
     assert (target / "thesis.tex").read_text() == "precious"
+    # issue 21: forcing moves the user's folder aside, it never deletes it
     with OutputSet(target, force=True) as out:
         out.write_text("a.txt", "a")
     check_set(target, {"a.txt": b"a"})
+    assert out.moved_aside is not None and out.moved_aside.parent == tmp_path
+    assert (out.moved_aside / "thesis.tex").read_text() == "precious"
     empty = tmp_path / "empty"
     empty.mkdir()
-    with OutputSet(empty) as out:  # an empty folder is fine
-        out.write_text("a.txt", "a")
+    with OutputSet(empty) as out2:  # an empty folder is fine
+        out2.write_text("a.txt", "a")
     check_set(empty, {"a.txt": b"a"})
-    only(tmp_path, "Documents", "empty")
+    only(tmp_path, "Documents", "empty", out.moved_aside.name)
 
 
 @pytest.mark.parametrize(
@@ -682,7 +687,8 @@ def test_write_json_and_manifest_are_strict(tmp_path):
 # --------------------------------------------------------------------------------------
 def test_output_file(tmp_path):
     target = tmp_path / "curves.csv"
-    with OutputFile(target, inputs=[tmp_path]) as f:
+    # (an output inside an input folder is refused since issue 21: the input is elsewhere)
+    with OutputFile(target, inputs=[Path(__file__)]) as f:
         assert f.path.suffix == ".csv" and f.path.parent == tmp_path
         f.path.write_text("a,b\n1,2\n")
         assert not target.exists()

@@ -5,7 +5,8 @@ Runs the real commands as subprocesses and checks, for every case, that the outc
 
 * exit 0 (and strict JSON on stdout with ``--json``: no ``NaN``/``Infinity``),
 * exit 2 with ONE line ``bendpam: error: ...`` on stderr (``bendpam: warning:`` lines may precede it),
-* exit 130/143 with the line ``bendpam: interrupted; no outputs were changed`` (SIGINT/SIGTERM),
+* exit 130/143 with the line ``bendpam: interrupted; no outputs were changed`` (SIGINT/SIGTERM), or
+  ``bendpam: interrupted after writing DIR`` when the signal came after the outputs were committed,
 
 and never a traceback, an exit-1 internal error or a hang.  Runs killed at random times (SIGINT,
 SIGTERM, SIGKILL) of ``process``, ``fit``, ``report`` and ``sweep`` check the output-set invariant:
@@ -42,6 +43,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 INTERRUPT_LINE = "bendpam: interrupted; no outputs were changed"
+#: the interrupt line once the outputs were committed (issue 21)
+INTERRUPT_AFTER = "bendpam: interrupted after writing "
 TIMEOUT_S = 120.0
 TEMP_RE = re.compile(r"\..+\.bendpam-(lock|tmp-|old-|del-).*")
 
@@ -118,7 +121,7 @@ def classify(r: Run) -> tuple[str, str]:
             return "error", errors[0]
         return "bad-error", r.stderr.strip()[-800:]
     if r.rc in (130, 143):
-        if err_lines and err_lines[-1] == INTERRUPT_LINE:
+        if err_lines and (err_lines[-1] == INTERRUPT_LINE or err_lines[-1].startswith(INTERRUPT_AFTER)):
             return "interrupt", ""
         return "bad-error", f"exit {r.rc}: {r.stderr.strip()[-500:]}"
     return "bad-error", f"exit {r.rc}: {r.stderr.strip()[-500:]}"

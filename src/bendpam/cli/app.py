@@ -1,18 +1,28 @@
 """The ``bendpam`` Typer application and its entry point :func:`main`.
 
 ``main`` turns the library's :class:`~bendpam.errors.BendpamError` into one line
-``bendpam: error: ...`` on stderr and exit status 2; SIGINT and SIGTERM into
-``bendpam: interrupted; no outputs were changed`` and 130/143.  Any other exception is a bug: one
-line saying so and where to report it, exit status 1 (``--debug`` prints the traceback).
+``bendpam: error: ...`` on stderr and exit status 2; SIGINT and SIGTERM into one line and 130/143:
+``bendpam: interrupted; no outputs were changed`` before any output was committed,
+``bendpam: interrupted after writing DIR`` after.  Any other exception is a bug: one line saying so
+and where to report it, exit status 1 (``--debug`` prints the traceback).
+
+Every output a command writes (through :func:`bendpam.cli.options.output_set` /
+:func:`~bendpam.cli.options.output_file`, or :class:`~bendpam.infra.outputs.OutputSet` /
+:class:`~bendpam.infra.outputs.OutputFile` directly) joins one
+:class:`~bendpam.infra.outputs.OutputGroup`: the outputs of a command are committed together when
+it returns with status 0, or all rolled back.
 """
 
 from __future__ import annotations
 
+import logging
 import sys
 import traceback
 from typing import Annotated, Any, Optional
 
 import typer
+
+from bendpam.cli.options import RUN_ARGS, RUN_COMMAND, RUN_FORCE
 
 __all__ = ["ISSUES_URL", "app", "main"]
 
@@ -40,13 +50,22 @@ def _version(value: bool) -> None:
         raise typer.Exit(0)
 
 
+FORCE_HELP = ("Replace an output that bendpam did not write, or that another bendpam command wrote: the old "
+              "folder is moved aside to NAME.moved-aside-TIME, never deleted (the home folder, the current folder "
+              "and the inputs are refused all the same).  Also accepted after the command's name.")
+
+
 @app.callback()
 def _root(
+    ctx: typer.Context,
     version: Annotated[Optional[bool], typer.Option("--version", callback=_version, is_eager=True,
                                                     help="Print the version and exit.")] = None,
     debug: Annotated[bool, typer.Option("--debug", help="Print the traceback of an internal error.")] = False,
+    force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
 ) -> None:
     """bendpam: models, tests and design tools for bending pneumatic artificial muscles."""
+    RUN_COMMAND.set(ctx.invoked_subcommand)
+    RUN_FORCE.set(force)
 
 
 # Typer >= 0.20 vendors click; find its exception base class without importing click directly.
@@ -55,8 +74,43 @@ _ClickException: type[Any] = next(c for c in typer.BadParameter.__mro__ if c.__n
 
 
 def _one_line(exc: BaseException) -> str:
+    from bendpam.infra.targets import OutputRefused
+
+    if isinstance(exc, OutputRefused) and exc.forceable:
+        moved = " (the old folder is then moved aside, not deleted)" if exc.reason.startswith("output folder") else ""
+        return f"{exc.reason}; choose another place, or add --force{moved}"
     text = str(exc).strip()
     return text.splitlines()[0] if text else type(exc).__name__
+
+
+def _lift_force(args: list[str]) -> list[str]:
+    """``--force`` after a command that has no such option of its own goes to the root options."""
+    end = args.index("--") if "--" in args else len(args)
+    if "--force" not in args[:end]:
+        return args
+    name = next((a for a in args[:end] if not a.startswith("-")), None)
+    group = typer.main.get_command(app)
+    cmd = getattr(group, "commands", {}).get(name) if name else None
+    if cmd is not None and any("--force" in getattr(p, "opts", ()) for p in cmd.params):
+        return args
+    rest = list(args)
+    rest.remove("--force")
+    return ["--force", *rest]
+
+
+def _run(args: list[str]) -> Any:
+    """Run the app with every output of the command in one group (committed when it returns 0)."""
+    from bendpam.infra.outputs import OutputGroup
+
+    group = OutputGroup()
+    with group:
+        rv = app(args=args, prog_name="bendpam", standalone_mode=False)
+        if isinstance(rv, int) and not isinstance(rv, bool) and rv != 0:
+            group.abort()  # a command that fails keeps no outputs
+    for m in group.members:
+        if m.moved_aside is not None:
+            typer.echo(f"bendpam: warning: the old content of {m.shown} was moved to {m.moved_aside}", err=True)
+    return rv
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -69,25 +123,27 @@ def main(argv: list[str] | None = None) -> int:
     2
     """
     from bendpam.errors import BendpamError
+    from bendpam.infra.signals import Interrupted, forget_written, interrupted_line, interrupts, quiet_logging
 
     args = list(sys.argv[1:] if argv is None else argv)
     if not args:
         args = ["--help"]
     debug = "--debug" in args
-    from bendpam.infra.outputs import Interrupted, interrupts
-
+    forget_written()
+    tokens = (RUN_ARGS.set(list(args)), RUN_COMMAND.set(None), RUN_FORCE.set(False))
     try:
-        with interrupts():
-            rv = app(args=args, prog_name="bendpam", standalone_mode=False)
+        args = _lift_force(args)
+        with interrupts(on_signal=quiet_logging):
+            rv = _run(args)
         if isinstance(rv, int) and not isinstance(rv, bool):  # typer.Exit(code) inside a command
             return rv
     except Interrupted as exc:
-        typer.echo("bendpam: interrupted; no outputs were changed", err=True)
+        typer.echo(interrupted_line(), err=True)
         return exc.exit_code
     except typer.Exit as exc:
         return exc.exit_code
     except (typer.Abort, KeyboardInterrupt):
-        typer.echo("bendpam: interrupted; no outputs were changed", err=True)
+        typer.echo(interrupted_line(), err=True)
         return 130
     except _ClickException as exc:
         typer.echo(f"bendpam: error: {exc.format_message()}", err=True)
@@ -112,4 +168,9 @@ def main(argv: list[str] | None = None) -> int:
                    f"please report it to {ISSUES_URL}" + ("" if debug else "; --debug shows the traceback"),
                    err=True)
         return 1
+    finally:
+        logging.disable(logging.NOTSET)  # (quiet_logging after a signal)
+        RUN_ARGS.reset(tokens[0])
+        RUN_COMMAND.reset(tokens[1])
+        RUN_FORCE.reset(tokens[2])
     return 0

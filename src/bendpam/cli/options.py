@@ -7,10 +7,14 @@ Multi-valued numbers (``--pressure-kpa``, ``--param``) take separate tokens, com
 
 from __future__ import annotations
 
+import contextvars
 import math
+import os
+import sys
+from collections.abc import Iterable
 from enum import Enum
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Optional
+from typing import TYPE_CHECKING, Annotated, Any, Optional
 
 import typer
 from typer.core import TyperCommand
@@ -19,11 +23,16 @@ from bendpam.errors import InputError
 from bendpam.validate import file_format
 
 if TYPE_CHECKING:
+    from bendpam.infra.outputs import OutputFile, OutputSet
     from bendpam.physics.actuator import Actuator
 
 __all__ = [
     "FIGURE_FORMATS",
     "MULTI_VALUE_OPTIONS",
+    "RANGE_HELP",
+    "RUN_ARGS",
+    "RUN_COMMAND",
+    "RUN_FORCE",
     "ActuatorOpt",
     "FigureFormat",
     "FigureFormatOpt",
@@ -36,15 +45,22 @@ __all__ = [
     "PressureOpt",
     "QuietOpt",
     "UserError",
+    "as_given",
     "collect_raw_files",
+    "command_inputs",
+    "command_line",
     "echo",
     "figure_format",
     "fmt_num",
     "format_prediction_table",
     "load_actuator",
     "model_name",
+    "output_file",
     "output_format",
+    "output_set",
     "parse_values",
+    "positive",
+    "pressure_kpa",
     "pressures_kpa",
 ]
 
@@ -53,20 +69,42 @@ MAX_VALUES = 1_000_000
 
 
 class UserError(InputError):
-    """A command line that cannot be acted on (a missing option, inconsistent options)."""
+    """A command line that cannot be acted on (a missing option, inconsistent options).
+
+    >>> issubclass(UserError, InputError)
+    True
+    """
 
 
 class Model(str, Enum):
+    """The moment model of ``--model``.
+
+    >>> Model("force-balance").name
+    'force_balance'
+    """
+
     energy = "energy"
     force_balance = "force-balance"
 
 
 class Preset(str, Enum):
+    """The paper's actuators of ``--preset``.
+
+    >>> [p.value for p in Preset]
+    ['be-pam', 'bc-pam']
+    """
+
     be_pam = "be-pam"
     bc_pam = "bc-pam"
 
 
 class Format(str, Enum):
+    """The export dialects of ``simulate-test --format``.
+
+    >>> Format("mts").value
+    'mts'
+    """
+
     csv = "csv"
     testxpert = "testxpert"
     bluehill = "bluehill"
@@ -88,7 +126,11 @@ MULTI_VALUE_OPTIONS = ("--pressure-kpa", "--diameter-mm", "--direction-deg")
 
 
 class MultiValueCommand(TyperCommand):
-    """A command in which ``--opt a b c`` means ``--opt a --opt b --opt c`` for the options above."""
+    """A command in which ``--opt a b c`` means ``--opt a --opt b --opt c`` for the options above.
+
+    >>> "--pressure-kpa" in MultiValueCommand.multi_value_options
+    True
+    """
 
     multi_value_options = MULTI_VALUE_OPTIONS
 
@@ -118,11 +160,20 @@ class MultiValueCommand(TyperCommand):
 
 
 def echo(text: str = "", err: bool = False) -> None:
+    """Print one line (to stderr with ``err``).
+
+    >>> echo("wrote out/")
+    wrote out/
+    """
     typer.echo(text, err=err)
 
 
 def parse_values(tokens: list[str] | None, name: str, *, max_values: int = MAX_VALUES) -> list[float]:
-    """Parse numbers given as separate tokens, comma lists or ranges ``start:stop:count``."""
+    """Parse numbers given as separate tokens, comma lists or ranges ``start:stop:count``.
+
+    >>> parse_values(["100,150", "200:300:3"], "--pressure-kpa")
+    [100.0, 150.0, 200.0, 250.0, 300.0]
+    """
     out: list[float] = []
     for tok in tokens or []:
         for part in str(tok).replace(",", " ").split():
@@ -155,12 +206,24 @@ def parse_values(tokens: list[str] | None, name: str, *, max_values: int = MAX_V
 
 
 def pressure_kpa(value: float, name: str = "--pressure-kpa") -> float:
-    """One pressure option in kPa, with the same checks as :func:`pressures_kpa`."""
+    """One pressure option in kPa, with the same checks as :func:`pressures_kpa`.
+
+    >>> pressure_kpa(150)
+    150.0
+    """
     return pressures_kpa([repr(float(value))], None, name)[0]
 
 
 def pressures_kpa(first: list[str] | None, more: list[str] | None = None, name: str = "--pressure-kpa") -> list[float]:
-    """Pressures (kPa) from the option's values (``more``: values that followed it, if any)."""
+    """Pressures (kPa) from the option's values (``more``: values that followed it, if any).
+
+    >>> pressures_kpa(["100:200:3"])
+    [100.0, 150.0, 200.0]
+    >>> pressures_kpa(["0.2"])
+    Traceback (most recent call last):
+    ...
+    bendpam.cli.options.UserError: --pressure-kpa: every pressure is below 5 kPa (largest 0.2); ...
+    """
     values = parse_values((first or []) + (more or []), name)
     if not values:
         raise UserError(f"give at least one pressure with {name} (kPa), e.g. {name} 100 150 200")
@@ -175,12 +238,22 @@ def pressures_kpa(first: list[str] | None, more: list[str] | None = None, name: 
 
 
 def model_name(model: Model) -> str:
+    """The library's name of a ``--model`` choice.
+
+    >>> model_name(Model.force_balance)
+    'force_balance'
+    """
     from bendpam.physics.models import normalise_model
 
     return normalise_model(model.value)
 
 
 def load_actuator(preset: Preset | None, actuator: Path | None, model: Model) -> Actuator:
+    """The actuator of ``--preset`` or ``--actuator`` (exactly one of them).
+
+    >>> load_actuator(Preset.be_pam, None, Model.energy).alpha0_deg
+    69.7
+    """
     if preset is not None and actuator is not None:
         raise UserError("give either --preset or --actuator, not both")
     if preset is None and actuator is None:
@@ -199,7 +272,11 @@ def load_actuator(preset: Preset | None, actuator: Path | None, model: Model) ->
 
 
 def fmt_num(x, fmt: str) -> str:
-    """``format(x, fmt)``, or a dash of the same width for None/NaN/inf."""
+    """``format(x, fmt)``, or a dash of the same width for None/NaN/inf.
+
+    >>> fmt_num(1.23456, "6.2f"), fmt_num(float("nan"), "6.2f")
+    ('  1.23', '     —')
+    """
     width = fmt.split(".")[0]
     try:
         ok = x is not None and math.isfinite(float(x))
@@ -209,6 +286,14 @@ def fmt_num(x, fmt: str) -> str:
 
 
 def format_prediction_table(df, title: str) -> str:
+    """The text table of ``predict``.
+
+    >>> import pandas as pd
+    >>> row = dict(pressure_kpa=150.0, blocked_moment_nmm=200.0, free_curvature_per_mm=0.01, free_angle_deg=30.0,
+    ...            note="")
+    >>> print(format_prediction_table(pd.DataFrame([row]), "BE-PAM").splitlines()[-1])
+         150            200.00        0.01000         30.00
+    """
     lines = [title, f"{'P (kPa)':>8}  {'M_blocked (N·mm)':>16}  {'k_free (1/mm)':>13}  {'θ_free (deg)':>12}  note"]
     for r in df.itertuples():
         lines.append(
@@ -219,37 +304,137 @@ def format_prediction_table(df, title: str) -> str:
 
 
 def collect_raw_files(paths: list[Path]) -> list[Path]:
-    """Expand folders into their raw test files (see :func:`bendpam.lab.files.collect_raw_files`)."""
+    """Expand folders into their raw test files (see :func:`bendpam.lab.files.collect_raw_files`).
+
+    >>> collect_raw_files([Path("no-such-folder")])
+    Traceback (most recent call last):
+    ...
+    bendpam.errors.InputError: no-such-folder: no such file or folder
+    """
     from bendpam.lab.files import collect_raw_files as collect
 
     return collect(paths)
 
 
+#: The arguments of the running command line (set by :func:`bendpam.cli.app.main`).
+RUN_ARGS: contextvars.ContextVar[list[str] | None] = contextvars.ContextVar("bendpam_run_args", default=None)
+#: The name of the running command (``"process"``): the producer recorded in its output sets.
+RUN_COMMAND: contextvars.ContextVar[str | None] = contextvars.ContextVar("bendpam_run_command", default=None)
+#: ``bendpam --force``: replace outputs that bendpam did not write, moving them aside.
+RUN_FORCE: contextvars.ContextVar[bool] = contextvars.ContextVar("bendpam_run_force", default=False)
+#: Parameters of a command that name its outputs (every other path parameter is an input).
+OUTPUT_PARAMS = ("out", "plot")
+
+
 def command_line() -> list[str]:
-    """The command line, for the manifests of output sets."""
-    import sys
+    """The command line, for the manifests of output sets.
 
-    return ["bendpam", *sys.argv[1:]]
+    >>> command_line()[0]
+    'bendpam'
+    """
+    args = RUN_ARGS.get()
+    return ["bendpam", *(sys.argv[1:] if args is None else args)]
 
 
-def output_set(out: Path, inputs=()):
-    """An :class:`~bendpam.infra.outputs.OutputSet` for a command's output folder (whole set or nothing)."""
+def _click_context() -> Any:
+    """The running command's click context (Typer may vendor click), or None."""
+    base = next((c for c in typer.Context.__mro__[1:] if c.__name__ == "Context"), None)
+    core = sys.modules.get(base.__module__) if base is not None else None
+    push = getattr(core, "push_context", None)
+    get = getattr(sys.modules.get(getattr(push, "__module__", "") or ""), "get_current_context", None)
+    return get(silent=True) if callable(get) else None
+
+
+def command_inputs() -> list[Path]:
+    """The existing paths among the running command's parameters, outputs (``--out``, ``--plot``) aside.
+
+    Every output is checked against them: an output equal to, inside or containing an input
+    folder given on the command line is refused for every command, whatever inputs the
+    command itself passes.
+
+    >>> command_inputs()      # outside a command
+    []
+    """
+    ctx = _click_context()
+    if ctx is None:
+        return []
+    found: list[Path] = []
+    for name, value in (getattr(ctx, "params", None) or {}).items():
+        if name in OUTPUT_PARAMS:
+            continue
+        for v in value if isinstance(value, list | tuple) else [value]:
+            if isinstance(v, os.PathLike) and os.path.exists(v):
+                found.append(Path(v))
+    return found
+
+
+def _inputs(inputs: Iterable[Path | None]) -> list[Path]:
+    out: list[Path] = []
+    for p in [*inputs, *command_inputs()]:
+        if p is not None and Path(p) not in out:
+            out.append(Path(p))
+    return out
+
+
+def as_given(out: Path) -> Path | str:
+    """``out`` as typed: Typer's ``Path("./~")`` is ``Path("~")``; only a ``~`` typed first means home.
+
+    >>> str(as_given(Path("data")))
+    'data'
+    """
+    text = str(out)
+    if not text.startswith("~"):
+        return out
+    values = [a.split("=", 1)[1] if a.startswith("--") and "=" in a else a for a in RUN_ARGS.get() or []]
+    typed = [v for v in values if v and Path(v) == out]
+    if typed and not any(v.startswith("~") for v in typed):
+        return os.path.join(".", text)  # typed as ./~ : a folder named ~ here
+    return text
+
+
+def output_set(out: Path, inputs: Iterable[Path | None] = (), *, force: bool | None = None) -> OutputSet:
+    """An :class:`~bendpam.infra.outputs.OutputSet` for a command's output folder (whole set or nothing).
+
+    The producer recorded is the command's name; ``force`` defaults to ``bendpam --force``;
+    the inputs are ``inputs`` and every path parameter of the command but its outputs.
+
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     with output_set(Path(d) / "out") as o:
+    ...         _ = o.write_text("a.txt", "a")
+    ...     print(sorted(p.name for p in (Path(d) / "out").iterdir()))
+    ['a.txt', 'manifest.json']
+    """
     from bendpam.infra.outputs import OutputSet
 
-    return OutputSet(out, inputs=[p for p in inputs if p is not None], command=command_line())
+    return OutputSet(as_given(out), inputs=_inputs(inputs), command=command_line(),
+                     force=RUN_FORCE.get() if force is None else force, producer=RUN_COMMAND.get())
 
 
-def output_file(out: Path, inputs=()):
-    """An :class:`~bendpam.infra.outputs.OutputFile` for a command's single output file."""
+def output_file(out: Path, inputs: Iterable[Path | None] = (), *, force: bool | None = None) -> OutputFile:
+    """An :class:`~bendpam.infra.outputs.OutputFile` for a command's single output file.
+
+    >>> output_file(Path("no-such-folder") / "x.csv")
+    Traceback (most recent call last):
+    ...
+    bendpam.cli.options.UserError: --out 'no-such-folder/x.csv': the folder 'no-such-folder' does not exist
+    """
     from bendpam.infra.outputs import OutputFile
 
-    if not out.parent.is_dir():
-        raise UserError(f"--out {str(out)!r}: the folder {str(out.parent)!r} does not exist")
-    return OutputFile(out, inputs=[p for p in inputs if p is not None], command=command_line())
+    typed = as_given(out)
+    given = Path(os.path.expanduser(typed) if isinstance(typed, str) and typed.startswith("~") else typed)
+    if not given.parent.is_dir():
+        raise UserError(f"--out {str(out)!r}: the folder {str(given.parent)!r} does not exist")
+    return OutputFile(typed, inputs=_inputs(inputs), command=command_line(),
+                      force=RUN_FORCE.get() if force is None else force)
 
 
 def positive(name: str, value: float | None, unit: str) -> float | None:
-    """A numeric option that must be > 0 (None passes)."""
+    """A numeric option that must be > 0 (None passes).
+
+    >>> positive("--width-mm", 2.0, "mm"), positive("--width-mm", None, "mm")
+    (2.0, None)
+    """
     if value is None:
         return None
     if not (math.isfinite(value) and value > 0):
@@ -259,6 +444,12 @@ def positive(name: str, value: float | None, unit: str) -> float | None:
 
 # ---- figure formats and progress (issue 16) -------------------------------------------------
 class FigureFormat(str, Enum):
+    """The figure formats of ``--format``.
+
+    >>> FIGURE_FORMATS
+    ('png', 'pdf', 'svg')
+    """
+
     png = "png"
     pdf = "pdf"
     svg = "svg"
@@ -279,6 +470,9 @@ def output_format(path: Path | None, fmt: str | Enum | None, formats: tuple[str,
     """The format of an output file from ``--format`` or the suffix of ``path`` (:func:`bendpam.validate.file_format`).
 
     Returns None when ``path`` is None.
+
+    >>> output_format(Path("sweep.csv"), None, ("nc", "csv"))
+    'csv'
     """
     if path is None:
         return None
@@ -286,5 +480,9 @@ def output_format(path: Path | None, fmt: str | Enum | None, formats: tuple[str,
 
 
 def figure_format(path: Path | None, fmt: str | Enum | None, option: str = "--out") -> str | None:
-    """:func:`output_format` for a figure (png, pdf or svg; png when neither the name nor --format says)."""
+    """:func:`output_format` for a figure (png, pdf or svg; png when neither the name nor --format says).
+
+    >>> figure_format(Path("fig.svg"), None), figure_format(Path("fig"), None)
+    ('svg', 'png')
+    """
     return output_format(path, fmt, FIGURE_FORMATS, option=option, default="png")

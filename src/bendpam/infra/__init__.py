@@ -1,5 +1,15 @@
-"""Infrastructure beside the layers: atomic writes, output sets, progress lines.
+"""Infrastructure beside the layers: output sets, atomic writes, signals, progress lines.
 
 These modules import only the standard library, :mod:`bendpam.errors`, :mod:`bendpam.validate` and
-:mod:`bendpam.version`, so every layer may use them.
+:mod:`bendpam.version` (and :mod:`filelock`, lazily, for the locks of output targets), so every
+layer may use them.  None imports a POSIX-only module at module level.
+
+* :mod:`.outputs`: :class:`~.outputs.OutputSet`, :class:`~.outputs.OutputFile`,
+  :class:`~.outputs.OutputGroup` (all-or-nothing outputs that replace only what bendpam wrote);
+* :mod:`.manifest`: the manifest of a set, its checks when a set is replaced or read back;
+* :mod:`.targets`: where an output may go (``~``, links, inputs, the home folder);
+* :mod:`.signals`: SIGINT/SIGTERM as :class:`~.signals.Interrupted`, held sections, honest words;
+* :mod:`.locks`: the portable lock of an output target;
+* :mod:`.fsops`: temporaries, flushing, hashing and the folder swap;
+* :mod:`.atomic`, :mod:`.progress`, :mod:`.accessors`.
 """

@@ -1,7 +1,10 @@
 """Atomic output helpers: write to a temporary file in the target folder, then rename.
 
 An interrupted run therefore never leaves a half-written output behind, and an existing file is
-replaced in one step (``os.replace`` is atomic on POSIX and Windows for same-volume renames).
+replaced in one step (``os.replace`` is atomic on POSIX and Windows for same-volume renames).  The
+temporary is named like the temporaries of :mod:`bendpam.infra.outputs`
+(``.NAME.bendpam-tmp-<pid>-<random><suffix>``), so that a run that writes the same target under
+its lock removes one left by a killed process.
 """
 
 from __future__ import annotations
@@ -14,9 +17,10 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-__all__ = ["atomic_path", "atomic_write_bytes", "atomic_write_text", "json_safe"]
+__all__ = ["UMASK", "atomic_path", "atomic_write_bytes", "atomic_write_text", "json_safe"]
 
-# mkstemp creates files readable by the owner only; outputs get the usual permissions instead
+#: The process's umask (mkstemp creates files readable by the owner only; outputs get the usual
+#: permissions instead).
 UMASK = os.umask(0)
 os.umask(UMASK)
 
@@ -27,12 +31,22 @@ def atomic_path(path: str | os.PathLike, suffix: str | None = None) -> Iterator[
 
     The temporary file keeps ``path``'s suffix (or ``suffix``) so that writers which choose a
     format from the extension (matplotlib, pandas, xarray) still work.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     with atomic_path(Path(d) / "a.csv") as tmp:
+    ...         _ = tmp.write_text("x\\n")
+    ...     print(sorted(p.name for p in Path(d).iterdir()))
+    ['a.csv']
     """
     target = Path(path)
     parent = target.parent if str(target.parent) else Path(".")
     if not parent.is_dir():
         raise FileNotFoundError(f"output folder {str(parent)!r} does not exist (for {str(target)!r})")
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=suffix or target.suffix or ".tmp", dir=parent)
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.bendpam-tmp-{os.getpid()}-",
+                               suffix=suffix or target.suffix or ".tmp", dir=parent)
     os.close(fd)
     tmp_path = Path(tmp)
     try:
@@ -47,13 +61,31 @@ def atomic_path(path: str | os.PathLike, suffix: str | None = None) -> Iterator[
 
 
 def atomic_write_text(path: str | os.PathLike, text: str, encoding: str = "utf-8") -> None:
-    """Write ``text`` to ``path`` atomically."""
+    """Write ``text`` to ``path`` atomically.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     atomic_write_text(Path(d) / "a.txt", "hello")
+    ...     print((Path(d) / "a.txt").read_text())
+    hello
+    """
     with atomic_path(path) as tmp:
         tmp.write_text(text, encoding=encoding)
 
 
 def atomic_write_bytes(path: str | os.PathLike, data: bytes) -> None:
-    """Write ``data`` to ``path`` atomically."""
+    """Write ``data`` to ``path`` atomically.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     atomic_write_bytes(Path(d) / "a.bin", b"\\x00\\x01")
+    ...     print((Path(d) / "a.bin").read_bytes())
+    b'\\x00\\x01'
+    """
     with atomic_path(path) as tmp:
         tmp.write_bytes(data)
 
@@ -65,6 +97,12 @@ def json_safe(obj: Any) -> Any:
     non-finite floats (NaN, +-inf) become ``None`` (JSON ``null``); tuples become
     lists; paths become strings; NumPy mapping keys become plain, non-finite float
     keys strings.  Anything else is returned unchanged (``json.dumps`` decides).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> json_safe({"x": np.float64("nan"), "a": np.arange(2), "t": (1, 2.5)})
+    {'x': None, 'a': [0, 1], 't': [1, 2.5]}
     """
     if isinstance(obj, dict):
         return {_json_key(k): json_safe(v) for k, v in obj.items()}
