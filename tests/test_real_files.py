@@ -89,7 +89,8 @@ SUMMARY = "whiterabbit_WaveMatrix_latexglove_Test6.steps.trends.csv"
 
 
 def test_all_real_files_are_covered():
-    names = {p.name for p in REAL.iterdir() if p.suffix != ".md"}
+    # the original seven files (the corpus of issue 22 lives in dev/ and holdout/ with its truth.toml)
+    names = {p.name for p in REAL.iterdir() if p.is_file() and p.suffix not in (".md", ".toml")}
     assert names == set(EXPECTED) | {SUMMARY}
 
 

@@ -456,13 +456,11 @@ def test_the_layer_check_sees_function_level_and_upward_imports():
     assert string_imports(ast.parse("importlib.import_module('bendpam.cli.app')")) == [(1, "bendpam.cli.app")]
 
 
-@pytest.mark.xfail(reason="issue 20: fixed layer by layer; the marker goes when they are", strict=False)
 def test_no_import_goes_up_a_layer():
     bad = upward_imports()
     assert bad == [], "imports that go up a layer (function-level ones included):\n" + "\n".join(bad)
 
 
-@pytest.mark.xfail(reason="issue 20: fixed layer by layer; the marker goes when they are", strict=False)
 def test_no_cycle_counting_function_level_imports():
     cycles = find_cycles({k: {v for v in vs if v in LAYERED} for k, vs in full_graph().items()})
     assert cycles == [], "import cycles (function-level imports included): " + "; ".join(" -> ".join(c) for c in cycles)
@@ -491,7 +489,6 @@ def names_used_outside_all() -> list[str]:
     return sorted(set(bad))
 
 
-@pytest.mark.xfail(reason="issue 20: fixed layer by layer; the marker goes when they are", strict=False)
 def test_every_name_used_across_modules_is_in_its_modules_all():
     bad = names_used_outside_all()
     assert bad == [], "names imported from another module but missing from its __all__:\n" + "\n".join(bad)
@@ -520,7 +517,6 @@ def library_messages_naming_flags() -> list[str]:
     return bad
 
 
-@pytest.mark.xfail(reason="issue 20: fixed layer by layer; the marker goes when they are", strict=False)
 def test_no_library_message_names_a_cli_flag():
     bad = library_messages_naming_flags()
     assert bad == [], "library errors and warnings name CLI flags (errors.py: the CLI adds those):\n" + "\n".join(bad)
@@ -558,13 +554,11 @@ def long_files() -> list[str]:
     return out
 
 
-@pytest.mark.xfail(reason="issue 20: fixed layer by layer; the marker goes when they are", strict=False)
 def test_no_function_is_over_80_lines():
     bad = long_functions()
     assert bad == [], f"functions over {MAX_FUNCTION_LINES} lines (carve them along their steps):\n" + "\n".join(bad)
 
 
-@pytest.mark.xfail(reason="issue 20: fixed layer by layer; the marker goes when they are", strict=False)
 def test_no_file_is_over_1000_lines():
     bad = long_files()
     assert bad == [], f"files over {MAX_FILE_LINES} lines:\n" + "\n".join(bad)

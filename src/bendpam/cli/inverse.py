@@ -24,7 +24,7 @@ from bendpam.cli.options import (
     pressures_kpa,
 )
 
-__all__ = ["design_cmd"]
+__all__: list[str] = []  # the command registers itself on the app (bendpam.cli.app); nothing to import
 
 _TARGET_HELP = (
     "A target NAME=VALUE@P, NAME>=VALUE@P or NAME<=VALUE@P (P in kPa; repeat for more). NAME: blocked_moment_nmm, "

@@ -224,11 +224,11 @@ def simulate_test_cmd(
                             hysteresis_offset_nmm=hysteresis_offset_nmm, dwell_s=dwell_s,
                             stroke_offset_mm=stroke_offset_mm, seed=seed)
     fx = Fixture.from_string(fixture, L0_mm=act.L0_mm, name="--fixture")
-    try:
-        with output_set(out, [actuator]) as o:
+    with output_set(out, [actuator]) as o:
+        try:
             truth = simulate_tests(act, P, o.staging, model_name(model), dialect=fmt.value, fixture=fx, settings=st)
-    except InputError as exc:  # the library names the settings; this command's options say them as flags
-        raise UserError(_SETTING_FLAGS.sub(lambda m: _FLAGS[m.group(0)], str(exc))) from None
+        except InputError as exc:  # the library names the settings; this command's options say them as flags
+            raise UserError(_SETTING_FLAGS.sub(lambda m: _FLAGS[m.group(0)], str(exc))) from None
     for t in truth["pressures"]:
         typer.echo(
             f"{t['file']}: {t['samples']} samples, blocked {t['blocked_moment_nmm']:.2f} N·mm, "

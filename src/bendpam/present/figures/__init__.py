@@ -54,4 +54,7 @@ __all__ = [
     "styled_figure",
     "sweep_figure",
 ]
-from bendpam.present.figures import design  # noqa: F401  (registers the design figures)
+from bendpam.present.figures import (
+    design,  # noqa: F401  (registers the design figures)
+    report,  # noqa: F401  (registers the report's figures)
+)

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-import matplotlib.pyplot as plt
+import matplotlib
 import numpy as np
 from matplotlib.colors import LogNorm
 
@@ -28,7 +28,7 @@ from bendpam.design.targets import NAN_MISS, TOL
 from bendpam.design.wrist import wrist_pressures
 from bendpam.errors import InputError
 from bendpam.infra.accessors import register
-from bendpam.present.figures.base import figure_size, figure_style, save_figure
+from bendpam.present.figures.style import figure_size, figure_style, new_figure, save_figure
 
 if TYPE_CHECKING:
     from bendpam.design.result import DesignResult
@@ -55,21 +55,20 @@ def plot_finger_shapes(shapes, ax=None, title: str | None = None):
 
     Examples
     --------
-    >>> import matplotlib.pyplot as plt
     >>> from bendpam.physics.presets import be_pam
     >>> from bendpam.design import Finger, solve_finger
     >>> finger = Finger(be_pam())
     >>> fig = plot_finger_shapes([solve_finger(finger, p) for p in (100.0, 150.0)])
     >>> len(fig.axes)                                     # fig.savefig("shapes.png") to keep it
     1
-    >>> plt.close(fig)
     """
     if ax is None:
-        fig, ax = plt.subplots(figsize=(6.0, 5.0))
+        fig = new_figure((6.0, 5.0))
+        ax = fig.add_subplot()
     else:
         fig = ax.figure
     shapes = list(shapes)
-    colors = plt.cm.viridis(np.linspace(0.0, 0.9, max(len(shapes), 1)))
+    colors = matplotlib.colormaps["viridis"](np.linspace(0.0, 0.9, max(len(shapes), 1)))
     for sh, col in zip(shapes, colors, strict=False):
         draw, style = (sh, "-") if sh.equilibrium else (sh.limit, "--")
         label = f"{sh.pressure_kpa:g} kPa" + ("" if sh.equilibrium else " (no equilibrium)")
@@ -103,25 +102,24 @@ def plot_grasp(ds, ax=None, title: str | None = None):
 
     Examples
     --------
-    >>> import matplotlib.pyplot as plt
     >>> from bendpam.physics.presets import be_pam
     >>> from bendpam.design import Gripper, grasp_sweep
     >>> gripper = Gripper(be_pam().replace(L0_mm=130.0))
     >>> fig = plot_grasp(grasp_sweep(gripper, [160.0, 200.0], [160.0]))
     >>> len(fig.axes)                                     # fig.savefig("grip.png") to keep it
     1
-    >>> plt.close(fig)
     """
     with figure_style():
         if ax is None:
-            fig, ax = plt.subplots(figsize=figure_size("single", 0.8))
+            fig = new_figure(figure_size("single", 0.8))
+            ax = fig.add_subplot()
         else:
             fig = ax.figure
         P = ds["pressure_kpa"].values
         D = ds["diameter_mm"].values
         grip = np.array(ds["grip_force_n"].values, dtype=float)
         hole = (ds["contact"].values == "none") | ~ds["equilibrium"].values.astype(bool) | ~np.isfinite(grip)
-        colors = plt.cm.viridis(np.linspace(0.0, 0.85, max(P.size, 1)))
+        colors = matplotlib.colormaps["viridis"](np.linspace(0.0, 0.85, max(P.size, 1)))
         for j, p in enumerate(P):
             y = np.where(hole[:, j], np.nan, grip[:, j])
             ax.plot(D, y, "-", marker=_MARKERS[j % len(_MARKERS)], color=colors[j], label=f"{p:g} kPa")
@@ -197,17 +195,16 @@ def plot_wrist(table, holds=(), ax=None, title: str | None = None, positions_deg
 
     Examples
     --------
-    >>> import matplotlib.pyplot as plt
     >>> from bendpam.design import Wrist, wrist_sweep
     >>> fig = plot_wrist(wrist_sweep(Wrist(), [100.0, 150.0], directions_deg=(90.0,)))
     >>> len(fig.axes) >= 1                                # fig.savefig("wrist.png") to keep it
     True
-    >>> plt.close(fig)
     """
     own = ax is None
     with figure_style():
         if ax is None:
-            fig, ax = plt.subplots(figsize=figure_size("single", 1.15))
+            fig = new_figure(figure_size("single", 1.15))
+            ax = fig.add_subplot()
         else:
             fig = ax.figure
         _draw_wrist(ax, table, holds, title, positions_deg)
@@ -243,18 +240,17 @@ def plot_coarse_map(result: DesignResult):
 
     Examples
     --------
-    >>> import matplotlib.pyplot as plt
     >>> from bendpam.physics.presets import be_pam
     >>> from bendpam.design.inverse import design_actuator
     >>> res = design_actuator(be_pam(), ["blocked_moment_nmm=400@200"], ["alpha0_deg=60:80"], n_coarse=16, n_starts=1)
     >>> fig = plot_coarse_map(res)
     >>> len(fig.axes)                                     # the map and its colour bar
     2
-    >>> plt.close(fig)
     """
     c = result.coarse
     names = [v.name for v in result.variables]
-    fig, ax = plt.subplots(figsize=(3.5, 2.9), layout="constrained")
+    fig = new_figure((3.5, 2.9), layout="constrained")
+    ax = fig.add_subplot()
     v = np.clip(np.nan_to_num(c["violation"], nan=NAN_MISS), 1e-3, 3.0)
     x = c["X"][:, 0]
     y = c["X"][:, 1] if len(names) > 1 else v
@@ -280,7 +276,6 @@ def plot_pareto(result: DesignResult):
 
     Examples
     --------
-    >>> import matplotlib.pyplot as plt
     >>> from bendpam.physics.presets import be_pam
     >>> from bendpam.design.inverse import design_actuator
     >>> res = design_actuator(be_pam(), ["blocked_moment_nmm>=300@150", "free_angle_deg>=60@150"],
@@ -288,13 +283,13 @@ def plot_pareto(result: DesignResult):
     >>> fig = plot_pareto(res)
     >>> len(fig.axes)                                     # fig.savefig("pareto.png") to keep it
     1
-    >>> plt.close(fig)
     """
     pf = result.pareto
     if pf is None:
         raise InputError("this design has no Pareto front (it needs exactly two targets)")
     t1, t2 = pf.targets
-    fig, ax = plt.subplots(figsize=(3.5, 2.8), layout="constrained")
+    fig = new_figure((3.5, 2.8), layout="constrained")
+    ax = fig.add_subplot()
     Q = result.coarse["quantities"]
     ok = np.isfinite(result.coarse["min_margin"]) & (result.coarse["min_margin"] >= result.min_margin_required * (
         1 - TOL)) if np.any(np.isfinite(result.coarse["min_margin"])) else np.ones(len(Q), bool)

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from bendpam.errors import BendpamError
+from bendpam.present.figures.report import alpha0_profile_figure, band_figure, loss_figure
 from bendpam.present.report.text import LAW_LABEL, MODEL_LABEL, finite, fmt_pct, fmt_value, plain_text
 
 __all__ = ["Drawn", "alpha0_profile", "draw_figures", "prediction_band"]
@@ -23,14 +24,9 @@ _DPI = 140
 
 
 def _fig_png(fig) -> bytes:
-    """Render a figure to PNG bytes in memory (``dpi=140``) and close it."""
-    import matplotlib.pyplot as plt
-
+    """Render a figure to PNG bytes in memory (``dpi=140``)."""
     buf = io.BytesIO()
-    try:
-        fig.savefig(buf, format="png", dpi=_DPI)
-    finally:
-        plt.close(fig)
+    fig.savefig(buf, format="png", dpi=_DPI)
     return buf.getvalue()
 
 
@@ -77,50 +73,6 @@ def alpha0_profile(res) -> dict | None:
             "interval_deg": tuple(float(v) for v in iv[:2]) if iv is not None and np.isfinite(iv[:2]).all() else None}
 
 
-def _figure_style():
-    from bendpam.present import figures as plots
-
-    style = getattr(plots, "figure_style", None)
-    return style() if style is not None else _nullcontext()
-
-
-class _nullcontext:
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        return False
-
-
-def _width_in() -> float:
-    from bendpam.present import figures as plots
-
-    return float(getattr(plots, "DOUBLE_COLUMN_IN", 7.2))
-
-
-def _alpha0_figure(prof: dict, res, label: str):
-    import matplotlib.pyplot as plt
-
-    with _figure_style():
-        x = prof["alpha0_deg"]
-        y = prof["nrmse_percent"] if prof["nrmse_percent"] is not None else prof["objective"]
-        fig, ax = plt.subplots(figsize=(0.6 * _width_in(), 2.6))
-        ok = np.isfinite(x) & np.isfinite(y)
-        order = np.argsort(x[ok])
-        ax.plot(x[ok][order], y[ok][order], "o-", ms=3, lw=1.2, color="C0", label="best fit at fixed α₀")
-        if prof["interval_deg"] is not None:
-            ax.axvspan(*prof["interval_deg"], color="C1", alpha=0.2, lw=0, label="reported interval (±2 SE)")
-        p = res.parameters.get("alpha0")
-        if p is not None:
-            ax.axvline(p.value, color="C3", lw=1.2, label=f"fitted α₀ = {fmt_value(p.value, p.stderr, '°')}")
-        ax.set_xlabel("α₀ (°)")
-        ax.set_ylabel("NRMSE of the fitted curves (%)" if prof["nrmse_percent"] is not None else "objective")
-        ax.set_title(f"Profile of α₀, {label} model")
-        ax.legend()
-        fig.tight_layout()
-    return fig
-
-
 def prediction_band(res, processed) -> dict | None:
     """Predictions with their uncertainty band inside and beyond the tested pressures, or None.
 
@@ -164,60 +116,14 @@ def prediction_band(res, processed) -> dict | None:
     return {"pressure_kpa": grid, "series": series, "extrapolated": extrap}
 
 
-_BAND_LABEL = {"blocked_moment": "blocked moment (N·mm)", "free_curvature": "free-bending curvature (1/mm)",
-               "moment": "moment (N·mm)"}
-
-
-def _band_figure(band: dict, processed, label: str):
-    import matplotlib.pyplot as plt
-
-    with _figure_style():
-        series = band["series"]
-        fig, axes = plt.subplots(1, len(series), figsize=(_width_in(), 2.6), squeeze=False)
-        P = processed.pressures_kpa
-        x = band["pressure_kpa"]
-        for ax, (name, _unit, mid, lo, hi) in zip(axes[0], series, strict=True):
-            ax.axvspan(P.min(), P.max(), color="0.88", lw=0, label="tested range")
-            ok = np.isfinite(lo) & np.isfinite(hi)
-            ax.fill_between(x, np.where(ok, lo, np.nan), np.where(ok, hi, np.nan), color="C0", alpha=0.3, lw=0,
-                            label="±2 SE band")
-            ax.plot(x, mid, "-", color="C0", lw=1.2, label="prediction")
-            data = ([r.blocked_moment[0] for r in processed.results] if name == "blocked_moment"
-                    else [r.free_curvature[0] for r in processed.results])
-            ax.plot(P, data, "o", color="k", ms=3, label="data")
-            ax.set_xlabel("pressure (kPa)")
-            ax.set_ylabel(_BAND_LABEL.get(name, name.replace("_", " ")))
-            ax.legend()
-        fig.suptitle(f"{label.capitalize()} model: predictions with their uncertainty band")
-        fig.tight_layout()
-    return fig
-
-
-def _loss_figure(processed, hyst: Mapping):
-    import matplotlib.pyplot as plt
-
-    with _figure_style():
-        fig, ax = plt.subplots(figsize=(0.6 * _width_in(), 2.6))
-        P = processed.pressures_kpa
-        ax.plot(P, [100 * float(r.energy_loss_ratio) for r in processed.results], "o", color="k", ms=4,
-                label="measured")
-        for i, (m, res) in enumerate(hyst.items()):
-            e = res.hysteresis.energy_loss_ratio
-            ax.plot([x.pressure_kpa for x in e], [100 * x.predicted for x in e], "s-" if i == 0 else "^--",
-                    ms=3, lw=1.1, color=f"C{i}", label=f"{MODEL_LABEL.get(m, m)} model with its loop")
-        ax.set_xlabel("pressure (kPa)")
-        ax.set_ylabel("energy-loss ratio (%)")
-        ax.set_ylim(bottom=0)
-        ax.set_title("Energy lost per cycle, measured and predicted")
-        ax.legend()
-        fig.tight_layout()
-    return fig
-
-
-
 # ------------------------------------------------------------------------------------------------
 # every figure of the page
 # ------------------------------------------------------------------------------------------------
+def _fitted_alpha0(res) -> tuple[float, str] | None:
+    p = res.parameters.get("alpha0")
+    return None if p is None else (p.value, fmt_value(p.value, p.stderr, "°"))
+
+
 @dataclass(frozen=True)
 class Drawn:
     """One figure of the report: its PNG with its alt text and caption (HTML), or why it could not be drawn.
@@ -332,7 +238,7 @@ def _model_figures(draw: _Drawer, processed, m: str, res) -> None:
              f"Profile of α₀, {label} model: at each fixed α₀ every other parameter is fitted again. "
              "A sharp minimum means that the data determine α₀; the shaded band is the reported "
              "interval (±2 standard errors).",
-             lambda: _alpha0_figure(prof, res, label))
+             lambda: alpha0_profile_figure(prof, label, _fitted_alpha0(res)))
     else:
         draw.skip()
     band = prediction_band(res, processed)
@@ -343,7 +249,7 @@ def _model_figures(draw: _Drawer, processed, m: str, res) -> None:
              f"Predictions of the {label} model with a band of ±2 standard errors from the parameters' "
              "covariance; the grey span is the tested pressure range: beyond it the predictions are "
              "extrapolations and the band widens.",
-             lambda: _band_figure(band, processed, label))
+             lambda: band_figure(band, processed, label))
     else:
         draw.skip()
 
@@ -359,7 +265,8 @@ def _hysteresis_figures(draw: _Drawer, processed, hyst: Mapping, separate) -> No
              "cycles) and predicted by the fitted loop model of each model (lines). The fitted loops "
              "themselves are drawn against the measured branches in Figure 7 (a)"
              + (" and below." if separate is not None else "."),
-             lambda: _loss_figure(processed, hyst))
+             lambda: loss_figure(processed, {f"{MODEL_LABEL.get(m, m)} model with its loop":
+                                              r.hysteresis.energy_loss_ratio for m, r in hyst.items()}))
     else:
         draw.skip()
     if separate is not None and separate.hysteresis is not None:
