@@ -562,3 +562,25 @@ def test_no_function_is_over_80_lines():
 def test_no_file_is_over_1000_lines():
     bad = long_files()
     assert bad == [], f"files over {MAX_FILE_LINES} lines:\n" + "\n".join(bad)
+
+
+# ------------------------------------------------------------------------------------------------
+# the README's layout section matches the tree
+# ------------------------------------------------------------------------------------------------
+def readme_layout() -> str:
+    text = (ROOT.parent / "README.md").read_text(encoding="utf-8")
+    section = text.split("## Layout\n", 1)[1]
+    return section.split("```", 2)[1]
+
+
+def test_readme_layout_names_every_module_and_nothing_else():
+    block = readme_layout()
+    named = set(re.findall(r"[A-Za-z_][\w]*\.py\b", block))
+    in_tree = {p.name for p in LAYERED.values() if p.name != "__init__.py"} | {"__init__.py", "_compat.py"}
+    missing = sorted(n for n in in_tree if n not in named)
+    assert missing == [], f"modules the README's layout section does not name: {missing}"
+    stale = sorted(n for n in named if n not in {p.name for p in MODULES.values()} | {"bendpam_entry.py"}
+                   and not (ROOT.parent / "tools" / n).exists())
+    assert stale == [], f"the README's layout section names files that are not in the tree: {stale}"
+    packages = {p.parent.name for p in LAYERED.values() if p.name == "__init__.py" and p.parent != SRC}
+    assert all(f"{pkg}/" in block for pkg in packages), sorted(pkg for pkg in packages if f"{pkg}/" not in block)
