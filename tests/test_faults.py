@@ -91,8 +91,9 @@ def test_simulate_rate_is_bounded_before_allocation(inputs):
                 "--out", "sim_big"], inputs["work"], timeout=30)
     kind, line = fi.classify(r)
     assert kind == "error", r.stderr
+    # refused by its sample count before anything is allocated (the message counts the samples);
+    # no wall-clock bound here: the time of a run says nothing on a loaded machine
     assert "samples" in line and "--rate-hz" in line and "--cycles" in line
-    assert r.seconds < 20
     assert not (inputs["work"] / "sim_big").exists()
     assert fi.temporaries(inputs["work"] / "sim_big") == []
 

@@ -151,14 +151,15 @@ def test_killed_worker_loses_no_results():
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
                                   dashboard_address=None) as cluster, distributed.Client(cluster) as client:
         futures = client.compute(lazy)
-        # wait until work is under way, then kill one worker process abruptly (its nanny restarts it)
+        # wait until a worker holds a task, then kill that worker's process abruptly (its nanny
+        # restarts it): the kill follows an event, not a delay
         t0 = time.monotonic()
-        while not client.processing() or not any(client.processing().values()):
+        while not any(client.processing().values()):
             assert time.monotonic() - t0 < 60
-            time.sleep(0.05)
-        time.sleep(0.3)
+            time.sleep(0.01)
+        busy = next(addr for addr, tasks in client.processing().items() if tasks)
         assert not futures.done(), "the sweep finished before the worker could be killed"
-        nanny = next(iter(cluster.workers.values()))
+        nanny = next(n for n in cluster.workers.values() if n.worker_address == busy)
         os.kill(nanny.process.process.pid, signal.SIGKILL)  # the worker process dies mid-task
         result = futures.result(timeout=300)
         assert sum(len(v) for v in client.processing().values()) == 0
