@@ -383,3 +383,19 @@ def test_commands_refuse_a_damaged_input_set(capsys, lab, tmp_path):
         (raw / f.name).write_bytes(f.read_bytes())
     (raw / "manifest.json").write_text('{"instrument": "Zwick"}')
     assert run(capsys, "process", raw, "--out", tmp_path / "p2", "--no-figure")[0] == 0
+
+
+def test_file_browser_litter_is_not_user_data(tmp_path):
+    out = tmp_path / "out"
+    with OutputSet(out) as s:
+        s.write_text("a.txt", "a")
+    (out / ".DS_Store").write_bytes(b"\0Bud1")
+    with OutputSet(out) as s:  # replaced with the set
+        s.write_text("a.txt", "b")
+    assert sorted(os.listdir(out)) == ["a.txt", "manifest.json"]
+    empty = tmp_path / "shown-in-a-browser"
+    empty.mkdir()
+    (empty / "Thumbs.db").write_bytes(b"x")
+    with OutputSet(empty) as s:
+        s.write_text("a.txt", "a")
+    assert sorted(os.listdir(empty)) == ["a.txt", "manifest.json"]

@@ -59,6 +59,8 @@ MANIFEST_FORMAT = "bendpam-output-set"
 MANIFEST_VERSION = 1
 
 _SHA256 = re.compile(r"[0-9a-f]{64}")
+#: Files that file browsers add to any folder they show (not the user's data): replaced with the set.
+OS_LITTER = re.compile(r"\.DS_Store|\._.*|Thumbs\.db|ehthumbs\.db|desktop\.ini|\.directory", re.IGNORECASE)
 
 
 def to_json(obj: Any, *, indent: int | None = 2) -> str:
@@ -361,7 +363,7 @@ def _first_unlisted(folder: Path, listed: set[str]) -> Path | None:
         for fn in names:
             p = Path(dirpath) / fn
             rel = p.relative_to(folder).as_posix()
-            if rel == MANIFEST_NAME:
+            if rel == MANIFEST_NAME or (rel not in listed and OS_LITTER.fullmatch(fn) and p.is_file()):
                 continue
             if rel not in listed or p.is_symlink() or not p.is_file():
                 return p
@@ -374,7 +376,8 @@ def ownership_problem(folder: Path, producer: str | None, shown: str | None = No
     Returns ``(reason, user_files)``: ``user_files`` is true when the folder holds content
     that bendpam did not write (or changed since), which must never be deleted -- only
     moved aside, and only when the caller forces the replacement.  An empty folder, and a
-    set of the same producer whose files all match its manifest, may be replaced.  Paths
+    set of the same producer whose files all match its manifest, may be replaced (files
+    that file browsers add, such as ``.DS_Store`` or ``Thumbs.db``, go with it).  Paths
     in the reason start with ``shown`` (the folder as the user named it).
 
     Examples
@@ -398,7 +401,8 @@ def ownership_problem(folder: Path, producer: str | None, shown: str | None = No
         return f"it holds a {MANIFEST_NAME} that bendpam did not write", True
     if m is None:
         stray = _first_unlisted(folder, set())
-        assert stray is not None  # the folder is not empty
+        if stray is None:  # nothing but empty folders and file-browser litter
+            return None
         return f"it holds {name(stray)}, which bendpam did not write (no bendpam {MANIFEST_NAME} there)", True
     stray = _first_unlisted(folder, {e["path"] for e in m["files"]})
     if stray is not None:
