@@ -22,6 +22,7 @@ from bendpam.cli import main
 from bendpam.errors import FileFormatError
 from bendpam.infra.manifest import read_manifest, verify_file, verify_set
 from bendpam.infra.outputs import OutputFile, OutputGroup, OutputSet
+from bendpam.infra.registry import REGISTRY_NAME
 from bendpam.infra.signals import Interrupted
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals and symbolic links")
@@ -203,10 +204,21 @@ def test_the_home_folder_is_never_replaced(capsys, lab, tmp_path, monkeypatch):
 SWEEP = ["sweep", "--preset", "be-pam", "--param", "alpha0_deg=60:80:3", "--pressure-kpa", "100:200:3", "-q"]
 
 
+def listing(folder: Path) -> list[str]:
+    """The folder's entries, without bendpam's record of the single files it wrote there."""
+    return sorted(n for n in os.listdir(folder) if n != REGISTRY_NAME)
+
+
+def written_by_bendpam_before(path: Path, data: bytes) -> None:
+    """``path`` as an earlier bendpam run would have left it (recorded as bendpam's)."""
+    with OutputFile(path) as o:
+        o.write_bytes(data)
+
+
 def test_sweep_out_and_plot_commit_together(capsys, tmp_path, monkeypatch):
     data, fig = tmp_path / "s.csv", tmp_path / "s.png"
-    data.write_text("old data\n")
-    fig.write_bytes(b"old figure")
+    written_by_bendpam_before(data, b"old data\n")
+    written_by_bendpam_before(fig, b"old figure")
     import bendpam.present.figures as figures
 
     def interrupted_while_plotting(*args, **kwargs):
@@ -216,19 +228,19 @@ def test_sweep_out_and_plot_commit_together(capsys, tmp_path, monkeypatch):
     code, _, err = run(capsys, *SWEEP, "--out", data, "--plot", fig)
     assert code == 130 and err.strip() == "bendpam: interrupted; no outputs were changed"
     assert data.read_text() == "old data\n" and fig.read_bytes() == b"old figure"
-    assert sorted(os.listdir(tmp_path)) == ["s.csv", "s.png"]
+    assert listing(tmp_path) == ["s.csv", "s.png"]
     monkeypatch.undo()
     code, _, err = run(capsys, *SWEEP, "--out", data, "--plot", fig)
     assert code == 0, err
     assert data.read_text().startswith("alpha0_deg") and fig.read_bytes()[:4] == b"\x89PNG"
-    assert sorted(os.listdir(tmp_path)) == ["s.csv", "s.png"]
+    assert listing(tmp_path) == ["s.csv", "s.png"]
 
 
 def test_output_group_rolls_back_sets_and_files(tmp_path):
     out, f = tmp_path / "out", tmp_path / "f.txt"
     with OutputSet(out) as s:
         s.write_text("a.txt", "old")
-    f.write_text("old")
+    written_by_bendpam_before(f, b"old")
     with pytest.raises(Interrupted), OutputGroup():
         with OutputSet(out) as s:
             s.write_text("a.txt", "new")
@@ -238,14 +250,14 @@ def test_output_group_rolls_back_sets_and_files(tmp_path):
         raise Interrupted(143, signal.SIGTERM)
     assert (out / "a.txt").read_text() == "old" and f.read_text() == "old"
     verify_set(out, required=True)
-    assert sorted(os.listdir(tmp_path)) == ["f.txt", "out"]
+    assert listing(tmp_path) == ["f.txt", "out"]
     with OutputGroup():
         with OutputSet(out) as s:
             s.write_text("a.txt", "new")
         with OutputFile(f) as o:
             o.write_text("new")
     assert (out / "a.txt").read_text() == "new" and f.read_text() == "new"
-    assert sorted(os.listdir(tmp_path)) == ["f.txt", "out"]
+    assert listing(tmp_path) == ["f.txt", "out"]
 
 
 def test_one_target_twice_in_a_run_is_one_line(tmp_path):
@@ -336,7 +348,7 @@ def test_temporaries_and_lock_of_a_killed_single_file_output_are_cleaned(capsys,
     assert left[1] == ".o-plot.png.bendpam-lock"  # and the lock file
     code, _, err = run(capsys, "curve", "--preset", "be-pam", "--pressure-kpa", "150", "--out", target)
     assert code == 0, err
-    assert sorted(os.listdir(tmp_path)) == ["o-plot.png"]
+    assert listing(tmp_path) == ["o-plot.png"]
 
 
 # ----------------------------------------------------------------------------------------------
@@ -399,3 +411,49 @@ def test_file_browser_litter_is_not_user_data(tmp_path):
     with OutputSet(empty) as s:
         s.write_text("a.txt", "a")
     assert sorted(os.listdir(empty)) == ["a.txt", "manifest.json"]
+
+
+def test_the_library_reads_a_bendpam_set_only_as_it_was_written(capsys, lab, tmp_path):
+    """``load_processed``, ``FitResult.load`` and ``read_test`` check a bendpam set's manifest (issue 21, item 5)."""
+    from bendpam.identify.result import FitResult
+    from bendpam.lab.processed import load_processed
+    from bendpam.lab.readers import read_test
+
+    proc, fit, raw = tmp_path / "proc", tmp_path / "fit", tmp_path / "raw"
+    assert run(capsys, "process", lab / "raw", "--out", proc, "--no-figure")[0] == 0
+    assert run(capsys, "fit", proc, "--preset", "be-pam", "--out", fit, "--no-figure")[0] == 0
+    assert run(capsys, *SIM, "--out", raw)[0] == 0
+    load_processed(proc), FitResult.load(fit), read_test(next(raw.glob("*.csv")))  # intact: read
+    for f in (proc / "curves.nc", fit / "fit.json", next(raw.glob("*.csv"))):
+        data = bytearray(f.read_bytes())
+        data[len(data) // 2] ^= 0x01
+        f.write_bytes(bytes(data))
+    with pytest.raises(FileFormatError, match=r"curves\.nc: does not match the manifest\.json"):
+        load_processed(proc)
+    with pytest.raises(FileFormatError, match=r"fit\.json: does not match the manifest\.json"):
+        FitResult.load(fit)
+    with pytest.raises(FileFormatError, match=r"\.csv: does not match the manifest\.json"):
+        read_test(next(raw.glob("*.csv")))
+
+
+def test_a_single_file_bendpam_did_not_write_is_never_overwritten(capsys, tmp_path):
+    """``--out F.toml`` over a hand-written file: refused; forced, the old file is moved aside (issue 21, 25)."""
+    f = tmp_path / "F.toml"
+    f.write_text("# my hand-edited actuator\n")
+    code, _, err = run(capsys, "actuator", "--preset", "be-pam", "--out", f)
+    assert code == 2
+    assert one_error(err).startswith(f"bendpam: error: output file '{f}' exists and is not a file bendpam wrote")
+    assert "--force" in err and "moved aside, not deleted" in err
+    assert f.read_text() == "# my hand-edited actuator\n" and sorted(os.listdir(tmp_path)) == ["F.toml"]
+    # forced: written, and the user's file kept beside it
+    code, _, err = run(capsys, "actuator", "--preset", "be-pam", "--out", f, "--force")
+    assert code == 0, err
+    aside = [p for p in tmp_path.iterdir() if p.name.startswith("F.toml.moved-aside-")]
+    assert len(aside) == 1 and aside[0].read_text() == "# my hand-edited actuator\n"
+    assert "alpha0_deg" in f.read_text() and "moved to" in err
+    # a file bendpam wrote and nobody changed is replaced without force ...
+    assert run(capsys, "actuator", "--preset", "bc-pam", "--out", f)[0] == 0
+    # ... but not once it was edited
+    f.write_text(f.read_text() + "# edited\n")
+    assert run(capsys, "actuator", "--preset", "be-pam", "--out", f)[0] == 2
+    assert f.read_text().endswith("# edited\n")

@@ -30,6 +30,7 @@ from bendpam.infra.outputs import (
     json_safe,
     to_json,
 )
+from bendpam.infra.registry import REGISTRY_NAME
 
 PKG_DIR = Path(outputs.__file__).resolve().parent.parent  # src/bendpam
 
@@ -130,8 +131,15 @@ def check_set(target: Path, expected: dict[str, bytes]) -> dict:
 
 
 def only(parent: Path, *names: str) -> None:
-    """``parent`` holds these names and nothing else: no temporaries, no lock file."""
-    assert sorted(os.listdir(parent)) == sorted(names)
+    """``parent`` holds these names and nothing else: no temporaries, no lock file (bendpam's record of
+    the single files it wrote there, :data:`bendpam.infra.registry.REGISTRY_NAME`, aside)."""
+    assert sorted(n for n in os.listdir(parent) if n != REGISTRY_NAME) == sorted(names)
+
+
+def bendpam_wrote(path: Path, text: str) -> None:
+    """``path`` as an earlier bendpam run left it (a single file bendpam may replace)."""
+    with OutputFile(path) as o:
+        o.write_text(text)
 
 
 def child(
@@ -707,7 +715,7 @@ def test_output_file(tmp_path):
 )
 def test_output_file_failure_leaves_target(tmp_path, exc):
     target = tmp_path / "report.html"
-    target.write_text("old")
+    bendpam_wrote(target, "old")
     with pytest.raises(type(exc)), OutputFile(target) as f:
         f.write_text("new, half")
         raise exc

@@ -77,7 +77,8 @@ def _one_line(exc: BaseException) -> str:
     from bendpam.infra.targets import OutputRefused
 
     if isinstance(exc, OutputRefused) and exc.forceable:
-        moved = " (the old folder is then moved aside, not deleted)" if exc.reason.startswith("output folder") else ""
+        kind = next((k for k in ("folder", "file") if exc.reason.startswith(f"output {k}")), "")
+        moved = f" (the old {kind} is then moved aside, not deleted)" if kind else ""
         return f"{exc.reason}; choose another place, or add --force{moved}"
     text = str(exc).strip()
     return text.splitlines()[0] if text else type(exc).__name__

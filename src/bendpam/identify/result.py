@@ -22,6 +22,7 @@ import numpy as np
 from bendpam.errors import FileFormatError, InputError
 from bendpam.infra.accessors import figure
 from bendpam.infra.atomic import atomic_write_text, json_safe
+from bendpam.infra.manifest import verify_input
 from bendpam.physics.actuator import Actuator
 from bendpam.physics.law import MomentLaw
 
@@ -585,6 +586,8 @@ class FitResult:
         """Read a fit written by :meth:`save` (the folder or its ``fit.json``)."""
         p = Path(path)
         fj = p / "fit.json" if p.is_dir() else p
+        if fj.exists():
+            verify_input(fj)  # a fit that bendpam wrote is read only as it wrote it (its manifest's hashes)
         try:
             return cls.from_dict(json.loads(fj.read_text(encoding="utf-8")), source=str(fj))
         except FileNotFoundError:

@@ -58,6 +58,7 @@ from bendpam.infra.manifest import (
     to_json,
     verify_input,
 )
+from bendpam.infra.registry import record_file, written_by_bendpam
 from bendpam.infra.signals import HeldSignals, Interrupted, interrupts, is_interruption, record_written
 from bendpam.infra.targets import (
     OutputRefused,
@@ -628,6 +629,7 @@ class OutputFile(_Output):
                  force: bool = False) -> None:
         super().__init__(target_path, inputs=inputs, command=command, lock_timeout_s=lock_timeout_s, force=force)
         self._tmp: Path | None = None
+        self._foreign = False  # the target exists and bendpam did not write it
 
     def _prepare(self) -> None:
         t, shown = self.target, self.shown
@@ -650,6 +652,12 @@ class OutputFile(_Output):
                 raise OutputRefused(f"{reason}; choose another folder", forceable=True, reason=reason)
 
     def _open(self) -> None:
+        # under the lock (a second write of the same target in one run is refused by the lock first)
+        t, shown = self.target, self.shown
+        self._foreign = t.is_file() and not written_by_bendpam(t)
+        if self._foreign and not self.force:
+            reason = f"output file {shown!r} exists and is not a file bendpam wrote (or it was changed since)"
+            raise OutputRefused(f"{reason}; choose another name", forceable=True, reason=reason)
         for _, stale in fsops.stale_temporaries(self.target.parent, self.target.name):
             fsops.remove_path(stale)
         self._tmp = self.target.parent / fsops.temp_name(self.target.name, "tmp", self.target.suffix)
@@ -696,7 +704,11 @@ class OutputFile(_Output):
 
     def _swap(self) -> None:
         tmp, target = self.path, self.target
-        if self._group is not None and os.path.lexists(target):
+        if self._foreign:  # forced over a file bendpam did not write: keep it, moved aside
+            aside = _aside_name(target)
+            os.rename(target, aside)
+            self._old = self.moved_aside = aside
+        elif self._group is not None and os.path.lexists(target):
             # keep the old file until the group ends (a hard link: the target never disappears)
             old = target.parent / fsops.temp_name(target.name, "old", target.suffix)
             try:
@@ -724,4 +736,8 @@ class OutputFile(_Output):
 
     def _finish(self) -> None:
         self._tmp = None
+        try:
+            record_file(self.target, producer=" ".join(self.command[:2]) or None)
+        except OSError:  # the file is in place; without its record a later run asks for force (safe)
+            pass
         super()._finish()

@@ -20,6 +20,7 @@ import numpy as np
 
 from bendpam.errors import InputError, ProcessingError
 from bendpam.infra.accessors import figure as figure_by_name
+from bendpam.infra.manifest import verify_input
 from bendpam.physics.fixture import Fixture
 
 if TYPE_CHECKING:  # pandas and xarray are imported by the functions that use them (fast start-up of `fit`)
@@ -511,6 +512,7 @@ def load_processed(path) -> ProcessedSet:
     nc = p / "curves.nc" if p.is_dir() else p
     if not nc.exists():
         raise ProcessingError(f"{p}: no curves.nc here; give the output folder of 'bendpam process'")
+    verify_input(nc)  # a set that bendpam wrote is read only as it wrote it (its manifest's hashes)
     try:
         ds = _read_curves(nc)
     except Exception as exc:

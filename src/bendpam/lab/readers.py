@@ -50,6 +50,7 @@ from typing import Any
 
 import numpy as np
 
+from bendpam.infra.manifest import verify_input
 from bendpam.lab.assemble import assemble
 from bendpam.lab.channels import FORCE_UNITS, LENGTH_UNITS, ROLES, TIME_UNITS
 from bendpam.lab.parser import Parsed, parse_path, parse_source
@@ -281,6 +282,7 @@ def read_test(
     pressure_kpa, rate_hz = _check_options(pressure_kpa, dialect, rate_hz)
     overrides = parse_columns(columns)
     p = Path(path)
+    verify_input(p)  # raw files of a bendpam set (simulate-test) are read only as bendpam wrote them
     parsed = parse_path(p, dialect=dialect, overrides=overrides, rate_hz=rate_hz, repair=repair)
     fmt = dialect or _classify_format(parsed)
     return assemble(parsed, fmt=fmt, pressure_kpa=pressure_kpa, rate_hz=rate_hz, repair=repair)
