@@ -198,7 +198,8 @@ def test_self_contained_and_atomic(built, expected):
     assert all(tables) and len(set(tables)) == len(tables)
     assert {"table2", "table3", "actuator", "inputs", "settings", "hysteresis-loss"} <= set(tables)
     # written atomically: the page and nothing else (no temporary file left behind)
-    assert sorted(p.name for p in html_path.parent.iterdir()) == ["report.html"]
+    # the page, and bendpam's record that it wrote it (nothing else: no temporaries, no lock)
+    assert sorted(p.name for p in html_path.parent.iterdir()) == [".bendpam-files.json", "report.html"]
     assert f"bendpam {bendpam.__version__}" in text
     assert "@media print" in text and "@page" in text
 
@@ -457,7 +458,7 @@ def test_build_report_bc_pam(bc_raw, tmp_path, capsys):
     err = capsys.readouterr().err
     assert all(line.startswith("bendpam: report") for line in err.splitlines()), err
     assert res.progress_shown
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["bc.html", "bc2.html"]
+    assert sorted(p.name for p in tmp_path.iterdir() if p.name != ".bendpam-files.json") == ["bc.html", "bc2.html"]
 
 
 @pytest.mark.slow
