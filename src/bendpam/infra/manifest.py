@@ -6,7 +6,7 @@ Every folder that :class:`bendpam.infra.outputs.OutputSet` writes holds ``manife
       "format": "bendpam-output-set",      # the marker: a manifest.json without it is not bendpam's
       "format_version": 1,
       "producer": "process",               # the command (or library name) that wrote the set
-      "bendpam_version": "0.3.0",
+      "bendpam_version": "0.4.0",
       "command": ["bendpam", "process", "raw", "--out", "proc"],
       "cwd": "...", "target": "...", "started_utc": "...", "finished_utc": "...",
       "files": [{"path": "curves.nc", "size": 12345, "sha256": "..."}, ...],   # every file but itself
