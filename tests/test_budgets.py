@@ -201,7 +201,7 @@ def test_a_sweep_past_the_time_budget_is_refused(capsys, tmp_path):
     err = one_error_line(capsys, "sweep", "--preset", "be-pam", "--param", "alpha0_deg=60:80:1000",
                          "--param", "t0_mm=1.5:3:1000", "--pressure-kpa", "150", "--out", tmp_path / "s.nc",
                          "--max-minutes", "1")
-    assert "the sweep of 1000000 (case, pressure) points (1000000 cases x 1 pressures) would take about 5.17 min" in err
+    assert "the sweep of 1000000 (case, pressure) points (1000000 cases x 1 pressure) would take about 5.17 min" in err
     assert "more than --max-minutes 1" in err
 
 
@@ -276,6 +276,10 @@ def test_scheduler_addresses_are_parsed(tmp_path):
     bad.write_text("[1, 2]")
     with pytest.raises(InputError, match="not a Dask scheduler file"):
         parse_scheduler_address(str(bad))
+    if hasattr(os, "mkfifo"):  # a scheduler file that is a named pipe is refused, not waited on
+        os.mkfifo(tmp_path / "pipe.json")
+        with pytest.raises(InputError, match="is a named pipe, not a regular file; expected a scheduler file"):
+            parse_scheduler_address(str(tmp_path / "pipe.json"))
 
 
 def test_scheduler_nonsense_is_one_line(capsys, tmp_path):

@@ -218,7 +218,8 @@ def check_budgets(n_params: int, n_pressures: int, n_cases: int, chunk_cases: in
 
     table = data_fmt if data_fmt in ("csv", "parquet") else None
     est = sweep_estimate(n_cases, n_pressures, n_params, chunk_cases=chunk_cases, table=table, remote=remote)
-    size = f"{est.points} (case, pressure) points ({n_cases} cases x {n_pressures} pressures)"
+    size = (f"{est.points} (case, pressure) points ({n_cases} case{'s' * (n_cases != 1)} x {n_pressures} "
+            f"pressure{'s' * (n_pressures != 1)})")
     problem = memory_problem(est.memory_bytes, max_memory_gib)
     if problem is not None:
         raise UserError(f"the sweep of {size} holds its whole result in memory before writing it: {problem}; give "
@@ -226,8 +227,8 @@ def check_budgets(n_params: int, n_pressures: int, n_cases: int, chunk_cases: in
                                           if est.memory_bytes > max_memory_gib * GIB else ""))
     if est.seconds > 60.0 * max_minutes:
         raise UserError(f"the sweep of {size} would take about {est.time_text} on one core (a conservative estimate), "
-                        f"more than --max-minutes {max_minutes:g}; give fewer values, or raise --max-minutes (more "
-                        "cores, --workers or --scheduler make it shorter)")
+                        f"more than --max-minutes {max_minutes:g}; give fewer values, or raise --max-minutes (the "
+                        "estimate is for one core: more cores, --workers or --scheduler finish sooner)")
 
 
 def sweep_grid(param: list[str] | None, pressure_kpa: list[str] | None, max_points: int | None,
