@@ -104,7 +104,7 @@ _UNITS = {
 #: Measured costs (one core of a 2-core x86-64 machine, 2026), rounded up about twice for slower machines.
 SECONDS_PER_CASE = 3e-4    # the free-bending branch of a case: measured 0.12-0.13 ms
 SECONDS_PER_POINT = 1e-5   # roots and limits per (case, pressure), assembling, NetCDF: measured 4-8 us
-TABLE_SECONDS_PER_POINT = {"csv": 1e-5, "parquet": 2e-6}  # a tidy table row written: measured 10 and 1 us
+TABLE_SECONDS_PER_POINT = {"csv": 2e-5, "parquet": 2e-6}  # a tidy table row written: measured 10 and 1 us
 WORK_BYTES_PER_POINT = 2048  # working arrays of a block being computed: measured 1.5-2 kB per point
 WORK_BYTES_PER_CASE = 40_000  # and 34 kB per case
 BASE_BYTES = 512 * MIB  # the process itself (Python, NumPy, xarray, Dask, pyarrow): measured 200-400 MB
@@ -151,7 +151,7 @@ def sweep_estimate(n_cases: int, n_pressures: int, n_params: int = 1, *, chunk_c
     --------
     >>> est = sweep_estimate(10_000, 100, table="csv", remote=True)        # one million points
     >>> est.points, est.memory_text, est.time_text
-    (1000000, '840 MiB', '23 s')
+    (1000000, '840 MiB', '33 s')
     """
     n_cases, n_pressures = int(n_cases), int(n_pressures)
     points = n_cases * n_pressures
