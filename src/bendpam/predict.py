@@ -22,6 +22,8 @@ from typing import Any
 import numpy as np
 
 from bendpam.errors import InputError
+from bendpam.infra import budgets
+from bendpam.infra.budgets import MEMORY_BUDGET_GIB, memory_problem
 from bendpam.physics.actuator import Actuator
 from bendpam.physics.braid import DEFAULT_ORDER, Kinematics
 from bendpam.physics.braid import kinematics as _kinematics
@@ -211,7 +213,7 @@ _STRESS_UNITS = {
 
 
 def internal_stresses(actuator: Actuator, pressure_kpa, curvature_per_mm, *, n_phi: int = 181,
-                      order: int = DEFAULT_ORDER) -> Any:
+                      order: int = DEFAULT_ORDER, max_memory_gib: float | None = MEMORY_BUDGET_GIB) -> Any:
     """Internal state of the force-balance model (eq 37-48) around the cross-section.
 
     Parameters
@@ -219,6 +221,10 @@ def internal_stresses(actuator: Actuator, pressure_kpa, curvature_per_mm, *, n_p
     pressure_kpa : float or 1-D array, kPa.
     curvature_per_mm : float or 1-D array, 1/mm.
     n_phi : number of angles on [0, 360] deg (2 to 100 000).
+    max_memory_gib : memory budget (GiB; None: only this machine's memory).  The result holds
+        ``8 x (4 n_phi + 7)`` bytes per (pressure, curvature); a result larger than the budget is
+        refused before any work.  The states are computed in chunks of pressures, so the
+        working arrays take at most about 64 MiB beside the result.
 
     Returns
     -------
@@ -244,28 +250,68 @@ def internal_stresses(actuator: Actuator, pressure_kpa, curvature_per_mm, *, n_p
     phi = np.linspace(0.0, 2.0 * np.pi, integer("n_phi", n_phi, 2, 100_000))
     pa = law.active_pressure_kpa(P) * 1e-3  # MPa inside the numerics
     Pg = pa.reshape(pa.shape + (1,) * k.ndim)
-    st = _fb.stress_state(law.params, Pg, k, phi, order=order)
-    return _stress_dataset(actuator, st, P, k, phi, np.broadcast_shapes(Pg.shape, k.shape))
+    S = np.broadcast_shapes(Pg.shape, k.shape)
+    _check_stress_memory(S, P, k, phi.size, max_memory_gib)
+    arrays = _stress_arrays(law, Pg, k, phi, S, order)
+    return _stress_dataset(actuator, arrays, P, k, phi)
 
 
-def _stress_dataset(actuator: Actuator, st: dict, P: np.ndarray, k: np.ndarray, phi: np.ndarray,
-                    S: tuple[int, ...]) -> Any:
-    """The :func:`internal_stresses` dataset from the force-balance stress state ``st`` (model units) of shape ``S``."""
+#: The variables of the stress state that vary around the section (the others are one value per state).
+_PER_ANGLE = ("sigma_bl1", "N_br1", "sigma_br1", "braid_angle")
+#: Working memory of the stress state per element of a chunk (its temporaries), bytes.
+_STRESS_WORK_BYTES = 160
+
+
+def _check_stress_memory(S: tuple[int, ...], P: np.ndarray, k: np.ndarray, n_phi: int,
+                         max_memory_gib: float | None) -> None:
+    """Refuse, before any work, an :func:`internal_stresses` result larger than the memory budget."""
+    if max_memory_gib is not None and not (isinstance(max_memory_gib, int | float) and max_memory_gib > 0):
+        raise InputError(f"max_memory_gib = {max_memory_gib!r} must be a number of GiB > 0 (or None)")
+    n = int(np.prod(S))
+    need = 8.0 * n * (len(_PER_ANGLE) * n_phi + len(_STRESS_UNITS) - len(_PER_ANGLE)) + budgets.CHUNK_BYTES
+    problem = memory_problem(need, max_memory_gib)
+    if problem is not None:
+        size = " x ".join([f"{P.size} pressures"] * bool(P.ndim) + [f"{k.size} curvatures"] * bool(k.ndim)
+                          + [f"{n_phi} angles"])
+        raise InputError(f"internal_stresses: {size} would hold {problem}; give fewer pressures, curvatures or "
+                         "angles (n_phi), or raise max_memory_gib")
+
+
+def _stress_arrays(law: MomentLaw, Pg: np.ndarray, k: np.ndarray, phi: np.ndarray, S: tuple[int, ...],
+                   order: int) -> dict[str, np.ndarray]:
+    """The stress state of shape ``S`` (+ angles) in the dataset's units, computed in chunks of rows of ``S``.
+
+    Each chunk's temporaries take at most about :data:`bendpam.infra.budgets.CHUNK_BYTES`; the
+    values are the same as in one block (the state is computed element by element).
+    """
+    per_row = int(np.prod(S[1:])) * max(phi.size, order)
+    rows = max(1, budgets.CHUNK_BYTES // (_STRESS_WORK_BYTES * per_row))
+    Pb, kb = np.broadcast_to(Pg, S), np.broadcast_to(k, S)
+    out: dict[str, np.ndarray] = {}
+    for start in range(0, S[0] if S else 1, rows):
+        sl = slice(start, start + rows) if S else ()
+        st = _fb.stress_state(law.params, Pb[sl], kb[sl], phi, order=order)
+        for name, arr in st.items():
+            if name not in out:
+                out[name] = np.empty(S + ((phi.size,) if name in _PER_ANGLE else ()))
+            scale = _STRESS_UNITS[name][2]
+            chunk = np.degrees(arr) if name == "braid_angle" else np.asarray(arr) * scale
+            out[name][sl] = chunk
+    return out
+
+
+def _stress_dataset(actuator: Actuator, arrays: dict[str, np.ndarray], P: np.ndarray, k: np.ndarray,
+                    phi: np.ndarray) -> Any:
+    """The :func:`internal_stresses` dataset from the stress state ``arrays`` (the dataset's units)."""
     import xarray as xr
 
     dims = (["pressure_kpa"] if P.ndim else []) + (["curvature_per_mm"] if k.ndim else [])
     data = {}
-    for name, arr in st.items():
-        arr = np.asarray(arr)
-        per_angle = arr.ndim == len(S) + 1
-        full = np.broadcast_to(arr, S + ((phi.size,) if per_angle else ()))
-        d = dims + (["phi_deg"] if per_angle else [])
-        unit, long_name, scale = _STRESS_UNITS[name]
-        if name == "braid_angle":
-            full, name = np.degrees(full), "braid_angle_deg"
-        else:
-            name = _STRESS_NAMES[name]
-        data[name] = xr.DataArray(np.array(full) * scale, dims=d, attrs={"units": unit, "long_name": long_name})
+    for name, arr in arrays.items():
+        d = dims + (["phi_deg"] if name in _PER_ANGLE else [])
+        unit, long_name, _scale = _STRESS_UNITS[name]
+        data["braid_angle_deg" if name == "braid_angle" else _STRESS_NAMES[name]] = xr.DataArray(
+            arr, dims=d, attrs={"units": unit, "long_name": long_name})
     coords: dict[str, Any] = {"phi_deg": np.degrees(phi)}
     if P.ndim:
         coords["pressure_kpa"] = P

@@ -35,9 +35,16 @@ Scaling out
     distributed cluster when ``scheduler`` (an address) is given, or on a ``LocalCluster`` of
     ``workers`` processes.  Each block is computed by the same deterministic function, so every
     way of running gives bit-for-bit the same numbers (tested).  Without Dask the same blocks
-    are computed in a loop.  Memory is bounded by the block size (``chunk_cases`` x pressures x the
-    1200 branch samples x the quadrature order), never by the sweep size: with ``compute=False``
-    the dataset stays lazy and ``to_netcdf`` writes it block by block.
+    are computed in a loop.  The working memory is bounded by the block size (``chunk_cases`` x
+    pressures, about 2 kB a point); a computed result holds 104 bytes a point (twice while the
+    blocks are assembled).  With ``compute=False`` the dataset stays lazy and ``to_netcdf`` writes
+    it block by block.
+
+Budgets
+    Before any work, :func:`sweep_estimate` estimates the peak memory from measured costs; a
+    sweep past ``max_memory_gib`` (2 GiB by default, :mod:`bendpam.infra.budgets`) or past this
+    machine's memory is refused in one line.  A ``scheduler`` must answer as a Dask scheduler
+    within ``scheduler_timeout_s`` (10 s by default, :mod:`bendpam.infra.scheduler`).
 
 When only ``R0_mm`` is swept, ``R0_start_mm`` keeps the base actuator's ratio ``R0_start / R0``;
 ``t0_start`` always follows from eq 52.
@@ -52,13 +59,16 @@ Files and progress
 from __future__ import annotations
 
 import contextlib
+import os
 import sys
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from bendpam.errors import InputError
+from bendpam.infra.budgets import MEMORY_BUDGET_GIB, MIB, SCHEDULER_TIMEOUT_S, format_bytes, memory_problem
 from bendpam.physics.actuator import Actuator, ModelParams
 from bendpam.physics.braid import DEFAULT_ORDER
 from bendpam.physics.law import MomentLaw
@@ -66,8 +76,8 @@ from bendpam.physics.limits import OUTPUTS as _LIMIT_OUTPUTS
 from bendpam.physics.limits import case_limits
 from bendpam.physics.models import normalise_model
 
-__all__ = ["SWEEP_FORMATS", "SWEEP_PARAMETERS", "build_cases", "evaluate_cases", "sweep", "sweep_format", "to_table",
-           "write_sweep"]
+__all__ = ["SWEEP_FORMATS", "SWEEP_PARAMETERS", "SweepEstimate", "build_cases", "evaluate_cases", "sweep",
+           "sweep_estimate", "sweep_format", "to_table", "write_sweep"]
 
 #: Parameters that can be swept (Actuator field names; units in the names).
 SWEEP_PARAMETERS = (
@@ -86,6 +96,74 @@ _UNITS = {
     "max_pressure_kpa": ("kPa", "highest pressure with a free-bending equilibrium (fold or lock-up)"),
     "branch_end": ("1", "end of the free-bending branch: 0 lock-up, 1 fold, 2 unbounded, 3 neutral"),
 }
+
+
+# ------------------------------------------------------------------------------------------------
+# costs: what a sweep takes in memory and time (docs/budgets.md); the budgets are in infra/budgets.py
+# ------------------------------------------------------------------------------------------------
+#: Measured costs (one core of a 2-core x86-64 machine, 2026), rounded up about twice for slower machines.
+SECONDS_PER_CASE = 3e-4    # the free-bending branch of a case: measured 0.12-0.13 ms
+SECONDS_PER_POINT = 1e-5   # roots and limits per (case, pressure), assembling, NetCDF: measured 4-8 us
+TABLE_SECONDS_PER_POINT = {"csv": 2e-5, "parquet": 2e-6}  # a tidy table row written: measured 10 and 1 us
+WORK_BYTES_PER_POINT = 2048  # working arrays of a block being computed: measured 1.5-2 kB per point
+WORK_BYTES_PER_CASE = 40_000  # and 34 kB per case
+BASE_BYTES = 512 * MIB  # the process itself (Python, NumPy, xarray, Dask, pyarrow): measured 200-400 MB
+#: The outputs of a point, as float64.
+RESULT_BYTES_PER_POINT = 8 * len(_OUTPUTS)
+
+
+@dataclass(frozen=True)
+class SweepEstimate:
+    """A sweep's size and a conservative estimate of its peak memory and run time (:func:`sweep_estimate`).
+
+    >>> est = SweepEstimate(cases=100, points=1600, memory_bytes=600e6, seconds=0.05)
+    >>> est.memory_text, est.time_text
+    ('572 MiB', '0.05 s')
+    """
+
+    cases: int
+    points: int
+    memory_bytes: float
+    seconds: float
+
+    @property
+    def memory_text(self) -> str:
+        return format_bytes(self.memory_bytes)
+
+    @property
+    def time_text(self) -> str:
+        s = self.seconds
+        return f"{s:.2g} s" if s < 60 else f"{s / 60:.3g} min" if s < 3600 else f"{s / 3600:.3g} h"
+
+
+def sweep_estimate(n_cases: int, n_pressures: int, n_params: int = 1, *, chunk_cases: int = 256,
+                   table: str | None = None, compute: bool = True, remote: bool = False) -> SweepEstimate:
+    """Peak memory and run time of a sweep, estimated before any work from the measured costs above.
+
+    Memory: the process (``BASE_BYTES``), the blocks being computed (one per core in-process,
+    ``WORK_BYTES_PER_POINT`` and ``WORK_BYTES_PER_CASE`` each; none here with ``remote``) and,
+    with ``compute``, the result: its outputs (``8 x 13`` bytes a point) held twice while the
+    blocks are assembled, plus a tidy table row when ``table`` ("csv" or "parquet") is written.
+    Time: ``SECONDS_PER_CASE`` a case and ``SECONDS_PER_POINT`` a point (plus the table's), on
+    one core (more cores and a cluster make it shorter).
+
+    Examples
+    --------
+    >>> est = sweep_estimate(10_000, 100, table="csv", remote=True)        # one million points
+    >>> est.points, est.memory_text, est.time_text
+    (1000000, '840 MiB', '33 s')
+    """
+    n_cases, n_pressures = int(n_cases), int(n_pressures)
+    points = n_cases * n_pressures
+    block_cases = max(1, min(int(chunk_cases), n_cases))
+    in_flight = 0 if remote else min(os.cpu_count() or 1, -(-n_cases // block_cases))
+    work = in_flight * block_cases * (n_pressures * WORK_BYTES_PER_POINT + WORK_BYTES_PER_CASE)
+    per_point = 0.0
+    if compute:
+        per_point = 2 * RESULT_BYTES_PER_POINT + (8 * (2 * (n_params + 1) + len(_OUTPUTS)) if table else 0)
+    seconds = n_cases * SECONDS_PER_CASE + points * (SECONDS_PER_POINT + TABLE_SECONDS_PER_POINT.get(table or "", 0))
+    return SweepEstimate(cases=n_cases, points=points, memory_bytes=BASE_BYTES + work + points * per_point,
+                         seconds=seconds)
 
 
 def build_cases(base: Actuator, values: dict[str, np.ndarray]) -> ModelParams:
@@ -213,6 +291,7 @@ def _block(base, model, names, grids, P, order, eq19, idx_block):
 def sweep(base_actuator: Actuator, pressure_kpa, model: str = "energy", *, chunk_cases: int = 256,
           scheduler: str | None = None, workers: int | None = None, compute: bool = True,
           progress: bool | Callable[[int], Any] | None = None, order: int = DEFAULT_ORDER, eq19_factor: bool = True,
+          max_memory_gib: float | None = MEMORY_BUDGET_GIB, scheduler_timeout_s: float = SCHEDULER_TIMEOUT_S,
           **params) -> Any:
     """Sweep actuator parameters crossed with pressures.  See the module docstring.
 
@@ -231,6 +310,10 @@ def sweep(base_actuator: Actuator, pressure_kpa, model: str = "energy", *, chunk
         threaded scheduler, so it must be thread-safe; ``Progress.advance`` is); ``False``: no
         report; ``None`` (default): a bar for sweeps of at least 20 blocks when stderr is a
         terminal.  Ignored with ``compute=False``.
+    max_memory_gib : the memory budget (GiB, default :data:`~bendpam.infra.budgets.MEMORY_BUDGET_GIB`;
+        None: only this machine's memory): a sweep whose estimated peak (:func:`sweep_estimate`) is
+        larger is refused before any work.  ``compute=False`` keeps only the blocks in memory.
+    scheduler_timeout_s : how long the scheduler has to answer as a Dask scheduler before it is refused.
     **params : Actuator field names with 1-D values, e.g. ``alpha0_deg=np.linspace(60, 80, 41)``.
 
     Examples
@@ -255,18 +338,38 @@ def sweep(base_actuator: Actuator, pressure_kpa, model: str = "energy", *, chunk
     chunk_cases = int(chunk_cases)
     if chunk_cases < 1:
         raise InputError(f"chunk_cases = {chunk_cases} must be >= 1")
+    if scheduler is not None:
+        from bendpam.infra.scheduler import parse_scheduler_address
+
+        scheduler = parse_scheduler_address(scheduler)
+    _check_memory(shape, P.size, chunk_cases, compute, bool(scheduler or workers), max_memory_gib)
     # validate before any work (the same checks as Actuator): every combination of the
     # parameters that constrain each other, each other parameter on its own
     _prevalidate(base_actuator, names, grids)
     chunks = _natural_chunks(shape, chunk_cases)
     fn = _block_fn(base_actuator, model, names, grids, P, order, eq19_factor)
     data = _run_blocks(fn, shape, chunks, P.size, scheduler=scheduler, workers=workers, compute=compute,
-                       progress=progress)
+                       progress=progress, timeout_s=scheduler_timeout_s)
     return _dataset(data, names, grids, shape, P, base_actuator, model, order)
 
 
+def _check_memory(shape: tuple[int, ...], n_pressures: int, chunk_cases: int, compute: bool, remote: bool,
+                  max_memory_gib: float | None) -> None:
+    """Refuse, before any work, a sweep whose estimated peak memory is past the budget or the machine's memory."""
+    if max_memory_gib is not None and not (isinstance(max_memory_gib, int | float) and max_memory_gib > 0):
+        raise InputError(f"max_memory_gib = {max_memory_gib!r} must be a number of GiB > 0 (or None)")
+    n_cases = int(np.prod(shape)) if shape else 1
+    est = sweep_estimate(n_cases, n_pressures, len(shape), chunk_cases=chunk_cases, compute=compute, remote=remote)
+    problem = memory_problem(est.memory_bytes, max_memory_gib)
+    if problem is not None:
+        raise InputError(f"a sweep of {est.points} (case, pressure) points would hold {problem}; give fewer values"
+                         + (", keep it lazy (compute=False: to_netcdf then writes it block by block)" if compute
+                            else ", or a smaller chunk_cases") + ", or raise max_memory_gib")
+
+
 def _run_blocks(fn, shape: tuple[int, ...], chunks, n_pressures: int, *, scheduler: str | None, workers: int | None,
-                compute: bool, progress: bool | Callable[[int], Any] | None) -> Any:
+                compute: bool, progress: bool | Callable[[int], Any] | None, timeout_s: float = SCHEDULER_TIMEOUT_S
+                ) -> Any:
     """The sweep's data (cases..., pressures, outputs): the blocks of ``fn`` in a loop without Dask, else a
     dask array, computed in-process or on a cluster, or left lazy; progress as :func:`sweep` describes."""
     n_cases = int(np.prod(shape)) if shape else 1
@@ -298,7 +401,7 @@ def _run_blocks(fn, shape: tuple[int, ...], chunks, n_pressures: int, *, schedul
         kernel = fn if remote or not compute or report is None else _Counted(fn, report)
         arr = idx.map_blocks(kernel, dtype=float, new_axis=[nd, nd + 1],
                              chunks=(*idx.chunks, (n_pressures,), (len(_OUTPUTS),)), meta=np.empty((0,) * (nd + 2)))
-        return _compute(arr, scheduler, workers, report, idx.chunks) if compute else arr
+        return _compute(arr, scheduler, workers, report, idx.chunks, timeout_s) if compute else arr
 
 
 def _natural_chunks(shape: tuple[int, ...], chunk_cases: int) -> tuple[tuple[int, ...], ...]:
@@ -387,14 +490,20 @@ def _block_cases(key, case_chunks) -> int:
         return 0
 
 
-def _compute(arr, scheduler, workers, report, case_chunks):
+def _compute(arr, scheduler, workers, report, case_chunks, timeout_s=SCHEDULER_TIMEOUT_S):
     import dask
 
     if scheduler or workers:
-        from distributed import Client, LocalCluster, as_completed, futures_of
+        try:
+            from distributed import Client, LocalCluster, as_completed, futures_of
+        except ImportError:
+            raise InputError("distributed sweeps need distributed: pip install 'bendpam[distributed]'") from None
 
         if scheduler:
-            client = Client(scheduler)
+            from bendpam.infra.scheduler import probe_scheduler
+
+            probe_scheduler(scheduler, timeout_s)  # Dask's client would wait without end for a silent server
+            client = Client(scheduler, timeout=timeout_s)
             cluster = None
         else:
             cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1, processes=True,

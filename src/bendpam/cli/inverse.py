@@ -82,6 +82,10 @@ def design_cmd(
     at = [repr(t.pressure_kpa) for t in targets if t.pressure_kpa is not None]
     if at:  # the pressures after '@' are kPa: the same refusal of MPa-looking values as --pressure-kpa
         pressures_kpa(at, None, "--target ...@P")
+    if scheduler is not None:
+        from bendpam.infra.scheduler import parse_scheduler_address
+
+        scheduler = parse_scheduler_address(scheduler, name="--scheduler")
     act = load_actuator(preset, actuator, model)
     variables = parse_variables(act, vary, "--vary")
     if max_pressure_kpa is not None and not max_pressure_kpa > 0:

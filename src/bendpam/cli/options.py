@@ -20,6 +20,7 @@ import typer
 from typer.core import TyperCommand
 
 from bendpam.errors import InputError
+from bendpam.infra.budgets import MAX_OPTION_VALUES, value_limit
 from bendpam.validate import file_format
 
 if TYPE_CHECKING:
@@ -64,8 +65,9 @@ __all__ = [
     "pressures_kpa",
 ]
 
-#: The largest number of values one option may expand to (a range like 100:200:30000000 is refused).
-MAX_VALUES = 1_000_000
+#: The largest number of values one option may expand to in any command (a range like 100:200:30000000 is
+#: refused); each command has its own, smaller limit (:data:`bendpam.infra.budgets.VALUE_LIMITS`).
+MAX_VALUES = MAX_OPTION_VALUES
 
 
 class UserError(InputError):
@@ -168,12 +170,27 @@ def echo(text: str = "", err: bool = False) -> None:
     typer.echo(text, err=err)
 
 
-def parse_values(tokens: list[str] | None, name: str, *, max_values: int = MAX_VALUES) -> list[float]:
+def _too_many(name: str, what: str, limit: int) -> UserError:
+    command = RUN_COMMAND.get()
+    who = f"bendpam {command}" if command else "an option"
+    return UserError(f"{name}: {what}; {who} takes at most {limit} values per option (about a minute of work or "
+                     "less): give fewer values")
+
+
+def parse_values(tokens: list[str] | None, name: str, *, max_values: int | None = None) -> list[float]:
     """Parse numbers given as separate tokens, comma lists or ranges ``start:stop:count``.
+
+    ``max_values`` defaults to the running command's limit (:func:`bendpam.infra.budgets.value_limit`);
+    a range is checked against it before it is expanded.
 
     >>> parse_values(["100,150", "200:300:3"], "--pressure-kpa")
     [100.0, 150.0, 200.0, 250.0, 300.0]
+    >>> parse_values(["100:200:999999"], "--pressure-kpa")
+    Traceback (most recent call last):
+    ...
+    bendpam.cli.options.UserError: --pressure-kpa: range '100:200:999999' gives 999999 values; an option takes ...
     """
+    limit = value_limit(RUN_COMMAND.get()) if max_values is None else int(max_values)
     out: list[float] = []
     for tok in tokens or []:
         for part in str(tok).replace(",", " ").split():
@@ -189,8 +206,9 @@ def parse_values(tokens: list[str] | None, name: str, *, max_values: int = MAX_V
                     raise UserError(f"{name}: range {part!r} must have finite ends")
                 if n < 1:
                     raise UserError(f"{name}: range {part!r} needs a count >= 1")
-                if len(out) + n > max_values:
-                    raise UserError(f"{name}: range {part!r} gives {n} values; at most {max_values} are allowed")
+                if len(out) + n > limit:
+                    raise _too_many(name, f"range {part!r} gives {n} values" + (f" after {len(out)}" if out else ""),
+                                    limit)
                 out.extend(a + (b - a) * i / (n - 1) if n > 1 else a for i in range(n))
             else:
                 try:
@@ -200,8 +218,8 @@ def parse_values(tokens: list[str] | None, name: str, *, max_values: int = MAX_V
                 if not math.isfinite(v):
                     raise UserError(f"{name}: {part!r} is not finite")
                 out.append(v)
-    if len(out) > max_values:
-        raise UserError(f"{name}: {len(out)} values; at most {max_values} are allowed")
+                if len(out) > limit:
+                    raise _too_many(name, f"more than {limit} values", limit)
     return out
 
 

@@ -25,11 +25,20 @@ from bendpam.cli.options import (
     parse_values,
     pressures_kpa,
 )
+from bendpam.infra.budgets import MEMORY_BUDGET_GIB, TIME_BUDGET_MIN
 
 #: The most (case, pressure) points one block may hold: the model's working arrays take about 2 kB per point.
 MAX_BLOCK_POINTS = 1_000_000
-#: The largest value of --max-points (the result alone takes 40 bytes per point).
+#: The largest value of --max-points (the result alone takes 104 bytes per point).
 MAX_POINTS_LIMIT = 1_000_000_000
+
+
+MaxMemoryOpt = Annotated[float, typer.Option(
+    "--max-memory-gib", min=0.01, help="Memory budget (GiB): a sweep whose estimated peak memory is larger is "
+    "refused before any work (the whole result is held in memory before it is written).")]
+MaxMinutesOpt = Annotated[float, typer.Option(
+    "--max-minutes", min=0.01, help="Time budget (minutes): a sweep whose estimated run time on one core is longer "
+    "is refused before any work.")]
 
 
 class SweepFormat(str, Enum):
@@ -96,9 +105,12 @@ def sweep_cmd(
     = None,
     chunk_cases: Annotated[int, typer.Option("--chunk-cases", min=1, max=1_000_000,
                                              help="Actuator cases per block (memory bound).")] = 256,
-    max_points: Annotated[int, typer.Option("--max-points", min=1, max=MAX_POINTS_LIMIT,
-                                            help="Refuse sweeps larger than this many (case, pressure) points.")]
-    = 100_000_000,
+    max_points: Annotated[Optional[int], typer.Option(
+        "--max-points", min=1, max=MAX_POINTS_LIMIT, show_default=False,
+        help="Refuse sweeps larger than this many (case, pressure) points (default: as many as fit "
+        "--max-memory-gib).")] = None,
+    max_memory_gib: MaxMemoryOpt = MEMORY_BUDGET_GIB,
+    max_minutes: MaxMinutesOpt = TIME_BUDGET_MIN,
     out: Annotated[Optional[Path], typer.Option(
         "--out", help="Output file: NetCDF (.nc), or a tidy table of one row per case and pressure (.csv, .parquet)."
     )] = None,
@@ -129,14 +141,16 @@ def sweep_cmd(
         raise UserError("give --out FILE.nc|.csv|.parquet and/or --plot FILE.png|.pdf|.svg")
     fixed_at = parse_at(at)
     data_fmt, fig_fmt = sweep_formats(out, plot, fmt)
-    check_run(out, data_fmt, scheduler, workers)
-    act = load_actuator(preset, actuator, model)
     grids, P, n_cases = sweep_grid(param, pressure_kpa, max_points, chunk_cases)
+    check_budgets(len(grids), len(P), n_cases, chunk_cases, data_fmt, bool(scheduler or workers), max_memory_gib,
+                  max_minutes)
+    scheduler = check_run(out, data_fmt, scheduler, workers)
+    act = load_actuator(preset, actuator, model)
     from bendpam.infra.progress import Progress
 
     with Progress(n_cases, "sweep", quiet=quiet or not progress) as bar:
         ds = sweep(act, P, model_name(model), chunk_cases=chunk_cases, scheduler=scheduler, workers=workers,
-                   progress=bar.advance, **grids)
+                   progress=bar.advance, max_memory_gib=max_memory_gib, **grids)
     if out is not None:
         from bendpam.sweeps import write_sweep
 
@@ -165,8 +179,11 @@ def parse_at(at: list[str] | None) -> dict[str, float]:
     return fixed_at
 
 
-def check_run(out: Path | None, data_fmt: str | None, scheduler: str | None, workers: int | None) -> None:
-    """Refuse, before any work, a Parquet --out without pyarrow and a --scheduler/--workers request that cannot run."""
+def check_run(out: Path | None, data_fmt: str | None, scheduler: str | None, workers: int | None) -> str | None:
+    """Refuse, before any work, a Parquet --out without pyarrow and a --scheduler/--workers request that cannot run.
+
+    Returns the scheduler's address (read from --scheduler, which must answer as a Dask scheduler).
+    """
     if data_fmt == "parquet":
         try:
             import pyarrow  # noqa: F401
@@ -180,9 +197,41 @@ def check_run(out: Path | None, data_fmt: str | None, scheduler: str | None, wor
     if workers is not None and workers > max_local_workers():
         raise UserError(f"--workers {workers}: at most {max_local_workers()} local processes (4 per CPU); "
                         "use --scheduler for a larger cluster")
+    return None if scheduler is None else scheduler_address(scheduler)
 
 
-def sweep_grid(param: list[str] | None, pressure_kpa: list[str] | None, max_points: int,
+def scheduler_address(text: str) -> str:
+    """The address of ``--scheduler`` (an address or a scheduler file), refused unless a Dask scheduler answers it."""
+    from bendpam.infra.budgets import SCHEDULER_TIMEOUT_S
+    from bendpam.infra.scheduler import parse_scheduler_address, probe_scheduler
+
+    address = parse_scheduler_address(text, name="--scheduler")
+    probe_scheduler(address, SCHEDULER_TIMEOUT_S)
+    return address
+
+
+def check_budgets(n_params: int, n_pressures: int, n_cases: int, chunk_cases: int, data_fmt: str | None,
+                  remote: bool, max_memory_gib: float, max_minutes: float) -> None:
+    """Refuse, before any work, a sweep whose estimated peak memory or run time is past its budget."""
+    from bendpam.infra.budgets import GIB, memory_problem
+    from bendpam.sweeps import sweep_estimate
+
+    table = data_fmt if data_fmt in ("csv", "parquet") else None
+    est = sweep_estimate(n_cases, n_pressures, n_params, chunk_cases=chunk_cases, table=table, remote=remote)
+    size = (f"{est.points} (case, pressure) points ({n_cases} case{'s' * (n_cases != 1)} x {n_pressures} "
+            f"pressure{'s' * (n_pressures != 1)})")
+    problem = memory_problem(est.memory_bytes, max_memory_gib)
+    if problem is not None:
+        raise UserError(f"the sweep of {size} holds its whole result in memory before writing it: {problem}; give "
+                        "fewer values" + (", or raise --max-memory-gib if this machine has the memory"
+                                          if est.memory_bytes > max_memory_gib * GIB else ""))
+    if est.seconds > 60.0 * max_minutes:
+        raise UserError(f"the sweep of {size} would take about {est.time_text} on one core (a conservative estimate), "
+                        f"more than --max-minutes {max_minutes:g}; give fewer values, or raise --max-minutes (the "
+                        "estimate is for one core: more cores, --workers or --scheduler finish sooner)")
+
+
+def sweep_grid(param: list[str] | None, pressure_kpa: list[str] | None, max_points: int | None,
                chunk_cases: int) -> tuple[dict[str, Any], list[float], int]:
     """``(grids, pressures, n_cases)`` from --param and --pressure-kpa, within --max-points and the block size."""
     from bendpam.sweeps import SWEEP_PARAMETERS
@@ -195,7 +244,7 @@ def sweep_grid(param: list[str] | None, pressure_kpa: list[str] | None, max_poin
         raise UserError("give the pressures with --pressure-kpa, e.g. 100:250:16")
     P = pressures_kpa(pressure_kpa)
     n_points = len(P) * int(np.prod([len(v) for v in params.values()] or [1]))
-    if n_points > max_points:
+    if max_points is not None and n_points > max_points:
         raise UserError(f"the sweep has {n_points} (case, pressure) points, more than --max-points {max_points}; "
                         "raise --max-points to run it")
     n_cases = n_points // len(P)

@@ -89,6 +89,7 @@ from bendpam.design.tip import blocked_tip_force
 from bendpam.errors import BendpamError, InputError
 from bendpam.infra.accessors import figure
 from bendpam.infra.progress import Progress
+from bendpam.infra.scheduler import parse_scheduler_address, probe_scheduler
 from bendpam.physics.actuator import Actuator
 from bendpam.physics.models import normalise_model
 from bendpam.predict import blocked_moment, free_branch, free_curvature, tangent_stiffness
@@ -235,7 +236,8 @@ def design_actuator(base: Actuator, targets: Iterable[Target | str], vary, *, mo
     n_coarse : designs in the coarse map (rounded up to a power of 2; 16 to 2**20).
     n_starts : local searches from the best distinct designs of the map (1 to 64).
     pareto : compute the Pareto front of two targets (None: when there are exactly two).
-    scheduler : a Dask scheduler address: the coarse map (a grid) is computed there.
+    scheduler : a Dask scheduler address (or scheduler file): the coarse map (a grid) is computed
+        there.  It must answer as a Dask scheduler within 10 s (:mod:`bendpam.infra.scheduler`).
     seed : seed of the Sobol sample (results are deterministic for a seed).
     progress : show a progress bar.
 
@@ -258,6 +260,7 @@ def design_actuator(base: Actuator, targets: Iterable[Target | str], vary, *, mo
     tg = parse_targets(targets)
     variables = parse_variables(base, vary)
     n_coarse, n_starts, want_pareto = _checked_search(tg, max_pressure_kpa, min_margin, n_coarse, n_starts, pareto)
+    scheduler = _checked_scheduler(scheduler)
     prob = DesignProblem(base, model, tg, variables, max_pressure_kpa, float(min_margin), int(seed))
     n = len(variables)
     all_t = list(range(len(tg)))
@@ -365,6 +368,15 @@ def _search(prob: DesignProblem, U, X, starts: list[int], tip: list[int], bar) -
         u_best = _settle_tip(prob, u_best, tip, all_t)
         u_best = _settle_tip(prob, _local(prob, u_best, all_t)[0], tip, all_t)
     return np.where(u_best < 1e-8, 0.0, np.where(u_best > 1.0 - 1e-8, 1.0, u_best))  # on a bound: exactly
+
+
+def _checked_scheduler(scheduler: str | None) -> str | None:
+    """The scheduler's address, read and asked before any work (refused in one line, never a hang)."""
+    if scheduler is None:
+        return None
+    address = parse_scheduler_address(scheduler)
+    probe_scheduler(address)
+    return address
 
 
 def _int_in(name: str, v, lo: int, hi: int) -> int:

@@ -6,6 +6,7 @@ import os
 from pathlib import Path
 
 from bendpam.errors import InputError
+from bendpam.infra.budgets import check_input_file
 
 __all__ = ["RAW_SUFFIXES", "collect_raw_files"]
 
@@ -17,7 +18,8 @@ def collect_raw_files(inputs) -> list[Path]:
     """Expand folders into their raw test files (known suffixes, sorted); check files exist.
 
     ``inputs`` is one path or a sequence of paths.  Raises ``ValueError`` (one line) for a missing
-    path, a folder without raw files, or no input at all.
+    path, a folder without raw files, a file that is not a regular file (a named pipe, a device) or
+    is larger than the limit of a raw test file (:mod:`bendpam.infra.budgets`), or no input at all.
 
     Examples
     --------
@@ -41,6 +43,7 @@ def collect_raw_files(inputs) -> list[Path]:
                 raise InputError(f"{p}: no raw test files here (looked for {', '.join(sorted(RAW_SUFFIXES))})")
             files.extend(found)
         elif p.exists():
+            check_input_file(p, "raw test file")  # a named pipe, a device or a file past the size limit
             files.append(p)
         else:
             raise InputError(f"{p}: no such file or folder")

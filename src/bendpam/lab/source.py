@@ -1,7 +1,7 @@
 """The source of a raw test: a file's bytes (or a workbook's sheets, or text) as lines.
 
 :func:`open_source` opens a file: refuses what is not a text export or a workbook (empty
-files, directories, Zwick ``.zs2``, binary data), chooses the encoding
+files, what is not a regular file, files past the size limit, Zwick ``.zs2``, binary data), chooses the encoding
 (:func:`bendpam.lab.encoding.detect_encoding`) and hands out the lines lazily; a workbook gives
 one :class:`Source` per sheet (:mod:`bendpam.lab.excel`).  :func:`text_source` does the same for
 text already in memory.
@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from bendpam.infra.budgets import input_file_problem
 from bendpam.lab.encoding import container_kind, detect_encoding
 from bendpam.lab.read_error import ReadError
 
@@ -65,6 +66,9 @@ class Source:
 
 
 def _read_head(path: Path) -> tuple[bytes, int]:
+    problem = input_file_problem(path, "raw test file")  # a named pipe or a device would hang or never end
+    if problem is not None and not problem.endswith("not found"):
+        raise ReadError(problem, path)
     try:
         size = path.stat().st_size
         if path.is_dir():
@@ -152,7 +156,9 @@ def open_source(path: Path) -> tuple[list[Source], int]:
     Raises
     ------
     ReadError
-        For a file that is missing, empty, a directory, unreadable, binary or a native Zwick file.
+        For a file that is missing, empty, not a regular file (a directory, a named pipe, a
+        device), larger than the limit of a raw test file (2 GiB, :mod:`bendpam.infra.budgets`),
+        unreadable, binary or a native Zwick file.
 
     Examples
     --------

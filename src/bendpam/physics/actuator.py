@@ -15,7 +15,6 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -25,6 +24,7 @@ import tomli_w
 
 from bendpam.errors import FileFormatError, InputError
 from bendpam.infra.atomic import atomic_write_text
+from bendpam.infra.budgets import loads_toml, read_input_bytes
 from bendpam.physics.material import MooneyRivlin
 from bendpam.validate import did_you_mean, number
 
@@ -382,20 +382,18 @@ class Actuator:
 
     @classmethod
     def from_toml(cls, path: str | os.PathLike) -> Actuator:
-        """Read an actuator from a TOML file with an ``[actuator]`` table (or top-level keys)."""
+        """Read an actuator from a TOML file with an ``[actuator]`` table (or top-level keys).
+
+        The file must be a regular file of at most 1 MiB with tables nested at most 3 deep
+        (:mod:`bendpam.infra.budgets`); anything else is refused in one line before it is read.
+        """
         p = Path(path)
+        raw = read_input_bytes(p, "actuator file")
         try:
-            raw = p.read_bytes()
-        except FileNotFoundError:
-            raise FileFormatError(f"{p}: actuator file not found") from None
-        except OSError as exc:
-            raise FileFormatError(f"{p}: cannot read actuator file ({exc.strerror})") from None
-        try:
-            data = tomllib.loads(raw.decode("utf-8"))
+            text = raw.decode("utf-8")
         except UnicodeDecodeError as exc:
             raise FileFormatError(f"{p}: not UTF-8 text (byte {exc.start})") from None
-        except tomllib.TOMLDecodeError as exc:
-            raise FileFormatError(f"{p}: invalid TOML: {exc}") from None
+        data = loads_toml(text, str(p), kind="actuator file")
         if "actuator" in data:
             extra = [k for k in data if k not in ("actuator", "hysteresis")]
             if extra:
