@@ -160,6 +160,10 @@ def main(argv: list[str] | None = None) -> int:
         where = f": {exc.filename}" if exc.filename else ""
         typer.echo(f"bendpam: error: {exc.strerror or _one_line(exc)}{where}", err=True)
         return 2
+    except MemoryError:
+        typer.echo("bendpam: error: out of memory: the machine could not hold this run's data; give fewer values "
+                   "or smaller inputs (docs/budgets.md: the memory budgets)", err=True)
+        return 2
     except BaseException as exc:
         if isinstance(exc, SystemExit):
             raise

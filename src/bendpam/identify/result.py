@@ -22,6 +22,7 @@ import numpy as np
 from bendpam.errors import FileFormatError, InputError
 from bendpam.infra.accessors import figure
 from bendpam.infra.atomic import atomic_write_text, json_safe
+from bendpam.infra.budgets import read_input_bytes
 from bendpam.infra.manifest import verify_input
 from bendpam.physics.actuator import Actuator
 from bendpam.physics.law import MomentLaw
@@ -586,13 +587,16 @@ class FitResult:
         """Read a fit written by :meth:`save` (the folder or its ``fit.json``)."""
         p = Path(path)
         fj = p / "fit.json" if p.is_dir() else p
-        if fj.exists():
-            verify_input(fj)  # a fit that bendpam wrote is read only as it wrote it (its manifest's hashes)
+        if not fj.exists():
+            raise FileFormatError(f"{fj}: no such fit file; give the output folder of 'bendpam fit'")
+        data = read_input_bytes(fj, "fit file")  # a regular file of a sane size, read without blocking
+        verify_input(fj)  # a fit that bendpam wrote is read only as it wrote it (its manifest's hashes)
         try:
-            return cls.from_dict(json.loads(fj.read_text(encoding="utf-8")), source=str(fj))
+            return cls.from_dict(json.loads(data.decode("utf-8")), source=str(fj))
         except FileNotFoundError:
             raise FileFormatError(f"{fj}: no such fit file; give the output folder of 'bendpam fit'") from None
-        except (OSError, UnicodeDecodeError, json.JSONDecodeError, KeyError, TypeError, ValueError) as exc:
+        except (OSError, UnicodeDecodeError, json.JSONDecodeError, KeyError, TypeError, ValueError,
+                RecursionError) as exc:
             raise FileFormatError(f"{fj}: not a bendpam fit.json ({type(exc).__name__}: {exc})") from None
 
     def __str__(self) -> str:

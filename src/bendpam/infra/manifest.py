@@ -29,11 +29,13 @@ import importlib.metadata
 import json
 import os
 import re
+import stat
 from pathlib import Path, PurePosixPath
 from typing import Any
 
 from bendpam.errors import FileFormatError
 from bendpam.infra.atomic import json_safe
+from bendpam.infra.budgets import read_input_bytes
 from bendpam.infra.fsops import ANY_TEMP, hash_file
 
 __all__ = [
@@ -208,8 +210,10 @@ def read_manifest(folder: str | os.PathLike[str]) -> dict[str, Any] | None:
     bendpam.errors.FileFormatError: .../manifest.json: not a bendpam manifest (no "format": "bendpam-output-set")
     """
     path = Path(folder) / MANIFEST_NAME
+    if not path.exists():
+        return None
     try:
-        text = path.read_bytes()
+        text = read_input_bytes(path, "manifest")
     except (FileNotFoundError, NotADirectoryError):
         return None
     except OSError as exc:
@@ -254,7 +258,13 @@ def manifest_producer(manifest: dict[str, Any]) -> str | None:
 def _entry_problem(folder: Path, entry: dict[str, Any]) -> str | None:
     p = folder.joinpath(*PurePosixPath(entry["path"]).parts)
     try:
-        size, digest = hash_file(p) if p.stat().st_size == entry["size"] else (-1, "")
+        st = p.stat()
+    except FileNotFoundError:
+        return "missing"
+    if not stat.S_ISREG(st.st_mode):  # a pipe or device in a file's place: never read it (it could hang)
+        return "changed"
+    try:
+        size, digest = hash_file(p) if st.st_size == entry["size"] else (-1, "")
     except FileNotFoundError:
         return "missing"
     if size != entry["size"] or digest != entry["sha256"]:

@@ -20,6 +20,7 @@ import numpy as np
 
 from bendpam.errors import InputError, ProcessingError
 from bendpam.infra.accessors import figure as figure_by_name
+from bendpam.infra.budgets import check_input_file
 from bendpam.infra.manifest import verify_input
 from bendpam.physics.fixture import Fixture
 
@@ -512,6 +513,7 @@ def load_processed(path) -> ProcessedSet:
     nc = p / "curves.nc" if p.is_dir() else p
     if not nc.exists():
         raise ProcessingError(f"{p}: no curves.nc here; give the output folder of 'bendpam process'")
+    check_input_file(nc, "processed curves file")  # a regular file of a sane size (a pipe would hang the read)
     verify_input(nc)  # a set that bendpam wrote is read only as it wrote it (its manifest's hashes)
     try:
         ds = _read_curves(nc)

@@ -295,12 +295,11 @@ class LoopModel:
     @classmethod
     def from_toml(cls, path) -> LoopModel | None:
         """The ``[hysteresis]`` table of an actuator TOML file (as ``bendpam fit --hysteresis`` writes), or None."""
-        import tomllib
-        from pathlib import Path
+        from bendpam.infra.budgets import loads_toml, read_input_bytes
 
         try:
-            data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
-        except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
+            data = loads_toml(read_input_bytes(path, "actuator file").decode("utf-8"), str(path))
+        except (OSError, UnicodeDecodeError) as exc:
             raise InputError(f"{path}: cannot read the hysteresis table ({exc})") from None
         table = data.get("hysteresis")
         return None if table is None else cls.from_dict(table, source=f"{path} [hysteresis]")
