@@ -38,7 +38,10 @@ ASIDE_RE = re.compile(r"\.moved-aside-[^/]*")
 
 def _fi() -> Any:
     """The harness module (loaded by whoever imported this one, or imported from this folder)."""
+    main = sys.modules.get("__main__")
     mod = sys.modules.get("bendpam_fault_injection") or sys.modules.get("fault_injection")
+    if mod is None and hasattr(main, "classify") and hasattr(main, "Tally"):  # run as a script
+        mod = main
     if mod is None:
         sys.path.insert(0, str(Path(__file__).resolve().parent))
         import fault_injection as mod  # type: ignore[no-redef]
@@ -567,5 +570,5 @@ def run_families(tally: Any, inputs: dict[str, Path], work: Path, seed: int, job
     log(f"  signals (--plot, post-commit, console script): done ({time.monotonic() - t0:.0f} s)")
     (work / "refuse").mkdir(exist_ok=True)
     refusal_cases(tally, budget_lines(work / "refuse") + plausible_lines(inputs, work / "refuse"), work / "refuse",
-                  jobs=jobs, timeout=45.0)
+                  jobs=jobs, timeout=30.0)
     log(f"  budgets and plausibility: done ({time.monotonic() - t0:.0f} s)")

@@ -735,6 +735,7 @@ def main(argv: list[str] | None = None) -> int:
             cases = [c for c in cases if "garble" in " ".join(c) or "binary" in " ".join(c)]
         run_cases(tally, cases, work / "inputs", jobs=a.jobs)
     print(f"  mutated inputs: done ({time.monotonic() - t0:.0f} s)", flush=True)
+    sys.modules.setdefault("fault_injection", sys.modules[__name__])  # one harness module for both files
     sys.path.insert(0, str(Path(__file__).resolve().parent))
     import fault_families  # issue 21: guards, read-back, post-commit and console signals, budgets, plausibility
 
