@@ -157,3 +157,92 @@ def test_concurrent_runs_never_mix(inputs, tmp_path, command):
     tally = fi.Tally()
     fi.concurrent_case(tally, command, inputs, tmp_path, stagger=0.0)
     _assert_clean(tally)
+
+
+# ---- issue 21: what bendpam may replace, read back and refuse (tools/fault_families.py) -----------
+_FAM = _TOOL.parent / "fault_families.py"
+_fspec = importlib.util.spec_from_file_location("bendpam_fault_families", _FAM)
+assert _fspec is not None and _fspec.loader is not None
+ff = importlib.util.module_from_spec(_fspec)
+sys.modules[_fspec.name] = ff
+_fspec.loader.exec_module(ff)
+
+
+def test_lost_files_finds_moved_aside_copies_and_changes(tmp_path):
+    (tmp_path / "out").mkdir()
+    (tmp_path / "out" / "notes.txt").write_text("mine")
+    before = ff.hashes(tmp_path, ["out"])
+    assert ff.lost_files(tmp_path, before) == []
+    (tmp_path / "out").rename(tmp_path / "out.moved-aside-20260101T000000Z")
+    assert ff.lost_files(tmp_path, before) == []  # moved aside, not lost
+    (tmp_path / "out.moved-aside-20260101T000000Z" / "notes.txt").write_text("changed")
+    assert ff.lost_files(tmp_path, before) == ["out/notes.txt"]
+
+
+_GUARD_SAMPLE = ["foreign manifest, process", "user file in a set --force", "hand-written --plot png",
+                 "--out ~ --force"]
+
+
+@pytest.mark.slow  # about 6 subprocesses: 5-15 s
+def test_guards_keep_user_files(inputs, tmp_path):
+    from concurrent.futures import ThreadPoolExecutor
+
+    cases = [g for g in ff.guard_cases() if g.name in _GUARD_SAMPLE]  # the tool runs all of them
+    assert len(cases) == len(_GUARD_SAMPLE)
+    tally = fi.Tally()
+    with ThreadPoolExecutor(2) as ex:
+        list(ex.map(lambda g: ff.guard_case(tally, g, inputs, tmp_path, TIMEOUT), cases))
+    _assert_clean(tally)
+    assert tally.counts["error"] == 3 and tally.counts["ok"] == 1
+
+
+@pytest.mark.parametrize("which", ["curves.nc", "raw"])
+def test_damaged_set_read_back_is_refused_naming_the_file(inputs, tmp_path, which):
+    tally = fi.Tally()
+    ff.readback_case(tally, which, inputs, tmp_path, seed=5, timeout=TIMEOUT)
+    _assert_clean(tally)
+
+
+def test_signal_after_the_commit_says_what_is_true(inputs, tmp_path):
+    tally = fi.Tally()
+    # the last line must match the disk ('after writing' and a complete set, or 'no outputs were changed' and
+    # none); that the 'wrote' line can precede a roll-back (the CLI commits when the command returns) is a
+    # defect reported by the long run (tools/fault_injection.py), not checked here
+    ff.post_commit_case(tally, "process", inputs, tmp_path, signal.SIGINT, timeout=TIMEOUT, early_wrote_ok=True)
+    _assert_clean(tally)
+
+
+def test_console_script_signal_once_its_handlers_are_in(tmp_path):
+    tally = fi.Tally()
+    ff.console_case(tally, tmp_path, signal.SIGTERM, "handlers", timeout=TIMEOUT)
+    _assert_clean(tally)
+    assert tally.counts["interrupt"] == 1
+
+
+@pytest.mark.skipif(not hasattr(__import__("os"), "mkfifo"), reason="POSIX FIFOs")
+@pytest.mark.xfail(strict=True, reason="input budgets (FIFO/huge file inputs) are being built by another helper: "
+                   "today `predict --actuator FIFO` blocks reading the FIFO")
+def test_fifo_actuator_is_refused_in_one_line(inputs, tmp_path):
+    tally = fi.Tally()
+    case = [c for c in ff.budget_lines(tmp_path) if c[0] == "fifo" and c[1][0] == "predict"]
+    ff.refusal_cases(tally, case, tmp_path, timeout=10.0)
+    _assert_clean(tally)
+
+
+@pytest.mark.parametrize("how", ["alpha0_deg=0.001", "R0_start_mm=1e22"])
+@pytest.mark.xfail(strict=True, reason="plausibility checks of actuator values are being built by another helper: "
+                   "today the value is accepted")
+def test_absurd_actuator_value_is_refused(inputs, tmp_path, how):
+    tally = fi.Tally()
+    case = [c for c in ff.plausible_lines(inputs, tmp_path) if c[0] == f"plausible {how}"]
+    ff.refusal_cases(tally, case, tmp_path, timeout=TIMEOUT)
+    _assert_clean(tally)
+
+
+@pytest.mark.xfail(strict=True, reason="plausibility of pressures (1 GPa) is being built by another helper: "
+                   "today `predict --pressure-kpa 1e6` answers")
+def test_absurd_pressure_is_refused(inputs, tmp_path):
+    tally = fi.Tally()
+    case = [c for c in ff.plausible_lines(inputs, tmp_path) if c[1][0] == "predict" and "1e6" in c[1]]
+    ff.refusal_cases(tally, case, tmp_path, timeout=TIMEOUT)
+    _assert_clean(tally)
