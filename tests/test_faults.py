@@ -206,9 +206,8 @@ def test_damaged_set_read_back_is_refused_naming_the_file(inputs, tmp_path, whic
 def test_signal_after_the_commit_says_what_is_true(inputs, tmp_path):
     tally = fi.Tally()
     # the last line must match the disk ('after writing' and a complete set, or 'no outputs were changed' and
-    # none); that the 'wrote' line can precede a roll-back (the CLI commits when the command returns) is a
-    # defect reported by the long run (tools/fault_injection.py), not checked here
-    ff.post_commit_case(tally, "process", inputs, tmp_path, signal.SIGINT, timeout=TIMEOUT, early_wrote_ok=True)
+    # none), and a 'wrote' line is printed only once the outputs are committed (never before a roll-back)
+    ff.post_commit_case(tally, "process", inputs, tmp_path, signal.SIGINT, timeout=TIMEOUT)
     _assert_clean(tally)
 
 
@@ -220,8 +219,6 @@ def test_console_script_signal_once_its_handlers_are_in(tmp_path):
 
 
 @pytest.mark.skipif(not hasattr(__import__("os"), "mkfifo"), reason="POSIX FIFOs")
-@pytest.mark.xfail(strict=True, reason="input budgets (FIFO/huge file inputs) are being built by another helper: "
-                   "today `predict --actuator FIFO` blocks reading the FIFO")
 def test_fifo_actuator_is_refused_in_one_line(inputs, tmp_path):
     tally = fi.Tally()
     case = [c for c in ff.budget_lines(tmp_path) if c[0] == "fifo" and c[1][0] == "predict"]

@@ -22,7 +22,7 @@ from typing import Annotated, Any, Optional
 
 import typer
 
-from bendpam.cli.options import RUN_ARGS, RUN_COMMAND, RUN_FORCE
+from bendpam.cli.options import RUN_ARGS, RUN_COMMAND, RUN_FORCE, WROTE_LINES
 
 __all__ = ["ISSUES_URL", "app", "main"]
 
@@ -104,10 +104,18 @@ def _run(args: list[str]) -> Any:
     from bendpam.infra.outputs import OutputGroup
 
     group = OutputGroup()
-    with group:
-        rv = app(args=args, prog_name="bendpam", standalone_mode=False)
-        if isinstance(rv, int) and not isinstance(rv, bool) and rv != 0:
-            group.abort()  # a command that fails keeps no outputs
+    wrote: list[str] = []
+    token = WROTE_LINES.set(wrote)
+    try:
+        with group:
+            rv = app(args=args, prog_name="bendpam", standalone_mode=False)
+            if isinstance(rv, int) and not isinstance(rv, bool) and rv != 0:
+                group.abort()  # a command that fails keeps no outputs
+                wrote.clear()
+    finally:
+        WROTE_LINES.reset(token)
+    for line in wrote:  # only now is every output in place
+        typer.echo(line)
     for m in group.members:
         if m.moved_aside is not None:
             typer.echo(f"bendpam: warning: the old content of {m.shown} was moved to {m.moved_aside}", err=True)

@@ -28,6 +28,7 @@ from bendpam.cli.options import (
     PressureOpt,
     QuietOpt,
     UserError,
+    echo_wrote,
     figure_format,
     load_actuator,
     model_name,
@@ -179,7 +180,7 @@ def finger_cmd(
         for v in (lm.violations if lm is not None else ()):
             typer.echo(f"bendpam: warning: past a limit: {v}", err=True)
     if plot is not None and not as_json:
-        typer.echo(f"wrote {plot}")
+        echo_wrote(f"wrote {plot}")
 
 
 def _print_finger_rows(rows: list[dict[str, Any]], blocked: bool) -> None:
@@ -294,7 +295,7 @@ def grasp_cmd(
         return
     _print_grasps(gr, rows)
     if plot is not None:
-        typer.echo(f"wrote {plot}")
+        echo_wrote(f"wrote {plot}")
 
 
 def _print_grasps(gr, rows: list[dict[str, Any]]) -> None:
@@ -376,7 +377,7 @@ def wrist_cmd(
                f"lateral stiffness {w.lateral_stiffness_nmm2:.4g} N·mm² — {mname.replace('_', '-')} model")
     _print_wrist(results, holding, holds, load_g, lever_mm, hand_mass_g, hand_lever_mm)
     if plot is not None:
-        typer.echo(f"wrote {plot}")
+        echo_wrote(f"wrote {plot}")
 
 
 def _wrist_runs(w, P, dirs, load: dict[str, float], quiet: bool):

@@ -17,6 +17,7 @@ from bendpam.cli.options import (
     PresetOpt,
     QuietOpt,
     UserError,
+    echo_wrote,
     load_actuator,
     model_name,
     output_set,
@@ -120,7 +121,7 @@ def fit(
         typer.echo((out / "fit.json").read_text())
         return
     typer.echo(str(res))
-    typer.echo(f"wrote {out}/ (fit.json, fitted_actuator.toml{', ' + fig_name if figure else ''})")
+    echo_wrote(f"wrote {out}/ (fit.json, fitted_actuator.toml{', ' + fig_name if figure else ''})")
 
 
 @app.command("fit-material")

@@ -17,6 +17,7 @@ from bendpam.cli.options import (
     ModelOpt,
     PresetOpt,
     UserError,
+    echo_wrote,
     load_actuator,
     model_name,
     output_set,
@@ -107,4 +108,4 @@ def design_cmd(
         return
     typer.echo(res.summary())
     if out is not None:
-        typer.echo(f"wrote {out}/ ({', '.join(files)})")
+        echo_wrote(f"wrote {out}/ ({', '.join(files)})")

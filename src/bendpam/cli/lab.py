@@ -21,6 +21,7 @@ from bendpam.cli.options import (
     QuietOpt,
     UserError,
     collect_raw_files,
+    echo_wrote,
     fmt_num,
     load_actuator,
     model_name,
@@ -146,7 +147,7 @@ def process(
         typer.echo((out / "summary.json").read_text())
         return
     _print_table2(processed.summary())
-    typer.echo(f"wrote {out}/ (curves.nc, curves.csv, summary.json{', ' + fig_name if figure else ''})")
+    echo_wrote(f"wrote {out}/ (curves.nc, curves.csv, summary.json{', ' + fig_name if figure else ''})")
 
 
 def _file_pressures(pressure_kpa: Optional[list[str]], files: list[Path]) -> list[float]:
@@ -234,4 +235,4 @@ def simulate_test_cmd(
             f"{t['file']}: {t['samples']} samples, blocked {t['blocked_moment_nmm']:.2f} N·mm, "
             f"free k' {t['free_curvature_per_mm']:.5f} 1/mm, loss ratio {100 * t['energy_loss_ratio']:.1f}%"
         )
-    typer.echo(f"wrote {out}/ ({len(truth['files'])} files and truth.json)")
+    echo_wrote(f"wrote {out}/ ({len(truth['files'])} files and truth.json)")

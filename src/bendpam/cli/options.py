@@ -34,6 +34,7 @@ __all__ = [
     "RUN_ARGS",
     "RUN_COMMAND",
     "RUN_FORCE",
+    "WROTE_LINES",
     "ActuatorOpt",
     "FigureFormat",
     "FigureFormatOpt",
@@ -51,6 +52,7 @@ __all__ = [
     "command_inputs",
     "command_line",
     "echo",
+    "echo_wrote",
     "figure_format",
     "fmt_num",
     "format_prediction_table",
@@ -338,6 +340,27 @@ def collect_raw_files(paths: list[Path]) -> list[Path]:
 RUN_ARGS: contextvars.ContextVar[list[str] | None] = contextvars.ContextVar("bendpam_run_args", default=None)
 #: The name of the running command (``"process"``): the producer recorded in its output sets.
 RUN_COMMAND: contextvars.ContextVar[str | None] = contextvars.ContextVar("bendpam_run_command", default=None)
+#: The ``wrote ...`` lines of the running command, printed once its outputs are committed (:func:`echo_wrote`).
+WROTE_LINES: contextvars.ContextVar[list[str] | None] = contextvars.ContextVar("bendpam_wrote_lines", default=None)
+
+
+def echo_wrote(text: str) -> None:
+    """Say that an output was written -- after the command's outputs are committed, so the line is true.
+
+    Inside a command run by :func:`bendpam.cli.app.main` the line waits until every output of the
+    command is in place (a signal or an error before then rolls them back, and the line is never
+    printed); elsewhere it is printed at once.
+
+    >>> echo_wrote("wrote out/")
+    wrote out/
+    """
+    pending = WROTE_LINES.get()
+    if pending is None:
+        typer.echo(text)
+    else:
+        pending.append(text)
+
+
 #: ``bendpam --force``: replace outputs that bendpam did not write, moving them aside.
 RUN_FORCE: contextvars.ContextVar[bool] = contextvars.ContextVar("bendpam_run_force", default=False)
 #: Parameters of a command that name its outputs (every other path parameter is an input).

@@ -22,6 +22,7 @@ from bendpam.cli.options import (
     PresetOpt,
     PressureOpt,
     UserError,
+    echo_wrote,
     figure_format,
     fmt_num,
     format_prediction_table,
@@ -206,7 +207,7 @@ def curve(
             f.write_text("\n".join(rows) + "\n")
         else:
             save_figure(moment_curvature_figure(act, P, mname, k_max, points), f.path, format=kind)
-    typer.echo(f"wrote {out}")
+    echo_wrote(f"wrote {out}")
 
 
 @app.command()
@@ -235,7 +236,7 @@ def stresses(
             internal_stresses(act, pressure_kpa, curvature).to_netcdf(f.path)
         else:
             f.write_text(internal_stresses(act, pressure_kpa, curvature).to_dataframe().to_csv())
-    typer.echo(f"wrote {out}")
+    echo_wrote(f"wrote {out}")
 
 
 @app.command("actuator")
@@ -253,7 +254,7 @@ def actuator_cmd(
     if out is not None:
         with output_file(out, [actuator]) as f:
             f.write_text(text)
-        typer.echo(f"wrote {out}")
+        echo_wrote(f"wrote {out}")
         return
     lim = curvature_limits(act)
     typer.echo(text.rstrip())
@@ -294,4 +295,4 @@ def demo(
     out.parent.mkdir(parents=True, exist_ok=True)
     with output_file(out) as f:
         save_figure(demo_figure(items), f.path, format=fmt)
-    typer.echo(f"\nwrote {out}  ({time.perf_counter() - t0:.1f} s)")
+    echo_wrote(f"\nwrote {out}  ({time.perf_counter() - t0:.1f} s)")

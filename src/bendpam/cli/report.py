@@ -65,7 +65,15 @@ def register(app: typer.Typer) -> None:
 
 
 def _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, model, progress) -> None:
-    from bendpam.cli.options import Model, UserError, collect_raw_files, load_actuator, output_file, parse_values
+    from bendpam.cli.options import (
+        Model,
+        UserError,
+        collect_raw_files,
+        echo_wrote,
+        load_actuator,
+        output_file,
+        parse_values,
+    )
     from bendpam.physics.fixture import Fixture
     from bendpam.present.report import build_report, fmt_value
 
@@ -115,4 +123,4 @@ def _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, m
         typer.echo(f"bendpam: warning: {note}", err=True)
     n_w = sum(w.severity == "warning" for w in res.warnings)
     box = f", {n_w} warning(s) and {len(res.warnings) - n_w} caution(s) at the top" if res.warnings else ""
-    typer.echo(f"wrote {out} ({res.bytes / 1024:.0f} KiB, {len(res.figures)} figures{box})")
+    echo_wrote(f"wrote {out} ({res.bytes / 1024:.0f} KiB, {len(res.figures)} figures{box})")

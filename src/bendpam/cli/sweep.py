@@ -18,6 +18,7 @@ from bendpam.cli.options import (
     PresetOpt,
     QuietOpt,
     UserError,
+    echo_wrote,
     load_actuator,
     model_name,
     output_file,
@@ -158,13 +159,13 @@ def sweep_cmd(
             write_sweep(ds, f.path, data_fmt)
         shape = " x ".join(f"{d}={n}" for d, n in ds.sizes.items())
         rows = f", {int(np.prod(list(ds.sizes.values())))} rows" if data_fmt != "nc" else ""
-        typer.echo(f"wrote {out} ({shape}{rows})")
+        echo_wrote(f"wrote {out} ({shape}{rows})")
     if plot is not None:
         from bendpam.present.figures import save_figure, sweep_figure
 
         with output_file(plot, [actuator]) as f:
             save_figure(sweep_figure(ds, plot_var, plot_x, plot_y, at=fixed_at), f.path, format=fig_fmt)
-        typer.echo(f"wrote {plot}")
+        echo_wrote(f"wrote {plot}")
 
 
 def parse_at(at: list[str] | None) -> dict[str, float]:
