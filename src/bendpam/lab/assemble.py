@@ -333,8 +333,8 @@ def _other_columns(blk: Block, ch: ChannelChoice) -> list[str]:
 
 
 def _samples(parsed: Parsed, rate_hz: float | None, repair: bool, warnings: list[str]) -> tuple[
-        pd.DataFrame, Channels, dict[str, str], str | None, np.ndarray | None, float | None]:
-    """Steps 1-3: the checked samples as a frame, with their channels, units, counter and rate."""
+        pd.DataFrame, Channels, dict[str, str], str | None, np.ndarray | None, float | None, tuple[int, int]]:
+    """Steps 1-3: the checked samples as a frame, with their channels, units, counter, rate and lines."""
     p, blk = parsed.parser, parsed.block
     label = p.label
     data = p.data
@@ -365,7 +365,8 @@ def _samples(parsed: Parsed, rate_hz: float | None, repair: bool, warnings: list
          "force_n": values.pop("force")},
         copy=False,
     )  # fmt: skip
-    return frame, channels, source_units, counter_source, samples.counter, sample_rate
+    data_lines = (int(samples.lines[0]), int(samples.lines[-1]))
+    return frame, channels, source_units, counter_source, samples.counter, sample_rate, data_lines
 
 
 def assemble(parsed: Parsed, *, fmt: str, pressure_kpa: float | None, rate_hz: float | None,
@@ -414,7 +415,8 @@ def assemble(parsed: Parsed, *, fmt: str, pressure_kpa: float | None, rate_hz: f
     path = Path(label) if isinstance(label, (str, Path)) else Path(str(label))
     assert blk.choice is not None
     warnings = list(p.warnings)
-    frame, channels, source_units, counter_source, counter, sample_rate = _samples(parsed, rate_hz, repair, warnings)
+    frame, channels, source_units, counter_source, counter, sample_rate, data_lines = _samples(
+        parsed, rate_hz, repair, warnings)
     metadata, meta_pressure = _metadata(p, blk, label, pressure_kpa)
     pressure, psource = _choose_pressure(pressure_kpa, meta_pressure, path, label)
     _file_warnings(parsed, warnings)
@@ -444,4 +446,5 @@ def assemble(parsed: Parsed, *, fmt: str, pressure_kpa: float | None, rate_hz: f
         cycle_counter_source=counter_source,
         blocks=blocks,
         sample_rate_hz=sample_rate,
+        data_lines=data_lines,
     )

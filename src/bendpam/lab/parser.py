@@ -722,10 +722,13 @@ def _no_header_error(p: Parser) -> ReadError:
             label,
             first_data,
         )
+    # no data row at all: the whole text was searched
+    where = f"lines 1-{p.text[-1][0]}: " if p.text and p.text[-1][0] > 1 else ""
     return ReadError(
-        "no header row naming time, stroke and force columns; expected e.g. "
+        f"{where}no header row naming time, stroke and force columns; expected e.g. "
         f"'time_s,stroke_mm,force_n' (accepted names: {ACCEPTED_NAMES})",
         label,
+        1 if not where else None,
     )
 
 

@@ -403,6 +403,19 @@ def _sorted(x, y):
 
 
 
+def _located(exc: ProcessingError, src: str, data_lines: tuple[int, int] | None) -> ProcessingError:
+    """``exc`` with the data lines of its test after the file name: ``FILE: lines A-B: ...``.
+
+    >>> str(_located(ProcessingError("a.csv: only 5 samples"), "a.csv", (4, 8)))
+    'a.csv: lines 4-8: only 5 samples'
+    """
+    msg = str(exc)
+    if data_lines is None or not msg.startswith(f"{src}: "):
+        return exc
+    first, last = data_lines
+    return ProcessingError(f"{src}: lines {first}-{last}: {msg[len(src) + 2:]}")
+
+
 def process_tests(tests, *, fixture: Fixture = PAPER_FIXTURE, options: ProcessingOptions | None = None,
                   keep_series: bool = True) -> ProcessedSet:
     """Process several raw tests (``RawTest`` objects from :func:`bendpam.lab.read_test`).
@@ -445,8 +458,11 @@ def process_tests(tests, *, fixture: Fixture = PAPER_FIXTURE, options: Processin
         d = rt.data
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
-            res = process_series(d["time_s"].to_numpy(), d["stroke_mm"].to_numpy(), d["force_n"].to_numpy(),
-                                 p, fixture=fixture, options=options, source=src, keep_series=keep_series)
+            try:
+                res = process_series(d["time_s"].to_numpy(), d["stroke_mm"].to_numpy(), d["force_n"].to_numpy(),
+                                     p, fixture=fixture, options=options, source=src, keep_series=keep_series)
+            except ProcessingError as exc:
+                raise _located(exc, src, getattr(rt, "data_lines", None)) from None
         res.notes.extend(getattr(rt, "warnings", []) or [])
         mismatch = check_cycle_count(rt, res.n_cycles)
         if mismatch:

@@ -78,6 +78,9 @@ class RawTest:
         Every data block of the file: ``{"line", "columns", "rows", "read"}``.
     sample_rate_hz : float or None
         The rate time was made from, when the file has no time column.
+    data_lines : tuple of int or None
+        First and last line (1-based; rows of a worksheet) of the samples read, for messages
+        about the data as a whole; None for a test not read from a file.
 
     Examples
     --------
@@ -109,6 +112,7 @@ class RawTest:
     cycle_counter_source: str | None = None
     blocks: list[dict[str, Any]] = field(default_factory=list)
     sample_rate_hz: float | None = None
+    data_lines: tuple[int, int] | None = None
 
     @property
     def format(self) -> str:
