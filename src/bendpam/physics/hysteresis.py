@@ -323,7 +323,7 @@ class LoopModel:
         """``A(P, k')`` in N*mm (pressure in kPa, curvature in 1/mm), broadcasting."""
         from bendpam.validate import pressure_kpa as check_pressure
 
-        pa = np.maximum(check_pressure(pressure_kpa) - actuator.P_start_kpa, 0.0)
+        pa = np.maximum(check_pressure(pressure_kpa, limit_kpa=actuator.max_pressure_kpa) - actuator.P_start_kpa, 0.0)
         if self.amplitude == "linear":
             return self.a0_nmm + self.a1_nmm_per_kpa * np.broadcast_to(
                 pa, np.broadcast_shapes(np.shape(pa), np.shape(curvature_per_mm)))
@@ -465,10 +465,9 @@ def predict_cycles(actuator, loop: LoopModel, pressures_kpa, model: str = "energ
     [15.9, 17.0]
     """
     from bendpam.physics.law import MomentLaw
-    from bendpam.validate import pressure_kpa as check_pressure
 
-    P = np.atleast_1d(np.asarray(check_pressure(pressures_kpa), dtype=float)).ravel()
     law = MomentLaw.of(actuator, model, order=order, eq19_factor=eq19_factor)
+    P = np.atleast_1d(np.asarray(law.check_pressure(pressures_kpa), dtype=float)).ravel()
     kf, flat = _free_states(actuator, loop, law, P)
     return _cycles(actuator, loop, law, P, kf, flat, int(n))
 
