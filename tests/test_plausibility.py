@@ -232,6 +232,53 @@ def test_property_plausible_inputs_give_finite_results(a, frac, kfrac, model):
     assert not np.any(np.isnan(lm.frame_axial_force_n))
 
 
+def _kernels():
+    """The numerics under the validated entries (model units; NaN in, NaN out by design): wrong kinds are refused."""
+    from bendpam.physics import actuator, branch, material, roots, sections, stable
+    from bendpam.physics.models import energy, force_balance
+
+    p, a0, k = BE.params, BE.params.alpha0, np.array([0.0, 0.01])
+    return [
+        ("energy.coefficients", energy.coefficients, (p, k)), ("energy.basis", energy.basis, (p, k)),
+        ("energy.terms", energy.terms, (p, 0.1, k)), ("energy.bladder_energy", energy.bladder_energy, (p, k)),
+        ("force_balance.coefficients", force_balance.coefficients, (p, k)),
+        ("force_balance.basis", force_balance.basis, (p, k)), ("force_balance.terms", force_balance.terms, (p, 0.1, k)),
+        ("force_balance.stress_state", force_balance.stress_state, (p, 0.1, k, np.array([0.0, 1.0]))),
+        ("force_balance.axial_forces", force_balance.axial_forces, (p, 0.1, k, 10.0 + k)),
+        ("braid.solve_u", braid.solve_u, (k, a0)), ("braid.radius_state", braid.radius_state, (k, a0, 10.1)),
+        ("braid.radius_terms", braid.radius_terms, (k, a0, 10.1)),
+        ("braid.circle_ibar", braid.circle_ibar, (k, math.cos(a0))),
+        ("braid.ibar_closed_form", braid.ibar_closed_form, (k, math.cos(a0))),
+        ("braid.radius_from_u", braid.radius_from_u, (k, np.ones(2), np.zeros(2), a0, 10.1)),
+        ("braid.limits", braid.limits, (p,)), ("braid.braid_range", braid.braid_range, (p,)),
+        ("actuator.t0_start_mm", actuator.t0_start_mm, (8.5, 2.5, 10.1)),
+        ("actuator.bladder_area_mm2", actuator.bladder_area_mm2, (8.5, 2.5)),
+        ("actuator.frame_inertia_mm4", actuator.frame_inertia_mm4, (5.0, 0.5)),
+        ("material.MooneyRivlin", MooneyRivlin, (0.2, 0.1)), ("material.within", material.within, (0.5, 0.0, 1.0)),
+        ("branch.branch_table", branch.branch_table, (LAW, 64)),
+        ("branch.describe_branch", branch.describe_branch, (LAW, LAW.branches())),
+        ("branch.solve_free", branch.solve_free, (LAW, LAW.branches(), np.array([[50.0]]))),
+        ("sections.branch_path", sections.branch_path, (LAW,)),
+        ("sections.SectionTables", sections.SectionTables, (energy, a0, 0)),
+        ("stable.stable_branch", stable.stable_branch, (TABLE, 150.0, 0.0)),
+        ("roots.illinois", lambda f, a, b: roots.illinois(f, a, b, 1e-12), (lambda x, idx: 0.5 - x, 0.0, 1.0)),
+        ("roots.bracketed_newton", lambda f, x: roots.bracketed_newton(f, x, 0.0, 1.0, maxiter=20),
+         (lambda x: (x - 0.5, np.ones_like(x)), 0.2)),
+        ("hysteresis.loss_ratio", bendpam.hysteresis.loss_ratio, (k, np.ones(2), np.zeros(2), 145.0)),
+    ]
+
+
+@pytest.mark.parametrize("name, fn, args", _kernels(), ids=[c[0] for c in _kernels()])
+def test_the_numerics_kernels_refuse_wrong_kinds(name, fn, args):
+    fn(*args)  # the valid call works
+    for i in range(len(args)):
+        for bad in (None, "x", ["a"], object()):
+            call = list(args)
+            call[i] = bad
+            with pytest.raises(InputError):
+                fn(*call)
+
+
 # ------------------------------------------------------------------------------------------------
 # the audit's findings, one by one
 # ------------------------------------------------------------------------------------------------

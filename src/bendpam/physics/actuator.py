@@ -26,12 +26,18 @@ import tomli_w
 from bendpam.errors import FileFormatError, InputError
 from bendpam.infra.atomic import atomic_write_text
 from bendpam.physics.material import MooneyRivlin
-from bendpam.validate import DEFAULT_MAX_PRESSURE_KPA, PLAUSIBLE, did_you_mean, number, plausible
+from bendpam.validate import DEFAULT_MAX_PRESSURE_KPA, PLAUSIBLE, did_you_mean, float_array, number, plausible
 
 __all__ = ["NEUTRAL_ANGLE_DEG", "Actuator", "ModelParams", "bladder_area_mm2", "frame_inertia_mm4", "t0_start_mm"]
 
 #: The braid angle at which a McKibben sleeve has maximum volume, arctan(sqrt 2) = 54.7356 deg.
 NEUTRAL_ANGLE_DEG = math.degrees(math.atan(math.sqrt(2.0)))
+
+
+def _numeric(**values) -> None:
+    """One InputError line for a value that is not a number or an array of numbers (mm)."""
+    for name, value in values.items():
+        float_array(name, value, "mm")
 
 
 def t0_start_mm(R0_mm, t0_mm, R0_start_mm):
@@ -40,6 +46,7 @@ def t0_start_mm(R0_mm, t0_mm, R0_start_mm):
     >>> round(float(t0_start_mm(8.5, 2.5, 10.1)), 4)     # the paper's BE-PAM: 2.5 mm stretched to 10.1 mm
     1.9907
     """
+    _numeric(R0_mm=R0_mm, t0_mm=t0_mm, R0_start_mm=R0_start_mm)
     return R0_start_mm - np.sqrt(R0_start_mm * R0_start_mm - 2.0 * R0_mm * t0_mm + t0_mm * t0_mm)
 
 
@@ -49,6 +56,7 @@ def bladder_area_mm2(R0_mm, t0_mm):
     >>> round(float(bladder_area_mm2(8.5, 2.5)), 2)
     113.88
     """
+    _numeric(R0_mm=R0_mm, t0_mm=t0_mm)
     return np.pi * (2.0 * R0_mm * t0_mm - t0_mm * t0_mm)
 
 
@@ -58,6 +66,7 @@ def frame_inertia_mm4(width_mm, thickness_mm):
     >>> frame_inertia_mm4(5.0, 0.5)                      # Table 1: 5 mm x 0.5 mm
     0.052083...
     """
+    _numeric(width_mm=width_mm, thickness_mm=thickness_mm)
     return width_mm * thickness_mm**3 / 12.0
 
 

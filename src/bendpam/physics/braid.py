@@ -82,6 +82,7 @@ __all__ = [
     "curvature_limits",
     "gauss_nodes",
     "ibar_closed_form",
+    "kernel_args",
     "kinematics",
     "limits",
     "radius_from_u",
@@ -182,7 +183,7 @@ def ibar_closed_form(u, c):
     """
     from scipy.special import ellipe, ellipk
 
-    u = np.asarray(u, dtype=float)
+    u, c = float_array("u", u, "1"), float_array("c", c, "1")
     pos = u >= 0.0
     cu = c * u
     D = np.where(pos, (1.0 - c) * (1.0 + c + 2.0 * cu), (1.0 + c) * (1.0 - c - 2.0 * cu))
@@ -217,10 +218,10 @@ def circle_ibar(u, c, order: int = DEFAULT_ORDER):
     if order == CLOSED_FORM:
         return ibar_closed_form(u, c)
     phi, wbar = gauss_nodes(order)
-    return ibar(np.asarray(u, dtype=float), c, 1.0 - np.cos(phi), wbar)
+    return ibar(float_array("u", u, "1"), float_array("c", c, "1"), 1.0 - np.cos(phi), wbar)
 
 
-def solve_u(q_target, alpha0: float, order: int = DEFAULT_ORDER, u_bounds: tuple[float, float] | None = None):
+def solve_u(q_target, alpha0: Any, order: int = DEFAULT_ORDER, u_bounds: tuple[float, float] | None = None):
     """Solve eq 5 for ``u = k' R`` given ``q = k' R0`` (vectorised safeguarded Newton).
 
     Parameters
@@ -247,8 +248,9 @@ def solve_u(q_target, alpha0: float, order: int = DEFAULT_ORDER, u_bounds: tuple
     >>> u.round(5).tolist()                      # u = k'R: R shrinks as the actuator bends
     [0.0, 0.04964]
     """
+    q, a0 = float_array("q_target", q_target, "1"), float_array("alpha0", alpha0, "rad")
+    alpha0 = a0 if a0.ndim else float(a0)
     c, s = np.cos(alpha0), np.sin(alpha0)
-    q = np.asarray(q_target, dtype=float)
     if np.ndim(alpha0):
         q = np.broadcast_to(q, np.broadcast_shapes(q.shape, np.shape(alpha0)))
     if np.ndim(alpha0) == 0 and u_bounds is None and q.size >= _UNIFORM_MIN_POINTS:
@@ -494,6 +496,8 @@ def limits(params, order: int = DEFAULT_ORDER) -> CurvatureLimits:
     >>> limits(cases).k_max.round(4).tolist()            # 1/mm
     [0.1038, 0.1917, 0.4511]
     """
+    kernel_args(params)
+    order = quadrature_order(order)
     scalar = np.ndim(params.alpha0) == 0 and np.ndim(params.R0_start) == 0 and np.ndim(params.t0_start) == 0
     shape = np.broadcast_shapes(np.shape(params.alpha0), np.shape(params.R0_start), np.shape(params.t0_start))
     a0 = np.broadcast_to(np.asarray(params.alpha0, dtype=float), shape).ravel()
@@ -542,6 +546,24 @@ def limits(params, order: int = DEFAULT_ORDER) -> CurvatureLimits:
                            u_lo.reshape(shape), u_hi.reshape(shape))
 
 
+def kernel_args(params, *arrays: tuple[str, Any, str]) -> tuple[np.ndarray, ...]:
+    """The numerics' entry check: ``params`` a :class:`~bendpam.ModelParams`, each ``(name, value, unit)`` a
+    float array; one :class:`~bendpam.errors.InputError` line otherwise (NaN passes: the kernels propagate it).
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> kernel_args(bendpam.physics.presets.be_pam().params, ("curvature", [0.0, 0.01], "1/mm"))[0].tolist()
+    [0.0, 0.01]
+    >>> kernel_args(None, ("curvature", 0.0, "1/mm"))
+    Traceback (most recent call last):
+    ...
+    bendpam.errors.InputTypeError: params = None must be a ModelParams (actuator.params), got NoneType
+    """
+    instance("params", params, (ModelParams, _Section), "a ModelParams (actuator.params)")
+    return tuple(float_array(name, value, unit) for name, value, unit in arrays)
+
+
 def braid_range(params, order: int = DEFAULT_ORDER) -> CurvatureLimits:
     """The curvatures eq 1-5 describe: the braid limits of :func:`limits` without the lumen closure (cheap).
 
@@ -558,6 +580,7 @@ def braid_range(params, order: int = DEFAULT_ORDER) -> CurvatureLimits:
     >>> round(r.k_min, 4), round(r.k_max, 4), bool(r.k_min <= lim.k_min and lim.k_max <= r.k_max)
     (-0.0471, 0.1878, True)
     """
+    kernel_args(params)
     a0 = np.asarray(params.alpha0, dtype=float)
     R0 = np.asarray(params.R0_start, dtype=float)
     c, s = np.cos(a0), np.sin(a0)
@@ -687,6 +710,8 @@ def radius_from_u(u, ib, dib, alpha0, R0, k=None):
     >>> R.round(4).tolist(), k.round(6).tolist()      # mm, 1/mm
     ([10.1, 10.0277], [0.0, 0.004986])
     """
+    u, ib, dib, alpha0, R0 = (float_array(n, v, unit) for n, v, unit in (
+        ("u", u, "1"), ("ib", ib, "1"), ("dib", dib, "1"), ("alpha0", alpha0, "rad"), ("R0", R0, "mm")))
     s = np.sin(alpha0)
     # eta(0) = 1 and xi'(0) = -cot^2 alpha0 hold exactly; don't let quadrature rounding blur them
     at0 = u == 0.0
@@ -711,7 +736,7 @@ def radius_state(kprime, alpha0, R0, order: int = DEFAULT_ORDER):
     >>> u.round(6).tolist(), R.round(4).tolist()
     ([0.0, 0.099494], [10.1, 9.9494])
     """
-    k = np.asarray(kprime, dtype=float)
+    k, R0 = float_array("kprime", kprime, "1/mm"), float_array("R0", R0, "mm")
     u, ib, dib = solve_u(k * R0, alpha0, order)
     R, dR, _ = radius_from_u(u, ib, dib, alpha0, R0, k)
     return u, R, dR, ib, dib

@@ -358,7 +358,11 @@ def loss_ratio(k_mag, upper, lower, L0_mm: float) -> tuple[float, float, float]:
     >>> round(ratio, 3), round(loss, 2), round(stored, 2)   # loss and stored energy in N*mm
     (0.4, 29.0, 72.5)
     """
-    th = np.asarray(k_mag, dtype=float) * L0_mm
+    from bendpam.validate import float_array, number
+
+    k_mag, upper, lower = (float_array(n, v, u) for n, v, u in (("k_mag", k_mag, "1/mm"), ("upper", upper, "N*mm"),
+                                                                 ("lower", lower, "N*mm")))
+    th = k_mag * number("L0_mm", L0_mm, 0.0, lo_open=True, unit="mm")
     loss = float(np.trapezoid(np.asarray(upper) - np.asarray(lower), th))
     stored = float(np.trapezoid(0.5 * (np.asarray(upper) + np.asarray(lower)), th))
     return (loss / stored if stored > 0 else math.nan), loss, stored

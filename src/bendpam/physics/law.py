@@ -137,7 +137,7 @@ class MomentLaw:
             self.params = actuator.params
         else:
             self.actuator = None
-            self.params = actuator
+            self.params = _checked_cases(actuator)
         #: The burst limit (kPa): pressures above it are refused (the smallest of a block of cases).
         self.max_pressure_kpa = float(np.min(self.params.max_pressure_kpa))
         self.model = normalise_model(model)
@@ -412,6 +412,21 @@ def _flag_angle(fb: FreeBending) -> FreeBending:
                       "the actuator would pass through itself, and the planar model ends there",
                       PlausibilityWarning, stacklevel=4)
     return fb
+
+
+def _checked_cases(params: ModelParams) -> ModelParams:
+    """A hand-made block of cases: every field finite numbers of shapes that broadcast (``R0`` may be None)."""
+    for name, value in params.__dict__.items():
+        if value is None and name == "R0":
+            continue
+        v = float_array(f"ModelParams.{name}", value, "model units")
+        if v.size and not np.all(np.isfinite(v)):
+            raise InputError(f"ModelParams.{name} has a non-finite value")
+    try:
+        _ = params.shape
+    except ValueError:
+        raise InputError("the fields of the ModelParams do not broadcast to one shape of cases") from None
+    return params
 
 
 @lru_cache(maxsize=128)

@@ -17,6 +17,7 @@ import numpy as np
 
 from bendpam.errors import NoEquilibrium
 from bendpam.physics.roots import bracketed_newton
+from bendpam.validate import instance, number
 
 if TYPE_CHECKING:
     from bendpam.physics.law import MomentTable
@@ -111,6 +112,11 @@ def stable_branch(table: MomentTable, P: float, friction: float = 0.0) -> Stable
     >>> sb.end_lo, sb.end_hi, round(sb.free_curvature, 5)
     ('lock-up', 'fold', 0.00816)
     """
+    from bendpam.physics.law import MomentTable  # at call time: the law module imports this one
+
+    instance("table", table, MomentTable, "a MomentTable (law.tabulated())")
+    P = float(table.law.check_pressure(number("P", P, unit="kPa")))
+    friction = number("friction", friction, unit="N*mm")
     pa = max(P - table.P_start_kpa, 0.0)
     kg = table.knot_curvatures
     _, _, dA, dB = table.derivatives(kg)
