@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from bendpam.errors import InputTypeError
 from bendpam.physics.roots import illinois
 from bendpam.physics.sections import branch_path
 from bendpam.validate import float_array, instance, integer
@@ -96,10 +97,10 @@ class BranchTable:
 
 
 def _law(law) -> None:
-    """One InputTypeError line unless ``law`` is a :class:`~bendpam.MomentLaw`."""
-    from bendpam.physics.law import MomentLaw  # at call time: the law module imports this one
-
-    instance("law", law, MomentLaw, "a MomentLaw")
+    """One InputTypeError line unless ``law`` is a :class:`~bendpam.MomentLaw` (by its attributes: the law module
+    imports this one, so this one cannot import it)."""
+    if not all(hasattr(law, a) for a in ("params", "check_curvature", "branches")):
+        raise InputTypeError(f"law = {law!r:.60} must be a MomentLaw, got {type(law).__name__}")
 
 
 def branch_table(law: MomentLaw, samples: int = BRANCH_SAMPLES) -> BranchTable:
@@ -117,6 +118,7 @@ def branch_table(law: MomentLaw, samples: int = BRANCH_SAMPLES) -> BranchTable:
     >>> tab.kind.tolist() == [BRANCH_END["fold"]], tab.p_end.round(1).tolist()   # active kPa
     (True, [102.2])
     """
+    _law(law)
     samples = integer("samples", samples, 8, 1_000_000)
     ev = branch_path(law)
     sgn = ev.cs.bend_sign

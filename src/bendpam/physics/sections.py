@@ -17,11 +17,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from bendpam.errors import InputError
+from bendpam.errors import InputError, InputTypeError
 from bendpam.physics.actuator import NEUTRAL_ANGLE_DEG, ModelParams
 from bendpam.physics.braid import LOCK_FRACTION, MIN_FAR_STRETCH, curvature_limits, radius_from_u
 from bendpam.physics.models import energy, force_balance, get_model
-from bendpam.validate import float_array, instance, integer, quadrature_order
+from bendpam.validate import float_array, integer, quadrature_order
 
 if TYPE_CHECKING:
     from bendpam.physics.law import MomentLaw
@@ -258,9 +258,8 @@ def branch_path(law: MomentLaw) -> _ExactUPath | _TablePath:
     >>> A.round(4).tolist(), path.to_k(np.array([0.05]), np.arange(1)).round(6).tolist()
     ([[2.351, 2.1476]], [0.004986])
     """
-    from bendpam.physics.law import MomentLaw  # at call time: the law module imports this one
-
-    instance("law", law, MomentLaw, "a MomentLaw")
+    if not all(hasattr(law, a) for a in ("params", "check_curvature", "order")):  # a MomentLaw (law.py imports us)
+        raise InputTypeError(f"law = {law!r:.60} must be a MomentLaw, got {type(law).__name__}")
     if law.is_cases:
         cs = _flat_params(law)
         uniq, inverse = np.unique(cs.alpha0, return_inverse=True)
