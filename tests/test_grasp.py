@@ -26,12 +26,13 @@ L, ELL, R, P = 130.0, 10.0, 100.0, 200.0  # finger, pad, sphere radius (mm), pre
 
 
 def _stiff_pair(mu):
-    """Two opposed fingers, nearly rigid (a 5 mm frame of 2e6 MPa), hanging straight down at x = +-R.
+    """Two opposed fingers, nearly rigid (an 8.25 mm frame of 450 GPa, as stiff in bending as the 5 mm frame of
+    2e6 MPa this test used before the plausibility ranges), hanging straight down at x = +-R.
 
     The sphere (radius R) is centred on the axis at the depth of the fingertips, so the straight
     fingertips touch it exactly at its equator (beta = 90 deg), with no offset of the contact surface.
     """
-    act = presets.be_pam().replace(L0_mm=L, frame_thickness_mm=5.0, frame_modulus_mpa=2e6)
+    act = presets.be_pam().replace(L0_mm=L, frame_thickness_mm=8.25, frame_modulus_mpa=4.5e5)
     return act, Gripper(act, fingers=2, base_radius_mm=R, fingertip_mm=ELL, contact_offset_mm=0.0, mu=mu,
                         center_depth_mm=L + ELL, splay_deg=0.0)
 

@@ -21,7 +21,16 @@ from __future__ import annotations
 from typing import Any
 
 from bendpam import errors
-from bendpam.errors import BendpamError, FileFormatError, FitError, InputError, NoEquilibrium, ProcessingError
+from bendpam.errors import (
+    BendpamError,
+    FileFormatError,
+    FitError,
+    InputError,
+    InputTypeError,
+    NoEquilibrium,
+    PlausibilityWarning,
+    ProcessingError,
+)
 from bendpam.physics import braid, material, models, presets
 from bendpam.physics.actuator import NEUTRAL_ANGLE_DEG, Actuator, ModelParams
 from bendpam.physics.braid import CurvatureLimits, Kinematics, curvature_limits
@@ -53,6 +62,7 @@ __all__ = [
     "FreeBending",
     "FreeBranch",
     "InputError",
+    "InputTypeError",
     "Kinematics",
     "Limits",
     "ModelParams",
@@ -60,6 +70,7 @@ __all__ = [
     "MomentTable",
     "MooneyRivlin",
     "NoEquilibrium",
+    "PlausibilityWarning",
     "ProcessingError",
     "StableBranch",
     "UnitWarning",

@@ -8,6 +8,8 @@ it is a bug and is reported as one.
 * :class:`BendpamError`: the base class.
 * :class:`InputError` (also a :class:`ValueError`): a value out of range, an unknown option or
   key, inconsistent arguments.
+* :class:`InputTypeError` (an :class:`InputError`, also a :class:`TypeError`): an argument of the
+  wrong kind (a string or ``None`` where an actuator is expected).
 * :class:`FileFormatError` (an :class:`InputError`): a file that cannot be read or understood;
   the message starts with the file name and, where it applies, the line.
 * :class:`ProcessingError` (an :class:`InputError`): a test that reads but cannot be processed
@@ -15,11 +17,15 @@ it is a bug and is reported as one.
 * :class:`NoEquilibrium`: no physical answer exists (above a fold, beyond lock-up).
 * :class:`FitError`: identification failed for a reason that lies in the data (curves that
   cannot separate two parameters, too few points), explained in terms of the data.
+
+One warning class lives here too: :class:`PlausibilityWarning`, for a result that the models
+computed but that lies beyond a physical plausibility bound (docs/plausibility.md).
 """
 
 from __future__ import annotations
 
-__all__ = ["BendpamError", "FileFormatError", "FitError", "InputError", "NoEquilibrium", "ProcessingError"]
+__all__ = ["BendpamError", "FileFormatError", "FitError", "InputError", "InputTypeError", "NoEquilibrium",
+           "PlausibilityWarning", "ProcessingError"]
 
 
 class BendpamError(Exception):
@@ -45,7 +51,44 @@ class InputError(BendpamError, ValueError):
     >>> bendpam.blocked_moment(bendpam.physics.presets.be_pam(), -10.0)
     Traceback (most recent call last):
     ...
-    bendpam.errors.InputError: pressure_kpa = -10 kPa at index 0 is below zero; allowed range [0, inf) kPa (gauge)
+    bendpam.errors.InputError: pressure_kpa = -10 kPa at index 0 is below zero; allowed range [0, 2000] kPa (gauge)
+    """
+
+
+class InputTypeError(InputError, TypeError):
+    """An argument of the wrong kind, e.g. ``None`` or a preset's name where an Actuator is expected.
+
+    It is an :class:`InputError` (one line, ``bendpam: error: ...`` on the command line) and a
+    :class:`TypeError`, so code written against the plain ``TypeError`` of earlier versions still
+    catches it.
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> try:
+    ...     bendpam.blocked_moment("be-pam", 200.0)
+    ... except bendpam.InputError as exc:
+    ...     print(isinstance(exc, TypeError), "-", exc)
+    True - actuator = 'be-pam' must be a bendpam.Actuator (e.g. bendpam.physics.presets.get('be-pam')), got str
+    """
+
+
+class PlausibilityWarning(UserWarning):
+    """A computed result beyond a physical plausibility bound (docs/plausibility.md).
+
+    The inputs were each within their plausible ranges, but the result is not what a bending PAM
+    can do (a free-bending angle past a full turn, a pneumatic moment far above the McKibben
+    bound), so the model is being used outside what it describes.
+
+    Examples
+    --------
+    >>> import warnings, bendpam
+    >>> long = bendpam.physics.presets.be_pam().replace(L0_mm=1000.0)
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     _ = bendpam.free_curvature(long, 200.0)
+    >>> caught[0].category.__name__, str(caught[0].message)[:59]
+    ('PlausibilityWarning', 'free-bending angle 775 deg at 200 kPa is beyond a full turn')
     """
 
 

@@ -3,7 +3,8 @@
 Thin functions over :class:`bendpam.MomentLaw` (the one object that samples the moment law), in
 the units a user types:
 
-* pressure ``pressure_kpa``: kPa (gauge), >= 0.  The active pressure is ``max(P - P_start, 0)``
+* pressure ``pressure_kpa``: kPa (gauge), >= 0 and at most the actuator's burst limit
+  ``max_pressure_kpa`` (2000 kPa unless raised).  The active pressure is ``max(P - P_start, 0)``
   (eq 50): below the threshold the actuator gives only its passive (frame + bladder) response.
   A set of pressures whose every nonzero value is below 5 kPa raises a
   :class:`~bendpam.validate.UnitWarning` (MPa passed as kPa?).
@@ -12,7 +13,10 @@ the units a user types:
 * moments: N*mm; stiffness dM/dk': N*mm^2.
 
 All functions broadcast pressure against curvature and share the cached law of the actuator
-(:meth:`MomentLaw.of`), so repeated calls do not rebuild the free-bending branch.
+(:meth:`MomentLaw.of`), so repeated calls do not rebuild the free-bending branch.  Bad input
+(``None``, a string, NaN, inf, a pressure above the burst limit, a curvature beyond lock-up) raises
+one :class:`~bendpam.errors.InputError` line; a result beyond a plausibility bound warns with
+:class:`~bendpam.errors.PlausibilityWarning` (docs/plausibility.md).
 """
 
 from __future__ import annotations
@@ -29,8 +33,7 @@ from bendpam.physics.braid import DEFAULT_ORDER, Kinematics
 from bendpam.physics.braid import kinematics as _kinematics
 from bendpam.physics.law import FreeBending, FreeBranch, MomentLaw
 from bendpam.physics.models import force_balance as _fb
-from bendpam.validate import integer
-from bendpam.validate import pressure_kpa as _check_pressure
+from bendpam.validate import instance, integer
 
 __all__ = [
     "active_pressure_kpa",
@@ -46,6 +49,9 @@ __all__ = [
 ]
 
 
+_ACTUATOR = "a bendpam.Actuator (e.g. bendpam.physics.presets.get('be-pam'))"
+
+
 def _law(actuator, model, eq19_factor, order) -> MomentLaw:
     return MomentLaw.of(actuator, model, eq19_factor=eq19_factor, order=order)
 
@@ -57,9 +63,8 @@ def active_pressure_kpa(actuator: Actuator, pressure_kpa) -> np.ndarray:
     >>> bendpam.active_pressure_kpa(bendpam.physics.presets.be_pam(), [50, 200]).tolist()
     [0.0, 132.0]
     """
-    if not isinstance(actuator, Actuator):
-        raise TypeError(f"actuator must be a bendpam.Actuator, got {type(actuator).__name__}")
-    return np.maximum(_check_pressure(pressure_kpa) - actuator.P_start_kpa, 0.0)
+    return _law(instance("actuator", actuator, Actuator, _ACTUATOR), "energy", True, DEFAULT_ORDER
+                ).active_pressure_kpa(pressure_kpa)
 
 
 def kinematics(actuator: Actuator, curvature_per_mm, *, order: int = DEFAULT_ORDER) -> Kinematics:
@@ -70,9 +75,7 @@ def kinematics(actuator: Actuator, curvature_per_mm, *, order: int = DEFAULT_ORD
     >>> round(float(kin.radius), 3), round(float(kin.eta), 4), round(float(kin.axis_curvature), 6)
     (9.949, 0.9851, 0.009095)
     """
-    if not isinstance(actuator, Actuator):
-        raise TypeError(f"actuator must be a bendpam.Actuator, got {type(actuator).__name__}")
-    return _kinematics(actuator, curvature_per_mm, order)
+    return _kinematics(instance("actuator", actuator, Actuator, _ACTUATOR), curvature_per_mm, order)
 
 
 def moment(actuator: Actuator, pressure_kpa, curvature_per_mm, model: str = "energy", *,
@@ -243,7 +246,7 @@ def internal_stresses(actuator: Actuator, pressure_kpa, curvature_per_mm, *, n_p
     ('kPa', ('phi_deg',))
     """
     law = _law(actuator, "force_balance", True, order)
-    P = _check_pressure(pressure_kpa)
+    P = law.check_pressure(pressure_kpa)
     k = law.check_curvature(curvature_per_mm)
     if P.ndim > 1 or k.ndim > 1:
         raise InputError("internal_stresses takes scalar or 1-D pressure_kpa and curvature_per_mm")
@@ -356,7 +359,9 @@ def prediction_table(actuator: Actuator, pressure_kpa, model: str = "energy", *,
     from bendpam.physics.limits import OUTPUTS, limits
 
     law = _law(actuator, model, eq19_factor, order)
-    P = np.atleast_1d(_check_pressure(pressure_kpa))
+    P = np.atleast_1d(law.check_pressure(pressure_kpa))
+    if P.ndim != 1:
+        raise InputError(f"pressure_kpa must be a number or a 1-D list of pressures, got shape {P.shape}")
     fb = law.free_curvature(P)
     lim = limits(actuator, P, model, eq19_factor=eq19_factor, order=order)
     return pd.DataFrame(

@@ -75,6 +75,8 @@ from bendpam.physics.law import MomentLaw
 from bendpam.physics.limits import OUTPUTS as _LIMIT_OUTPUTS
 from bendpam.physics.limits import case_limits
 from bendpam.physics.models import normalise_model
+from bendpam.validate import instance, plausible
+from bendpam.validate import pressure_kpa as check_pressure
 
 __all__ = ["SWEEP_FORMATS", "SWEEP_PARAMETERS", "SweepEstimate", "build_cases", "evaluate_cases", "sweep",
            "sweep_estimate", "sweep_format", "to_table", "write_sweep"]
@@ -191,12 +193,13 @@ def build_cases(base: Actuator, values: dict[str, np.ndarray]) -> ModelParams:
         R0s = np.broadcast_to(np.asarray(values["R0_start_mm"], dtype=float), n)
     else:
         R0s = get["R0_mm"] * (float(base.params.R0_start) / base.R0_mm)
-    _validate(get, R0s)
+    _validate(get, R0s, base.max_pressure_kpa)
     return ModelParams.build(R0_start_mm=np.array(R0s, dtype=float), braid_thickness_mm=base.braid_thickness_mm,
+                             max_pressure_kpa=base.max_pressure_kpa,
                              **{k: np.array(v, dtype=float) for k, v in get.items()})
 
 
-def _validate(get: dict[str, np.ndarray], R0s: np.ndarray) -> None:
+def _validate(get: dict[str, np.ndarray], R0s: np.ndarray, max_pressure_kpa: float) -> None:
     """The Actuator's range checks, vectorised: the first bad value is reported with its parameter."""
     def bad(name, mask, rng, unit):
         if np.any(mask):
@@ -218,6 +221,10 @@ def _validate(get: dict[str, np.ndarray], R0s: np.ndarray) -> None:
         c10 = np.broadcast_to(get["C10_kpa"], np.shape(mu)).ravel()[i]
         c01 = np.broadcast_to(get["C01_kpa"], np.shape(mu)).ravel()[i]
         raise InputError(f"C10_kpa + C01_kpa = {c10 + c01:g} kPa must be > 0 (C10_kpa = {c10:g}, C01_kpa = {c01:g})")
+    values = {**get, "R0_start_mm": R0s, "max_pressure_kpa": max_pressure_kpa}
+    for name in values:  # the physical plausibility of every case (docs/plausibility.md)
+        if name != "max_pressure_kpa":
+            plausible(name, values[name], values)
 
 
 def evaluate_cases(base: Actuator, model: str, values: dict[str, np.ndarray], pressure_kpa, *,
@@ -325,11 +332,10 @@ def sweep(base_actuator: Actuator, pressure_kpa, model: str = "energy", *, chunk
     >>> ds["free_angle_deg"].round(1).values.tolist()      # rows: braid angle, columns: pressure
     [[50.1, 77.8], [68.7, 114.2], [80.2, 137.1]]
     """
-    if not isinstance(base_actuator, Actuator):
-        raise TypeError(f"base_actuator must be a bendpam.Actuator, got {type(base_actuator).__name__}")
+    instance("base_actuator", base_actuator, Actuator, "a bendpam.Actuator")
     model = normalise_model(model)
-    P = np.atleast_1d(np.asarray(pressure_kpa, dtype=float))
-    if P.ndim != 1 or P.size == 0 or not np.all(np.isfinite(P)) or np.any(P < 0):
+    P = np.atleast_1d(check_pressure(pressure_kpa, limit_kpa=base_actuator.max_pressure_kpa))
+    if P.ndim != 1 or P.size == 0:
         raise InputError("pressure_kpa must be a non-empty 1-D list of pressures >= 0 kPa")
     grids_d = _grid_values(params)
     names = list(grids_d)

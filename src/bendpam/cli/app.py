@@ -4,7 +4,9 @@
 ``bendpam: error: ...`` on stderr and exit status 2; SIGINT and SIGTERM into one line and 130/143:
 ``bendpam: interrupted; no outputs were changed`` before any output was committed,
 ``bendpam: interrupted after writing DIR`` after.  Any other exception is a bug: one line saying so
-and where to report it, exit status 1 (``--debug`` prints the traceback).
+and where to report it, exit status 1 (``--debug`` prints the traceback).  A result beyond a
+plausibility bound (:class:`~bendpam.errors.PlausibilityWarning`) is one ``bendpam: warning: ...``
+line, like every other warning of a command.
 
 Every output a command writes (through :func:`bendpam.cli.options.output_set` /
 :func:`~bendpam.cli.options.output_file`, or :class:`~bendpam.infra.outputs.OutputSet` /
@@ -18,6 +20,7 @@ from __future__ import annotations
 import logging
 import sys
 import traceback
+import warnings
 from typing import Annotated, Any, Optional
 
 import typer
@@ -84,6 +87,25 @@ def _one_line(exc: BaseException) -> str:
     return text.splitlines()[0] if text else type(exc).__name__
 
 
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """``warnings.showwarning`` while a command runs: a PlausibilityWarning is one ``bendpam: warning:`` line."""
+    from bendpam.errors import PlausibilityWarning
+
+    if issubclass(category, PlausibilityWarning):
+        text = _one_line(message) if isinstance(message, BaseException) else str(message).strip().splitlines()[0]
+        if "max_pressure_kpa" in text:
+            text += _MAX_PRESSURE_HINT
+        typer.echo(f"bendpam: warning: {text}", err=True)
+    else:
+        _SHOW_WARNING(message, category, filename, lineno, file, line)
+
+
+_SHOW_WARNING = warnings.showwarning
+#: Where a command-line user sets the burst limit (added to a message that names it).
+_MAX_PRESSURE_HINT = (" (max_pressure_kpa is a key of the [actuator] table of an --actuator file; "
+                      "`bendpam actuator --preset NAME --out FILE.toml` writes one to edit)")
+
+
 def _lift_force(args: list[str]) -> list[str]:
     """``--force`` after a command that has no such option of its own goes to the root options."""
     end = args.index("--") if "--" in args else len(args)
@@ -142,7 +164,8 @@ def main(argv: list[str] | None = None) -> int:
     tokens = (RUN_ARGS.set(list(args)), RUN_COMMAND.set(None), RUN_FORCE.set(False))
     try:
         args = _lift_force(args)
-        with interrupts(on_signal=quiet_logging):
+        with interrupts(on_signal=quiet_logging), warnings.catch_warnings():
+            warnings.showwarning = _show_warning
             rv = _run(args)
         if isinstance(rv, int) and not isinstance(rv, bool):  # typer.Exit(code) inside a command
             return rv
@@ -158,7 +181,9 @@ def main(argv: list[str] | None = None) -> int:
         typer.echo(f"bendpam: error: {exc.format_message()}", err=True)
         return 2
     except BendpamError as exc:
-        typer.echo(f"bendpam: error: {_one_line(exc)}", err=True)
+        text = _one_line(exc)
+        typer.echo(f"bendpam: error: {text}{_MAX_PRESSURE_HINT if 'max_pressure_kpa to go higher' in text else ''}",
+                   err=True)
         return 2
     except (FileNotFoundError, PermissionError, IsADirectoryError, NotADirectoryError, FileExistsError) as exc:
         where = f": {exc.filename}" if exc.filename else ""

@@ -47,6 +47,17 @@ _FLAGS = {"rate_hz": "--rate-hz", "fewer cycles": "fewer --cycles", "dwell_s": "
 _SETTING_FLAGS = re.compile(r"(?<![\w-])(?:rate_hz|fewer cycles|dwell_s|speed_mm_min)(?![\w-])")
 
 
+def _check_l0(l0_mm: float) -> None:
+    """--l0-mm: a positive length in the plausible range of an actuator's (docs/plausibility.md)."""
+    import math
+
+    from bendpam.validate import plausible
+
+    if not (math.isfinite(l0_mm) and l0_mm > 0):
+        raise UserError(f"--l0-mm: {l0_mm:g} mm must be a positive length")
+    plausible("L0_mm", l0_mm, label="--l0-mm")
+
+
 @app.command()
 def inspect(
     files: Annotated[list[Path], typer.Argument(help="Raw test files (or folders of them).", show_default=False)],
@@ -111,6 +122,7 @@ def process(
 
     if out is None:
         raise UserError("give an output folder with --out OUTDIR")
+    _check_l0(l0_mm)
     files = collect_raw_files(inputs)
     pressures = _file_pressures(pressure_kpa, files)
     fx = Fixture.from_string(fixture, L0_mm=l0_mm, name="--fixture")

@@ -126,6 +126,7 @@ from bendpam.physics.braid import DEFAULT_ORDER
 from bendpam.physics.law import MomentLaw
 from bendpam.physics.material import admissible_shape_range
 from bendpam.physics.models import normalise_model
+from bendpam.validate import PLAUSIBLE
 
 __all__ = ["PAPER_START", "fit", "parse_free"]
 
@@ -172,7 +173,8 @@ def parse_free(free) -> list[str]:
 
 def _default_bounds(actuator: Actuator, P_min_kpa: float) -> dict[str, tuple[float, float]]:
     a0 = actuator.alpha0_deg
-    lo, hi = 0.9 * a0, min(1.1 * a0, 89.9)
+    angles, moduli = PLAUSIBLE["alpha0_deg"], PLAUSIBLE["frame_modulus_mpa"]  # within the plausible ranges
+    lo, hi = max(0.9 * a0, angles.lo), min(1.1 * a0, angles.hi)
     if actuator.bend_sign > 0:
         lo = max(lo, NEUTRAL_ANGLE_DEG + 0.05)
     elif actuator.bend_sign < 0:
@@ -182,7 +184,7 @@ def _default_bounds(actuator: Actuator, P_min_kpa: float) -> dict[str, tuple[flo
         "C10": (-5000.0, 5000.0),
         "C01": (-5000.0, 5000.0),
         "P_start": (0.0, 0.98 * P_min_kpa),
-        "E_f": (0.1 * actuator.frame_modulus_mpa, 10.0 * actuator.frame_modulus_mpa),
+        "E_f": (max(0.1 * actuator.frame_modulus_mpa, moduli.lo), min(10.0 * actuator.frame_modulus_mpa, moduli.hi)),
         "R0_start": (actuator.R0_mm, 1.5 * actuator.R0_mm),
     }
 

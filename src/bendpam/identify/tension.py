@@ -46,7 +46,7 @@ from bendpam.errors import FitError, InputError, ProcessingError
 from bendpam.identify.diagnose import LIMITS, tension_identifiability
 from bendpam.infra.atomic import json_safe
 from bendpam.physics.material import MooneyRivlin, admissible_shape_range, within
-from bendpam.validate import number
+from bendpam.validate import PLAUSIBLE, number, plausible
 
 __all__ = [
     "DEFAULT_ADMISSIBLE_RANGE",
@@ -199,7 +199,7 @@ def _pair(name: str, value: Any) -> tuple[float, float]:
 def _column(name: str, value: Any, unit: str) -> np.ndarray:
     try:
         arr = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise InputError(f"{name} is not numeric ({unit} expected)") from None
     if arr.ndim != 1:
         raise InputError(f"{name} must be one-dimensional, got shape {arr.shape}")
@@ -243,10 +243,10 @@ def fit_tension(
     Raises
     ------
     InputError
-        Non-numeric, non-finite or mismatched arrays, a stretch <= 0, a bad range, or
-        fewer than 3 points with stretch != 1 inside ``stretch_range``.
+        Non-numeric, non-finite or mismatched arrays, a stretch <= 0 or > 20, a stress beyond
+        100 MPa (a unit mistake), a bad range, or fewer than 3 points with stretch != 1.
     FitError
-        If no positive shear modulus fits (the stress does not rise with stretch).
+        No positive shear modulus fits, or the constants are beyond a rubber's (|C10|, |C01| <= 100 MPa).
 
     Examples
     --------
@@ -272,6 +272,7 @@ def fit_tension(
         )
     beta = float(x[1]) / mu
     c10, c01 = 0.5 * mu * (1.0 - beta), 0.5 * mu * beta
+    _plausible_constants(c10, c01, source or "tension data")
     resid = p_kpa - (c10 * 2.0 * g1 + c01 * 2.0 * g1 / lam)
     rss = float(resid @ resid)
     rmse = math.sqrt(rss / lam.size)
@@ -304,6 +305,8 @@ def _points(stretch: ArrayLike, nominal_stress_kpa: ArrayLike, stretch_range, so
     if lam.size and float(lam.min()) <= 0.0:
         i = int(np.argmin(lam))
         raise InputError(f"stretch = {lam[i]:g} at index {i} is not > 0")
+    plausible("stretch", lam, indexed=True)
+    plausible("nominal_stress_kpa", p_kpa, indexed=True)
     if stretch_range is not None:
         lo, hi = _pair("stretch_range", stretch_range)
         keep = (lam >= lo) & (lam <= hi)
@@ -316,6 +319,16 @@ def _points(stretch: ArrayLike, nominal_stress_kpa: ArrayLike, stretch_range, so
             f"a fit of C10 and C01 needs at least {_MIN_POINTS}"
         )
     return lam, p_kpa
+
+
+def _plausible_constants(c10: float, c01: float, source: str) -> None:
+    """A :class:`FitError` when the fitted constants are beyond a rubber's (:data:`bendpam.validate.PLAUSIBLE`)."""
+    for name, value in (("C10_kpa", c10), ("C01_kpa", c01)):
+        b = PLAUSIBLE[name]
+        if not b.lo <= value <= b.hi:
+            raise FitError(f"{source}: the fitted {name} = {value:.4g} kPa is beyond the plausible range "
+                           f"[{b.lo:g}, {b.hi:g}] kPa ({b.reason}); are the stresses in kPa and the stretches "
+                           "L/L0 (not strains)?")
 
 
 def _bounds_span(lam: np.ndarray, admissible_range) -> tuple[float, float]:

@@ -26,12 +26,18 @@ from bendpam.errors import FileFormatError, InputError
 from bendpam.infra.atomic import atomic_write_text
 from bendpam.infra.budgets import loads_toml, read_input_bytes
 from bendpam.physics.material import MooneyRivlin
-from bendpam.validate import did_you_mean, number
+from bendpam.validate import DEFAULT_MAX_PRESSURE_KPA, PLAUSIBLE, did_you_mean, float_array, number, plausible
 
 __all__ = ["NEUTRAL_ANGLE_DEG", "Actuator", "ModelParams", "bladder_area_mm2", "frame_inertia_mm4", "t0_start_mm"]
 
 #: The braid angle at which a McKibben sleeve has maximum volume, arctan(sqrt 2) = 54.7356 deg.
 NEUTRAL_ANGLE_DEG = math.degrees(math.atan(math.sqrt(2.0)))
+
+
+def _numeric(**values) -> None:
+    """One InputError line for a value that is not a number or an array of numbers (mm)."""
+    for name, value in values.items():
+        float_array(name, value, "mm")
 
 
 def t0_start_mm(R0_mm, t0_mm, R0_start_mm):
@@ -40,6 +46,7 @@ def t0_start_mm(R0_mm, t0_mm, R0_start_mm):
     >>> round(float(t0_start_mm(8.5, 2.5, 10.1)), 4)     # the paper's BE-PAM: 2.5 mm stretched to 10.1 mm
     1.9907
     """
+    _numeric(R0_mm=R0_mm, t0_mm=t0_mm, R0_start_mm=R0_start_mm)
     return R0_start_mm - np.sqrt(R0_start_mm * R0_start_mm - 2.0 * R0_mm * t0_mm + t0_mm * t0_mm)
 
 
@@ -49,6 +56,7 @@ def bladder_area_mm2(R0_mm, t0_mm):
     >>> round(float(bladder_area_mm2(8.5, 2.5)), 2)
     113.88
     """
+    _numeric(R0_mm=R0_mm, t0_mm=t0_mm)
     return np.pi * (2.0 * R0_mm * t0_mm - t0_mm * t0_mm)
 
 
@@ -58,11 +66,28 @@ def frame_inertia_mm4(width_mm, thickness_mm):
     >>> frame_inertia_mm4(5.0, 0.5)                      # Table 1: 5 mm x 0.5 mm
     0.052083...
     """
+    _numeric(width_mm=width_mm, thickness_mm=thickness_mm)
     return width_mm * thickness_mm**3 / 12.0
 
 
 #: Actuator fields that are not inputs of the models (labels and the limits of :mod:`bendpam.physics.limits`).
 _NOT_MODEL_PARAMS = ("name", "model", "frame_strength_mpa", "bladder_stretch_limit")
+
+#: The hard limits of the numeric fields (the models' domain): (lo, hi, lo open, hi open, unit); ``t0_mm``
+#: and ``R0_start_mm`` are bounded by ``R0_mm``.  The plausible ranges inside them: :data:`bendpam.validate.PLAUSIBLE`.
+_HARD = {
+    "alpha0_deg": (0.0, 90.0, True, True, "deg"),
+    "R0_mm": (0.0, None, True, False, "mm"),
+    "L0_mm": (0.0, None, True, False, "mm"),
+    "frame_thickness_mm": (0.0, None, True, False, "mm"),
+    "frame_width_mm": (0.0, None, True, False, "mm"),
+    "frame_modulus_mpa": (0.0, None, True, False, "MPa"),
+    "C10_kpa": (None, None, False, False, "kPa"),
+    "C01_kpa": (None, None, False, False, "kPa"),
+    "P_start_kpa": (0.0, None, False, False, "kPa"),
+    "braid_thickness_mm": (0.0, None, True, False, "mm"),
+    "max_pressure_kpa": (0.0, None, True, False, "kPa"),
+}
 
 
 def _suggest(key: str, known) -> str:
@@ -91,6 +116,8 @@ class ModelParams:
     L0 : active length, mm.  braid_thickness : t_br, mm.
     R0 : outer radius of the as-made (unstressed) bladder, mm, for the stretches of
         :mod:`bendpam.physics.limits`; ``None`` (a hand-made block) means no prestrain, ``R0 = R0_start``.
+    max_pressure_kpa : the burst limit, kPa (the actuator's; default 2000): the law of these cases
+        refuses pressures above it.
 
     Examples
     --------
@@ -114,10 +141,12 @@ class ModelParams:
     braid_thickness: Any
     P_start_kpa: Any = 0.0
     R0: Any = None
+    max_pressure_kpa: Any = DEFAULT_MAX_PRESSURE_KPA
 
     @classmethod
     def build(cls, *, alpha0_deg, R0_mm, t0_mm, L0_mm, frame_thickness_mm, frame_width_mm, frame_modulus_mpa,
-              C10_kpa, C01_kpa, P_start_kpa, R0_start_mm, braid_thickness_mm=0.3) -> ModelParams:
+              C10_kpa, C01_kpa, P_start_kpa, R0_start_mm, braid_thickness_mm=0.3,
+              max_pressure_kpa=DEFAULT_MAX_PRESSURE_KPA) -> ModelParams:
         """From user units (the :class:`Actuator` field names); scalars or arrays that broadcast."""
         return cls(
             alpha0=np.radians(alpha0_deg), R0_start=R0_start_mm * 1.0,
@@ -126,6 +155,7 @@ class ModelParams:
             frame_modulus=frame_modulus_mpa * 1.0, frame_thickness=frame_thickness_mm * 1.0,
             C10=C10_kpa * 1e-3, C01=C01_kpa * 1e-3, P_start=P_start_kpa * 1e-3, L0=L0_mm * 1.0,
             braid_thickness=braid_thickness_mm * 1.0, P_start_kpa=P_start_kpa * 1.0, R0=R0_mm * 1.0,
+            max_pressure_kpa=max_pressure_kpa * 1.0,
         )
 
     @property
@@ -198,6 +228,14 @@ class Actuator:
         as-made tube (``R0_mm``, ``t0_mm``: the prestrain of eq 51-52 included), e.g. 3.0 for a
         latex tube used well below its elongation at break.  :func:`bendpam.physics.limits` reports the
         margin in strain, ``(limit - 1) / (stretch - 1)``; ``None`` (default): no stretch check.
+    max_pressure_kpa : float
+        The burst limit, kPa (default 2000 = 2 MPa, more than any pneumatic PAM holds): every
+        function that takes this actuator and pressures refuses a pressure above it.  Raise it for
+        a hydraulic muscle (up to 100 MPa).
+
+    Every numeric field must also lie in its physical plausibility range
+    (:data:`bendpam.validate.PLAUSIBLE`, docs/plausibility.md): a braid angle of 10 to 88 deg,
+    ``R0_start_mm`` at most 3 ``R0_mm``, a frame modulus from rubber to steel, and so on.
 
     Examples
     --------
@@ -215,6 +253,10 @@ class Actuator:
     Traceback (most recent call last):
     ...
     bendpam.errors.InputError: t0_mm = 9 mm is outside the allowed range (0, 8.5) mm
+    >>> a.replace(R0_start_mm=1e22)
+    Traceback (most recent call last):
+    ...
+    bendpam.errors.InputError: R0_start_mm = 1e+22 mm is outside the plausible range [R0_mm, 3 R0_mm] = [8.5, 25.5] ...
     """
 
     alpha0_deg: float
@@ -233,6 +275,7 @@ class Actuator:
     model: str = ""
     frame_strength_mpa: float | None = None
     bladder_stretch_limit: float | None = None
+    max_pressure_kpa: float = DEFAULT_MAX_PRESSURE_KPA
 
     # derived, filled in __post_init__
     _material: MooneyRivlin = field(init=False, repr=False, compare=False, hash=False)
@@ -240,31 +283,19 @@ class Actuator:
 
     def __post_init__(self) -> None:
         s = object.__setattr__
-        s(self, "alpha0_deg", number("alpha0_deg", self.alpha0_deg, 0.0, 90.0, lo_open=True, hi_open=True,
-                                     unit="deg"))
-        s(self, "R0_mm", number("R0_mm", self.R0_mm, 0.0, lo_open=True, unit="mm"))
+        for name, (lo, hi, open_lo, open_hi, unit) in _HARD.items():
+            s(self, name, number(name, getattr(self, name), lo, hi, lo_open=open_lo, hi_open=open_hi, unit=unit))
         s(self, "t0_mm", number("t0_mm", self.t0_mm, 0.0, self.R0_mm, lo_open=True, hi_open=True, unit="mm"))
-        s(self, "L0_mm", number("L0_mm", self.L0_mm, 0.0, lo_open=True, unit="mm"))
-        s(self, "frame_thickness_mm", number("frame_thickness_mm", self.frame_thickness_mm, 0.0, lo_open=True,
-                                             unit="mm"))
-        s(self, "frame_width_mm", number("frame_width_mm", self.frame_width_mm, 0.0, lo_open=True, unit="mm"))
-        s(self, "frame_modulus_mpa", number("frame_modulus_mpa", self.frame_modulus_mpa, 0.0, lo_open=True,
-                                            unit="MPa"))
-        s(self, "C10_kpa", number("C10_kpa", self.C10_kpa, unit="kPa"))
-        s(self, "C01_kpa", number("C01_kpa", self.C01_kpa, unit="kPa"))
         if self.C10_kpa + self.C01_kpa <= 0.0:
             raise InputError(
                 f"C10_kpa + C01_kpa = {self.C10_kpa + self.C01_kpa:g} kPa must be > 0 "
                 "(the bladder's initial shear modulus 2(C10 + C01) must be positive); "
                 f"got C10_kpa = {self.C10_kpa:g}, C01_kpa = {self.C01_kpa:g}"
             )
-        s(self, "P_start_kpa", number("P_start_kpa", self.P_start_kpa, 0.0, unit="kPa"))
         if self.R0_start_mm is None:
             s(self, "R0_start_mm", self.R0_mm)
         else:
             s(self, "R0_start_mm", number("R0_start_mm", self.R0_start_mm, self.R0_mm, unit="mm"))
-        s(self, "braid_thickness_mm", number("braid_thickness_mm", self.braid_thickness_mm, 0.0, lo_open=True,
-                                             unit="mm"))
         if self.model not in ("", "energy", "force_balance"):
             raise InputError(f"model = {self.model!r}: the model the constants were identified with must be "
                              "'energy', 'force_balance' or '' (unknown)")
@@ -276,6 +307,9 @@ class Actuator:
         if self.bladder_stretch_limit is not None:
             s(self, "bladder_stretch_limit",
               number("bladder_stretch_limit", self.bladder_stretch_limit, 1.0, lo_open=True))  # a stretch: no unit
+        values = {f: getattr(self, f) for f in PLAUSIBLE if getattr(self, f, None) is not None}
+        for name, value in values.items():  # physical plausibility (docs/plausibility.md), after the hard limits
+            plausible(name, value, values)
         s(self, "_material", MooneyRivlin(self.C10_kpa * 1e-3, self.C01_kpa * 1e-3))
         s(self, "_params", ModelParams.build(**{f: getattr(self, f) for f in self.field_names()
                                                      if f not in _NOT_MODEL_PARAMS}))

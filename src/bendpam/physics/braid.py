@@ -64,8 +64,9 @@ from typing import Any
 import numpy as np
 
 from bendpam.errors import InputError
+from bendpam.physics.actuator import Actuator, ModelParams
 from bendpam.physics.roots import bracketed_newton
-from bendpam.validate import quadrature_order
+from bendpam.validate import float_array, instance, quadrature_order
 
 __all__ = [
     "CLOSED_FORM",
@@ -75,11 +76,13 @@ __all__ = [
     "NODE_ORDER",
     "CurvatureLimits",
     "Kinematics",
+    "braid_range",
     "case_column",
     "circle_ibar",
     "curvature_limits",
     "gauss_nodes",
     "ibar_closed_form",
+    "kernel_args",
     "kinematics",
     "limits",
     "radius_from_u",
@@ -180,7 +183,7 @@ def ibar_closed_form(u, c):
     """
     from scipy.special import ellipe, ellipk
 
-    u = np.asarray(u, dtype=float)
+    u, c = float_array("u", u, "1"), float_array("c", c, "1")
     pos = u >= 0.0
     cu = c * u
     D = np.where(pos, (1.0 - c) * (1.0 + c + 2.0 * cu), (1.0 + c) * (1.0 - c - 2.0 * cu))
@@ -215,10 +218,10 @@ def circle_ibar(u, c, order: int = DEFAULT_ORDER):
     if order == CLOSED_FORM:
         return ibar_closed_form(u, c)
     phi, wbar = gauss_nodes(order)
-    return ibar(np.asarray(u, dtype=float), c, 1.0 - np.cos(phi), wbar)
+    return ibar(float_array("u", u, "1"), float_array("c", c, "1"), 1.0 - np.cos(phi), wbar)
 
 
-def solve_u(q_target, alpha0: float, order: int = DEFAULT_ORDER, u_bounds: tuple[float, float] | None = None):
+def solve_u(q_target, alpha0: Any, order: int = DEFAULT_ORDER, u_bounds: tuple[float, float] | None = None):
     """Solve eq 5 for ``u = k' R`` given ``q = k' R0`` (vectorised safeguarded Newton).
 
     Parameters
@@ -245,8 +248,9 @@ def solve_u(q_target, alpha0: float, order: int = DEFAULT_ORDER, u_bounds: tuple
     >>> u.round(5).tolist()                      # u = k'R: R shrinks as the actuator bends
     [0.0, 0.04964]
     """
+    q, a0 = float_array("q_target", q_target, "1"), float_array("alpha0", alpha0, "rad")
+    alpha0 = a0 if a0.ndim else float(a0)
     c, s = np.cos(alpha0), np.sin(alpha0)
-    q = np.asarray(q_target, dtype=float)
     if np.ndim(alpha0):
         q = np.broadcast_to(q, np.broadcast_shapes(q.shape, np.shape(alpha0)))
     if np.ndim(alpha0) == 0 and u_bounds is None and q.size >= _UNIFORM_MIN_POINTS:
@@ -439,9 +443,13 @@ class CurvatureLimits:
     u_min: Any
     u_max: Any
 
-    def check(self, curvature, *, name: str = "curvature_per_mm") -> None:
-        """Raise :class:`~bendpam.errors.InputError` if a curvature is outside ``[k_min, k_max]`` or not finite."""
-        k = np.asarray(curvature, dtype=float)
+    def check(self, curvature, *, name: str = "curvature_per_mm", slack: float = 0.0) -> None:
+        """Raise :class:`~bendpam.errors.InputError` if a curvature is outside ``[k_min, k_max]`` or not finite.
+
+        ``slack``: tolerate curvatures this fraction of ``k_max - k_min`` beyond either limit (the
+        rounding of limits computed with another quadrature order).
+        """
+        k = float_array(name, curvature, "1/mm")
         if k.size == 0:
             return
         if not np.all(np.isfinite(k)):
@@ -449,12 +457,13 @@ class CurvatureLimits:
             raise InputError(f"{name} has a non-finite value {k.ravel()[bad]!r} at index {int(bad)}")
         kmin, kmax = float(k.min()), float(k.max())
         lo, hi = float(np.min(self.k_min)), float(np.max(self.k_max))
-        if np.any(k > self.k_max):
+        pad = slack * (np.asarray(self.k_max) - np.asarray(self.k_min))
+        if np.any(k > self.k_max + pad):
             raise InputError(
                 f"{name} k' = {kmax:.6g} 1/mm is beyond the braid lock-up limit k'_max = {hi:.6g} 1/mm "
                 f"({self.reason_max}); allowed range [{lo:.6g}, {hi:.6g}] 1/mm"
             )
-        if np.any(k < self.k_min):
+        if np.any(k < self.k_min - pad):
             raise InputError(
                 f"{name} k' = {kmin:.6g} 1/mm is beyond the braid lock-up limit k'_min = {lo:.6g} 1/mm "
                 f"({self.reason_min}); allowed range [{lo:.6g}, {hi:.6g}] 1/mm"
@@ -487,6 +496,8 @@ def limits(params, order: int = DEFAULT_ORDER) -> CurvatureLimits:
     >>> limits(cases).k_max.round(4).tolist()            # 1/mm
     [0.1038, 0.1917, 0.4511]
     """
+    kernel_args(params)
+    order = quadrature_order(order)
     scalar = np.ndim(params.alpha0) == 0 and np.ndim(params.R0_start) == 0 and np.ndim(params.t0_start) == 0
     shape = np.broadcast_shapes(np.shape(params.alpha0), np.shape(params.R0_start), np.shape(params.t0_start))
     a0 = np.broadcast_to(np.asarray(params.alpha0, dtype=float), shape).ravel()
@@ -535,6 +546,60 @@ def limits(params, order: int = DEFAULT_ORDER) -> CurvatureLimits:
                            u_lo.reshape(shape), u_hi.reshape(shape))
 
 
+def kernel_args(params, *arrays: tuple[str, Any, str]) -> tuple[np.ndarray, ...]:
+    """The numerics' entry check: ``params`` a :class:`~bendpam.ModelParams`, each ``(name, value, unit)`` a
+    float array; one :class:`~bendpam.errors.InputError` line otherwise (NaN passes: the kernels propagate it).
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> kernel_args(bendpam.physics.presets.be_pam().params, ("curvature", [0.0, 0.01], "1/mm"))[0].tolist()
+    [0.0, 0.01]
+    >>> kernel_args(None, ("curvature", 0.0, "1/mm"))
+    Traceback (most recent call last):
+    ...
+    bendpam.errors.InputTypeError: params = None must be a ModelParams (actuator.params), got NoneType
+    """
+    instance("params", params, (ModelParams, _Section), "a ModelParams (actuator.params)")
+    return tuple(float_array(name, value, unit) for name, value, unit in arrays)
+
+
+def braid_range(params, order: int = DEFAULT_ORDER) -> CurvatureLimits:
+    """The curvatures eq 1-5 describe: the braid limits of :func:`limits` without the lumen closure (cheap).
+
+    ``k'_max`` where ``u = k'R`` reaches :data:`LOCK_FRACTION` of ``u_lock`` and ``k'_min`` where the
+    far-side stretch falls to :data:`MIN_FAR_STRETCH`, from two closed-form evaluations of eq 5 per
+    case (no scan): the range :meth:`bendpam.MomentLaw.coefficients` and ``basis`` accept.  It
+    contains the lock-up limits of :func:`limits`, which the lumen closing can narrow.
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> be = bendpam.physics.presets.be_pam()
+    >>> r, lim = braid_range(be.params), bendpam.curvature_limits(be)
+    >>> round(r.k_min, 4), round(r.k_max, 4), bool(r.k_min <= lim.k_min and lim.k_max <= r.k_max)
+    (-0.0471, 0.1878, True)
+    """
+    kernel_args(params)
+    a0 = np.asarray(params.alpha0, dtype=float)
+    R0 = np.asarray(params.R0_start, dtype=float)
+    c, s = np.cos(a0), np.sin(a0)
+    u_hi = LOCK_FRACTION * (1.0 / c - 1.0) / 2.0
+    u_lo = np.broadcast_to(-0.5 * (1.0 - MIN_FAR_STRETCH), np.shape(u_hi))
+    ends = []
+    for u in (u_lo, u_hi):
+        ib, _ = circle_ibar(np.asarray(u, dtype=float).reshape(-1), c.reshape(-1), order)
+        ends.append((np.asarray(u).reshape(-1) * s.reshape(-1) * ib / R0.reshape(-1)).reshape(np.shape(u_hi)))
+    k_lo, k_hi = ends
+    reason_max = (f"braid lock-up: far-side fibres within {100 * (1 - LOCK_FRACTION):g}% of straight, beyond which "
+                  "eq 5 has no solution")
+    reason_min = (f"braid lock-up: far-side axial stretch lambda1(pi) = 1 + 2k'R falls to {MIN_FAR_STRETCH:g} "
+                  "(fibres fully circumferential)")
+    if np.ndim(k_hi) == 0:
+        return CurvatureLimits(float(k_lo), float(k_hi), reason_min, reason_max, float(u_lo), float(u_hi))
+    return CurvatureLimits(k_lo, k_hi, reason_min, reason_max, u_lo, u_hi)
+
+
 @lru_cache(maxsize=512)
 def _scalar_limits(alpha0: float, R0: float, t0: float, order: int) -> CurvatureLimits:
     return limits(_Section(alpha0, R0, t0), order)
@@ -550,7 +615,8 @@ class _Section:
 def curvature_limits(actuator, order: int = DEFAULT_ORDER) -> CurvatureLimits:
     """The braid lock-up limits ``[k'_min, k'_max]`` of ``actuator`` (1/mm), cached per geometry.
 
-    ``actuator`` is an :class:`~bendpam.Actuator` or a :class:`~bendpam.ModelParams`.
+    ``actuator`` is an :class:`~bendpam.Actuator` or a :class:`~bendpam.ModelParams`; anything
+    else raises :class:`~bendpam.errors.InputTypeError` (an InputError).
 
     Examples
     --------
@@ -559,9 +625,11 @@ def curvature_limits(actuator, order: int = DEFAULT_ORDER) -> CurvatureLimits:
     >>> round(lim.k_min, 4), round(lim.k_max, 4)          # 1/mm; a BC-PAM bends toward k' < 0
     (-0.0413, 0.0275)
     """
+    instance("actuator", actuator, (Actuator, ModelParams, _Section), "a bendpam.Actuator or a ModelParams")
+    order = quadrature_order(order)
     p = getattr(actuator, "params", actuator)
     if np.ndim(p.alpha0) == 0 and np.ndim(p.R0_start) == 0 and np.ndim(p.t0_start) == 0:
-        return _scalar_limits(float(p.alpha0), float(p.R0_start), float(p.t0_start), int(order))
+        return _scalar_limits(float(p.alpha0), float(p.R0_start), float(p.t0_start), order)
     return limits(p, order)
 
 
@@ -642,6 +710,8 @@ def radius_from_u(u, ib, dib, alpha0, R0, k=None):
     >>> R.round(4).tolist(), k.round(6).tolist()      # mm, 1/mm
     ([10.1, 10.0277], [0.0, 0.004986])
     """
+    u, ib, dib, alpha0, R0 = (float_array(n, v, unit) for n, v, unit in (
+        ("u", u, "1"), ("ib", ib, "1"), ("dib", dib, "1"), ("alpha0", alpha0, "rad"), ("R0", R0, "mm")))
     s = np.sin(alpha0)
     # eta(0) = 1 and xi'(0) = -cot^2 alpha0 hold exactly; don't let quadrature rounding blur them
     at0 = u == 0.0
@@ -666,7 +736,7 @@ def radius_state(kprime, alpha0, R0, order: int = DEFAULT_ORDER):
     >>> u.round(6).tolist(), R.round(4).tolist()
     ([0.0, 0.099494], [10.1, 9.9494])
     """
-    k = np.asarray(kprime, dtype=float)
+    k, R0 = float_array("kprime", kprime, "1/mm"), float_array("R0", R0, "mm")
     u, ib, dib = solve_u(k * R0, alpha0, order)
     R, dR, _ = radius_from_u(u, ib, dib, alpha0, R0, k)
     return u, R, dR, ib, dib
@@ -692,16 +762,21 @@ def kinematics(actuator, curvature_per_mm, order: int = DEFAULT_ORDER) -> Kinema
     """Kinematics (eq 1-5) of ``actuator`` at frame curvature(s) ``curvature_per_mm`` (1/mm).
 
     Raises :class:`~bendpam.errors.InputError` if a curvature lies beyond the braid lock-up
-    limits (see :func:`curvature_limits`).
+    limits (see :func:`curvature_limits`) or is not a finite number, or ``actuator`` is not one
+    actuator (an :class:`~bendpam.Actuator`, or a :class:`~bendpam.ModelParams` of one case).
 
     >>> import bendpam
     >>> kin = bendpam.kinematics(bendpam.physics.presets.be_pam(), [0.0, 0.01])
     >>> round(float(kin.radius[0]), 6), bool(kin.radius[1] < kin.radius[0])
     (10.1, True)
     """
-    k = np.asarray(curvature_per_mm, dtype=float)
+    instance("actuator", actuator, (Actuator, ModelParams), "a bendpam.Actuator")
+    p = actuator.params if isinstance(actuator, Actuator) else actuator
+    if p.shape != ():
+        raise InputError("kinematics() describes one actuator, not a block of cases")
+    order = quadrature_order(order)
+    k = float_array("curvature_per_mm", curvature_per_mm, "1/mm")
     curvature_limits(actuator, order).check(k)
-    p = actuator.params
     a0 = float(p.alpha0)
     R0 = float(p.R0_start)
     u, R, dR = radius_terms(k, a0, R0, order)

@@ -27,8 +27,10 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from bendpam.errors import InputTypeError
 from bendpam.physics.roots import illinois
 from bendpam.physics.sections import branch_path
+from bendpam.validate import float_array, instance, integer
 
 if TYPE_CHECKING:
     from bendpam.physics.law import MomentLaw
@@ -94,6 +96,13 @@ class BranchTable:
     path: Any = field(repr=False, compare=False)
 
 
+def _law(law) -> None:
+    """One InputTypeError line unless ``law`` is a :class:`~bendpam.MomentLaw` (by its attributes: the law module
+    imports this one, so this one cannot import it)."""
+    if not all(hasattr(law, a) for a in ("params", "check_curvature", "branches")):
+        raise InputTypeError(f"law = {law!r:.60} must be a MomentLaw, got {type(law).__name__}")
+
+
 def branch_table(law: MomentLaw, samples: int = BRANCH_SAMPLES) -> BranchTable:
     """Sample ``P_a(x) = B/A`` along each case's bending direction; find its end (fold, lock-up).
 
@@ -109,6 +118,8 @@ def branch_table(law: MomentLaw, samples: int = BRANCH_SAMPLES) -> BranchTable:
     >>> tab.kind.tolist() == [BRANCH_END["fold"]], tab.p_end.round(1).tolist()   # active kPa
     (True, [102.2])
     """
+    _law(law)
+    samples = integer("samples", samples, 8, 1_000_000)
     ev = branch_path(law)
     sgn = ev.cs.bend_sign
     ncase = sgn.size
@@ -224,6 +235,9 @@ def solve_free(law: MomentLaw, tab: BranchTable, pa: np.ndarray, xtol: float = 1
     >>> k.round(5).tolist()                              # 1/mm
     [[0.0, 0.00816]]
     """
+    _law(law)
+    instance("tab", tab, BranchTable, "a BranchTable (law.branches())")
+    pa = float_array("pa", pa, "kPa")
     k = np.zeros(pa.shape)
     u = np.zeros(pa.shape)
     above = pa > tab.p_end[:, None]
@@ -313,6 +327,8 @@ def describe_branch(law: MomentLaw, tab: BranchTable) -> FreeBranch:
     >>> br.kind, br.direction
     ('unbounded', 1)
     """
+    _law(law)
+    instance("tab", tab, BranchTable, "a BranchTable (law.branches())")
     sgn = int(tab.sgn[0])
     kind = _END_NAME[int(tab.kind[0])]
     P0 = float(law.P_start_kpa)
@@ -395,6 +411,9 @@ def assemble_free(law: MomentLaw, P: np.ndarray, k: np.ndarray, br: FreeBranch) 
     >>> fb.status.tolist(), fb.angle_deg.round(1).tolist()
     (['deadband', 'ok'], [0.0, 67.7])
     """
+    _law(law)
+    instance("br", br, FreeBranch, "a FreeBranch (law.free_branch())")
+    P, k = float_array("P", P, "kPa"), float_array("k", k, "1/mm")
     P0 = float(law.P_start_kpa)
     flat = P.ravel()
     status = np.full(flat.shape, "ok", dtype=object)

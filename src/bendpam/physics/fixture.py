@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from bendpam.errors import InputError
+from bendpam.validate import float_array, plausible
 
 __all__ = ["PAPER_FIXTURE", "Fixture"]
 
@@ -43,6 +44,10 @@ class Fixture:
     r_mm : loading roller radius (paper: 2.5 mm).
     t_mm : connecting plate thickness (paper: 4 mm).
     L0_mm : active length of the actuator, for k' = 2 beta / L0 (paper: 145 mm).
+
+    Each dimension must be a finite number in its physical plausibility range
+    (:data:`bendpam.validate.PLAUSIBLE`: ``d`` 1 mm to 2 m, ``r`` and ``t`` up to 200 mm, ``L0`` as an
+    actuator's, 1 mm to 5 m), else one :class:`~bendpam.errors.InputError` line names it.
 
     Examples
     --------
@@ -62,12 +67,13 @@ class Fixture:
             v = getattr(self, name)
             try:
                 fv = float(v)
-            except (TypeError, ValueError):
+            except (TypeError, ValueError, OverflowError):
                 raise InputError(f"fixture {name} = {v!r} is not a number") from None
             lo = 0.0
             if not math.isfinite(fv) or fv < lo or (fv == 0.0 and name in ("d_mm", "L0_mm")):
                 rng = "(0, inf)" if name in ("d_mm", "L0_mm") else "[0, inf)"
                 raise InputError(f"fixture {name} = {v!r} mm is outside the allowed range {rng} mm")
+            plausible("L0_mm" if name == "L0_mm" else f"fixture_{name}", fv, label=f"fixture {name}")
             object.__setattr__(self, name, fv)
 
     @property
@@ -100,7 +106,7 @@ class Fixture:
     # ---- eq 6 ---------------------------------------------------------------------------------
     def stroke_to_beta(self, stroke_mm):
         """Plate pitch angle beta (rad) from the stroke ``ds`` (mm, from the blocked state), eq 6."""
-        s = np.asarray(stroke_mm, dtype=float)
+        s = _data("stroke_mm", stroke_mm, "mm")
         a = np.abs(s)
         c, d = self.c, self.d_mm
         e = a + c
@@ -116,20 +122,18 @@ class Fixture:
 
     def beta_to_stroke(self, beta):
         """Stroke ``ds`` (mm) from beta (rad), eq 6 evaluated directly (odd extension for beta < 0)."""
-        b = np.asarray(beta, dtype=float)
+        b = _beta(beta)
         ab = np.abs(b)
-        if np.any(ab >= np.pi / 2):
-            raise InputError("beta must lie in (-pi/2, pi/2)")
         return np.sign(b) * (self.d_mm * np.tan(ab) + (1.0 / np.cos(ab) - 1.0) * self.c)
 
     # ---- eq 8 ---------------------------------------------------------------------------------
     def beta_to_curvature(self, beta):
         """Frame curvature magnitude k' = 2 beta / L0 (1/mm), eq 8."""
-        return 2.0 * np.asarray(beta, dtype=float) / self.L0_mm
+        return 2.0 * _beta(beta) / self.L0_mm
 
     def curvature_to_beta(self, curvature):
         """beta = k' L0 / 2 (rad), the inverse of eq 8."""
-        return 0.5 * np.asarray(curvature, dtype=float) * self.L0_mm
+        return 0.5 * _data("curvature", curvature, "1/mm") * self.L0_mm
 
     def stroke_to_curvature(self, stroke_mm):
         """k' (1/mm) from the stroke (mm): eq 6 then eq 8."""
@@ -142,16 +146,16 @@ class Fixture:
     # ---- eq 7 ---------------------------------------------------------------------------------
     def lever(self, beta):
         """Moment per unit force ``[d + (2r + t) sin(beta)] / (2 cos^2 beta)`` (mm), eq 7."""
-        b = np.abs(np.asarray(beta, dtype=float))
+        b = np.abs(_beta(beta))
         return (self.d_mm + self.c * np.sin(b)) / (2.0 * np.cos(b) ** 2)
 
     def force_to_moment(self, force_n, beta):
         """Moment (N*mm) from the machine force F_load (N) at pitch beta (rad), eq 7."""
-        return np.asarray(force_n, dtype=float) * self.lever(beta)
+        return _data("force_n", force_n, "N") * self.lever(beta)
 
     def moment_to_force(self, moment_nmm, beta):
         """Machine force (N) that balances the moment (N*mm) at pitch beta (rad), inverse of eq 7."""
-        return np.asarray(moment_nmm, dtype=float) / self.lever(beta)
+        return _data("moment_nmm", moment_nmm, "N*mm") / self.lever(beta)
 
     def convert(self, stroke_mm, force_n, tare_n: float = 0.0):
         """Raw (stroke, force) to (beta, k', M): eq 6-8, with an optional force tare (N).
@@ -160,8 +164,31 @@ class Fixture:
         actuator and the connecting plates, as read with the actuator unpressurised.
         """
         beta = self.stroke_to_beta(stroke_mm)
-        f = np.asarray(force_n, dtype=float) - float(tare_n)
+        tare = _data("tare_n", tare_n, "N")
+        if tare.ndim:
+            raise InputError(f"tare_n has shape {tare.shape}; one force (N) expected")
+        f = _data("force_n", force_n, "N") - float(tare)
         return beta, self.beta_to_curvature(beta), self.force_to_moment(f, beta)
+
+
+def _data(name: str, value, unit: str) -> np.ndarray:
+    """A float array of finite values (strokes and forces in their plausible ranges), else one InputError line."""
+    v = float_array(name, value, unit)
+    if v.size and not np.all(np.isfinite(v)):
+        i = int(np.flatnonzero(~np.isfinite(v.ravel()))[0])
+        raise InputError(f"{name} has a non-finite value {float(v.ravel()[i])!r} at index {i}")
+    key = {"stroke_mm": "stroke_mm", "force_n": "force_n", "tare_n": "force_n"}.get(name)
+    if key is not None:
+        plausible(key, v, label=name, indexed=v.ndim > 0)
+    return v
+
+
+def _beta(beta) -> np.ndarray:
+    """Plate pitch angles (rad) in (-pi/2, pi/2), else one InputError line."""
+    b = _data("beta", beta, "rad")
+    if np.any(np.abs(b) >= np.pi / 2):
+        raise InputError("beta must lie in (-pi/2, pi/2)")
+    return b
 
 
 #: The paper's fixture (section 2.2): d = 35 mm, r = 2.5 mm, t = 4 mm, L0 = 145 mm.

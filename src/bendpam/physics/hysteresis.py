@@ -322,7 +322,7 @@ class LoopModel:
         """``A(P, k')`` in N*mm (pressure in kPa, curvature in 1/mm), broadcasting."""
         from bendpam.validate import pressure_kpa as check_pressure
 
-        pa = np.maximum(check_pressure(pressure_kpa) - actuator.P_start_kpa, 0.0)
+        pa = np.maximum(check_pressure(pressure_kpa, limit_kpa=actuator.max_pressure_kpa) - actuator.P_start_kpa, 0.0)
         if self.amplitude == "linear":
             return self.a0_nmm + self.a1_nmm_per_kpa * np.broadcast_to(
                 pa, np.broadcast_shapes(np.shape(pa), np.shape(curvature_per_mm)))
@@ -357,7 +357,11 @@ def loss_ratio(k_mag, upper, lower, L0_mm: float) -> tuple[float, float, float]:
     >>> round(ratio, 3), round(loss, 2), round(stored, 2)   # loss and stored energy in N*mm
     (0.4, 29.0, 72.5)
     """
-    th = np.asarray(k_mag, dtype=float) * L0_mm
+    from bendpam.validate import float_array, number
+
+    k_mag, upper, lower = (float_array(n, v, u) for n, v, u in (("k_mag", k_mag, "1/mm"), ("upper", upper, "N*mm"),
+                                                                 ("lower", lower, "N*mm")))
+    th = k_mag * number("L0_mm", L0_mm, 0.0, lo_open=True, unit="mm")
     loss = float(np.trapezoid(np.asarray(upper) - np.asarray(lower), th))
     stored = float(np.trapezoid(0.5 * (np.asarray(upper) + np.asarray(lower)), th))
     return (loss / stored if stored > 0 else math.nan), loss, stored
@@ -464,10 +468,9 @@ def predict_cycles(actuator, loop: LoopModel, pressures_kpa, model: str = "energ
     [15.9, 17.0]
     """
     from bendpam.physics.law import MomentLaw
-    from bendpam.validate import pressure_kpa as check_pressure
 
-    P = np.atleast_1d(np.asarray(check_pressure(pressures_kpa), dtype=float)).ravel()
     law = MomentLaw.of(actuator, model, order=order, eq19_factor=eq19_factor)
+    P = np.atleast_1d(np.asarray(law.check_pressure(pressures_kpa), dtype=float)).ravel()
     kf, flat = _free_states(actuator, loop, law, P)
     return _cycles(actuator, loop, law, P, kf, flat, int(n))
 

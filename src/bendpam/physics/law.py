@@ -39,14 +39,15 @@ here and nowhere else.
 
 from __future__ import annotations
 
+import warnings
 from functools import cached_property, lru_cache
 from typing import Any
 
 import numpy as np
 
-from bendpam.errors import InputError
+from bendpam.errors import InputError, PlausibilityWarning
 from bendpam.physics.actuator import Actuator, ModelParams
-from bendpam.physics.braid import DEFAULT_ORDER, CurvatureLimits, curvature_limits
+from bendpam.physics.braid import DEFAULT_ORDER, CurvatureLimits, braid_range, curvature_limits
 from bendpam.physics.branch import (
     BRANCH_END,
     BRANCH_SAMPLES,
@@ -62,7 +63,7 @@ from bendpam.physics.models import energy, force_balance, normalise_model
 from bendpam.physics.roots import bracketed_newton
 from bendpam.physics.sections import MPA_PER_KPA
 from bendpam.physics.stable import StableBranch, stable_branch
-from bendpam.validate import boolean, float_array, quadrature_order
+from bendpam.validate import boolean, float_array, instance, integer, number, quadrature_order
 from bendpam.validate import pressure_kpa as _check_pressure
 
 #: ``BRANCH_END``, ``BranchTable``, ``FreeBending``, ``FreeBranch`` (:mod:`bendpam.physics.branch`) and
@@ -78,6 +79,15 @@ __all__ = [
 ]
 
 _CHUNK = 1 << 13  # curvatures per block: keeps the (points x nodes) temporaries in cache
+#: A pneumatic moment above this many times the McKibben bound ``pi R0_start^3 (1 + 2 cot^2 alpha0) P_a`` is flagged
+#: (:class:`~bendpam.errors.PlausibilityWarning`, docs/plausibility.md).
+MCKIBBEN_FACTOR = 10.0
+#: A free-bending angle beyond this (deg, a full turn) is flagged: the actuator would pass through itself.
+FULL_TURN_DEG = 360.0
+#: The numerics' entries (:meth:`MomentLaw.coefficients`, :meth:`MomentLaw.basis`) accept curvatures this fraction
+#: of the admissible span beyond the lock-up limits: the limits of another quadrature order differ by rounding.
+_LIMIT_SLACK = 1e-9
+_ACTUATOR = "a bendpam.Actuator (e.g. bendpam.physics.presets.get('be-pam'))"
 #: Interpolation tolerance of the table behind :meth:`MomentLaw.stable_branch` (finger statics).
 STABLE_BRANCH_TOL = 1e-8
 
@@ -103,6 +113,12 @@ class MomentLaw:
     -----
     Build one with :meth:`of` to share it (and its cached branch and table) between calls.
 
+    Every method validates its arguments: a pressure above the actuator's ``max_pressure_kpa``
+    (the burst limit, 2 MPa by default), a curvature beyond the lock-up limits (:attr:`limits`),
+    NaN, inf, ``None`` or a string raise one :class:`~bendpam.errors.InputError` line.  A result
+    beyond a plausibility bound warns (:class:`~bendpam.errors.PlausibilityWarning`,
+    docs/plausibility.md).
+
     Examples
     --------
     >>> import numpy as np, bendpam
@@ -115,14 +131,15 @@ class MomentLaw:
 
     def __init__(self, actuator: Actuator | ModelParams, model: str = "energy", *, eq19_factor: bool = True,
                  order: int = DEFAULT_ORDER):
+        instance("actuator", actuator, (Actuator, ModelParams), _ACTUATOR + " or a ModelParams block of cases")
         if isinstance(actuator, Actuator):
             self.actuator: Actuator | None = actuator
             self.params = actuator.params
-        elif isinstance(actuator, ModelParams):
-            self.actuator = None
-            self.params = actuator
         else:
-            raise TypeError(f"actuator must be a bendpam.Actuator, got {type(actuator).__name__}")
+            self.actuator = None
+            self.params = _checked_cases(actuator)
+        #: The burst limit (kPa): pressures above it are refused (the smallest of a block of cases).
+        self.max_pressure_kpa = float(np.min(self.params.max_pressure_kpa))
         self.model = normalise_model(model)
         self.eq19_factor = boolean("eq19_factor", eq19_factor)
         self.order = quadrature_order(order)
@@ -136,8 +153,7 @@ class MomentLaw:
     def of(cls, actuator: Actuator, model: str = "energy", *, eq19_factor: bool = True,
            order: int = DEFAULT_ORDER) -> MomentLaw:
         """The shared (cached) law of ``actuator``: its branch and table are built once."""
-        if not isinstance(actuator, Actuator):
-            raise TypeError(f"actuator must be a bendpam.Actuator, got {type(actuator).__name__}")
+        instance("actuator", actuator, Actuator, _ACTUATOR)
         return _cached_law(actuator, normalise_model(model), boolean("eq19_factor", eq19_factor),
                            quadrature_order(order))
 
@@ -157,13 +173,31 @@ class MomentLaw:
         """Admissible curvature range (braid lock-up, lumen closure), see :func:`bendpam.curvature_limits`."""
         return curvature_limits(self.params, self.order)
 
+    def check_pressure(self, pressure_kpa, name: str = "pressure_kpa") -> np.ndarray:
+        """Pressures (kPa) checked like every entry: finite, >= 0 and at most the burst limit ``max_pressure_kpa``."""
+        return _check_pressure(pressure_kpa, name, limit_kpa=self.max_pressure_kpa)
+
+    @cached_property
+    def _braid_range(self) -> CurvatureLimits:
+        return braid_range(self.params, self.order)
+
+    def _curvature(self, curvature_per_mm, params: ModelParams | None) -> np.ndarray:
+        """Curvatures (1/mm) checked at the numerics' entries: finite and inside the braid's range (eq 1-5)."""
+        k = float_array("curvature_per_mm", curvature_per_mm, "1/mm")
+        lim = self._braid_range if params is None else braid_range(instance("params", params, ModelParams,
+                                                                            "a ModelParams"), self.order)
+        lim.check(k, slack=_LIMIT_SLACK)
+        return k
+
     def coefficients(self, curvature_per_mm, params: ModelParams | None = None):
-        """``(A, B)`` with ``M = P_a A - B``: A in N*mm/kPa, B in N*mm; no range check.
+        """``(A, B)`` with ``M = P_a A - B``: A in N*mm/kPa, B in N*mm.
 
         For a block of cases ``curvature_per_mm`` broadcasts against the case shape (or against
         ``params``, a subset of the cases, when given).  Large inputs are evaluated in blocks.
+        A curvature that is not finite or lies beyond the braid's range, where eq 5 has no solution
+        (:func:`bendpam.physics.braid.braid_range`, which contains :attr:`limits`), is refused.
         """
-        k = np.asarray(curvature_per_mm, dtype=float)
+        k = self._curvature(curvature_per_mm, params)
         p = self.params if params is None else params
         if k.size <= _CHUNK or np.ndim(p.alpha0) or k.ndim == 0:
             A, B = self._mod.coefficients(p, k, **self._opts)
@@ -181,8 +215,9 @@ class MomentLaw:
 
         Returns ``(A, b10, b01)`` in N*mm/kPa; they depend only on the kinematics (alpha0,
         R0_start, t0_start), so identification solves C10, C01, E_f and P_start linearly.
+        Curvatures are checked as in :meth:`coefficients`.
         """
-        k = np.asarray(curvature_per_mm, dtype=float)
+        k = self._curvature(curvature_per_mm, params)
         A, b10, b01 = self._mod.basis(self.params if params is None else params, k, **self._opts)
         return A * MPA_PER_KPA, b10 * MPA_PER_KPA, b01 * MPA_PER_KPA
 
@@ -195,7 +230,7 @@ class MomentLaw:
 
     def active_pressure_kpa(self, pressure_kpa) -> np.ndarray:
         """Active pressure ``max(P - P_start, 0)`` in kPa (eq 50)."""
-        return np.maximum(_check_pressure(pressure_kpa) - self.P_start_kpa, 0.0)
+        return np.maximum(self.check_pressure(pressure_kpa) - self.P_start_kpa, 0.0)
 
     def moment(self, pressure_kpa, curvature_per_mm) -> np.ndarray:
         """``M(P, k')`` in N*mm (eq 21 or eq 49 with eq 50-52), broadcasting pressure against curvature.
@@ -206,12 +241,14 @@ class MomentLaw:
         p = self.active_pressure_kpa(pressure_kpa)
         k = self.check_curvature(curvature_per_mm)
         A, B = self.coefficients(k)
+        _flag_moment(self.params, p, p * A, "pneumatic moment")
         return p * A - B
 
     def blocked_moment(self, pressure_kpa) -> np.ndarray:
         """``M(P, 0)`` in N*mm: ``pi R0_start^3 (1 - 2 cot^2 alpha0) P_a`` for both models (negative for a BC-PAM)."""
         p = self.active_pressure_kpa(pressure_kpa)
         A0, _ = self.coefficients(np.zeros(()))
+        _flag_moment(self.params, p, p * A0, "blocked moment")
         return p * A0
 
     def terms(self, pressure_kpa, curvature_per_mm) -> dict[str, np.ndarray]:
@@ -249,9 +286,10 @@ class MomentLaw:
     # ---- free bending -------------------------------------------------------------------------
     def branches(self, samples: int = BRANCH_SAMPLES) -> BranchTable:
         """The sampled free-bending branch of every case (cached for the default sample count)."""
+        samples = integer("samples", samples, 8, 1_000_000)
         if samples == BRANCH_SAMPLES:
             return self._branches
-        return branch_table(self, int(samples))
+        return branch_table(self, samples)
 
     @cached_property
     def _branches(self) -> BranchTable:
@@ -282,8 +320,9 @@ class MomentLaw:
         >>> k.round(5).tolist(), round(float(u[1] / k[1]), 4)  # R (mm) at 200 kPa
         ([0.0, 0.01353], 9.891)
         """
-        P = _check_pressure(pressure_kpa)
-        tab = self._branches if table is None else table
+        P = self.check_pressure(pressure_kpa)
+        number("xtol", xtol, 0.0, 0.1, lo_open=True)
+        tab = self._branches if table is None else instance("table", table, BranchTable, "a BranchTable")
         if self.is_cases:
             if P.ndim != 1:
                 raise InputError("pressure_kpa must be 1-D for a block of cases")
@@ -305,9 +344,9 @@ class MomentLaw:
         """
         if self.is_cases:
             raise InputError("free_curvature() describes one actuator; use free_curvature_array() for cases")
-        P = _check_pressure(pressure_kpa)
+        P = self.check_pressure(pressure_kpa)
         k = self.free_curvature_array(P, xtol=xtol)
-        return assemble_free(self, P, k, self.free_branch())
+        return _flag_angle(assemble_free(self, P, k, self.free_branch()))
 
     # ---- the stable branch for loaded fingers -------------------------------------------------
     def stable_branch(self, pressure_kpa: float, friction_nmm: float = 0.0) -> StableBranch:
@@ -318,19 +357,76 @@ class MomentLaw:
         """
         if self.is_cases:
             raise InputError("stable_branch() describes one actuator")
-        P = float(_check_pressure(pressure_kpa, "pressure_kpa"))
-        return stable_branch(self.tabulated(STABLE_BRANCH_TOL), P, float(friction_nmm))
+        P = self.check_pressure(pressure_kpa)
+        if P.size != 1:
+            raise InputError(f"pressure_kpa has {P.size} values: stable_branch() takes one pressure")
+        cap = _mckibben_nmm(self.params, self.max_pressure_kpa)  # a friction moment beyond every moment it could resist
+        friction = number("friction_nmm", friction_nmm, -cap, cap, unit="N*mm")
+        return stable_branch(self.tabulated(STABLE_BRANCH_TOL), float(P.ravel()[0]), friction)
 
     # ---- the fast path ------------------------------------------------------------------------
     def tabulated(self, tol: float = 1e-6) -> MomentTable:
         """The fast path: :class:`MomentTable` of this law with interpolation error below ``tol`` (cached)."""
         if self.is_cases:
             raise InputError("tabulated() builds the table of one actuator")
-        key = float(tol)
+        key = number("tol", tol, 0.0, 0.1, lo_open=True)
         tabs = self.__dict__.setdefault("_tables", {})
         if key not in tabs:
             tabs[key] = MomentTable(self, tol=key)
         return tabs[key]
+
+
+def _mckibben_nmm(params: ModelParams, pa_kpa):
+    """:data:`MCKIBBEN_FACTOR` times the McKibben bound ``pi R0_start^3 (1 + 2 cot^2 alpha0) P_a`` (N*mm; P_a, kPa)."""
+    cot2 = 1.0 / np.tan(params.alpha0) ** 2
+    return MCKIBBEN_FACTOR * np.pi * params.R0_start ** 3 * (1.0 + 2.0 * cot2) * np.asarray(pa_kpa) * 1e-3
+
+
+def _flag_moment(params: ModelParams, pa_kpa, moment_nmm, what: str) -> None:
+    """Warn when a pneumatic moment exceeds :data:`MCKIBBEN_FACTOR` times the McKibben bound (docs/plausibility.md).
+
+    The bound ``pi R0_start^3 (1 + 2 cot^2 alpha0) P_a`` is the largest moment the pressure can give
+    through a McKibben sleeve of the actuator's size: the blocked moment is
+    ``pi R0_start^3 (1 - 2 cot^2 alpha0) P_a``, and bending only shrinks the radius.
+    """
+    bound = _mckibben_nmm(params, pa_kpa)
+    with np.errstate(invalid="ignore"):
+        over = np.abs(moment_nmm) > bound
+    if np.any(over):
+        i = int(np.flatnonzero(np.broadcast_to(over, np.shape(over)))[0])
+        m = float(np.ravel(moment_nmm)[i])
+        b = float(np.ravel(np.broadcast_to(bound, np.shape(over)))[i])
+        warnings.warn(f"{what} {m:.4g} N*mm is beyond {MCKIBBEN_FACTOR:g} times the McKibben bound "
+                      f"pi R0_start^3 (1 + 2 cot^2 alpha0) P_a ({b / MCKIBBEN_FACTOR:.4g} N*mm): "
+                      "the model is outside what it describes", PlausibilityWarning, stacklevel=4)
+
+
+def _flag_angle(fb: FreeBending) -> FreeBending:
+    """Warn when a free-bending angle is beyond a full turn (:data:`FULL_TURN_DEG`): the actuator would cross itself."""
+    with np.errstate(invalid="ignore"):
+        over = np.abs(np.asarray(fb.angle_deg)) > FULL_TURN_DEG
+    if np.any(over):
+        i = int(np.flatnonzero(np.ravel(over))[0])
+        warnings.warn(f"free-bending angle {float(np.ravel(fb.angle_deg)[i]):.4g} deg at "
+                      f"{float(np.ravel(fb.pressure_kpa)[i]):g} kPa is beyond a full turn ({FULL_TURN_DEG:g} deg): "
+                      "the actuator would pass through itself, and the planar model ends there",
+                      PlausibilityWarning, stacklevel=4)
+    return fb
+
+
+def _checked_cases(params: ModelParams) -> ModelParams:
+    """A hand-made block of cases: every field finite numbers of shapes that broadcast (``R0`` may be None)."""
+    for name, value in params.__dict__.items():
+        if value is None and name == "R0":
+            continue
+        v = float_array(f"ModelParams.{name}", value, "model units")
+        if v.size and not np.all(np.isfinite(v)):
+            raise InputError(f"ModelParams.{name} has a non-finite value")
+    try:
+        _ = params.shape
+    except ValueError:
+        raise InputError("the fields of the ModelParams do not broadcast to one shape of cases") from None
+    return params
 
 
 @lru_cache(maxsize=128)
@@ -388,10 +484,13 @@ class MomentTable:
     """
 
     def __init__(self, law: MomentLaw, *, knots: int = 513, tol: float = 1e-6, max_knots: int = 32769):
-        if not isinstance(law, MomentLaw) or law.is_cases:
-            raise TypeError("MomentTable tabulates the MomentLaw of one actuator")
-        if not (isinstance(tol, float | int) and tol > 0):
-            raise InputError(f"tol = {tol!r} must be a positive number")
+        instance("law", law, MomentLaw, "the MomentLaw of one actuator")
+        if law.is_cases:
+            raise InputError("MomentTable tabulates the MomentLaw of one actuator, not a block of cases")
+        if not (isinstance(tol, float | int) and not isinstance(tol, bool) and 0 < tol < 0.1):
+            raise InputError(f"tol = {tol!r} must be a number in (0, 0.1)")
+        knots = integer("knots", knots, 5, 1 << 20)
+        max_knots = integer("max_knots", max_knots, 5, 1 << 20)
         self.law = law
         self._exact_law = law
         self.limits = law.limits
@@ -470,17 +569,25 @@ class MomentTable:
 
     def coefficients(self, curvature_per_mm):
         """Interpolated ``(A, B)`` (N*mm/kPa, N*mm) at ``curvature_per_mm``; no range check."""
-        k = np.asarray(curvature_per_mm)
-        if not np.iscomplexobj(k):
-            k = k.astype(float, copy=False)
+        k = self._curvature(curvature_per_mm)
         v, _ = self._eval(k, False)
         return v[..., 0], k * v[..., 1]
 
+    def _curvature(self, curvature_per_mm) -> np.ndarray:
+        """Real or complex curvatures whose real part is finite and inside the lock-up limits."""
+        if isinstance(curvature_per_mm, complex | np.complexfloating) or np.iscomplexobj(curvature_per_mm):
+            k = np.asarray(curvature_per_mm)
+            self.limits.check(np.real(k))
+            if not np.all(np.isfinite(np.imag(k))):
+                raise InputError("curvature_per_mm has a non-finite imaginary part")
+            return k
+        k = float_array("curvature_per_mm", curvature_per_mm, "1/mm")
+        self.limits.check(k)
+        return k
+
     def derivatives(self, curvature_per_mm):
         """``(A, B, dA/dk', dB/dk')`` from the splines (complex curvatures allowed)."""
-        k = np.asarray(curvature_per_mm)
-        if not np.iscomplexobj(k):
-            k = k.astype(float, copy=False)
+        k = self._curvature(curvature_per_mm)
         v, d = self._eval(k, True)
         A, G = v[..., 0], v[..., 1]
         return A, k * G, d[..., 0], G + k * d[..., 1]
@@ -491,7 +598,7 @@ class MomentTable:
         Evaluated in blocks of 8192 points that stay in cache: one ``arccos`` gives the interval
         on either side of 0, then eight gathers and two Horner steps, in place.
         """
-        p = _check_pressure(pressure_kpa)
+        p = self.law.check_pressure(pressure_kpa)
         k = self.law.check_curvature(curvature_per_mm)
         shape = np.broadcast_shapes(p.shape, k.shape)
         pf = np.ascontiguousarray(np.broadcast_to(p, shape), dtype=float).reshape(-1)
@@ -545,7 +652,7 @@ class MomentTable:
 
     def tangent_stiffness(self, pressure_kpa, curvature_per_mm):
         """``dM/dk'`` (N*mm^2) from the spline derivatives."""
-        p = np.maximum(_check_pressure(pressure_kpa) - self.P_start_kpa, 0.0)
+        p = self.law.active_pressure_kpa(pressure_kpa)
         k = self.law.check_curvature(curvature_per_mm)
         _, _, dA, dB = self.derivatives(k)
         return p * dA - dB
@@ -557,7 +664,8 @@ class MomentTable:
         Newton steps on the interpolated moment.
         """
         law = self.law
-        P = _check_pressure(pressure_kpa)
+        P = law.check_pressure(pressure_kpa)
+        newton_steps = integer("newton_steps", newton_steps, 0, 100)
         tab = law.branches()
         br = law.free_branch()
         kt, pt = br.k_table_per_mm, br.p_table_kpa
@@ -579,4 +687,4 @@ class MomentTable:
                 return -(q * A - B), -(q * dA - dB)
 
             k[want] = bracketed_newton(f_and_slope, x, lo, hi, maxiter=newton_steps)
-        return assemble_free(law, P, k.reshape(P.shape), br)
+        return _flag_angle(assemble_free(law, P, k.reshape(P.shape), br))

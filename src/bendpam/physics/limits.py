@@ -110,19 +110,24 @@ Units: pressure kPa, force N, stress MPa (``_mpa``), curvature 1/mm, foundation 
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from bendpam.errors import InputError
+from bendpam.errors import InputError, PlausibilityWarning
 from bendpam.physics.actuator import Actuator, ModelParams
 from bendpam.physics.braid import DEFAULT_ORDER, curvature_limits, radius_state, solve_u
 from bendpam.physics.branch import BRANCH_END, BranchTable
 from bendpam.physics.law import MomentLaw
 from bendpam.physics.models.force_balance import axial_forces
-from bendpam.validate import float_array, number
-from bendpam.validate import pressure_kpa as _check_pressure
+from bendpam.validate import float_array, instance, plausible
+
+_ACTUATOR = "a bendpam.Actuator (e.g. bendpam.physics.presets.get('be-pam'))"
+#: A frame bending strain ``h |k'| / 2`` beyond this is flagged (:class:`~bendpam.errors.PlausibilityWarning`): the
+#: models' frame is a linear-elastic beam (eq 16, 27), which no frame material stays near at 20 % strain.
+FRAME_STRAIN_BOUND = 0.2
 
 __all__ = [
     "MARGINS",
@@ -167,6 +172,11 @@ def frame_width_mm(params: ModelParams):
     >>> round(float(frame_width_mm(bendpam.physics.presets.bc_pam().params)), 12)
     5.0
     """
+    instance("params", params, ModelParams, "a ModelParams (actuator.params)")
+    return _width(params)
+
+
+def _width(params: ModelParams):
     return 12.0 * params.frame_stiffness / (params.frame_modulus * params.frame_thickness**3)
 
 
@@ -180,8 +190,16 @@ def foundation_modulus(params: ModelParams, eta=1.0):
     >>> round(float(foundation_modulus(bendpam.physics.presets.bc_pam().params)), 4)
     3.5195
     """
+    instance("params", params, ModelParams, "a ModelParams (actuator.params)")
+    eta = _positive("eta", eta, "1")
+    plausible("stretch", eta, label="eta")  # R / R0_start: a hoop stretch of the bladder
+    return _foundation(params, eta)
+
+
+def _foundation(params: ModelParams, eta):
+    """:func:`foundation_modulus` without the checks (the kernel's own, validated states)."""
     E_bl = 6.0 * (params.C10 + params.C01)  # MPa: small-strain Young's modulus of the bladder
-    return E_bl * frame_width_mm(params) * eta / params.t0_start
+    return E_bl * _width(params) * eta / params.t0_start
 
 
 def buckling_load(stiffness_nmm2, foundation_n_per_mm2, length_mm):
@@ -195,9 +213,18 @@ def buckling_load(stiffness_nmm2, foundation_n_per_mm2, length_mm):
     >>> round(float(n), 2), int(m)
     (70.71, 15)
     """
-    EI = np.asarray(stiffness_nmm2, dtype=float)
-    beta = np.asarray(foundation_n_per_mm2, dtype=float)
-    L = np.asarray(length_mm, dtype=float)
+    EI = _positive("stiffness_nmm2", stiffness_nmm2, "N*mm^2")
+    beta = _positive("foundation_n_per_mm2", foundation_n_per_mm2, "N/mm^2", zero=True)
+    L = _positive("length_mm", length_mm, "mm")
+    with np.errstate(over="ignore", invalid="ignore"):
+        n_cr, m = _buckling(EI, beta, L)
+    if not np.all(np.isfinite(n_cr)):
+        raise InputError("buckling_load: the inputs are too large for a finite buckling load (N); check their units")
+    return n_cr, m
+
+
+def _buckling(EI, beta, L):
+    """:func:`buckling_load` without the checks (arrays of the kernel's own states)."""
     m_star = (L / np.pi) * np.sqrt(np.sqrt(beta / EI))
     lo = np.maximum(np.floor(m_star), 1.0)
     best, m_best = None, None
@@ -210,6 +237,23 @@ def buckling_load(stiffness_nmm2, foundation_n_per_mm2, length_mm):
             m_best = np.where(n < best, m, m_best)
             best = np.minimum(n, best)
     return best, m_best
+
+
+def _positive(name: str, value, unit: str, *, zero: bool = False) -> np.ndarray:
+    """``value`` as a float array of finite numbers > 0 (>= 0 with ``zero``), else one InputError line."""
+    v = float_array(name, value, unit)
+    bad = ~np.isfinite(v) | ((v < 0.0) if zero else (v <= 0.0))
+    if np.any(bad):
+        x = float(v.ravel()[int(np.flatnonzero(bad.ravel())[0])])
+        raise InputError(f"{name} = {x:g} {unit} must be finite and {'>= 0' if zero else '> 0'}")
+    return v
+
+
+def _broadcasts_to(shape: tuple[int, ...], target: tuple[int, ...]) -> bool:
+    try:
+        return np.broadcast_shapes(shape, target) == target
+    except ValueError:
+        return False
 
 
 def _ratio(capacity, demand):
@@ -231,12 +275,12 @@ def _section(params, p_active_mpa, k, u, R, *, strength, stretch_limit, external
     f = axial_forces(params, p_active_mpa, u, R, order=order)
     N = f["N_frame"] + external_n
     h = params.frame_thickness
-    area = frame_width_mm(params) * h
+    area = _width(params) * h
     sig_a = N / area
     sig_b = params.frame_modulus * h * 0.5 * np.abs(k)
     sig = np.abs(sig_a) + sig_b
-    beta = foundation_modulus(params, f["eta"])
-    n_cr, m = buckling_load(params.frame_stiffness, beta, params.L0)
+    beta = _foundation(params, f["eta"])
+    n_cr, m = _buckling(np.asarray(params.frame_stiffness, dtype=float), beta, np.asarray(params.L0, dtype=float))
     R0, ri0 = _as_made(params)
     lam_hoop = (R - f["t_bar"]) / ri0  # inner surface: the largest hoop stretch
     u = np.asarray(u, dtype=float)
@@ -293,22 +337,34 @@ def section_limits(actuator: Actuator, pressure_kpa, curvature_per_mm, *, extern
     >>> sec["axial_force_n"].round(1).tolist()
     [-102.8, -53.7]
     """
-    if not isinstance(actuator, Actuator):
-        raise TypeError(f"actuator must be a bendpam.Actuator, got {type(actuator).__name__}")
-    P = float(number("pressure_kpa", pressure_kpa, 0.0, unit="kPa"))
+    instance("actuator", actuator, Actuator, _ACTUATOR)
+    P_arr = MomentLaw.of(actuator, order=order).check_pressure(pressure_kpa)
+    if P_arr.size != 1:
+        raise InputError(f"pressure_kpa has {P_arr.size} values: section_limits() takes one pressure")
+    P = float(P_arr.ravel()[0])
     k = float_array("curvature_per_mm", curvature_per_mm, "1/mm")
     curvature_limits(actuator, order).check(k)
+    external = float_array("external_axial_force_n", external_axial_force_n, "N")
+    if not np.all(np.isfinite(external)):
+        raise InputError("external_axial_force_n has a non-finite value")
+    plausible("force_n", external, label="external_axial_force_n")
+    lock = None if lockup_curvature_per_mm is None else float_array("lockup_curvature_per_mm",
+                                                                    lockup_curvature_per_mm, "1/mm")
+    if lock is not None and np.any(np.isnan(lock)):
+        raise InputError("lockup_curvature_per_mm has a NaN (inf: no lock-up in that direction)")
+    for name, arr in (("external_axial_force_n", external), ("lockup_curvature_per_mm", lock)):
+        if arr is not None and not _broadcasts_to(arr.shape, k.shape):
+            raise InputError(f"{name} has shape {arr.shape}; it must broadcast to curvature_per_mm's {k.shape}")
     p = actuator.params
     u, R, _dR, _ib, _dib = radius_state(k, p.alpha0, p.R0_start, order)
     pa = max(P - actuator.P_start_kpa, 0.0) * 1e-3
     out = _section(p, pa, k, u, R, strength=actuator.frame_strength_mpa,
-                   stretch_limit=actuator.bladder_stretch_limit, external_n=np.asarray(external_axial_force_n, float),
-                   order=order)
+                   stretch_limit=actuator.bladder_stretch_limit, external_n=external, order=order)
     out = {key: np.broadcast_to(v, k.shape).copy() for key, v in out.items()}
-    if lockup_curvature_per_mm is None:
+    if lock is None:
         out["lockup_margin"] = np.full(k.shape, np.inf)
     else:
-        out["lockup_margin"] = _ratio(np.abs(np.asarray(lockup_curvature_per_mm, dtype=float)), np.abs(k))
+        out["lockup_margin"] = _ratio(np.abs(lock), np.abs(k))
     return out
 
 
@@ -358,6 +414,7 @@ def case_limits(law: MomentLaw, pressure_kpa, free_curvature, table: BranchTable
     >>> r["buckling_margin"].shape, bool(r["buckling_margin"][1, 1] < 1.0)
     ((2, 2), True)
     """
+    instance("law", law, MomentLaw, "a MomentLaw")
     tab = law.branches() if table is None else table
     cs = _flat(law.params)
     m = cs.alpha0.size
@@ -549,6 +606,18 @@ def violation_lines(pressure_kpa, margins: dict[str, np.ndarray], blocked: dict,
     return lines
 
 
+def _flag_frame_strain(actuator: Actuator, P: np.ndarray, k_free: np.ndarray) -> None:
+    """Warn when the free state bends the frame beyond :data:`FRAME_STRAIN_BOUND` (docs/plausibility.md)."""
+    with np.errstate(invalid="ignore"):
+        strain = 0.5 * actuator.frame_thickness_mm * np.abs(k_free)
+        over = strain > FRAME_STRAIN_BOUND
+    if np.any(over):
+        i = int(np.flatnonzero(over)[0])
+        warnings.warn(f"frame bending strain h |k'| / 2 = {100 * strain[i]:.3g} % at {P[i]:g} kPa is beyond "
+                      f"{100 * FRAME_STRAIN_BOUND:g} %: the models' frame is a linear-elastic beam (eq 16, 27), "
+                      "which no frame material stays near there", PlausibilityWarning, stacklevel=3)
+
+
 def limits(actuator: Actuator, pressure_kpa, model: str = "energy", *, eq19_factor: bool = True,
            order: int = DEFAULT_ORDER) -> Limits:
     """The structural limits of ``actuator`` at each pressure: see the module docstring and :class:`Limits`.
@@ -567,13 +636,12 @@ def limits(actuator: Actuator, pressure_kpa, model: str = "energy", *, eq19_fact
     >>> lim.frame_axial_force_n.round(1).tolist(), lim.buckling_margin.tolist()
     ([7.4, 30.7], [inf, inf])
     """
-    if not isinstance(actuator, Actuator):
-        raise TypeError(f"actuator must be a bendpam.Actuator, got {type(actuator).__name__}")
-    P = _check_pressure(pressure_kpa)
+    instance("actuator", actuator, Actuator, _ACTUATOR)
+    law = MomentLaw.of(actuator, model, eq19_factor=eq19_factor, order=order)
+    P = law.check_pressure(pressure_kpa)
     if P.ndim > 1:
         raise InputError(f"pressure_kpa must be a number or a 1-D list of pressures, got shape {P.shape}")
     P = np.atleast_1d(P)
-    law = MomentLaw.of(actuator, model, eq19_factor=eq19_factor, order=order)
     tab = law.branches()
     k, u = law.free_state_array(P, table=tab)
     r = case_limits(law, P, k, tab, free_u=u, frame_strength_mpa=actuator.frame_strength_mpa,
@@ -584,6 +652,7 @@ def limits(actuator: Actuator, pressure_kpa, model: str = "energy", *, eq19_fact
     kind = _BRANCH_NAME[int(r["branch_end"][0])]
     p_max = float(r["max_pressure_kpa"][0])
     lines = violation_lines(P, one, blocked, free, kind, p_max)
+    _flag_frame_strain(actuator, P, free["curvature_per_mm"])
     return Limits(model=law.model, pressure_kpa=P, **one, max_pressure_kpa=p_max, branch_end=kind,
                   frame_strength_mpa=actuator.frame_strength_mpa, bladder_stretch_limit=actuator.bladder_stretch_limit,
                   violations=tuple(t for _, t in lines), blocked=blocked, free=free,

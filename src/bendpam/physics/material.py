@@ -74,7 +74,7 @@ from typing import Any
 import numpy as np
 
 from bendpam.errors import InputError
-from bendpam.validate import finite_number
+from bendpam.validate import finite_number, float_array
 
 __all__ = [
     "BindingState",
@@ -113,10 +113,10 @@ class MooneyRivlin:
 
     def __post_init__(self) -> None:
         for name in ("C10", "C01"):
-            v = getattr(self, name)
-            if not np.isfinite(v):
-                raise InputError(f"{name} = {v!r} MPa is not finite")
-        if self.C10 + self.C01 <= 0:
+            v = float_array(name, getattr(self, name), "MPa")
+            if not np.all(np.isfinite(v)):
+                raise InputError(f"{name} = {getattr(self, name)!r} MPa is not finite")
+        if np.any(np.asarray(self.C10 + self.C01) <= 0):
             raise InputError(
                 f"C10 + C01 = {self.C10 + self.C01:g} MPa must be > 0 "
                 "(the initial shear modulus 2(C10 + C01) must be positive)"
@@ -418,6 +418,9 @@ def within(beta: float, lo: float, hi: float) -> bool:
     >>> within(1.0 + 1e-12, 0.0, 1.0), within(1.001, 0.0, 1.0)
     (True, False)
     """
+    for name, v in (("beta", beta), ("lo", lo), ("hi", hi)):  # numbers (bounds may be infinite), not NaN
+        if np.any(np.isnan(float_array(name, v, "1"))):
+            raise InputError(f"{name} = {v!r} is not a number")
     lo_ok = lo - _BOUND_TOL * max(1.0, abs(lo)) <= beta
     return lo_ok and beta <= hi + _BOUND_TOL * max(1.0, abs(hi))
 

@@ -16,7 +16,15 @@ from typing import Any
 
 import numpy as np
 
+from bendpam.errors import InputTypeError
+from bendpam.validate import float_array, integer
+
 __all__ = ["bracketed_newton", "illinois"]
+
+
+def _callable(name: str, f: Any) -> None:
+    if not callable(f):
+        raise InputTypeError(f"{name} = {f!r:.60} must be a function")
 
 
 def bracketed_newton(f_and_slope: Callable[[np.ndarray], tuple[Any, Any]], x, lo, hi, *, maxiter: int,
@@ -57,7 +65,9 @@ def bracketed_newton(f_and_slope: Callable[[np.ndarray], tuple[Any, Any]], x, lo
     >>> bool(np.allclose(x, np.sqrt(q), rtol=1e-15, atol=0.0))
     True
     """
-    x = np.asarray(x, dtype=float)
+    _callable("f_and_slope", f_and_slope)
+    x, lo, hi = (float_array(name, v, "1") for name, v in (("x", x), ("lo", lo), ("hi", hi)))
+    maxiter = integer("maxiter", maxiter, 0, 10_000)
     for _ in range(maxiter):
         f, df = f_and_slope(x)
         # maintain the bracket (f is increasing in x)
@@ -90,9 +100,12 @@ def illinois(F, a, b, tol, maxiter: int = 100):
     >>> bool(np.allclose(x, np.sqrt(q), rtol=1e-13))
     True
     """
+    _callable("F", F)
+    maxiter = integer("maxiter", maxiter, 0, 10_000)
+    tol = float_array("tol", tol, "1")
     shape = np.shape(a)
-    a = np.array(a, dtype=float).ravel()
-    b = np.array(b, dtype=float).ravel()
+    a = np.array(float_array("a", a, "1"), dtype=float).ravel()
+    b = np.array(float_array("b", b, "1"), dtype=float).ravel()
     tol = np.broadcast_to(np.asarray(tol, dtype=float), shape).ravel()
     every = np.arange(a.size)
     fa, fb = F(a, every), F(b, every)

@@ -17,9 +17,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from bendpam.errors import InputError, InputTypeError
 from bendpam.physics.actuator import NEUTRAL_ANGLE_DEG, ModelParams
 from bendpam.physics.braid import LOCK_FRACTION, MIN_FAR_STRETCH, curvature_limits, radius_from_u
 from bendpam.physics.models import energy, force_balance, get_model
+from bendpam.validate import float_array, integer, quadrature_order
 
 if TYPE_CHECKING:
     from bendpam.physics.law import MomentLaw
@@ -105,7 +107,13 @@ class SectionTables:
     """
 
     def __init__(self, mod, alpha0, order: int, *, knots: int = 513, tol: float = 1e-7, max_knots: int = 4097):
-        self.alpha0 = np.atleast_1d(np.asarray(alpha0, dtype=float))
+        if mod not in (energy, force_balance):
+            raise InputError(f"mod = {mod!r} must be a model module (bendpam.physics.models.get_model(name))")
+        self.alpha0 = np.atleast_1d(float_array("alpha0", alpha0, "rad"))
+        if self.alpha0.size == 0 or not np.all((self.alpha0 > 0.0) & (self.alpha0 < np.pi / 2)):
+            raise InputError("alpha0 must be one or more braid angles in (0, pi/2) rad")
+        order, knots, max_knots = quadrature_order(order), integer("knots", knots, 5, 1 << 20), \
+            integer("max_knots", max_knots, 5, 1 << 20)
         c = np.cos(self.alpha0)
         # one side per angle: the bending direction (k' > 0 above the neutral angle, k' < 0 below)
         self.side = np.where(np.degrees(self.alpha0) < NEUTRAL_ANGLE_DEG, -1.0, 1.0)
@@ -250,6 +258,8 @@ def branch_path(law: MomentLaw) -> _ExactUPath | _TablePath:
     >>> A.round(4).tolist(), path.to_k(np.array([0.05]), np.arange(1)).round(6).tolist()
     ([[2.351, 2.1476]], [0.004986])
     """
+    if not all(hasattr(law, a) for a in ("params", "check_curvature", "order")):  # a MomentLaw (law.py imports us)
+        raise InputTypeError(f"law = {law!r:.60} must be a MomentLaw, got {type(law).__name__}")
     if law.is_cases:
         cs = _flat_params(law)
         uniq, inverse = np.unique(cs.alpha0, return_inverse=True)

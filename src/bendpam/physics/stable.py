@@ -15,8 +15,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from bendpam.errors import NoEquilibrium
+from bendpam.errors import InputTypeError, NoEquilibrium
 from bendpam.physics.roots import bracketed_newton
+from bendpam.validate import number
 
 if TYPE_CHECKING:
     from bendpam.physics.law import MomentTable
@@ -111,6 +112,11 @@ def stable_branch(table: MomentTable, P: float, friction: float = 0.0) -> Stable
     >>> sb.end_lo, sb.end_hi, round(sb.free_curvature, 5)
     ('lock-up', 'fold', 0.00816)
     """
+    if not all(hasattr(table, a) for a in ("law", "knot_curvatures", "derivatives")):  # a MomentTable (law.py
+        raise InputTypeError(f"table = {table!r:.60} must be a MomentTable (law.tabulated()), "  # imports this one)
+                             f"got {type(table).__name__}")
+    P = float(table.law.check_pressure(number("P", P, unit="kPa")))
+    friction = number("friction", friction, unit="N*mm")
     pa = max(P - table.P_start_kpa, 0.0)
     kg = table.knot_curvatures
     _, _, dA, dB = table.derivatives(kg)

@@ -31,7 +31,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from bendpam.physics.braid import CLOSED_FORM, DEFAULT_ORDER, circle_ibar, gauss_nodes, radius_state, radius_terms
+from bendpam.physics.braid import (
+    CLOSED_FORM,
+    DEFAULT_ORDER,
+    circle_ibar,
+    gauss_nodes,
+    kernel_args,
+    radius_state,
+    radius_terms,
+)
 from bendpam.physics.material import MooneyRivlin
 
 __all__ = ["basis", "bladder_energy", "coefficients", "terms"]
@@ -126,7 +134,7 @@ def basis(params, curvature, *, order: int = DEFAULT_ORDER, eq19_factor: bool = 
     >>> A.round(2).tolist(), b10.round(1).tolist(), b01.round(1).tolist()
     ([2350.98, 1932.5], [0.0, 1088.7], [0.0, 1038.9])
     """
-    k = np.asarray(curvature, dtype=float)
+    k, = kernel_args(params, ("curvature", curvature, "1/mm"))
     u, R, dR, ib, dib = radius_state(k, params.alpha0, params.R0_start, order)
     means = section_means(u, params.alpha0, order, ib, dib)
     return assemble(params, k, u, R, dR, means, eq19_factor=eq19_factor)
@@ -146,7 +154,7 @@ def coefficients(params, curvature, *, order: int = DEFAULT_ORDER, eq19_factor: 
     >>> A.round(2).tolist(), B.round(2).tolist(), round(0.132 * float(A[0]), 2)
     ([2350.98, 1932.5], [0.0, 191.91], 310.33)
     """
-    k = np.asarray(curvature, dtype=float)
+    k, = kernel_args(params, ("curvature", curvature, "1/mm"))
     A, b10, b01 = basis(params, k, order=order, eq19_factor=eq19_factor)
     return A, params.C10 * b10 + params.C01 * b01 + params.frame_stiffness * k
 
@@ -163,7 +171,7 @@ def terms(params, p_active, curvature, *, order: int = DEFAULT_ORDER, eq19_facto
     >>> {name: v.round(2).tolist() for name, v in t.items()}
     {'M_load': [310.33, 63.18], 'M_air': [310.33, 255.09], 'M_bl': [0.0, 188.37], 'M_f': [0.0, 3.54]}
     """
-    k = np.asarray(curvature, dtype=float)
+    k, p_active = kernel_args(params, ("curvature", curvature, "1/mm"), ("p_active", p_active, "MPa"))
     A, b10, b01 = basis(params, k, order=order, eq19_factor=eq19_factor)
     m_air = np.asarray(p_active, dtype=float) * A
     m_bl = params.C10 * b10 + params.C01 * b01
@@ -185,7 +193,7 @@ def bladder_energy(params, curvature, *, order: int = DEFAULT_ORDER):
     >>> bladder_energy(bendpam.physics.presets.be_pam().params, np.array([0.0, 0.01])).round(4).tolist()
     [0.0, 0.9774]
     """
-    k = np.asarray(curvature, dtype=float)
+    k, = kernel_args(params, ("curvature", curvature, "1/mm"))
     _u, R, _dR, _omc, wbar, lam1 = _state(params, k, order)
     eta = (R / params.R0_start)[..., None]
     return params.bladder_area * (MooneyRivlin(params.C10, params.C01).energy(lam1, eta) @ wbar)

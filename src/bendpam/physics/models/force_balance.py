@@ -45,6 +45,7 @@ from bendpam.physics.braid import (
     case_column,
     circle_ibar,
     gauss_nodes,
+    kernel_args,
     radius_state,
     radius_terms,
 )
@@ -165,7 +166,7 @@ def basis(params, curvature, *, order: int = DEFAULT_ORDER):
     >>> A.round(2).tolist(), bool(abs(b10[0]) + abs(b01[0]) < 1e-9)    # no bladder terms when straight
     ([2350.98, 1919.94], True)
     """
-    k = np.asarray(curvature, dtype=float)
+    k, = kernel_args(params, ("curvature", curvature, "1/mm"))
     u, R, dR, ib, dib = radius_state(k, params.alpha0, params.R0_start, order)
     return assemble(params, k, u, R, dR, section_means(u, params.alpha0, order, ib, dib))
 
@@ -178,7 +179,7 @@ def coefficients(params, curvature, *, order: int = DEFAULT_ORDER):
     >>> A.round(2).tolist(), B.round(2).tolist()
     ([2350.98, 1919.94], [0.0, 194.51])
     """
-    k = np.asarray(curvature, dtype=float)
+    k, = kernel_args(params, ("curvature", curvature, "1/mm"))
     A, b10, b01 = basis(params, k, order=order)
     return A, params.C10 * b10 + params.C01 * b01 + params.frame_stiffness * k
 
@@ -192,8 +193,7 @@ def terms(params, p_active, curvature, *, order: int = DEFAULT_ORDER):
     {'M_load': [310.33, 58.92], 'M_p': [427.26, 408.42], 'M_frame': [0.0, 3.54],
      'M_bl': [0.0, 207.22], 'M_br': [116.93, 138.74]}
     """
-    k = np.asarray(curvature, dtype=float)
-    p = np.asarray(p_active, dtype=float)
+    k, p = kernel_args(params, ("curvature", curvature, "1/mm"), ("p_active", p_active, "MPa"))
     st = _state(params, k, order)
     R, c, J = st["R"], st["c"], st["J"]
     m_p = p * np.pi * R**3
@@ -231,11 +231,10 @@ def stress_state(params, p_active, curvature, phi, *, order: int = DEFAULT_ORDER
     >>> st["sigma_bl1"].round(4).tolist(), round(float(st["P_e"]), 4)      # MPa
     ([-0.0649, -0.0959, -0.0508], 0.0375)
     """
-    k = np.asarray(curvature, dtype=float)
-    p = np.asarray(p_active, dtype=float)
+    k, p = kernel_args(params, ("curvature", curvature, "1/mm"), ("p_active", p_active, "MPa"))
     k, p = np.broadcast_arrays(k, p)
     st = _state(params, k, order)
-    phi = np.asarray(phi, dtype=float)
+    phi, = kernel_args(params, ("phi", phi, "rad"))
     lam1 = 1.0 + st["u"][..., None] * (1.0 - np.cos(phi))
     C1, C2 = params.C10, params.C01
     c = st["c"]
@@ -295,8 +294,7 @@ def axial_forces(params, p_active, u, R, *, order: int = DEFAULT_ORDER):
     >>> round(float(f["N_frame"]), 3), round(float(f["N_frame"] * p.R0_start), 2)
     (30.726, 310.33)
     """
-    u = np.asarray(u, dtype=float)
-    p = np.asarray(p_active, dtype=float)
+    u, p, R = kernel_args(params, ("u", u, "1"), ("p_active", p_active, "MPa"), ("R", R, "mm"))
     phi, wbar = gauss_nodes(order)
     lam1 = 1.0 + u[..., None] * (1.0 - np.cos(phi))
     lbar = 1.0 + u

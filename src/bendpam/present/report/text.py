@@ -240,6 +240,8 @@ SYMBOLS: dict[str, Symbol] = {
     "a1": Symbol("a₁", "a<sub>1</sub>", "N·mm/kPa", "loop amplitude per kPa of active pressure"),
     "sigma_f": Symbol("σ_f,max", "σ<sub>f,max</sub>", "MPa", "strength of the frame material"),
     "lambda_max": Symbol("λ_max", "λ<sub>max</sub>", "", "largest allowed principal stretch of the bladder"),
+    "P_max": Symbol("P_max", "P<sub>max</sub>", "kPa", "burst limit: the highest pressure the actuator is "
+                    "evaluated at"),
 }
 _FIELD_KEY = {
     "alpha0_deg": "alpha0", "R0_mm": "R0", "t0_mm": "t0", "L0_mm": "L0", "frame_thickness_mm": "h_f",
@@ -247,7 +249,7 @@ _FIELD_KEY = {
     "P_start_kpa": "P_start", "R0_start_mm": "R0_start", "braid_thickness_mm": "t_br", "t0_start_mm": "t0_start",
     "bladder_area_mm2": "A_bl", "frame_inertia_mm4": "I_f", "frame_stiffness_nmm2": "EI_f",
     "shear_modulus_kpa": "mu", "theta_h_deg": "theta_h", "a0_nmm": "a0", "a1_nmm_per_kpa": "a1",
-    "frame_strength_mpa": "sigma_f", "bladder_stretch_limit": "lambda_max",
+    "frame_strength_mpa": "sigma_f", "bladder_stretch_limit": "lambda_max", "max_pressure_kpa": "P_max",
 }
 #: Unit suffixes of field names (longest first) -> the unit as shown.
 _UNIT_SUFFIX = (("_nmm_per_kpa", "N·mm/kPa"), ("_per_mm", "1/mm"), ("_nmm2", "N·mm²"), ("_nmm", "N·mm"),
