@@ -227,8 +227,6 @@ def test_fifo_actuator_is_refused_in_one_line(inputs, tmp_path):
 
 
 @pytest.mark.parametrize("how", ["alpha0_deg=0.001", "R0_start_mm=1e22"])
-@pytest.mark.xfail(strict=True, reason="plausibility checks of actuator values are being built by another helper: "
-                   "today the value is accepted")
 def test_absurd_actuator_value_is_refused(inputs, tmp_path, how):
     tally = fi.Tally()
     case = [c for c in ff.plausible_lines(inputs, tmp_path) if c[0] == f"plausible {how}"]
@@ -236,8 +234,6 @@ def test_absurd_actuator_value_is_refused(inputs, tmp_path, how):
     _assert_clean(tally)
 
 
-@pytest.mark.xfail(strict=True, reason="plausibility of pressures (1 GPa) is being built by another helper: "
-                   "today `predict --pressure-kpa 1e6` answers")
 def test_absurd_pressure_is_refused(inputs, tmp_path):
     tally = fi.Tally()
     case = [c for c in ff.plausible_lines(inputs, tmp_path) if c[1][0] == "predict" and "1e6" in c[1]]
