@@ -381,7 +381,8 @@ def _bound(b: Plausible, which: str, values: dict[str, Any]):
     base = b.lo if which == "lo" else b.hi
     if of is None:
         return base, f"{base:g}"
-    value = base * np.asarray(values[of], dtype=float)
+    ref = values[of]
+    value = base * (ref if isinstance(ref, float | int) else np.asarray(ref, dtype=float))
     what = of if base == 1.0 else f"{base:g} {of}"
     return value, what
 
@@ -404,10 +405,13 @@ def plausible(name: str, value: Any, values: dict[str, Any] | None = None, *, la
     bendpam.errors.InputError: R0_start_mm = 1e+22 mm is outside the plausible range [R0_mm, 3 R0_mm] = [8.5, 25.5] ...
     """
     b = PLAUSIBLE[name]
-    v = np.asarray(value, dtype=float)
     vals = values or {}
     lo, lo_text = _bound(b, "lo", vals)
     hi, hi_text = _bound(b, "hi", vals)
+    if isinstance(value, float | int) and np.ndim(lo) == 0 and np.ndim(hi) == 0:  # one actuator: the fast path
+        if lo <= value and (value < hi if b.hi_open else value <= hi):
+            return
+    v = np.asarray(value, dtype=float)
     bad = (v < lo) | ((v >= hi) if b.hi_open else (v > hi))
     if not np.any(bad):
         return

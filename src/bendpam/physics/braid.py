@@ -582,15 +582,16 @@ def braid_range(params, order: int = DEFAULT_ORDER) -> CurvatureLimits:
     """
     kernel_args(params)
     a0 = np.asarray(params.alpha0, dtype=float)
-    R0 = np.asarray(params.R0_start, dtype=float)
-    c, s = np.cos(a0), np.sin(a0)
+    shape = np.broadcast_shapes(a0.shape, np.shape(params.R0_start))
+    R0 = np.broadcast_to(np.asarray(params.R0_start, dtype=float), shape)
+    a0 = np.broadcast_to(a0, R0.shape)
+    c, s = np.cos(a0).reshape(-1), np.sin(a0).reshape(-1)
     u_hi = LOCK_FRACTION * (1.0 / c - 1.0) / 2.0
-    u_lo = np.broadcast_to(-0.5 * (1.0 - MIN_FAR_STRETCH), np.shape(u_hi))
-    ends = []
-    for u in (u_lo, u_hi):
-        ib, _ = circle_ibar(np.asarray(u, dtype=float).reshape(-1), c.reshape(-1), order)
-        ends.append((np.asarray(u).reshape(-1) * s.reshape(-1) * ib / R0.reshape(-1)).reshape(np.shape(u_hi)))
-    k_lo, k_hi = ends
+    u_lo = np.full(c.shape, -0.5 * (1.0 - MIN_FAR_STRETCH))
+    ib, _ = circle_ibar(np.concatenate([u_lo, u_hi]), np.concatenate([c, c]), order)  # one evaluation, both ends
+    k_lo, k_hi = (x.reshape(R0.shape) for x in np.split(np.concatenate([u_lo, u_hi]) * np.concatenate([s, s]) * ib
+                                                       / np.concatenate([R0.reshape(-1)] * 2), 2))
+    u_lo, u_hi = u_lo.reshape(R0.shape), u_hi.reshape(R0.shape)
     reason_max = (f"braid lock-up: far-side fibres within {100 * (1 - LOCK_FRACTION):g}% of straight, beyond which "
                   "eq 5 has no solution")
     reason_min = (f"braid lock-up: far-side axial stretch lambda1(pi) = 1 + 2k'R falls to {MIN_FAR_STRETCH:g} "

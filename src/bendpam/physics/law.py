@@ -47,7 +47,14 @@ import numpy as np
 
 from bendpam.errors import InputError, PlausibilityWarning
 from bendpam.physics.actuator import Actuator, ModelParams
-from bendpam.physics.braid import DEFAULT_ORDER, CurvatureLimits, braid_range, curvature_limits
+from bendpam.physics.braid import (
+    DEFAULT_ORDER,
+    LOCK_FRACTION,
+    MIN_FAR_STRETCH,
+    CurvatureLimits,
+    braid_range,
+    curvature_limits,
+)
 from bendpam.physics.branch import (
     BRANCH_END,
     BRANCH_SAMPLES,
@@ -181,9 +188,22 @@ class MomentLaw:
     def _braid_range(self) -> CurvatureLimits:
         return braid_range(self.params, self.order)
 
+    @cached_property
+    def _inside(self) -> tuple[Any, Any]:
+        """Curvatures surely inside :attr:`_braid_range`, without solving eq 5: ``q = k' R0 = s u Ibar(u)`` with
+        ``Ibar >= 1`` everywhere and ``Ibar >= 1/s`` for ``u > 0``, so ``|q| >= s |u|`` and ``q >= u`` there."""
+        p = self.params
+        u_hi = LOCK_FRACTION * (1.0 / np.cos(p.alpha0) - 1.0) / 2.0
+        return -np.sin(p.alpha0) * 0.5 * (1.0 - MIN_FAR_STRETCH) / p.R0_start, u_hi / p.R0_start
+
     def _curvature(self, curvature_per_mm, params: ModelParams | None) -> np.ndarray:
         """Curvatures (1/mm) checked at the numerics' entries: finite and inside the braid's range (eq 1-5)."""
         k = float_array("curvature_per_mm", curvature_per_mm, "1/mm")
+        if params is None:
+            lo, hi = self._inside
+            with np.errstate(invalid="ignore"):
+                if np.all((k >= lo) & (k <= hi)):  # the fast path (False for NaN)
+                    return k
         lim = self._braid_range if params is None else braid_range(instance("params", params, ModelParams,
                                                                             "a ModelParams"), self.order)
         lim.check(k, slack=_LIMIT_SLACK)

@@ -113,7 +113,10 @@ class MooneyRivlin:
 
     def __post_init__(self) -> None:
         for name in ("C10", "C01"):
-            v = float_array(name, getattr(self, name), "MPa")
+            value = getattr(self, name)
+            if isinstance(value, float | int) and not isinstance(value, bool) and math.isfinite(value):
+                continue  # a number: the common case, fast
+            v = float_array(name, value, "MPa")
             if not np.all(np.isfinite(v)):
                 raise InputError(f"{name} = {getattr(self, name)!r} MPa is not finite")
         if np.any(np.asarray(self.C10 + self.C01) <= 0):
