@@ -569,35 +569,13 @@ def wrist_sweep(wrist: Wrist, pressures_kpa, directions_deg=(0.0, 90.0, 180.0, 2
 
 
 def plot_wrist(table, holds=(), ax=None, title: str | None = None, positions_deg=(0.0, 90.0, 180.0, 270.0)):
-    """Bending angle against pressure per inflated actuator (and the holding angles with the load, dashed).
-
-    Each curve has its own colour, line style and marker, and its legend entry names the inflated
-    actuator(s) by their position (deg) and the bending direction.  Directions whose curves
-    coincide (identical actuators at symmetric positions) are drawn once, and the legend says so
-    instead of drawing identical lines on top of each other.
-
-    Parameters
-    ----------
-    table : pandas.DataFrame
-        From :func:`wrist_sweep`.
-    holds : sequence of :class:`WristHold`, optional
-        From :func:`wrist_hold`, one per pressure (drawn dashed in black).
-    ax : matplotlib Axes, optional
-        Default: a new single-column figure.
-    title : str, optional
-    positions_deg : 4 floats
-        The actuators' positions (deg), to name them (default the :class:`Wrist` default).
-
-    Returns
-    -------
-    matplotlib.figure.Figure
+    """Bending angle against pressure per inflated actuator: :func:`bendpam.present.figures.design.plot_wrist`,
+    reached lazily (its parameters and figure are documented there).
 
     Examples
     --------
-    >>> import matplotlib.pyplot as plt
     >>> fig = plot_wrist(wrist_sweep(Wrist(), [100.0, 150.0], directions_deg=(90.0,)))
     >>> len(fig.axes) >= 1                                # fig.savefig("wrist.png") to keep it
     True
-    >>> plt.close(fig)
     """
     return figure("wrist")(table, holds, ax=ax, title=title, positions_deg=positions_deg)
