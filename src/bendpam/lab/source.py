@@ -97,7 +97,7 @@ def _binary_error(path: Path, head: bytes) -> None:
         )
 
 
-def _check_text_head(text: str, label: Path | str) -> None:
+def _check_text_head(text: str, label: Path | str, whole: bool = True) -> None:
     if "\x00" in text:
         raise ReadError(
             "binary data (NUL character); expected a text export (CSV/TXT)",
@@ -115,7 +115,10 @@ def _check_text_head(text: str, label: Path | str) -> None:
             head.count("\n", 0, first.start()) + 1,
         )
     if not text.strip():
-        raise ReadError("file contains only whitespace; expected a header row and data rows", label)
+        n = max(1, len(text.splitlines()))
+        where = "line 1" if n == 1 else f"lines 1-{n}"
+        what = "the whole file" if whole else f"the first {len(text.encode())} bytes"
+        raise ReadError(f"{where}: only whitespace in {what}; expected a header row and data rows", label)
 
 
 def _open_excel(path: Path, kind: str) -> list[tuple[str, list[str]]]:
@@ -175,7 +178,7 @@ def open_source(path: Path) -> tuple[list[Source], int]:
     """
     head, size = _read_head(path)
     if size == 0 or not head:
-        raise ReadError("file is empty; expected a header row and data rows", path)
+        raise ReadError("byte 0: the file is empty (0 bytes); expected a header row and data rows", path)
     kind = container_kind(head)
     if path.suffix.lower() in (".zs2", ".zp2") or (kind == "gzip"):
         raise ReadError(
@@ -200,7 +203,7 @@ def open_source(path: Path) -> tuple[list[Source], int]:
         head_text = head.decode(encoding, errors="replace")
     except LookupError:  # pragma: no cover - codecs are fixed
         head_text = head.decode("latin-1")
-    _check_text_head(head_text, path)
+    _check_text_head(head_text, path, whole=len(head) >= size)
     fh = open(path, encoding=encoding, errors="replace", newline=None)
     first = head_text.lstrip("\ufeff").splitlines()[0] if head_text.strip() else ""
     return [Source(path, encoding, fh, first, close=fh.close)], size
