@@ -85,9 +85,14 @@ def test_every_file_has_a_truth_entry_and_every_entry_a_file() -> None:
         files = {p.name for p in folder.iterdir() if p.is_file() and p.name not in NOT_DATA}
         names = set(_load(folder / "truth.toml"))
         assert files == names, f"{folder}: no truth for {sorted(files - names)}, no file for {sorted(names - files)}"
+    data = _corpus3_data()
     for split in ("dev", "holdout"):
         here = {p.name for p in (CORPUS3 / split).iterdir()}
         assert here == {"truth.toml"}, "corpus3 holds truth only; its files live in shared/"
+        if data is not None:
+            placed = {p.name for p in (data / split).iterdir() if p.is_file() and p.name not in NOT_DATA}
+            differ = placed ^ set(_load(CORPUS3 / split / "truth.toml"))
+            assert not differ, f"{data / split}: files and truth entries differ: {sorted(differ)}"
     assert len(ENTRIES) == len(set(IDS))
     assert len({name for _, name, _, _ in ENTRIES}) == len(ENTRIES), "a file name appears in two splits"
 
