@@ -97,7 +97,7 @@ def test_every_file_has_a_truth_entry_and_every_entry_a_file() -> None:
     assert len({name for _, name, _, _ in ENTRIES}) == len(ENTRIES), "a file name appears in two splits"
 
 
-def test_sources_and_attribution_list_every_file() -> None:
+def test_sources_list_every_file_with_its_path() -> None:
     sources = (REAL / "SOURCES.md").read_text(encoding="utf-8")
     for _, name, _, entry in ENTRIES:
         assert f"`{name}`" in sources, f"SOURCES.md has no row for {name}"
