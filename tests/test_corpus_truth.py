@@ -1,8 +1,8 @@
 """The real-data corpus against its hand-written truth, independently of bendpam's reader.
 
 Every file in ``tests/data/real`` (the original seven, ``dev/``, ``holdout/``) and every file of the
-third round (``corpus3/``: truth here, the files under ``shared/realdata/corpus3`` beside the
-checkout, or wherever ``BENDPAM_CORPUS3`` points) must have a truth entry with every schema key and
+third round (``corpus3/``: truth here, the files wherever ``BENDPAM_CORPUS3`` points; fetched data
+is not committed) must have a truth entry with every schema key and
 valid values, a row in SOURCES.md, and first/last samples and a row count that the raw text (or the
 spreadsheet cells) confirms. This checks the truth entries, not a reader: it parses the raw lines with
 the standard library (and python-calamine for spreadsheets), guided by the truth's own header line,
@@ -57,10 +57,7 @@ def _load(path: Path) -> dict[str, dict[str, Any]]:
 
 def _corpus3_data() -> Path | None:
     env = os.environ.get("BENDPAM_CORPUS3")
-    if env:
-        return Path(env)
-    shared = Path(__file__).resolve().parents[1].parent / "shared" / "realdata" / "corpus3"
-    return shared if shared.is_dir() else None
+    return Path(env) if env else None
 
 
 def _entries() -> list[tuple[str, str, Path | None, dict[str, Any]]]:
@@ -88,7 +85,7 @@ def test_every_file_has_a_truth_entry_and_every_entry_a_file() -> None:
     data = _corpus3_data()
     for split in ("dev", "holdout"):
         here = {p.name for p in (CORPUS3 / split).iterdir()}
-        assert here == {"truth.toml"}, "corpus3 holds truth only; its files live in shared/"
+        assert here == {"truth.toml"}, "corpus3 holds truth only; its files are not committed"
         if data is not None:
             placed = {p.name for p in (data / split).iterdir() if p.is_file() and p.name not in NOT_DATA}
             differ = placed ^ set(_load(CORPUS3 / split / "truth.toml"))
@@ -283,7 +280,8 @@ def _check_xml(entry: dict[str, Any], path: Path) -> None:
 @pytest.mark.parametrize(("path", "entry"), [(p, e) for _, _, p, e in ENTRIES], ids=IDS)
 def test_first_last_and_rows_agree_with_the_raw_text(path: Path | None, entry: dict[str, Any]) -> None:
     if path is None:
-        pytest.skip("third-round files are not here: place them in shared/realdata/corpus3 or set BENDPAM_CORPUS3")
+        pytest.skip("third-round files are not in the repository (fetched data is not committed): "
+                    "set BENDPAM_CORPUS3 to the folder holding their dev/ and holdout/")
     assert path.is_file(), f"{path} is missing"
     if "sha256" in entry:
         digest = hashlib.sha256(path.read_bytes()).hexdigest()
