@@ -346,3 +346,24 @@ def test_a_dask_worker_is_not_a_scheduler():
         worker = next(iter(cluster.scheduler.workers))
         with pytest.raises(InputError, match="answered, but as a Dask Worker, not a scheduler"):
             probe_scheduler(worker, timeout_s=10)
+
+
+def test_simulate_tests_refuse_a_run_past_the_sample_budget_before_writing(tmp_path):
+    from bendpam.lab.simulate import MAX_TOTAL_SAMPLES, SimulationSettings, simulate_tests
+
+    # 50 cycles of the be-pam at 20 Hz: about 9.5e4 samples per test (30 mm/min over a free stroke of
+    # 20-45 mm, 4 ramps... per cycle); 1000 tests are about 1e8 samples, past 3e7
+    out = tmp_path / "sim"
+    with pytest.raises(InputError, match=r"1000 tests of 50 cycles at 20 Hz would record about [\d,]+ samples"):
+        simulate_tests(presets.be_pam(), np.linspace(100.0, 200.0, 1000), out,
+                       settings=SimulationSettings(cycles=50))
+    assert not out.exists()
+    assert MAX_TOTAL_SAMPLES == 30_000_000
+
+
+def test_simulate_test_cli_refuses_the_harness_case_quickly(capsys, tmp_path):
+    rc = main(["simulate-test", "--preset", "be-pam", "--pressure-kpa", "100:200:1000", "--cycles", "50",
+               "--out", str(tmp_path / "sim")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and len(err) == 1 and "more than the limit of 30,000,000 for one run" in err[0]
+    assert not (tmp_path / "sim").exists()

@@ -51,6 +51,10 @@ DIALECT_SUFFIX = {"csv": ".csv", "testxpert": ".txt", "bluehill": ".csv", "mts":
 #: The most samples one simulated test may record (rate x duration); a larger test is refused before any
 #: allocation (10^7 samples are a few hundred MB of working arrays).
 MAX_SAMPLES = 10_000_000
+#: The most samples one call of :func:`simulate_tests` may record over all its pressures: about five
+#: minutes of simulation at roughly 10^5 samples/s (and 0.6 GB of text files); larger requests are
+#: refused before the first test is simulated (see docs/budgets.md).
+MAX_TOTAL_SAMPLES = 30_000_000
 
 
 @dataclass(frozen=True)
@@ -142,20 +146,7 @@ def simulate_test(actuator, pressure_kpa: float, model: str = "energy", *, fixtu
     st = settings or SimulationSettings()
     model = normalise_model(model)
     rng = rng if rng is not None else np.random.default_rng(st.seed)
-    P = float(number("pressure_kpa", pressure_kpa, 0.0, unit="kPa"))
-    sgn = _signed(actuator)
-    Mb = abs(float(blocked_moment(actuator, P, model)))
-    if Mb <= 0.0:
-        raise InputError(
-            f"pressure {pressure_kpa:g} kPa is at or below P_start = {actuator.P_start_kpa:g} kPa: "
-            "the actuator produces no moment to test"
-        )
-    A = st.hysteresis * Mb + st.hysteresis_offset_nmm
-    law = make_law(st.hysteresis_law, st.hysteresis_angle_deg)
-
-    def m_qs(k):  # model moment magnitude at curvature magnitude k
-        return sgn * moment(actuator, P, sgn * np.asarray(k, dtype=float), model)
-
+    P, Mb, A, law, m_qs = _setup(actuator, pressure_kpa, model, st)
     k_f, s_f = _free_state(actuator, P, pressure_kpa, model, fixture, law, A, st, m_qs)
     t, s, T = _stroke_path(s_f, st, pressure_kpa)
     force, _M, _k = _machine(actuator, P, model, fixture, law, A, s, m_qs)
@@ -182,6 +173,25 @@ def simulate_test(actuator, pressure_kpa: float, model: str = "energy", *, fixtu
         "duration_s": float(T),
     }
     return data, truth
+
+
+def _setup(actuator, pressure_kpa: float, model: str, st: SimulationSettings):
+    """The pressure, blocked moment, loop amplitude, loop law and quasi-static moment of one test."""
+    P = float(number("pressure_kpa", pressure_kpa, 0.0, unit="kPa"))
+    sgn = _signed(actuator)
+    Mb = abs(float(blocked_moment(actuator, P, model)))
+    if Mb <= 0.0:
+        raise InputError(
+            f"pressure {pressure_kpa:g} kPa is at or below P_start = {actuator.P_start_kpa:g} kPa: "
+            "the actuator produces no moment to test"
+        )
+    A = st.hysteresis * Mb + st.hysteresis_offset_nmm
+    law = make_law(st.hysteresis_law, st.hysteresis_angle_deg)
+
+    def m_qs(k):  # model moment magnitude at curvature magnitude k
+        return sgn * moment(actuator, P, sgn * np.asarray(k, dtype=float), model)
+
+    return P, Mb, A, law, m_qs
 
 
 def _free_state(actuator, P: float, pressure_kpa: float, model: str, fixture: Fixture, law, A: float,
@@ -224,6 +234,21 @@ def _stroke_path(s_f: float, st: SimulationSettings, pressure_kpa: float) -> tup
 
     The sample count is checked against :data:`MAX_SAMPLES` before any array is made.
     """
+    knots_t, knots_s = _stroke_knots(s_f, st)
+    T = knots_t[-1]
+    n_samples = math.floor(T * st.rate_hz + 0.5) + 1
+    if n_samples > MAX_SAMPLES:
+        raise InputError(
+            f"at {pressure_kpa:g} kPa the test would record {n_samples:,} samples ({st.rate_hz:g} Hz x {T:.4g} s), "
+            f"more than the limit of {MAX_SAMPLES:,} per test; use a lower rate_hz, fewer cycles, a shorter "
+            "dwell_s or a higher speed_mm_min"
+        )
+    t = np.arange(0.0, T + 0.5 / st.rate_hz, 1.0 / st.rate_hz)
+    return t, np.interp(t, knots_t, knots_s), T
+
+
+def _stroke_knots(s_f: float, st: SimulationSettings) -> tuple[list[float], list[float]]:
+    """The corners ``(time s, stroke mm)`` of the triangular stroke path with its dwells."""
     t_ramp = s_f / (st.speed_mm_min / 60.0)
     legs = []
     for _ in range(st.cycles):
@@ -235,16 +260,31 @@ def _stroke_path(s_f: float, st: SimulationSettings, pressure_kpa: float) -> tup
             continue
         knots_t.append(knots_t[-1] + dur)
         knots_s.append(b)
-    T = knots_t[-1]
-    n_samples = math.floor(T * st.rate_hz + 0.5) + 1
-    if n_samples > MAX_SAMPLES:
+    return knots_t, knots_s
+
+
+def _check_total_samples(actuator, pressures_kpa: list[float], model: str, fixture: Fixture,
+                         st: SimulationSettings) -> None:
+    """Refuse, before any test is simulated, a run that would record more than :data:`MAX_TOTAL_SAMPLES`.
+
+    The count is estimated from the free strokes at the lowest, middle and highest pressure (three
+    free-state solutions, a few tens of milliseconds); :func:`simulate_tests` stops a run whose
+    real count passes twice the limit.
+    """
+    ordered = sorted(pressures_kpa)
+    picks = sorted({ordered[0], ordered[len(ordered) // 2], ordered[-1]})
+    counts = []
+    for p in picks:
+        P, _Mb, A, law, m_qs = _setup(actuator, p, model, st)
+        _k, s_f = _free_state(actuator, P, p, model, fixture, law, A, st, m_qs)
+        counts.append(math.floor(_stroke_knots(s_f, st)[0][-1] * st.rate_hz + 0.5) + 1)
+    expected = int(len(ordered) * float(np.mean(counts)))
+    if expected > MAX_TOTAL_SAMPLES:
         raise InputError(
-            f"at {pressure_kpa:g} kPa the test would record {n_samples:,} samples ({st.rate_hz:g} Hz x {T:.4g} s), "
-            f"more than the limit of {MAX_SAMPLES:,} per test; use a lower rate_hz, fewer cycles, a shorter "
-            "dwell_s or a higher speed_mm_min"
+            f"{len(ordered)} tests of {st.cycles} cycles at {st.rate_hz:g} Hz would record about {expected:,} "
+            f"samples, more than the limit of {MAX_TOTAL_SAMPLES:,} for one run (about five minutes); use fewer "
+            "pressures, fewer cycles or a lower rate_hz"
         )
-    t = np.arange(0.0, T + 0.5 / st.rate_hz, 1.0 / st.rate_hz)
-    return t, np.interp(t, knots_t, knots_s), T
 
 
 def _machine(actuator, P, model, fixture, law, A, stroke, m_qs):
@@ -305,12 +345,16 @@ def simulate_tests(actuator, pressures_kpa, out_dir, model: str = "energy", *, d
     model = normalise_model(model)
     if dialect not in DIALECT_SUFFIX:
         raise InputError(f"format {dialect!r} is not known; choose one of: {', '.join(DIALECT_SUFFIX)}")
+    pressures_kpa = [float(p) for p in pressures_kpa]
+    if pressures_kpa:
+        _check_total_samples(actuator, pressures_kpa, model, fixture, st)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     rng = np.random.default_rng(st.seed)
     prefix = prefix or (actuator.kind.lower())
     truths = []
     files = []
+    recorded = 0
     for p in pressures_kpa:
         data, truth = simulate_test(actuator, p, model, fixture=fixture, settings=st, rng=rng)
         name = f"{prefix}_{p:g}kPa{DIALECT_SUFFIX[dialect]}"
@@ -320,6 +364,13 @@ def simulate_tests(actuator, pressures_kpa, out_dir, model: str = "energy", *, d
                    force_unit="kN" if dialect == "mts" else "N")
         truth["file"] = name
         truths.append(truth)
+        recorded += truth["samples"]
+        if recorded > 2 * MAX_TOTAL_SAMPLES:
+            raise InputError(
+                f"the tests recorded {recorded:,} samples by {p:g} kPa, more than twice the limit of "
+                f"{MAX_TOTAL_SAMPLES:,} for one run that the estimate allowed; use fewer pressures, fewer "
+                "cycles or a lower rate_hz"
+            )
         files.append(name)
     result = {
         "model": model,
