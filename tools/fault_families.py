@@ -476,7 +476,10 @@ def budget_lines(folder: Path) -> list[tuple[str, list[str]]]:
         cases.append(("dev-zero", ["predict", "--actuator", "/dev/zero", "--pressure-kpa", "150"]))
         cases.append(("dev-zero", ["inspect", "/dev/zero"]))
     cases += [
-        ("huge-range", ["sweep", "--preset", "be-pam", "--param", "alpha0_deg=60:80:1000", "--pressure-kpa",
+        # (1000 x 1000 points is about 10 s of legitimate work, inside the time budget: not a refusal case)
+        ("huge-range", ["sweep", "--preset", "be-pam", "--param", "alpha0_deg=60:80:1000000", "--no-progress",
+                        "--out", "s.nc"]),
+        ("huge-range", ["sweep", "--preset", "be-pam", "--param", "alpha0_deg=60:80:100000", "--pressure-kpa",
                         "100:200:1000", "--no-progress", "--out", "s.nc"]),
         ("huge-range", ["simulate-test", "--preset", "be-pam", "--pressure-kpa", "100:200:1000", "--cycles", "50",
                         "--out", "sim"]),
