@@ -17,7 +17,14 @@ if TYPE_CHECKING:
     from bendpam.lab.pressure import PRESSURE_RANGE_KPA, parse_pressure, pressure_from_filename
     from bendpam.lab.rawtest import COLUMNS, DIALECTS, FORMATS, RawTest, check_cycle_count
     from bendpam.lab.read_error import ReadError
-    from bendpam.lab.readers import detect_dialect, format_inspection, inspect_file, parse_columns, read_test, read_tests
+    from bendpam.lab.readers import (
+        detect_dialect,
+        format_inspection,
+        inspect_file,
+        parse_columns,
+        read_test,
+        read_tests,
+    )
     from bendpam.lab.writers import write_test
 
 __all__ = [

@@ -125,8 +125,9 @@ def compression_like(stroke_mm, force_n, threshold_mm: float) -> str | None:
     Examples
     --------
     >>> s = np.linspace(0.0, 3.0, 200)
-    >>> print(compression_like(s, -40000.0 * s, 0.15))
-    force of one sign only (-1.2e+05 to 0 N), stroke monotone over 3 mm, no cycle: a compression or tension test
+    >>> print(compression_like(s, -40000.0 * s, 0.15))      # doctest: +NORMALIZE_WHITESPACE
+    force of one sign only (-1.2e+05 to 0 N), stroke monotone over 3 mm, no cycle:
+    a compression or tension test
     >>> compression_like(np.abs(np.sin(np.linspace(0, 6, 200))), np.ones(200), 0.05) is None
     True
     """
@@ -136,7 +137,7 @@ def compression_like(stroke_mm, force_n, threshold_mm: float) -> str | None:
         return None
     fmin, fmax = float(f.min()), float(f.max())
     span = max(abs(fmin), abs(fmax))
-    if span == 0.0 or min(abs(fmin), abs(fmax)) > 0.02 * span and fmin * fmax < 0:
+    if span == 0.0 or (min(abs(fmin), abs(fmax)) > 0.02 * span and fmin * fmax < 0):
         return None  # force of both signs
     # monotone: the stroke never comes back by more than the threshold from its running extreme
     run_max, run_min = np.maximum.accumulate(s), np.minimum.accumulate(s)
@@ -144,5 +145,5 @@ def compression_like(stroke_mm, force_n, threshold_mm: float) -> str | None:
     falling = float(np.max(s - run_min)) <= threshold_mm
     if not (rising or falling):
         return None
-    return (f"force of one sign only ({fmin + 0.0:.3g} to {fmax + 0.0:.3g} N), stroke monotone over {float(np.ptp(s)):.3g} mm, "
-            "no cycle: a compression or tension test")
+    return (f"force of one sign only ({fmin + 0.0:.3g} to {fmax + 0.0:.3g} N), stroke monotone over "
+            f"{float(np.ptp(s)):.3g} mm, no cycle: a compression or tension test")

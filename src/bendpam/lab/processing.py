@@ -453,8 +453,10 @@ def raw_test_name(rt) -> str:
     """How a raw test is named in results and messages: its file, and its specimen or block when it has one.
 
     >>> from types import SimpleNamespace as NS
-    >>> raw_test_name(NS(path="s.csv", specimen="3", block=None)), raw_test_name(NS(path="m.txt", specimen=None, block=2))
-    ('s.csv [specimen 3]', 'm.txt [block 2]')
+    >>> raw_test_name(NS(path="s.csv", specimen="3", block=None))
+    's.csv [specimen 3]'
+    >>> raw_test_name(NS(path="m.txt", specimen=None, block=2))
+    'm.txt [block 2]'
     """
     name = str(rt.path)
     specimen, block = getattr(rt, "specimen", None), getattr(rt, "block", None)
@@ -482,12 +484,17 @@ def process_one(rt, *, fixture: Fixture = PAPER_FIXTURE, options: ProcessingOpti
     205
     """
     src = raw_test_name(rt)
+    d = rt.data
     if rt.pressure_kpa is None:
+        s = d["stroke_mm"].to_numpy(dtype=float)
+        threshold = (options or ProcessingOptions()).reversal_fraction * float(np.ptp(s)) if s.size else 0.0
+        why = compression_like(s, d["force_n"].to_numpy(dtype=float), threshold)
+        if why is not None:  # say what the test is rather than ask for its pressure
+            raise NotABendingTest(f"{src}: not a cyclic bending test: {why}")
         raise ProcessingError(
             f"{src}: no pressure: give pressure_kpa when reading it, a 'Pressure' metadata line, "
             "or a filename token like 200kPa"
         )
-    d = rt.data
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
         try:
@@ -509,7 +516,8 @@ def number_replicates(results: list[PressureResult]) -> list[PressureResult]:
     """``results`` sorted by pressure (then source), with ``replicate`` = 1, 2, ... at each pressure.
 
     >>> from types import SimpleNamespace as NS
-    >>> rs = number_replicates([NS(pressure_kpa=p, source=s, replicate=0) for p, s in ((200, "b"), (100, "x"), (200, "a"))])
+    >>> rs = number_replicates([NS(pressure_kpa=p, source=s, replicate=0)
+    ...                         for p, s in ((200, "b"), (100, "x"), (200, "a"))])
     >>> [(r.pressure_kpa, r.source, r.replicate) for r in rs]
     [(100, 'x', 1), (200, 'a', 1), (200, 'b', 2)]
     """
