@@ -156,8 +156,9 @@ def process(
     except FilesRefused as exc:  # every bad file, one line each; raised before anything is written
         for problem in exc.problems:
             typer.echo(f"bendpam: error: {_flags(problem)}", err=True)
-        typer.echo(f"bendpam: error: {len(exc.problems)} of {len(files)} file(s) cannot be processed; nothing "
-                   "written (--keep-going skips them)", err=True)
+        if len(exc.problems) > 1:
+            typer.echo(f"bendpam: error: {len(exc.problems)} of {len(files)} file(s) cannot be processed; nothing "
+                       "written (--keep-going skips them)", err=True)
         raise typer.Exit(2) from None
     except ProcessingError as exc:
         raise UserError(_flags(str(exc))) from None

@@ -384,7 +384,7 @@ def process_series(
         raise ProcessingError(f"{source}: the stroke does not move; no cycles to process")
     why = compression_like(s_f, f_f, opt.reversal_fraction * rng)
     if why is not None:
-        raise NotABendingTest(f"{source}: not a cyclic bending test: {why}")
+        raise NotABendingTest(f"{source}: not a cyclic bending test (no complete cycle): {why}")
     s_f, f_f, s_raw, f_raw = _orient(s_f, f_f, s_raw, f_raw, notes)
 
     s_z, f_f, cycles = _segment(s_raw, f_raw, s_f, f_f, rng, fs, cutoff, opt, source, notes)
@@ -490,7 +490,7 @@ def process_one(rt, *, fixture: Fixture = PAPER_FIXTURE, options: ProcessingOpti
         threshold = (options or ProcessingOptions()).reversal_fraction * float(np.ptp(s)) if s.size else 0.0
         why = compression_like(s, d["force_n"].to_numpy(dtype=float), threshold)
         if why is not None:  # say what the test is rather than ask for its pressure
-            raise NotABendingTest(f"{src}: not a cyclic bending test: {why}")
+            raise NotABendingTest(f"{src}: not a cyclic bending test (no complete cycle): {why}")
         raise ProcessingError(
             f"{src}: no pressure: give pressure_kpa when reading it, a 'Pressure' metadata line, "
             "or a filename token like 200kPa"
