@@ -214,5 +214,5 @@ def test_compression_detection_is_not_fooled_by_a_bending_test():
     ramp = np.linspace(0.0, 2.0, 300)
     assert compression_like(ramp, 5000.0 * ramp + 1.0, 0.1) is not None      # tension, one sign
     assert compression_like(ramp, np.sin(8 * ramp) * 100.0, 0.1) is None   # force of both signs
-    with pytest.raises(NotABendingTest, match="c.csv: not a cyclic bending test"):
+    with pytest.raises(NotABendingTest, match=r"c\.csv: not a cyclic bending test"):
         process_series(np.arange(300.0), ramp, -4e4 * ramp, 100.0, source="c.csv")
