@@ -216,3 +216,23 @@ def test_compression_detection_is_not_fooled_by_a_bending_test():
     assert compression_like(ramp, np.sin(8 * ramp) * 100.0, 0.1) is None   # force of both signs
     with pytest.raises(NotABendingTest, match=r"c\.csv: not a cyclic bending test"):
         process_series(np.arange(300.0), ramp, -4e4 * ramp, 100.0, source="c.csv")
+
+
+def test_report_lists_each_replicate_their_mean_and_the_warnings(folder):
+    from bendpam.present.report.findings import plausibility_warnings
+    from bendpam.present.report.html import _tests_context
+
+    _, raw, _ = folder
+    files = sorted(p for p in raw.iterdir() if p.suffix == ".csv")
+    processed = process_files(files, keep_going=True, keep_series=False)
+    summ = processed.summary()
+    ctx = _tests_context(bendpam.physics.presets.be_pam(), summ, 0.2)
+    heads = [str(r.cells[0].text) for r in ctx["table2"].rows]
+    assert heads == ["100", "150 (#1)", "150 (#2)", "150 mean (n = 2)", "200"]
+    mean_row = ctx["table2"].rows[3]
+    rep = next(g for g in summ["replicates"] if g["pressure_kpa"] == 150.0)
+    assert mean_row.cells[2].value == rep["blocked_moment_nmm"]
+    assert mean_row.cells[2].se == rep["blocked_moment_std_nmm"]
+    assert len(ctx["skipped_files"]) == 2
+    w = plausibility_warnings(processed)
+    assert len(w) == 1 and w[0].kind == "implausible" and "concrete_200kPa.csv" in w[0].title
