@@ -236,3 +236,38 @@ def test_report_lists_each_replicate_their_mean_and_the_warnings(folder):
     assert len(ctx["skipped_files"]) == 2
     w = plausibility_warnings(processed)
     assert len(w) == 1 and w[0].kind == "implausible" and "concrete_200kPa.csv" in w[0].title
+
+
+# --- real exports (tests/data/real/dev): concrete tests on an MTS 793 frame --------------------------
+REAL = __import__("pathlib").Path(__file__).parent / "data" / "real" / "dev"
+CONCRETE = ["lebedigital_MTS793_DEU_compression_BAM_M03_W01.dat", "lebedigital_MTS793_DEU_compression_BAM_M05_W04.dat",
+            "lebedigital_MTS793_DEU_compression_Wolf82_Probe3.dat"]
+
+
+def test_real_concrete_compression_tests_are_recognised(folder):
+    _, raw, truth = folder
+    files = [raw / truth["files"][0]] + [REAL / n for n in CONCRETE]
+    processed = process_files(files, pressures_kpa=[None, 200.0, 200.0, 200.0], keep_going=True, keep_series=False)
+    assert [f["status"] for f in processed.files] == ["read", "skipped", "skipped", "skipped"]
+    assert [w["check"] for w in processed.findings] == ["not-bending"] * 3
+    for f in processed.files[1:]:
+        assert "not a cyclic bending test" in f["reason"] and "force of one sign only" in f["reason"]
+
+
+def test_real_cyclic_concrete_test_is_warned_about_its_blocked_moment():
+    # the example: a cyclic (E-modulus) concrete test on an MTS frame processed as a bending actuator
+    path = REAL / "lebedigital_MTS793_DEU_cyclic_Emodul_BALosMV6.dat"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PlausibilityWarning)
+        processed = process_files([path], pressures_kpa=[200.0], keep_series=False)
+    (r,) = processed.results
+    checks = {f["check"]: f for f in r.findings}
+    assert "blocked-moment" in checks
+    # the raw text: the first data block (line 14 names, line 15 units kN, data to line 623), 'Ch 1 Kraft' in kN
+    lines = path.read_text(encoding="latin-1").splitlines()
+    assert lines[13].split("\t")[3] == "Ch 1 Kraft" and lines[14].split("\t")[3] == "kN"
+    kraft_kn = [float(ln.split("\t")[3].replace(",", ".")) for ln in lines[15:622] if ln.split("\t")[0].isdigit()]
+    peak_n = 1000.0 * max(abs(v) for v in kraft_kn)
+    blocked_force_n = 2.0 * checks["blocked-moment"]["value"] / PAPER_FIXTURE.d_mm  # eq 7 at beta = 0
+    assert blocked_force_n == pytest.approx(peak_n, rel=0.03)
+    assert checks["blocked-moment"]["value"] > 3 * moment_bound_nmm(PAPER_FIXTURE, 200.0)

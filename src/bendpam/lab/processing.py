@@ -382,7 +382,7 @@ def process_series(
     rng = float(np.ptp(s_f))
     if rng <= 0:
         raise ProcessingError(f"{source}: the stroke does not move; no cycles to process")
-    why = compression_like(s_f, f_f, opt.reversal_fraction * rng)
+    why = compression_like(s_raw, f_raw, opt.reversal_fraction * rng)  # raw: a filter rings at a break
     if why is not None:
         raise NotABendingTest(f"{source}: not a cyclic bending test (no complete cycle): {why}")
     s_f, f_f, s_raw, f_raw = _orient(s_f, f_f, s_raw, f_raw, notes)
