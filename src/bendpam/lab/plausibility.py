@@ -131,7 +131,7 @@ def compression_like(stroke_mm, force_n, threshold_mm: float) -> str | None:
     --------
     >>> s = np.linspace(0.0, 3.0, 200)
     >>> print(compression_like(s, -40000.0 * s, 0.15))      # doctest: +NORMALIZE_WHITESPACE
-    force of one sign only (-1.2e+05 to 0 N), stroke one way over 3 mm while the force grows
+    force of one sign only (-1.2e+05 to 0 N), stroke one way over 2.94 mm while the force grows
     (correlation 1.00), no cycle: a compression or tension test
     >>> compression_like(s, 5.0 - 1.5 * s, 0.15) is None      # one release from the blocked state
     True
