@@ -136,8 +136,6 @@ def compression_like(stroke_mm, force_n, threshold_mm: float) -> str | None:
     >>> compression_like(s, 5.0 - 1.5 * s, 0.15) is None      # one release from the blocked state
     True
     """
-    from bendpam.lab.processing import find_turning_points  # the one zig-zag rule (processing imports this module)
-
     s = np.asarray(stroke_mm, dtype=float)
     f = np.asarray(force_n, dtype=float)
     if s.size < 3 or not (np.isfinite(s).all() and np.isfinite(f).all()):
@@ -150,8 +148,7 @@ def compression_like(stroke_mm, force_n, threshold_mm: float) -> str | None:
     sl, fl = s[loaded], np.abs(f[loaded])
     if sl.size < 3 or np.ptp(sl) <= threshold_mm:
         return None
-    idx, _ = find_turning_points(sl, threshold_mm)
-    if idx.size - 2 > 1:
+    if not _at_most_one_reversal(sl, threshold_mm):
         return None  # back and forth: cycles
     travel = np.abs(sl - sl[0])
     if np.ptp(travel) == 0.0 or np.ptp(fl) == 0.0:
@@ -162,3 +159,19 @@ def compression_like(stroke_mm, force_n, threshold_mm: float) -> str | None:
     return (f"force of one sign only ({fmin + 0.0:.3g} to {fmax + 0.0:.3g} N), stroke one way over "
             f"{float(np.ptp(sl)):.3g} mm while the force grows (correlation {r:.2f}), no cycle: "
             "a compression or tension test")
+
+
+def _at_most_one_reversal(x: np.ndarray, threshold: float) -> bool:
+    """True when ``x`` rises then falls (or falls then rises, or is monotone), back-steps up to ``threshold`` aside.
+
+    >>> _at_most_one_reversal(np.array([0.0, 1.0, 2.0, 1.0]), 0.1), _at_most_one_reversal(np.array([0, 2, 0, 2.0]), 0.1)
+    (True, False)
+    """
+    def rises(y: np.ndarray) -> bool:
+        return y.size < 2 or float(np.max(np.maximum.accumulate(y) - y)) <= threshold
+
+    def falls(y: np.ndarray) -> bool:
+        return y.size < 2 or float(np.max(y - np.minimum.accumulate(y))) <= threshold
+
+    i, j = int(np.argmax(x)), int(np.argmin(x))
+    return (rises(x[:i + 1]) and falls(x[i:])) or (falls(x[:j + 1]) and rises(x[j:]))

@@ -382,9 +382,7 @@ def process_series(
     rng = float(np.ptp(s_f))
     if rng <= 0:
         raise ProcessingError(f"{source}: the stroke does not move; no cycles to process")
-    why = compression_like(s_raw, f_raw, opt.reversal_fraction * rng)  # raw: a filter rings at a break
-    if why is not None:
-        raise NotABendingTest(f"{source}: not a cyclic bending test (no complete cycle): {why}")
+    _refuse_compression(s_raw, f_raw, opt.reversal_fraction * rng, source)
     s_f, f_f, s_raw, f_raw = _orient(s_f, f_f, s_raw, f_raw, notes)
 
     s_z, f_f, cycles = _segment(s_raw, f_raw, s_f, f_f, rng, fs, cutoff, opt, source, notes)
@@ -403,10 +401,23 @@ def process_series(
         branches=branches, blocked_moments=bm, free_curvatures=kf, energy_loss_ratios=ratio, loop_energy=loss,
         stored_energy=stored, sample_rate_hz=fs, cutoff_hz=cutoff, notes=notes, series=series,
     )
+    _judge(result, fixture, cycles, k)
+    return result
+
+
+def _refuse_compression(s_raw: np.ndarray, f_raw: np.ndarray, threshold_mm: float, source: str) -> None:
+    """Refuse a compression or tension test (:func:`~bendpam.lab.plausibility.compression_like` on the raw samples:
+    a low-pass filter rings at a break)."""
+    why = compression_like(s_raw, f_raw, threshold_mm)
+    if why is not None:
+        raise NotABendingTest(f"{source}: not a cyclic bending test (no complete cycle): {why}")
+
+
+def _judge(result: PressureResult, fixture: Fixture, cycles: list[tuple[int, int, int]], k: np.ndarray) -> None:
+    """The plausibility findings of a processed test, kept on it and warned about (PlausibilityWarning)."""
     result.findings = check_result(result, fixture, _return_gaps(cycles, k))
     for f in result.findings:
-        warnings.warn(f["message"], PlausibilityWarning, stacklevel=2)
-    return result
+        warnings.warn(f["message"], PlausibilityWarning, stacklevel=3)
 
 
 def _return_gaps(cycles: list[tuple[int, int, int]], k: np.ndarray) -> np.ndarray:
