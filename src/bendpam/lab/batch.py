@@ -73,6 +73,9 @@ def _one_file(path: Path, read_kw: dict, fixture: Fixture, options, keep_series:
     except BendpamError as exc:
         info.update(status="skipped", reason=str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
         return info, []
+    except OSError as exc:  # the file vanished or cannot be opened while the folder is read
+        info.update(status="skipped", reason=f"{path}: cannot be read ({exc.strerror or type(exc).__name__})")
+        return info, []
     info["tests"] = len(results)
     info["findings"] = [f for r in results for f in r.findings]
     return info, results
