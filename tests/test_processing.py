@@ -248,6 +248,12 @@ def test_cli_errors(capsys, tmp_path, monkeypatch, args, words):
     write_test(tmp_path / "raw" / "u.csv", data, "csv", pressure_kpa=160)
     code, out, err = run(capsys, *args)
     assert code == 2, (out, err)
-    assert err.startswith("bendpam: error:") and err.count("\n") == 1, err
+    lines = err.splitlines()
+    assert all(ln.startswith("bendpam: error:") for ln in lines), err
+    # one line, or (a problem found in the files: issue 22) one line per bad file and a count of them
+    per_file = "--cutoff-hz" in args
+    assert len(lines) == (3 if per_file else 1), err
+    if per_file:
+        assert "t.csv" in lines[0] and "u.csv" in lines[1] and "2 of 2 file(s)" in lines[2]
     for w in words:
         assert w in err

@@ -18,7 +18,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from bendpam import presets
-from bendpam.errors import BendpamError
+from bendpam.errors import BendpamError, PlausibilityWarning
 from bendpam.lab import RawTest, inspect_file, read_test, write_test
 from bendpam.lab.processing import process_tests
 from bendpam.lab.simulate import simulate_test
@@ -138,6 +138,8 @@ def _check_result(raw: RawTest) -> None:
     assert np.all(np.diff(d[:, 0]) > 0)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
+        # a plausibility finding is a result, not a fault (mts793.dat is a concrete test: issue 22 item 7)
+        warnings.simplefilter("ignore", PlausibilityWarning)
         ps = process_tests([raw], keep_series=False)
     for r in ps.results:
         for arr in (r.curvature_grid, r.branches, r.blocked_moments, r.free_curvatures):

@@ -29,7 +29,7 @@ from bendpam.cli.options import (
     parse_values,
     pressures_kpa,
 )
-from bendpam.errors import InputError
+from bendpam.errors import InputError, ProcessingError
 
 FixtureOpt = Annotated[str, typer.Option("--fixture", help="Fixture geometry d,r,t in mm.")]
 ColumnsOpt = Annotated[Optional[str], typer.Option(
@@ -112,12 +112,17 @@ def process(
     rate_hz: RateOpt = None,
     repair: RepairOpt = False,
     as_json: Annotated[bool, typer.Option("--json", help="Print summary.json to stdout.")] = False,
+    keep_going: Annotated[bool, typer.Option(
+        "--keep-going", help="Skip the files that cannot be read or processed (each reported) instead of refusing.")]
+    = False,
     quiet: QuietOpt = False,
 ):
-    """Process raw four-point-bending cyclic tests into moment-curvature curves and Table 2 values."""
-    from bendpam.lab import read_test
+    """Process raw four-point-bending cyclic tests into moment-curvature curves and Table 2 values.
+
+    Every file is reported (read, or skipped and why); several tests at one pressure are replicates.
+    """
+    from bendpam.lab.batch import FilesRefused, file_line, process_files
     from bendpam.lab.processed import ProcessingOptions
-    from bendpam.lab.processing import process_tests
     from bendpam.physics.fixture import Fixture
 
     if out is None:
@@ -132,34 +137,43 @@ def process(
     if fig_format is not None and not figure:
         raise UserError(f"--format {fig_format.value}: there is no figure with --no-figure")
 
-    def tests(bar):
-        # read lazily: process_tests takes each test in turn, so a file counts as done (read and
-        # processed) when the next one is asked for
-        for i, f in enumerate(files):
-            raw = read_test(f, pressure_kpa=pressures[i] if pressures else None, columns=columns, rate_hz=rate_hz,
-                            repair=repair)
-            if raw.pressure_kpa is None:
-                raise UserError(f"{raw.path}: no pressure: give --pressure-kpa, a 'Pressure' metadata line, "
-                                "or a filename token like 200kPa")
-            yield raw
-            bar.advance()
-
     from bendpam.infra.progress import Progress
 
-    with output_set(out, inputs) as o, Progress(len(files) + 1, "process", quiet=quiet) as bar:
-        processed = process_tests(tests(bar), fixture=fx, options=opts)
-        bar.advance(0, description="process: writing")
-        processed.save(o.staging, figure=False)
-        if figure:
-            from bendpam.present.figures import save_figure
+    read_kw = {"columns": columns, "rate_hz": rate_hz, "repair": repair}
+    per_file = (pressures * len(files) if len(pressures) == 1 else pressures) if pressures else None
+    try:
+        with Progress(len(files) + 1, "process", quiet=quiet) as bar:
+            processed = process_files(files, pressures_kpa=per_file, fixture=fx, options=opts, keep_going=keep_going,
+                                      read_options=read_kw, on_file=lambda _f: bar.advance())
+            bar.advance(0, description="process: writing")
+            with output_set(out, inputs) as o:
+                processed.save(o.staging, figure=False)
+                if figure:
+                    from bendpam.present.figures import save_figure
 
-            save_figure(processed.plot(), o.path(fig_name))
-        bar.advance()
+                    save_figure(processed.plot(), o.path(fig_name))
+            bar.advance()
+    except FilesRefused as exc:  # every bad file, one line each; raised before anything is written
+        for problem in exc.problems:
+            typer.echo(f"bendpam: error: {_flags(problem)}", err=True)
+        if len(exc.problems) > 1:
+            typer.echo(f"bendpam: error: {len(exc.problems)} of {len(files)} file(s) cannot be processed; nothing "
+                       "written (--keep-going skips them)", err=True)
+        raise typer.Exit(2) from None
+    except ProcessingError as exc:
+        raise UserError(_flags(str(exc))) from None
     if as_json:
         typer.echo((out / "summary.json").read_text())
         return
+    for info in processed.files:
+        typer.echo(_flags(file_line(info)))
     _print_table2(processed.summary())
     echo_wrote(f"wrote {out}/ (curves.nc, curves.csv, summary.json{', ' + fig_name if figure else ''})")
+
+
+def _flags(message: str) -> str:
+    """A library message in this command's words: the pressure is given with --pressure-kpa."""
+    return message.replace("give pressure_kpa when reading it", "give --pressure-kpa")
 
 
 def _file_pressures(pressure_kpa: Optional[list[str]], files: list[Path]) -> list[float]:
@@ -176,16 +190,36 @@ def _file_pressures(pressure_kpa: Optional[list[str]], files: list[Path]) -> lis
 
 
 def _print_table2(summ: dict) -> None:
-    """Table 2 of a processed set (its ``summary()``), one line per pressure, then the deadband."""
+    """Table 2 of a processed set (its ``summary()``): a line per test, the replicates' mean ± std (n), the deadband.
+
+    Tests at one pressure are replicates: each has its line (``#1``, ``#2``, ... and its file), then
+    a ``mean`` line with the standard deviation over them and their number.  Plausibility warnings
+    follow their test.
+    """
     typer.echo(f"{'P (kPa)':>8} {'cycles':>6} {'M_blocked (N·mm)':>18} {'k_free (1/mm)':>20} {'loss ratio':>10}")
-    for r in summ["pressures"]:
+    groups = {float(g["pressure_kpa"]): g for g in summ.get("replicates", [])}
+    tests = summ["pressures"]
+    for k, r in enumerate(tests):
+        group = groups.get(float(r["pressure_kpa"])) or {}
+        several = int(group.get("n", 1)) > 1
+        tag = f"  #{r.get('replicate', 1)} {r['source']}" if several else ""
         typer.echo(
             f"{r['pressure_kpa']:8.4g} {r['cycles']:6d} {r['blocked_moment_nmm']:9.2f} ± "
             f"{fmt_num(r['blocked_moment_se_nmm'], '6.2f')} {r['free_curvature_per_mm']:10.5f} ± "
-            f"{fmt_num(r['free_curvature_se_per_mm'], '7.1e')} {100 * r['energy_loss_ratio']:9.2f}%"
+            f"{fmt_num(r['free_curvature_se_per_mm'], '7.1e')} {100 * r['energy_loss_ratio']:9.2f}%{tag}"
         )
         for note in r["notes"]:
             typer.echo(f"         note: {note}")
+        for warning in r.get("warnings", []):
+            typer.echo(f"         warning: {warning}")
+        last = k + 1 == len(tests) or float(tests[k + 1]["pressure_kpa"]) != float(r["pressure_kpa"])
+        if several and last:
+            typer.echo(
+                f"{'mean':>8} {'':6} {group['blocked_moment_nmm']:9.2f} ± "
+                f"{fmt_num(group['blocked_moment_std_nmm'], '6.2f')} {group['free_curvature_per_mm']:10.5f} ± "
+                f"{fmt_num(group['free_curvature_std_per_mm'], '7.1e')} {100 * group['energy_loss_ratio']:9.2f}%"
+                f"  std over n = {group['n']} replicates"
+            )
     typer.echo(f"deadband: {fmt_num(summ['deadband_kpa'], '.4g')} ± {fmt_num(summ['deadband_se_kpa'], '.2g')} kPa")
 
 

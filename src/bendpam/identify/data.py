@@ -3,6 +3,8 @@
 :func:`fit_data` takes the mean curve of every pressure (where the loop is developed,
 :func:`developed_range`), :func:`branch_data` both mean branches (for fits with a loop model); both
 give a :class:`FitData` whose weights make the sum of squares the paper's cycle metric (eq 53).
+Replicates (several tests at one pressure, :meth:`bendpam.lab.processed.ProcessedSet.replicates`)
+are curves of their own: each test's curve is data, weighted as a test of its own, not their mean.
 :func:`bladder_stretch_range` gives the bladder's stretches at the tested curvatures (eq 17).
 """
 

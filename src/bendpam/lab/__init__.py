@@ -17,7 +17,14 @@ if TYPE_CHECKING:
     from bendpam.lab.pressure import PRESSURE_RANGE_KPA, parse_pressure, pressure_from_filename
     from bendpam.lab.rawtest import COLUMNS, DIALECTS, FORMATS, RawTest, check_cycle_count
     from bendpam.lab.read_error import ReadError
-    from bendpam.lab.readers import detect_dialect, format_inspection, inspect_file, parse_columns, read_test
+    from bendpam.lab.readers import (
+        detect_dialect,
+        format_inspection,
+        inspect_file,
+        parse_columns,
+        read_test,
+        read_tests,
+    )
     from bendpam.lab.writers import write_test
 
 __all__ = [
@@ -35,6 +42,7 @@ __all__ = [
     "parse_pressure",
     "pressure_from_filename",
     "read_test",
+    "read_tests",
     "write_test",
 ]
 
@@ -44,6 +52,7 @@ _FROM = {
     "check_cycle_count": "rawtest", "PRESSURE_RANGE_KPA": "pressure", "parse_pressure": "pressure",
     "pressure_from_filename": "pressure", "ReadError": "read_error", "detect_dialect": "readers",
     "format_inspection": "readers", "inspect_file": "readers", "parse_columns": "readers", "read_test": "readers",
+    "read_tests": "readers",
     "write_test": "writers",
 }  # fmt: skip
 

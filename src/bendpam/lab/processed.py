@@ -120,6 +120,9 @@ class PressureResult:
     cutoff_hz: float
     notes: list[str] = field(default_factory=list)
     series: pd.DataFrame | None = None  # filtered, converted samples with cycle/branch labels
+    specimen: str | None = None  # the specimen's name when a file holds several
+    replicate: int = 1  # 1, 2, ... among the tests at this pressure
+    findings: list[dict] = field(default_factory=list)  # plausibility findings (bendpam.lab.plausibility)
 
     @property
     def mean_loading(self) -> np.ndarray:
@@ -182,7 +185,10 @@ class PressureResult:
             "free_curvature_se_per_mm": kf_se,
             "energy_loss_ratio": self.energy_loss_ratio,
             "source": self.source,
+            "specimen": self.specimen,
+            "replicate": self.replicate,
             "notes": list(self.notes),
+            "warnings": [f["message"] for f in self.findings],
         }
 
 
@@ -252,12 +258,13 @@ class ProcessedSet:
     >>> round(p0), round(se, 1)
     (68, 0.1)
     >>> processed.to_frame().columns.tolist()
-    ['pressure_kpa', 'cycle', 'branch', 'curvature_per_mm', 'moment_nmm']
+    ['pressure_kpa', 'cycle', 'branch', 'curvature_per_mm', 'moment_nmm', 'replicate']
     """
 
     results: list[PressureResult]
     fixture: Fixture
     options: ProcessingOptions
+    files: list[dict] = field(default_factory=list)  # what became of each input file (bendpam.lab.batch)
 
     @property
     def pressures_kpa(self) -> np.ndarray:
@@ -284,11 +291,55 @@ class ProcessedSet:
         p0, se, _, _ = self.deadband_fit()
         return p0, se
 
+    @property
+    def findings(self) -> list[dict]:
+        """Every plausibility finding: of the processed tests, then of the files that were skipped."""
+        out = [f for r in self.results for f in r.findings]
+        return out + [f for info in self.files for f in info.get("findings", [])]
+
+    def replicates(self) -> list[dict]:
+        """Per pressure: the tests there (replicates), their mean and spread (std over the tests, n).
+
+        The spread is the sample standard deviation (ddof 1) of the tests' own values (each test's
+        mean over its cycles); NaN with one test.
+
+        Examples
+        --------
+        >>> from types import SimpleNamespace as NS
+        >>> tests = [NS(pressure_kpa=150.0, source=name, blocked_moment=(bm, 1.0), free_curvature=(0.007, 1e-5),
+        ...             energy_loss_ratio=0.1) for name, bm in (("a.csv", 200.0), ("b.csv", 210.0))]
+        >>> row = ProcessedSet.replicates(NS(results=tests))[0]
+        >>> row["n"], row["blocked_moment_nmm"], round(row["blocked_moment_std_nmm"], 3), row["tests"]
+        (2, 205.0, 7.071, ['a.csv', 'b.csv'])
+        """
+        rows = []
+        pressures = sorted({float(r.pressure_kpa) for r in self.results})
+        for p in pressures:
+            group = [r for r in self.results if float(r.pressure_kpa) == p]
+            row: dict = {"pressure_kpa": p, "n": len(group), "tests": [r.source for r in group]}
+            for key, vals in (("blocked_moment", [r.blocked_moment[0] for r in group]),
+                              ("free_curvature", [r.free_curvature[0] for r in group]),
+                              ("energy_loss_ratio", [r.energy_loss_ratio for r in group])):
+                unit = {"blocked_moment": "_nmm", "free_curvature": "_per_mm"}.get(key, "")
+                v = np.asarray(vals, dtype=float)
+                row[f"{key}{unit}"] = float(np.mean(v))
+                row[f"{key}_std{unit}"] = float(np.std(v, ddof=1)) if v.size > 1 else math.nan
+            rows.append(row)
+        return rows
+
     def summary(self) -> dict:
-        """Table 2 as a JSON-ready dict: every pressure's summary, the deadband, units and fixture."""
+        """Table 2 as a JSON-ready dict: every test's summary, the replicates' means, the deadband, units, fixture.
+
+        ``pressures`` holds one entry per test (several at one pressure are replicates, numbered
+        by ``replicate``); ``replicates`` one per pressure with the mean and spread of its tests;
+        ``warnings`` every plausibility finding; ``files`` what became of each input file.
+        """
         p0, se = self.deadband()
         return {
             "pressures": [r.summary() for r in self.results],
+            "replicates": self.replicates(),
+            "warnings": self.findings,
+            "files": list(self.files),
             "deadband_kpa": p0,
             "deadband_se_kpa": se,
             "units": {"pressure_kpa": "kPa", "blocked_moment_nmm": "N*mm", "free_curvature_per_mm": "1/mm",
@@ -318,6 +369,8 @@ class ProcessedSet:
             bmc[i, : r.n_cycles] = r.blocked_moments
             kfc[i, : r.n_cycles] = r.free_curvatures
             elc[i, : r.n_cycles] = r.energy_loss_ratios
+        import json
+
         import xarray as xr
 
         P = self.pressures_kpa
@@ -349,6 +402,8 @@ class ProcessedSet:
                 "branch": ("branch", list(BRANCHES)),
                 "point": ("point", np.arange(npt)),
                 "curvature_per_mm": (("pressure_kpa", "point"), kg, {"units": "1/mm"}),
+                "replicate": ("pressure_kpa", np.array([r.replicate for r in self.results]),
+                              {"long_name": "replicate number among the tests at this pressure"}),
             },
         )
         ds["mean_curve_nmm"] = 0.5 * (ds["mean_loading_nmm"] + ds["mean_unloading_nmm"])
@@ -358,6 +413,8 @@ class ProcessedSet:
             deadband_kpa=p0, deadband_se_kpa=se, fixture_d_mm=self.fixture.d_mm, fixture_r_mm=self.fixture.r_mm,
             fixture_t_mm=self.fixture.t_mm, L0_mm=self.fixture.L0_mm, sign_convention="magnitudes",
             sources="; ".join(r.source for r in self.results),
+            specimens="; ".join(r.specimen or "" for r in self.results),
+            plausibility_json=json.dumps([r.findings for r in self.results], allow_nan=True),
         )
         return ds
 
@@ -403,7 +460,7 @@ class ProcessedSet:
         return load_processed(path)
 
     def to_frame(self) -> pd.DataFrame:
-        """Tidy table of the resampled branches: pressure, cycle, branch, curvature, moment."""
+        """Tidy table of the resampled branches: pressure, cycle, branch, curvature, moment, replicate."""
         import pandas as pd
 
         rows = []
@@ -413,12 +470,13 @@ class ProcessedSet:
                     rows.append(pd.DataFrame({
                         "pressure_kpa": r.pressure_kpa, "cycle": ci + 1, "branch": name,
                         "curvature_per_mm": r.curvature_grid, "moment_nmm": r.branches[ci, bi],
+                        "replicate": r.replicate,
                     }))
             for name, arr in (("mean_loading", r.mean_loading), ("mean_unloading", r.mean_unloading),
                               ("mean", r.mean_curve)):
                 rows.append(pd.DataFrame({
                     "pressure_kpa": r.pressure_kpa, "cycle": 0, "branch": name,
-                    "curvature_per_mm": r.curvature_grid, "moment_nmm": arr,
+                    "curvature_per_mm": r.curvature_grid, "moment_nmm": arr, "replicate": r.replicate,
                 }))
         return pd.concat(rows, ignore_index=True)
 
@@ -528,6 +586,9 @@ def load_processed(path) -> ProcessedSet:
     fx = Fixture(ds.attrs["fixture_d_mm"], ds.attrs["fixture_r_mm"], ds.attrs["fixture_t_mm"], ds.attrs["L0_mm"])
     results = []
     sources = str(ds.attrs.get("sources", "")).split("; ")
+    specimens = str(ds.attrs.get("specimens", "")).split("; ")
+    findings = _stored_findings(ds.attrs.get("plausibility_json"))
+    replicate = ds["replicate"].values if "replicate" in ds.data_vars else None
     for i, P in enumerate(ds["pressure_kpa"].values):
         bmc = ds["blocked_moment_cycle_nmm"].values[i]
         n = int(np.sum(np.isfinite(bmc)))
@@ -543,5 +604,25 @@ def load_processed(path) -> ProcessedSet:
             blocked_moments=bmc[:n], free_curvatures=ds["free_curvature_cycle_per_mm"].values[i, :n],
             energy_loss_ratios=ds["energy_loss_ratio_cycle"].values[i, :n], loop_energy=np.full(n, np.nan),
             stored_energy=np.full(n, np.nan), sample_rate_hz=math.nan, cutoff_hz=math.nan,
+            specimen=(specimens[i] or None) if i < len(specimens) else None,
+            replicate=int(replicate[i]) if replicate is not None else 1,
+            findings=findings[i] if i < len(findings) else [],
         ))
     return ProcessedSet(results=results, fixture=fx, options=ProcessingOptions())
+
+
+def _stored_findings(text) -> list[list[dict]]:
+    """The per-test plausibility findings stored in a ``curves.nc`` (none in files older than 0.4).
+
+    >>> _stored_findings('[[], [{"check": "loss-ratio"}]]')[1][0]["check"], _stored_findings(None)
+    ('loss-ratio', [])
+    """
+    import json
+
+    if not text:
+        return []
+    try:
+        value = json.loads(str(text))
+    except ValueError:
+        return []
+    return [list(v) if isinstance(v, list) else [] for v in value] if isinstance(value, list) else []

@@ -47,7 +47,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from bendpam.errors import ProcessingError
+from bendpam.errors import PlausibilityWarning, ProcessingError
+from bendpam.lab.plausibility import check_result, compression_like
 from bendpam.lab.processed import (
     PressureResult,
     ProcessedSet,
@@ -63,6 +64,7 @@ if TYPE_CHECKING:  # pandas is imported by the functions that use it (fast start
     import pandas as pd
 
 __all__ = [
+    "NotABendingTest",
     "PressureResult",
     "ProcessedSet",
     "ProcessingError",
@@ -70,8 +72,11 @@ __all__ = [
     "deadband_fit",
     "find_turning_points",
     "load_processed",
+    "number_replicates",
+    "process_one",
     "process_series",
     "process_tests",
+    "raw_test_name",
     "write_processed",
 ]
 
@@ -377,6 +382,7 @@ def process_series(
     rng = float(np.ptp(s_f))
     if rng <= 0:
         raise ProcessingError(f"{source}: the stroke does not move; no cycles to process")
+    _refuse_compression(s_raw, f_raw, opt.reversal_fraction * rng, source)
     s_f, f_f, s_raw, f_raw = _orient(s_f, f_f, s_raw, f_raw, notes)
 
     s_z, f_f, cycles = _segment(s_raw, f_raw, s_f, f_f, rng, fs, cutoff, opt, source, notes)
@@ -390,11 +396,49 @@ def process_series(
         notes.append("energy-loss ratio undefined for a cycle with no stored energy")
 
     series = _labelled_series(t, s_z, f_f, beta, k, M, cycles) if keep_series else None
-    return PressureResult(
+    result = PressureResult(
         pressure_kpa=float(pressure_kpa), source=source, n_cycles=len(cycles), curvature_grid=grid,
         branches=branches, blocked_moments=bm, free_curvatures=kf, energy_loss_ratios=ratio, loop_energy=loss,
         stored_energy=stored, sample_rate_hz=fs, cutoff_hz=cutoff, notes=notes, series=series,
     )
+    _judge(result, fixture, cycles, k)
+    return result
+
+
+def _refuse_compression(s_raw: np.ndarray, f_raw: np.ndarray, threshold_mm: float, source: str) -> None:
+    """Refuse a compression or tension test (:func:`~bendpam.lab.plausibility.compression_like` on the raw samples:
+    a low-pass filter rings at a break)."""
+    why = compression_like(s_raw, f_raw, threshold_mm)
+    if why is not None:
+        raise NotABendingTest(f"{source}: not a cyclic bending test (no complete cycle): {why}")
+
+
+def _judge(result: PressureResult, fixture: Fixture, cycles: list[tuple[int, int, int]], k: np.ndarray) -> None:
+    """The plausibility findings of a processed test, kept on it and warned about (PlausibilityWarning)."""
+    result.findings = check_result(result, fixture, _return_gaps(cycles, k))
+    for f in result.findings:
+        warnings.warn(f["message"], PlausibilityWarning, stacklevel=3)
+
+
+def _return_gaps(cycles: list[tuple[int, int, int]], k: np.ndarray) -> np.ndarray:
+    """Per cycle ``(blocked, free, blocked)``: how far its end curvature lies from its start, over its range.
+
+    >>> _return_gaps([(0, 2, 4)], np.array([0.0, 0.5, 1.0, 0.6, 0.3])).tolist()
+    [0.3]
+    """
+    idx = np.asarray(cycles, dtype=int).reshape(-1, 3)
+    a, b, c = k[idx[:, 0]], k[idx[:, 1]], k[idx[:, 2]]
+    span = np.abs(b - a)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(span > 0, np.abs(c - a) / span, np.nan)
+
+
+class NotABendingTest(ProcessingError):
+    """A record that is no cyclic bending test (a monotone compression or tension test): a plausibility refusal.
+
+    >>> isinstance(NotABendingTest("c.csv: not a cyclic bending test"), ProcessingError)
+    True
+    """
 
 
 def _sorted(x, y):
@@ -416,12 +460,95 @@ def _located(exc: ProcessingError, src: str, data_lines: tuple[int, int] | None)
     return ProcessingError(f"{src}: lines {first}-{last}: {msg[len(src) + 2:]}")
 
 
+def raw_test_name(rt) -> str:
+    """How a raw test is named in results and messages: its file, and its specimen or block when it has one.
+
+    >>> from types import SimpleNamespace as NS
+    >>> raw_test_name(NS(path="s.csv", specimen="3", block=None))
+    's.csv [specimen 3]'
+    >>> raw_test_name(NS(path="m.txt", specimen=None, block=2))
+    'm.txt [block 2]'
+    """
+    name = str(rt.path)
+    specimen, block = getattr(rt, "specimen", None), getattr(rt, "block", None)
+    if specimen is not None:
+        return f"{name} [specimen {specimen}]"
+    if block is not None:
+        return f"{name} [block {block}]"
+    return name
+
+
+def process_one(rt, *, fixture: Fixture = PAPER_FIXTURE, options: ProcessingOptions | None = None,
+                keep_series: bool = True) -> PressureResult:
+    """Process one raw test (a ``RawTest``); its pressure must be known.
+
+    Raises :class:`~bendpam.errors.ProcessingError` naming the test (and its data lines) when it
+    cannot be processed, :class:`NotABendingTest` when it is no cyclic bending test.
+
+    >>> from pathlib import Path
+    >>> import bendpam
+    >>> from bendpam.lab import RawTest
+    >>> from bendpam.lab.simulate import SimulationSettings, simulate_test
+    >>> data, _ = simulate_test(bendpam.physics.presets.be_pam(), 150.0,
+    ...                         settings=SimulationSettings(cycles=2, rate_hz=5.0, seed=1))
+    >>> round(process_one(RawTest(data, Path("be.csv"), "csv", pressure_kpa=150.0)).blocked_moment[0])   # N*mm
+    205
+    """
+    src = raw_test_name(rt)
+    d = rt.data
+    if rt.pressure_kpa is None:
+        s = d["stroke_mm"].to_numpy(dtype=float)
+        threshold = (options or ProcessingOptions()).reversal_fraction * float(np.ptp(s)) if s.size else 0.0
+        why = compression_like(s, d["force_n"].to_numpy(dtype=float), threshold)
+        if why is not None:  # say what the test is rather than ask for its pressure
+            raise NotABendingTest(f"{src}: not a cyclic bending test (no complete cycle): {why}")
+        raise ProcessingError(
+            f"{src}: no pressure: give pressure_kpa when reading it, a 'Pressure' metadata line, "
+            "or a filename token like 200kPa"
+        )
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        try:
+            res = process_series(d["time_s"].to_numpy(), d["stroke_mm"].to_numpy(), d["force_n"].to_numpy(),
+                                 float(rt.pressure_kpa), fixture=fixture, options=options, source=src,
+                                 keep_series=keep_series)
+        except ProcessingError as exc:
+            located = _located(exc, src, getattr(rt, "data_lines", None))
+            raise (type(exc)(str(located)) if isinstance(exc, NotABendingTest) else located) from None
+    res.specimen = getattr(rt, "specimen", None)
+    res.notes.extend(getattr(rt, "warnings", []) or [])
+    mismatch = check_cycle_count(rt, res.n_cycles)
+    if mismatch:
+        res.notes.append(mismatch)
+    return res
+
+
+def number_replicates(results: list[PressureResult]) -> list[PressureResult]:
+    """``results`` sorted by pressure (then source), with ``replicate`` = 1, 2, ... at each pressure.
+
+    >>> from types import SimpleNamespace as NS
+    >>> rs = number_replicates([NS(pressure_kpa=p, source=s, replicate=0)
+    ...                         for p, s in ((200, "b"), (100, "x"), (200, "a"))])
+    >>> [(r.pressure_kpa, r.source, r.replicate) for r in rs]
+    [(100, 'x', 1), (200, 'a', 1), (200, 'b', 2)]
+    """
+    results = sorted(results, key=lambda r: (r.pressure_kpa, r.source))
+    count: dict[float, int] = {}
+    for r in results:
+        count[r.pressure_kpa] = count.get(r.pressure_kpa, 0) + 1
+        r.replicate = count[r.pressure_kpa]
+    return results
+
+
 def process_tests(tests, *, fixture: Fixture = PAPER_FIXTURE, options: ProcessingOptions | None = None,
                   keep_series: bool = True) -> ProcessedSet:
     """Process several raw tests (``RawTest`` objects from :func:`bendpam.lab.read_test`).
 
-    Every test needs a pressure (from the reader: option, metadata or filename).  Two tests at one
-    pressure are an error.
+    Every test needs a pressure (from the reader: option, metadata or filename).  Several tests at
+    one pressure (specimens, repeats) are replicates: each is kept and numbered
+    (:attr:`PressureResult.replicate`), :meth:`ProcessedSet.replicates` gives their mean and spread,
+    and a fit uses every one.  The first test that cannot be processed raises; to go on past it,
+    see :func:`bendpam.lab.batch.process_files`.
 
     Examples
     --------
@@ -442,33 +569,7 @@ def process_tests(tests, *, fixture: Fixture = PAPER_FIXTURE, options: Processin
     >>> round(processed.deadband()[0])                  # kPa: the x-intercept (P_start = 68 kPa)
     68
     """
-    results = []
-    seen: dict[float, str] = {}
-    for rt in tests:
-        src = str(rt.path)
-        if rt.pressure_kpa is None:
-            raise ProcessingError(
-                f"{src}: no pressure: give pressure_kpa when reading it, a 'Pressure' metadata line, "
-                "or a filename token like 200kPa"
-            )
-        p = float(rt.pressure_kpa)
-        if p in seen:
-            raise ProcessingError(f"{src}: a second test at {p:g} kPa (the first is {seen[p]})")
-        seen[p] = src
-        d = rt.data
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)
-            try:
-                res = process_series(d["time_s"].to_numpy(), d["stroke_mm"].to_numpy(), d["force_n"].to_numpy(),
-                                     p, fixture=fixture, options=options, source=src, keep_series=keep_series)
-            except ProcessingError as exc:
-                raise _located(exc, src, getattr(rt, "data_lines", None)) from None
-        res.notes.extend(getattr(rt, "warnings", []) or [])
-        mismatch = check_cycle_count(rt, res.n_cycles)
-        if mismatch:
-            res.notes.append(mismatch)
-        results.append(res)
+    results = [process_one(rt, fixture=fixture, options=options, keep_series=keep_series) for rt in tests]
     if not results:
         raise ProcessingError("no tests to process")
-    results.sort(key=lambda r: r.pressure_kpa)
-    return ProcessedSet(results=results, fixture=fixture, options=options or ProcessingOptions())
+    return ProcessedSet(results=number_replicates(results), fixture=fixture, options=options or ProcessingOptions())

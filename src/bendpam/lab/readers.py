@@ -89,6 +89,7 @@ __all__ = [
     "parse_pressure",
     "pressure_from_filename",
     "read_test",
+    "read_tests",  # SHIM until h-reader lands
 ]
 
 
@@ -479,3 +480,24 @@ def format_inspection(info: Mapping[str, Any]) -> str:
         out.append(f"  warning: {w}")
     return "\n".join(out)
 
+
+
+# ------------------------------------------------------------------------------------------------
+# TEMPORARY SHIM until h-reader lands: h-reader adds the real ``read_tests`` (one RawTest per
+# specimen/block).  Until then a file is one test.  Delete this block when merging h-reader.
+# ------------------------------------------------------------------------------------------------
+def read_tests(path, **kw) -> list[RawTest]:
+    """Every test in one file: one :class:`RawTest` per specimen or block (SHIM: one per file for now).
+
+    Takes the keywords of :func:`read_test`.
+
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     _ = Path(folder, "t.csv").write_text("time_s,stroke_mm,force_n\\n" + "".join(
+    ...         f"{i},{i % 7},{7 - i % 7}\\n" for i in range(30)))
+    ...     tests = read_tests(Path(folder, "t.csv"), pressure_kpa=100.0)
+    >>> len(tests), tests[0].pressure_kpa
+    (1, 100.0)
+    """
+    return [read_test(path, **kw)]  # SHIM until h-reader lands

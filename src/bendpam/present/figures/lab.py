@@ -57,7 +57,9 @@ def _loops_panel(ax, processed) -> None:
             for ci in range(r.n_cycles):
                 ax.plot(r.curvature_grid, r.branches[ci, 0], color=c, lw=0.7)
                 ax.plot(r.curvature_grid, r.branches[ci, 1], color=c, lw=0.7)
-        ax.plot(r.curvature_grid, r.mean_curve, "--", color=c, lw=1.2, label=f"{r.pressure_kpa:g} kPa")
+        rep = int(getattr(r, "replicate", 1))  # a second test at one pressure is a replicate: #2, #3, ...
+        ax.plot(r.curvature_grid, r.mean_curve, "--", color=c, lw=1.2,
+                label=f"{r.pressure_kpa:g} kPa" + (f" #{rep}" if rep > 1 else ""))
     ax.set_xlabel("curvature |k'| (1/mm)")
     ax.set_ylabel("moment |M| (N·mm)")
     ax.set_title("(a) cyclic loops\n(dashed: mean of the branches)")

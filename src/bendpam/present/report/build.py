@@ -27,7 +27,7 @@ from bendpam.lab.files import collect_raw_files
 from bendpam.physics.actuator import Actuator
 from bendpam.physics.fixture import PAPER_FIXTURE, Fixture
 from bendpam.physics.presets import normalise_model
-from bendpam.present.report.findings import report_warnings
+from bendpam.present.report.findings import plausibility_warnings, report_warnings
 from bendpam.present.report.html import render_page
 from bendpam.present.report.plots import draw_figures
 from bendpam.present.report.tables import table2_rows, table3_rows
@@ -142,7 +142,8 @@ def build_report(
         tests, processed = _read_and_process(files, pressures, fx, opts, bar)
         summary = processed.summary()
         fits, failed = _fit_models(processed, actuator, model_names, free_names, bar)
-        warnings = _judge(processed, actuator, fits, failed, tests, model_names[0], free_names, bar)
+        warnings = plausibility_warnings(processed) + _judge(processed, actuator, fits, failed, tests, model_names[0],
+                                                              free_names, bar)
         loops = has_loop(processed)
         hyst, separate, hyst_error = _loop_fit(processed, actuator, fits, free_names, loops, bar)
         figures, notes, stresses = draw_figures(processed, actuator, fits, model_names, hyst, separate, bar)
@@ -203,13 +204,13 @@ def _arguments(inputs, actuator, out_html, models, free, pressure_kpa, fixture, 
 
 def _read_and_process(files, pressures, fx: Fixture, opts, bar):
     """Read every file (one step each) and process the cycles (one step): ``(tests, processed)``."""
-    from bendpam.lab import read_test
+    from bendpam.lab import read_tests
     from bendpam.lab.processing import process_tests
 
     tests = []
     for f, p in zip(files, pressures, strict=True):
         bar.advance(0, description=f"report: reading {f.name}")
-        tests.append(read_test(f, pressure_kpa=p))
+        tests.extend(read_tests(f, pressure_kpa=p))  # every specimen or block of the file
         bar.advance()
     bar.advance(0, description="report: processing the cycles")
     processed = process_tests(tests, fixture=fx, options=opts)

@@ -26,7 +26,7 @@ from bendpam.present.report.text import (
     symbol,
 )
 
-__all__ = ["ReportWarning", "diagnosis", "fit_notes", "report_warnings"]
+__all__ = ["ReportWarning", "diagnosis", "fit_notes", "plausibility_warnings", "report_warnings"]
 
 
 @dataclass(frozen=True)
@@ -36,7 +36,8 @@ class ReportWarning:
     Attributes
     ----------
     kind : ``"fit-failed"``, ``"poor-fit"``, ``"not-converged"``, ``"at-bound"``, ``"correlated"``,
-        ``"fold"``, ``"deadband"`` or ``"direction"`` (:data:`bendpam.identify.diagnose.KINDS`).
+        ``"fold"``, ``"deadband"`` or ``"direction"`` (:data:`bendpam.identify.diagnose.KINDS`), or
+        ``"implausible"`` (a test no bending actuator gives: :func:`plausibility_warnings`).
     title : one line (plain text with symbols such as α₀ and P_start).
     meaning : what it means for the results.
     action : what to try.
@@ -200,6 +201,26 @@ def _direction(f: Finding) -> ReportWarning:
 
 
 _DATA_WORDS = {"fit-failed": _fit_failed, "deadband": _deadband, "direction": _direction}
+
+
+def plausibility_warnings(processed) -> list[ReportWarning]:
+    """A warning per plausibility finding of the processed tests (:mod:`bendpam.lab.plausibility`), naming the test.
+
+    >>> from types import SimpleNamespace as NS
+    >>> found = {"check": "loss-ratio", "message": "c.csv (200 kPa): energy-loss ratio 68.0 % is above 60 %: ..."}
+    >>> w = plausibility_warnings(NS(findings=[found]))[0]
+    >>> w.kind, w.title
+    ('implausible', 'Implausible test: c.csv (200 kPa): energy-loss ratio 68.0 % is above 60 %: ...')
+    """
+    out = []
+    for f in getattr(processed, "findings", []):
+        out.append(ReportWarning(
+            "implausible", f"Implausible test: {f['message']}",
+            "These numbers cannot come from a bending actuator in this fixture; the tables, the fits and the "
+            "deadband include them as they are.",
+            "Check that the file is a four-point-bending cyclic test of this actuator and that its force is in N "
+            "and its stroke in mm; remove it from the input if it is not."))
+    return out
 
 
 def report_warnings(processed, actuator: Actuator, fits: Mapping, *, metadata: Iterable[tuple[str, Mapping]] = (),

@@ -171,12 +171,20 @@ def _warnings_context(warnings: Sequence[ReportWarning]) -> dict:
 def _tests_context(actuator, summary: dict, mean_ratio: float) -> dict:
     """Section 1: Table 2, the deadband, the processing notes."""
     rows = []
-    for r, txt in zip(summary["pressures"], table2_rows(summary), strict=True):
+    groups = {float(g["pressure_kpa"]): g for g in summary.get("replicates", [])}
+    tests = summary["pressures"]
+    for k, (r, txt) in enumerate(zip(tests, table2_rows(summary), strict=True)):
+        group = groups.get(float(r["pressure_kpa"])) or {}
+        several = int(group.get("n", 1)) > 1
+        label = f"{txt['pressure_kpa']} (#{r.get('replicate', 1)})" if several else txt["pressure_kpa"]
         rows.append(_Row([
-            _td(txt["pressure_kpa"], r["pressure_kpa"]), _td(txt["cycles"], r["cycles"]),
+            _td(label, r["pressure_kpa"]), _td(txt["cycles"], r["cycles"]),
             _td(txt["blocked_moment_nmm"], r["blocked_moment_nmm"], r["blocked_moment_se_nmm"], "num pm"),
             _td(txt["free_curvature_per_mm"], r["free_curvature_per_mm"], r["free_curvature_se_per_mm"], "num pm"),
-            _td(txt["energy_loss_percent"], r["energy_loss_ratio"])]))
+            _td(txt["energy_loss_percent"], r["energy_loss_ratio"])],
+            attrs={"data-source": str(r.get("source", "")), "data-replicate": str(r.get("replicate", 1))}))
+        if several and (k + 1 == len(tests) or float(tests[k + 1]["pressure_kpa"]) != float(r["pressure_kpa"])):
+            rows.append(_replicate_row(group))
     table = _Table("table2",
                    "Table 2. Blocked moment, free-bending curvature and energy-loss ratio of the cyclic tests",
                    ["P (kPa)", "Cycles", Markup("Blocked moment M<sub>b</sub> (N·mm)"),
@@ -186,7 +194,22 @@ def _tests_context(actuator, summary: dict, mean_ratio: float) -> dict:
             "deadband": {"value": db, "se": db_se, "text": fmt_value(db, db_se, "kPa"),
                          "p_start": fmt_value(actuator.P_start_kpa, unit="kPa")},
             "processing_notes": [f"{r['pressure_kpa']:g} kPa: {note}" for r in summary["pressures"]
-                                 for note in r["notes"]]}
+                                 for note in r["notes"]],
+            "skipped_files": [f"{f['file']}: {f.get('reason', '')}" for f in summary.get("files", [])
+                              if f.get("status") == "skipped"]}
+
+
+def _replicate_row(group: dict) -> _Row:
+    """The mean of the replicates at one pressure, ± their standard deviation, with their number."""
+    p = float(group["pressure_kpa"])
+    return _Row([
+        _td(f"{p:g} mean (n = {group['n']})", p), _td("", None, cls=""),
+        _td(fmt_value(group["blocked_moment_nmm"], group["blocked_moment_std_nmm"]), group["blocked_moment_nmm"],
+            group["blocked_moment_std_nmm"], "num pm"),
+        _td(fmt_value(group["free_curvature_per_mm"], group["free_curvature_std_per_mm"]),
+            group["free_curvature_per_mm"], group["free_curvature_std_per_mm"], "num pm"),
+        _td(fmt_pct(group["energy_loss_ratio"]), group["energy_loss_ratio"])],
+        attrs={"class": "replicate-mean", "data-n": str(group["n"])})
 
 
 def _fits_context(fits: Mapping, failed: Mapping[str, str]) -> dict:
