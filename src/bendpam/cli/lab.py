@@ -142,16 +142,16 @@ def process(
     read_kw = {"columns": columns, "rate_hz": rate_hz, "repair": repair}
     per_file = (pressures * len(files) if len(pressures) == 1 else pressures) if pressures else None
     try:
-        with Progress(len(files) + 1, "process", quiet=quiet) as bar:
+        # the output target is checked (and locked) before any work; a refusal inside leaves it unchanged
+        with output_set(out, inputs) as o, Progress(len(files) + 1, "process", quiet=quiet) as bar:
             processed = process_files(files, pressures_kpa=per_file, fixture=fx, options=opts, keep_going=keep_going,
                                       read_options=read_kw, on_file=lambda _f: bar.advance())
             bar.advance(0, description="process: writing")
-            with output_set(out, inputs) as o:
-                processed.save(o.staging, figure=False)
-                if figure:
-                    from bendpam.present.figures import save_figure
+            processed.save(o.staging, figure=False)
+            if figure:
+                from bendpam.present.figures import save_figure
 
-                    save_figure(processed.plot(), o.path(fig_name))
+                save_figure(processed.plot(), o.path(fig_name))
             bar.advance()
     except FilesRefused as exc:  # every bad file, one line each; raised before anything is written
         for problem in exc.problems:
