@@ -12,7 +12,6 @@ from bendpam.cli.app import app
 from bendpam.cli.options import (
     ActuatorOpt,
     FigureFormatOpt,
-    Model,
     ModelOpt,
     PresetOpt,
     QuietOpt,
@@ -60,7 +59,7 @@ def fit(
     processed_dir: Annotated[Path, typer.Argument(help="Output folder of `bendpam process`.", show_default=False)],
     preset: PresetOpt = None,
     actuator: ActuatorOpt = None,
-    model: ModelOpt = Model.energy,
+    model: ModelOpt = None,
     free: Annotated[str, typer.Option("--free", help="Parameters to identify: alpha0,C10,C01,P_start,E_f,R0_start.")]
     = "alpha0,C10,C01",
     tension: Annotated[Optional[Path], typer.Option(

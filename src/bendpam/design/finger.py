@@ -87,7 +87,7 @@ from bendpam.errors import InputError, NoEquilibrium
 from bendpam.infra.accessors import figure
 from bendpam.physics.actuator import Actuator
 from bendpam.physics.law import MomentLaw, StableBranch
-from bendpam.physics.models import normalise_model
+from bendpam.physics.models import resolve_model
 from bendpam.validate import number
 
 if TYPE_CHECKING:
@@ -112,7 +112,7 @@ __all__ = [
 # ------------------------------------------------------------------------------------------------
 # the moment law on its stable branch
 # ------------------------------------------------------------------------------------------------
-def stable_branch(actuator: Actuator, pressure_kpa, model: str = "energy",
+def stable_branch(actuator: Actuator, pressure_kpa, model: str | None = None,
                   friction_nmm: float = 0.0) -> StableBranch:
     """The stable branch of the moment law at ``pressure_kpa`` (kPa): see :class:`bendpam.StableBranch`.
 
@@ -147,7 +147,8 @@ class Finger:
     ----------
     actuator : Actuator
         The actuator; its ``L0_mm`` is the finger's active length.
-    model : {"energy", "force_balance"}
+    model : {"energy", "force_balance"} or None
+        None (default): the actuator's own model (energy when unknown); another than the actuator's warns.
     base_xy_mm : (float, float)
         Position of the frame line's base, mm.
     base_angle_deg : float
@@ -180,7 +181,7 @@ class Finger:
     """
 
     actuator: Actuator
-    model: str = "energy"
+    model: str | None = None
     base_xy_mm: tuple[float, float] = (0.0, 0.0)
     base_angle_deg: float = 0.0
     bend: int = 1
@@ -197,7 +198,7 @@ class Finger:
         if self.actuator.bend_sign == 0:
             raise InputError(f"alpha0_deg = {self.actuator.alpha0_deg:g} deg is the neutral braid angle: "
                              "the actuator does not bend, so it cannot be a finger")
-        s(self, "model", normalise_model(self.model))
+        s(self, "model", resolve_model(self.actuator, self.model))
         s(self, "base_xy_mm", checked_pair("base_xy_mm", self.base_xy_mm, "mm"))
         s(self, "base_angle_deg", number("base_angle_deg", self.base_angle_deg, -720.0, 720.0, unit="deg"))
         b = self.bend

@@ -91,7 +91,7 @@ from bendpam.infra.accessors import figure
 from bendpam.infra.progress import Progress
 from bendpam.infra.scheduler import parse_scheduler_address, probe_scheduler
 from bendpam.physics.actuator import Actuator
-from bendpam.physics.models import normalise_model
+from bendpam.physics.models import resolve_model
 from bendpam.predict import blocked_moment, free_branch, free_curvature, tangent_stiffness
 from bendpam.sweeps import evaluate_cases, sweep
 
@@ -213,7 +213,7 @@ def _progress(total: int, description: str, show: bool | None) -> Any:
     return Progress(total, description, quiet=not show)
 
 
-def design_actuator(base: Actuator, targets: Iterable[Target | str], vary, *, model: str = "energy",
+def design_actuator(base: Actuator, targets: Iterable[Target | str], vary, *, model: str | None = None,
                     max_pressure_kpa: float | None = None, min_margin: float = 1.0, n_coarse: int = 2048,
                     n_starts: int = 4, pareto: bool | None = None, scheduler: str | None = None, seed: int = 0,
                     progress: bool | None = None) -> DesignResult:
@@ -228,7 +228,8 @@ def design_actuator(base: Actuator, targets: Iterable[Target | str], vary, *, mo
         negative blocked moment is met by a positive value).
     vary : Variable objects, texts ``NAME=LOW:HIGH`` or a mapping ``{name: (low, high)}`` of
         :data:`DESIGN_VARIABLES` (units in the names).
-    model : ``"energy"`` or ``"force_balance"``.
+    model : ``"energy"``, ``"force_balance"`` or None (default): the base actuator's own model (energy
+        when unknown); another than the actuator's warns (:class:`~bendpam.errors.ModelMismatchWarning`).
     max_pressure_kpa : the operating pressure (kPa): every margin must hold up to it, and the
         fold or lock-up pressure must exceed it by ``min_margin``.  Default: the highest target
         pressure.
@@ -256,7 +257,7 @@ def design_actuator(base: Actuator, targets: Iterable[Target | str], vary, *, mo
     t_start = time.perf_counter()
     if not isinstance(base, Actuator):
         raise TypeError(f"base must be a bendpam.Actuator, got {type(base).__name__}")
-    model = normalise_model(model)
+    model = resolve_model(base, model)
     tg = parse_targets(targets)
     variables = parse_variables(base, vary)
     n_coarse, n_starts, want_pareto = _checked_search(tg, max_pressure_kpa, min_margin, n_coarse, n_starts, pareto)

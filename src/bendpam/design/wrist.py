@@ -58,7 +58,7 @@ from bendpam.infra.accessors import figure
 from bendpam.physics import presets
 from bendpam.physics.actuator import Actuator
 from bendpam.physics.law import MomentLaw, StableBranch
-from bendpam.physics.models import normalise_model
+from bendpam.physics.models import normalise_model, resolve_model
 from bendpam.validate import number
 
 __all__ = [
@@ -92,7 +92,8 @@ class Wrist:
     ----------
     actuator : Actuator
         The actuators (default: the paper's BC-PAM with the model's constants).
-    model : {"energy", "force_balance"}
+    model : {"energy", "force_balance"} or None
+        None (default): the actuator's own model (energy when unknown); another than the actuator's warns.
     radius_mm : float
         Mounting radius of the actuators around the column axis, mm (default 20: four tubes of
         17 mm diameter around a thin column).  Geometry only (see the module docstring).
@@ -114,7 +115,7 @@ class Wrist:
     """
 
     actuator: Actuator | None = None
-    model: str = "energy"
+    model: str | None = None
     radius_mm: float = DEFAULT_RADIUS_MM
     length_mm: float | None = None
     lateral_stiffness_nmm2: float | None = None
@@ -123,11 +124,11 @@ class Wrist:
 
     def __post_init__(self):
         s = object.__setattr__
-        s(self, "model", normalise_model(self.model))
         if self.actuator is None:
-            s(self, "actuator", presets.bc_pam(self.model))
+            s(self, "actuator", presets.bc_pam(normalise_model(self.model or "energy")))
         if not isinstance(self.actuator, Actuator):
             raise TypeError(f"actuator must be a bendpam.Actuator, got {type(self.actuator).__name__}")
+        s(self, "model", resolve_model(self.actuator, self.model))
         if self.actuator.bend_sign == 0:
             raise InputError("the actuator has the neutral braid angle (54.74 deg): it does not bend")
         s(self, "radius_mm", number("radius_mm", self.radius_mm, 0.0, 1e3, unit="mm"))

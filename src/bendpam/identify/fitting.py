@@ -125,7 +125,7 @@ from bendpam.physics.actuator import NEUTRAL_ANGLE_DEG, Actuator
 from bendpam.physics.braid import DEFAULT_ORDER
 from bendpam.physics.law import MomentLaw
 from bendpam.physics.material import admissible_shape_range
-from bendpam.physics.models import normalise_model
+from bendpam.physics.models import resolve_model
 from bendpam.validate import PLAUSIBLE
 
 __all__ = ["PAPER_START", "fit", "parse_free"]
@@ -392,7 +392,7 @@ def _loop_law(hysteresis, hysteresis_law: str, processed) -> str | None:
     return key
 
 
-def fit(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C10", "C01"), *,
+def fit(processed, actuator: Actuator, model: str | None = None, free=("alpha0", "C10", "C01"), *,
         bounds: dict[str, tuple[float, float]] | None = None, tension=None, tension_data=None,
         order: int = DEFAULT_ORDER, eq19_factor: bool = True, grid_alpha: int = 41, grid_r0: int = 9,
         corr_flag: float = LIMITS.correlation,
@@ -409,7 +409,8 @@ def fit(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C
     ----------
     processed : :class:`bendpam.lab.processing.ProcessedSet` (or ``load_processed(dir)``).
     actuator : the nominal actuator (geometry, and the values of the parameters held fixed).
-    model : ``"energy"`` or ``"force_balance"``.
+    model : ``"energy"``, ``"force_balance"`` or None (default): the start actuator's own model (energy when
+        unknown).  Fitting the other model from its constants is deliberate and does not warn.
     free : names among alpha0, C10, C01, P_start, E_f, R0_start (aliases such as ``alpha0_deg`` work).
     bounds : overrides of the default bounds, ``{name: (lo, hi)}`` in the parameter's unit;
         ``"shape"`` narrows the admissible shapes C01/(C10 + C01).
@@ -459,7 +460,7 @@ def fit(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C
     (True, True)
     """
     t0 = time.perf_counter()
-    model = normalise_model(model)
+    model = resolve_model(actuator, model, warn=False)  # fitting another model from these constants is deliberate
     free = parse_free(free)
     if tension is not None:
         actuator = actuator.replace(C10_kpa=tension.C10_kpa, C01_kpa=tension.C01_kpa)
