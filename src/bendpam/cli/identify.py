@@ -106,11 +106,8 @@ def fit(
                       admissible_range=admissible_range)
         bar.advance(0, description="fit (writing)")
         with output_set(out, [processed_dir, actuator, tension]) as o:
-            res.save(o.staging)
-            if tfit is not None:
-                obj = json.loads((o.staging / "fit.json").read_text())
-                obj["tension"] = tfit.to_dict()
-                o.write_json("fit.json", obj)
+            res.save(o.staging, processed=Path(processed_dir).resolve().name,
+                     extra={"tension": tfit.to_dict()} if tfit is not None else None)
             if figure:  # matplotlib is imported only when a figure is drawn
                 from bendpam.present.figures import figure7, save_figure
 

@@ -130,7 +130,7 @@ def stable_branch(actuator: Actuator, pressure_kpa, model: str | None = None,
     """
     if not isinstance(actuator, Actuator):
         raise TypeError(f"actuator must be a bendpam.Actuator, got {type(actuator).__name__}")
-    P = checked_pressure_kpa(pressure_kpa)
+    P = checked_pressure_kpa(pressure_kpa, actuator=actuator)
     fr = number("friction_nmm", friction_nmm, unit="N*mm")
     with pressures_checked():
         return MomentLaw.of(actuator, model).stable_branch(P, fr)
@@ -534,7 +534,7 @@ def solve_finger(finger: Finger, pressure_kpa, loads: FingerLoads | None = None)
     (True, True)
     """
     loads = check_finger(finger, loads)
-    P = checked_pressure_kpa(pressure_kpa)
+    P = checked_pressure_kpa(pressure_kpa, actuator=finger.actuator)
     with pressures_checked():
         return _solve_finger(finger, P, loads)
 
@@ -617,7 +617,7 @@ def finger_sweep(finger: Finger, pressures_kpa, loads: FingerLoads | None = None
     import pandas as pd
 
     loads = check_finger(finger, loads)
-    P = checked_pressures_kpa(pressures_kpa)
+    P = checked_pressures_kpa(pressures_kpa, actuator=finger.actuator)
     with pressures_checked():
         shapes = [_solve_finger(finger, float(p), loads) for p in P]
     return pd.DataFrame({
@@ -764,7 +764,7 @@ def free_tip_trajectory(finger: Finger, pressures_kpa):
 
     if not isinstance(finger, Finger):
         raise TypeError(f"finger must be a bendpam.design.Finger, got {type(finger).__name__}")
-    P = checked_pressures_kpa(pressures_kpa)
+    P = checked_pressures_kpa(pressures_kpa, actuator=finger.actuator)
     with pressures_checked():
         fb = finger.law.free_curvature(P)
     k = fb.curvature_per_mm

@@ -259,6 +259,7 @@ def design_actuator(base: Actuator, targets: Iterable[Target | str], vary, *, mo
         raise TypeError(f"base must be a bendpam.Actuator, got {type(base).__name__}")
     model = resolve_model(base, model)
     tg = parse_targets(targets)
+    base.outside_tested([t.pressure_kpa for t in tg if t.pressure_kpa is not None])  # warns outside the tests
     variables = parse_variables(base, vary)
     n_coarse, n_starts, want_pareto = _checked_search(tg, max_pressure_kpa, min_margin, n_coarse, n_starts, pareto)
     scheduler = _checked_scheduler(scheduler)
@@ -637,6 +638,45 @@ def _achieved(prob: DesignProblem, act: Actuator) -> np.ndarray:
     return out
 
 
+#: The factors on P_start of the deadband study (:func:`_deadband`): the deadband moved by -20 % and +20 %.
+DEADBAND_FACTORS = (0.8, 1.2)
+
+
+def _deadband(prob: DesignProblem, act: Actuator) -> dict[str, Any]:
+    """What the design delivers if its deadband ``P_start`` is not the one assumed (x 0.8 and x 1.2).
+
+    The search keeps the base actuator's ``P_start`` (and its prestrain ratio ``R0_start / R0``) while it
+    varies the geometry; the threshold of a real bladder moves with it (docs/design.md, "The deadband").
+    Each target is recomputed with the public prediction functions at ``P_start * factor``.
+    """
+    import warnings
+
+    values = np.array([t.value for t in prob.targets])
+    rows: list[dict[str, Any]] = []
+    for f in DEADBAND_FACTORS:
+        row: dict[str, Any] = {"factor": f, "P_start_kpa": act.P_start_kpa * f}
+        try:
+            with warnings.catch_warnings():  # the design's own warnings were given once already
+                warnings.simplefilter("ignore")
+                ach = _achieved(prob, act.replace(P_start_kpa=act.P_start_kpa * f))
+        except BendpamError as exc:
+            rows.append({**row, "achieved": None, "relative_error": None, "met": None, "note": str(exc)})
+            continue
+        with np.errstate(invalid="ignore", divide="ignore"):
+            rel = ach / values - 1.0
+        met = [bool(abs(float(t.miss(np.array([a]))[0])) <= TOL) for t, a in zip(prob.targets, ach, strict=True)]
+        rows.append({**row, "achieved": [float(a) for a in ach], "relative_error": [float(e) for e in rel],
+                     "met": met, "note": ""})
+    varied = any(v.name == "P_start_kpa" for v in prob.variables)
+    return {"P_start_kpa": act.P_start_kpa, "R0_start_mm": act.R0_start_mm, "assumed": not varied,
+            "meaning": ("P_start is a design variable; the rows show the targets if the built actuator's "
+                        "threshold differs from it by -20 % / +20 %" if varied else
+                        "P_start is the base actuator's and R0_start keeps its ratio R0_start / R0: both assumed, "
+                        "not modelled from the bladder and sleeve geometry; the rows show the targets if the "
+                        "deadband moves by -20 % / +20 %"),
+            "moved": rows}
+
+
 def _sensitivities(prob: DesignProblem, x: np.ndarray) -> dict[str, dict[str, float]]:
     """``d ln q / d ln x`` of each target quantity (and the smallest margin) by central differences."""
     n = x.size
@@ -724,7 +764,8 @@ def _result(prob: DesignProblem, x: np.ndarray, binding, detail: str, front, coa
         achieved=achieved, relative_error=rel, met=met, feasible=feasible, message=message, binding=tuple(binding),
         active=tuple(active), closest=None if feasible else dict(values), margins=margins, margins_by_pressure=by_p,
         min_margin=mmin, min_margin_required=prob.min_margin, max_pressure_kpa=prob.p_op,
-        sensitivities=_sensitivities(prob, x), coarse=coarse, pareto=front, search=search)
+        sensitivities=_sensitivities(prob, x), coarse=coarse, pareto=front, search=search,
+        deadband=_deadband(prob, act))
 
 
 # ------------------------------------------------------------------------------------------------

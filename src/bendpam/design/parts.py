@@ -90,11 +90,13 @@ def _numeric_pressures(value, name: str) -> np.ndarray:
     return p
 
 
-def checked_pressure_kpa(value, name: str = "pressure_kpa") -> float:
+def checked_pressure_kpa(value, name: str = "pressure_kpa", actuator=None) -> float:
     """One gauge pressure in kPa as a float (:func:`bendpam.validate.pressure_kpa`, and a single value).
 
     A negative, non-finite or non-numeric value raises :class:`~bendpam.errors.InputError`; a
     nonzero value below 5 kPa warns with :class:`~bendpam.validate.UnitWarning` (MPa passed as kPa?).
+    With ``actuator``, a pressure outside its tested range warns
+    (:class:`~bendpam.errors.OutsideTestedRangeWarning`).
 
     >>> checked_pressure_kpa(150)
     150.0
@@ -106,10 +108,12 @@ def checked_pressure_kpa(value, name: str = "pressure_kpa") -> float:
     p = _numeric_pressures(value, name)
     if p.size != 1:
         raise InputError(f"{name} has {p.size} values; give one pressure (kPa)")
+    if actuator is not None:
+        actuator.outside_tested(p)
     return float(p.reshape(()))
 
 
-def checked_pressures_kpa(value, name: str = "pressures_kpa") -> np.ndarray:
+def checked_pressures_kpa(value, name: str = "pressures_kpa", actuator=None) -> np.ndarray:
     """Gauge pressures in kPa as a 1-D float array (at least one), validated as :func:`checked_pressure_kpa`.
 
     >>> checked_pressures_kpa(150).tolist(), checked_pressures_kpa([100, 150]).tolist()
@@ -118,6 +122,8 @@ def checked_pressures_kpa(value, name: str = "pressures_kpa") -> np.ndarray:
     p = np.atleast_1d(_numeric_pressures(value, name)).ravel()
     if p.size == 0:
         raise InputError(f"{name} is empty; give at least one pressure (kPa)")
+    if actuator is not None:
+        actuator.outside_tested(p)
     return p
 
 

@@ -386,6 +386,7 @@ def wrist_bend(wrist: Wrist, pressures_kpa=None, *, direction_deg=None, pressure
         raise InputError("give either the four pressures_kpa or direction_deg and pressure_kpa, not both")
     else:
         P = _four_pressures_kpa(pressures_kpa)
+    wrist._actuator.outside_tested(P[P > 0])  # an actuator left unpressurised is not an extrapolation
     return _bend(wrist, P)
 
 
@@ -499,7 +500,7 @@ def wrist_hold(wrist: Wrist, pressure_kpa, *, load_g: float = BOTTLE_G, lever_mm
     (False, True)
     """
     _check_wrist(wrist)
-    P = checked_pressure_kpa(pressure_kpa)
+    P = checked_pressure_kpa(pressure_kpa, actuator=wrist._actuator)
     mL = number("load_g", load_g, 0.0, unit="g")
     lev = number("lever_mm", lever_mm, 0.0, unit="mm")
     mh = number("hand_mass_g", hand_mass_g, 0.0, unit="g")
@@ -556,7 +557,7 @@ def wrist_sweep(wrist: Wrist, pressures_kpa, directions_deg=(0.0, 90.0, 180.0, 2
     import pandas as pd
 
     _check_wrist(wrist)
-    Ps = checked_pressures_kpa(pressures_kpa)
+    Ps = checked_pressures_kpa(pressures_kpa, actuator=wrist._actuator)
     dirs = [number("directions_deg", d, -720.0, 720.0, unit="deg")
             for d in np.atleast_1d(np.asarray(directions_deg, dtype=object)).ravel()]
     rows = []

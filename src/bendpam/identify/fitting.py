@@ -95,6 +95,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
+from datetime import UTC, datetime
 
 import numpy as np
 
@@ -121,12 +122,13 @@ from bendpam.identify.result import (
     Profile,
 )
 from bendpam.identify.uncertainty import Uncertainty, material_fit, sandwich_covariance
-from bendpam.physics.actuator import NEUTRAL_ANGLE_DEG, Actuator
+from bendpam.physics.actuator import NEUTRAL_ANGLE_DEG, Actuator, FitIdentity
 from bendpam.physics.braid import DEFAULT_ORDER
 from bendpam.physics.law import MomentLaw
 from bendpam.physics.material import admissible_shape_range
 from bendpam.physics.models import resolve_model
 from bendpam.validate import PLAUSIBLE
+from bendpam.version import __version__
 
 __all__ = ["PAPER_START", "fit", "parse_free"]
 
@@ -847,6 +849,9 @@ def _result(processed, actuator: Actuator, run: _Run, unc: Uncertainty, tension,
         message += (f"; fitted with the {law} loop model on both branches (the tests show a loop, median "
                     f"energy-loss ratio {100 * ratio:.1f} %)")
     P = np.array([r.pressure_kpa for r in processed.results], dtype=float)
+    # the fitted actuator remembers where it was tested and which fit made it (save() adds fit.json's hash)
+    fitted = fitted.replace(tested_pressure_kpa=(float(P.min()), float(P.max())), fit_identity=FitIdentity(
+        date=datetime.now(UTC).strftime("%Y-%m-%dT%H:%M:%SZ"), version=__version__))
     return FitResult(
         model=model, actuator=fitted, parameters=params, correlation=unc.corr, correlation_names=unc.names,
         metrics=metrics, converged=run.converged, message=message, nfev=run.nfev, time_s=time.perf_counter() - t0,

@@ -31,7 +31,8 @@ bendpam computes
    ``bladder_stretch_limit``.
 
 Every margin is a safety factor, capacity / demand: ``>= 1`` within the limit, ``inf`` when
-there is no demand (a frame in tension cannot buckle) or no limit is given.  ``min_margin`` is the
+there is no demand (a frame in tension cannot buckle; a demand below ``1e-9`` of the capacity is
+round-off and counts as none) or no limit is given.  ``min_margin`` is the
 smallest; the margins reported per pressure are the worse of the two states.
 
 Buckling model (Hetényi's beam on an elastic foundation)
@@ -256,11 +257,18 @@ def _broadcasts_to(shape: tuple[int, ...], target: tuple[int, ...]) -> bool:
         return False
 
 
+#: A demand below this fraction of the capacity is round-off, not a demand: its margin is inf ("no demand").
+NO_DEMAND = 1e-9
+
+
 def _ratio(capacity, demand):
-    """Safety factor ``capacity / demand``: inf where the demand is <= 0; NaN where the demand is NaN."""
+    """Safety factor ``capacity / demand``: inf where there is no demand (``demand <= NO_DEMAND * capacity``,
+    round-off included, so never a stand-in like 1e15); NaN where the demand is NaN."""
     d = np.asarray(demand, dtype=float)
+    c = np.asarray(capacity, dtype=float)
+    some = d > NO_DEMAND * np.abs(c)
     with np.errstate(divide="ignore", invalid="ignore"):
-        r = np.where(d > 0.0, capacity / np.where(d > 0.0, d, 1.0), np.inf)
+        r = np.where(some, c / np.where(some, d, 1.0), np.inf)
     return np.where(np.isnan(d), np.nan, r)
 
 
