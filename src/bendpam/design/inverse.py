@@ -82,6 +82,7 @@ from typing import Any
 import numpy as np
 
 from bendpam.design.finger import Finger
+from bendpam.design.parts import pressures_checked
 from bendpam.design.problem import MARGIN_CAP, DesignProblem
 from bendpam.design.result import DesignResult, ParetoFront, fmt_margin
 from bendpam.design.targets import TOL, Target, parse_targets, parse_variables
@@ -259,9 +260,10 @@ def design_actuator(base: Actuator, targets: Iterable[Target | str], vary, *, mo
         raise TypeError(f"base must be a bendpam.Actuator, got {type(base).__name__}")
     model = resolve_model(base, model)
     tg = parse_targets(targets)
-    base.outside_tested([t.pressure_kpa for t in tg if t.pressure_kpa is not None])  # warns outside the tests
     variables = parse_variables(base, vary)
     n_coarse, n_starts, want_pareto = _checked_search(tg, max_pressure_kpa, min_margin, n_coarse, n_starts, pareto)
+    base.outside_tested([t.pressure_kpa for t in tg if t.pressure_kpa is not None]
+                        + ([] if max_pressure_kpa is None else [max_pressure_kpa]))  # once, outside the tests
     scheduler = _checked_scheduler(scheduler)
     prob = DesignProblem(base, model, tg, variables, max_pressure_kpa, float(min_margin), int(seed))
     n = len(variables)
@@ -270,7 +272,7 @@ def design_actuator(base: Actuator, targets: Iterable[Target | str], vary, *, mo
     m = math.ceil(math.log2(n_coarse))
     n_map = (1 << m) if scheduler is None else max(2, round(n_coarse ** (1.0 / n))) ** n
     # progress in designs: the coarse map's, then _BLOCK per local search and per final stage
-    with _progress(n_map + _BLOCK * (n_starts + 2), "design", progress) as bar:
+    with _progress(n_map + _BLOCK * (n_starts + 2), "design", progress) as bar, pressures_checked():
         # 1. the coarse map, ranked
         U, X, Q, MG, method = _coarse_map(prob, m, n_coarse, scheduler, seed, bar)
         tip = [i for i, t in enumerate(tg) if t.quantity == "blocked_tip_force_n"]
@@ -290,11 +292,12 @@ def design_actuator(base: Actuator, targets: Iterable[Target | str], vary, *, mo
         front = _pareto(prob, U, Q, MG, seed) if want_pareto else None
         bar.advance(_BLOCK, "design: done")
 
-    return _result(prob, x_best, binding, detail, front,
-                   dict(X=X, quantities=Q, violation=viol, min_margin=_min_margin(MG), method=method),
-                   dict(seed=int(seed), n_coarse=len(X), n_starts=len(starts), coarse_method=method,
-                        evaluations=int(prob.n_evaluations), scheduler=scheduler,
-                        elapsed_s=round(time.perf_counter() - t_start, 3)))
+    with pressures_checked():  # checked above: the designs' own predictions do not warn again
+        return _result(prob, x_best, binding, detail, front,
+                       dict(X=X, quantities=Q, violation=viol, min_margin=_min_margin(MG), method=method),
+                       dict(seed=int(seed), n_coarse=len(X), n_starts=len(starts), coarse_method=method,
+                            evaluations=int(prob.n_evaluations), scheduler=scheduler,
+                            elapsed_s=round(time.perf_counter() - t_start, 3)))
 
 
 def _checked_search(tg: tuple[Target, ...], max_pressure_kpa, min_margin, n_coarse, n_starts,

@@ -3,8 +3,9 @@
 Every public function of :mod:`bendpam.design` validates its pressures once, here
 (:func:`checked_pressure_kpa`, :func:`checked_pressures_kpa`), and then runs its numerics inside
 :func:`pressures_checked` so that the law, evaluated many times at the same pressures, does not
-repeat the :class:`~bendpam.validate.UnitWarning` of a pressure that looks like MPa.  The warning
-is reported at the user's call (the first frame outside :mod:`bendpam.design`).
+repeat the :class:`~bendpam.validate.UnitWarning` of a pressure that looks like MPa, nor the
+:class:`~bendpam.errors.OutsideTestedRangeWarning` of a fitted actuator used outside its tested
+pressures.  The warning is reported at the user's call (the first frame outside :mod:`bendpam.design`).
 
 Units: kPa for every pressure, N for forces, g for masses (weights with g = 9.80665 m/s^2).
 """
@@ -20,7 +21,7 @@ from types import FrameType
 
 import numpy as np
 
-from bendpam.errors import InputError
+from bendpam.errors import InputError, OutsideTestedRangeWarning
 from bendpam.validate import UnitWarning
 from bendpam.validate import pressure_kpa as _check_pressures
 
@@ -131,9 +132,10 @@ def checked_pressures_kpa(value, name: str = "pressures_kpa", actuator=None) -> 
 def pressures_checked() -> Iterator[None]:
     """Run the numerics of a public function whose pressures were already validated.
 
-    The entry point validates (and warns about a suspected MPa value) once; inside, the law is
-    evaluated many times at the same pressures and must not repeat the
-    :class:`~bendpam.validate.UnitWarning`.
+    The entry point validates (and warns about a suspected MPa value, or a pressure outside the
+    actuator's tested range) once; inside, the law is evaluated many times at the same pressures
+    and must not repeat the :class:`~bendpam.validate.UnitWarning` or the
+    :class:`~bendpam.errors.OutsideTestedRangeWarning`.
 
     >>> import warnings
     >>> with warnings.catch_warnings():
@@ -143,6 +145,7 @@ def pressures_checked() -> Iterator[None]:
     """
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UnitWarning)
+        warnings.simplefilter("ignore", OutsideTestedRangeWarning)
         yield
 
 
