@@ -256,17 +256,10 @@ def design_actuator(base: Actuator, targets: Iterable[Target | str], vary, *, mo
     (True, 79.87, 400.0)
     """
     t_start = time.perf_counter()
-    if not isinstance(base, Actuator):
-        raise TypeError(f"base must be a bendpam.Actuator, got {type(base).__name__}")
-    model = resolve_model(base, model)
-    tg = parse_targets(targets)
-    variables = parse_variables(base, vary)
-    n_coarse, n_starts, want_pareto = _checked_search(tg, max_pressure_kpa, min_margin, n_coarse, n_starts, pareto)
-    base.outside_tested([t.pressure_kpa for t in tg if t.pressure_kpa is not None]
-                        + ([] if max_pressure_kpa is None else [max_pressure_kpa]))  # once, outside the tests
-    scheduler = _checked_scheduler(scheduler)
-    prob = DesignProblem(base, model, tg, variables, max_pressure_kpa, float(min_margin), int(seed))
-    n = len(variables)
+    prob, n_coarse, n_starts, want_pareto, scheduler = _problem(base, targets, vary, model, max_pressure_kpa,
+                                                                 min_margin, n_coarse, n_starts, pareto,
+                                                                 scheduler, seed)
+    tg, n = prob.targets, len(prob.variables)
     all_t = list(range(len(tg)))
 
     m = math.ceil(math.log2(n_coarse))
@@ -298,6 +291,26 @@ def design_actuator(base: Actuator, targets: Iterable[Target | str], vary, *, mo
                        dict(seed=int(seed), n_coarse=len(X), n_starts=len(starts), coarse_method=method,
                             evaluations=int(prob.n_evaluations), scheduler=scheduler,
                             elapsed_s=round(time.perf_counter() - t_start, 3)))
+
+
+def _problem(base, targets, vary, model, max_pressure_kpa, min_margin, n_coarse, n_starts, pareto, scheduler,
+             seed) -> tuple[DesignProblem, int, int, bool, Any]:
+    """:func:`design_actuator`'s arguments checked: the problem, the search sizes, the Pareto flag, the scheduler.
+
+    The model is the base actuator's unless ``model`` says otherwise (then it warns once); a target or
+    operating pressure outside a fitted base actuator's tested range warns once here.
+    """
+    if not isinstance(base, Actuator):
+        raise TypeError(f"base must be a bendpam.Actuator, got {type(base).__name__}")
+    model = resolve_model(base, model)
+    tg = parse_targets(targets)
+    variables = parse_variables(base, vary)
+    n_coarse, n_starts, want_pareto = _checked_search(tg, max_pressure_kpa, min_margin, n_coarse, n_starts, pareto)
+    base.outside_tested([t.pressure_kpa for t in tg if t.pressure_kpa is not None]
+                        + ([] if max_pressure_kpa is None else [max_pressure_kpa]))  # once, outside the tests
+    scheduler = _checked_scheduler(scheduler)
+    prob = DesignProblem(base, model, tg, variables, max_pressure_kpa, float(min_margin), int(seed))
+    return prob, n_coarse, n_starts, want_pareto, scheduler
 
 
 def _checked_search(tg: tuple[Target, ...], max_pressure_kpa, min_margin, n_coarse, n_starts,
