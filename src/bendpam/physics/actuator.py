@@ -402,6 +402,8 @@ class Actuator:
             s(self, "R0_start_mm", self.R0_mm)
         else:
             s(self, "R0_start_mm", number("R0_start_mm", self.R0_start_mm, self.R0_mm, unit="mm"))
+        if type(self.model) is not str and isinstance(self.model, str):
+            s(self, "model", str(self.model))  # a plain name (a resolved model name is a str subclass)
         if self.model not in ("", "energy", "force_balance"):
             raise InputError(f"model = {self.model!r}: the model the constants were identified with must be "
                              "'energy', 'force_balance' or '' (unknown)")
