@@ -231,6 +231,9 @@ def internal_stresses(actuator: Actuator, pressure_kpa, curvature_per_mm, *, n_p
                       order: int = DEFAULT_ORDER, max_memory_gib: float | None = MEMORY_BUDGET_GIB) -> Any:
     """Internal state of the force-balance model (eq 37-48) around the cross-section.
 
+    The stress state exists in the force-balance model only: an actuator whose constants were
+    identified with the energy model warns (:class:`~bendpam.errors.ModelMismatchWarning`).
+
     Parameters
     ----------
     pressure_kpa : float or 1-D array, kPa.
