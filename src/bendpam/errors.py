@@ -18,14 +18,41 @@ it is a bug and is reported as one.
 * :class:`FitError`: identification failed for a reason that lies in the data (curves that
   cannot separate two parameters, too few points), explained in terms of the data.
 
-One warning class lives here too: :class:`PlausibilityWarning`, for a result that the models
-computed but that lies beyond a physical plausibility bound (docs/plausibility.md).
+Three warning classes live here too: :class:`PlausibilityWarning`, for a result that the models
+computed but that lies beyond a physical plausibility bound (docs/plausibility.md);
+:class:`ModelMismatchWarning`, for an actuator used with another model than the one its constants
+were identified with; :class:`OutsideTestedRangeWarning`, for a fitted actuator used at pressures
+outside those it was tested at.
 """
 
 from __future__ import annotations
 
-__all__ = ["BendpamError", "FileFormatError", "FitError", "InputError", "InputTypeError", "NoEquilibrium",
-           "PlausibilityWarning", "ProcessingError"]
+__all__ = ["BendpamError", "FileFormatError", "FitError", "InputError", "InputTypeError", "ModelMismatchWarning",
+           "NoEquilibrium", "OutsideTestedRangeWarning", "PlausibilityWarning", "ProcessingError", "warn_user"]
+
+import sys
+import warnings
+from types import FrameType
+
+
+def warn_user(message: str, category: type[Warning] = UserWarning) -> None:
+    """``warnings.warn(message, category)`` located at the user's call: the first frame outside bendpam.
+
+    Python's default filter then shows a warning once per line of the user's code, however deep in
+    bendpam it was raised.
+
+    >>> import warnings
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     warn_user("a word of caution")
+    >>> str(caught[0].message)
+    'a word of caution'
+    """
+    level = 1
+    frame: FrameType | None = sys._getframe(1)
+    while frame is not None and (frame.f_globals.get("__name__", "") + ".").startswith("bendpam."):
+        frame, level = frame.f_back, level + 1
+    warnings.warn(message, category, stacklevel=level + 1)
 
 
 class BendpamError(Exception):
@@ -89,6 +116,42 @@ class PlausibilityWarning(UserWarning):
     ...     _ = bendpam.free_curvature(long, 200.0)
     >>> caught[0].category.__name__, str(caught[0].message)[:59]
     ('PlausibilityWarning', 'free-bending angle 775 deg at 200 kPa is beyond a full turn')
+    """
+
+
+class ModelMismatchWarning(UserWarning):
+    """An actuator evaluated with another model than the one its constants were identified with.
+
+    Table 3 gives different constants for each model; an actuator records its model
+    (:attr:`bendpam.Actuator.model`) and every function that takes it uses that model unless told
+    otherwise.  Asking for the other one explicitly warns in one line naming both.
+
+    Examples
+    --------
+    >>> import warnings, bendpam
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     _ = bendpam.blocked_moment(bendpam.physics.presets.be_pam("force_balance"), 200.0, "energy")
+    >>> caught[0].category.__name__, str(caught[0].message)
+    ('ModelMismatchWarning', 'BE-PAM (paper, force-balance constants): its constants were identified with the
+    force-balance model; using them with the energy model')
+    """
+
+
+class OutsideTestedRangeWarning(UserWarning):
+    """A fitted actuator (or fit) used at a pressure outside the pressures it was tested at.
+
+    The prediction is an extrapolation of the identified constants.
+
+    Examples
+    --------
+    >>> import warnings, bendpam
+    >>> act = bendpam.physics.presets.be_pam().replace(tested_pressure_kpa=(100.0, 200.0))
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     _ = bendpam.blocked_moment(act, 250.0)
+    >>> caught[0].category.__name__, str(caught[0].message)[:73]
+    ('OutsideTestedRangeWarning', 'pressure 250 kPa is outside the tested range [100, 200] kPa of BE-PAM (...')
     """
 
 

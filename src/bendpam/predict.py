@@ -56,6 +56,12 @@ def _law(actuator, model, eq19_factor, order) -> MomentLaw:
     return MomentLaw.of(actuator, model, eq19_factor=eq19_factor, order=order)
 
 
+def _tested(actuator: Actuator, pressure_kpa, result):
+    """``result``, after warning if ``pressure_kpa`` (already validated) is outside the actuator's tested range."""
+    actuator.outside_tested(pressure_kpa)
+    return result
+
+
 def active_pressure_kpa(actuator: Actuator, pressure_kpa) -> np.ndarray:
     """Active pressure ``max(P - P_start, 0)`` in kPa (eq 50).
 
@@ -63,7 +69,7 @@ def active_pressure_kpa(actuator: Actuator, pressure_kpa) -> np.ndarray:
     >>> bendpam.active_pressure_kpa(bendpam.physics.presets.be_pam(), [50, 200]).tolist()
     [0.0, 132.0]
     """
-    return _law(instance("actuator", actuator, Actuator, _ACTUATOR), "energy", True, DEFAULT_ORDER
+    return _law(instance("actuator", actuator, Actuator, _ACTUATOR), None, True, DEFAULT_ORDER
                 ).active_pressure_kpa(pressure_kpa)
 
 
@@ -78,7 +84,7 @@ def kinematics(actuator: Actuator, curvature_per_mm, *, order: int = DEFAULT_ORD
     return _kinematics(instance("actuator", actuator, Actuator, _ACTUATOR), curvature_per_mm, order)
 
 
-def moment(actuator: Actuator, pressure_kpa, curvature_per_mm, model: str = "energy", *,
+def moment(actuator: Actuator, pressure_kpa, curvature_per_mm, model: str | None = None, *,
            eq19_factor: bool = True, order: int = DEFAULT_ORDER) -> np.ndarray:
     """Output moment ``M_load(P, k')`` in N*mm (eq 21 or eq 49, corrected by eq 50-52).
 
@@ -89,8 +95,10 @@ def moment(actuator: Actuator, pressure_kpa, curvature_per_mm, model: str = "ene
         Gauge pressure, kPa, >= 0.
     curvature_per_mm : array_like
         Frame curvature k', 1/mm, within the lock-up limits (:func:`bendpam.curvature_limits`).
-    model : {"energy", "force_balance"}
-        ``"force-balance"`` is accepted too.
+    model : {"energy", "force_balance"} or None
+        ``"force-balance"`` is accepted too.  None (default): the actuator's own model
+        (:attr:`Actuator.model <bendpam.Actuator.model>`, energy when unknown); another model than the
+        actuator's warns (:class:`~bendpam.errors.ModelMismatchWarning`).
     eq19_factor : bool
         Energy model only: keep eq 19's ``(1 + k'R)`` factor (default, as printed).
     order : int
@@ -108,10 +116,11 @@ def moment(actuator: Actuator, pressure_kpa, curvature_per_mm, model: str = "ene
     >>> bendpam.moment(be, [[100.0], [200.0]], [0.0, 0.01]).round(1).tolist()
     [[75.2, -130.1], [310.3, 63.2]]
     """
-    return _law(actuator, model, eq19_factor, order).moment(pressure_kpa, curvature_per_mm)
+    return _tested(actuator, pressure_kpa, _law(actuator, model, eq19_factor, order).moment(pressure_kpa,
+                                                                                           curvature_per_mm))
 
 
-def moment_terms(actuator: Actuator, pressure_kpa, curvature_per_mm, model: str = "energy", *,
+def moment_terms(actuator: Actuator, pressure_kpa, curvature_per_mm, model: str | None = None, *,
                  eq19_factor: bool = True, order: int = DEFAULT_ORDER) -> dict[str, np.ndarray]:
     """The named parts of the moment in N*mm.
 
@@ -123,10 +132,11 @@ def moment_terms(actuator: Actuator, pressure_kpa, curvature_per_mm, model: str 
     >>> sorted(t)
     ['M_air', 'M_bl', 'M_f', 'M_load']
     """
-    return _law(actuator, model, eq19_factor, order).terms(pressure_kpa, curvature_per_mm)
+    return _tested(actuator, pressure_kpa, _law(actuator, model, eq19_factor, order).terms(pressure_kpa,
+                                                                                          curvature_per_mm))
 
 
-def blocked_moment(actuator: Actuator, pressure_kpa, model: str = "energy", *, eq19_factor: bool = True,
+def blocked_moment(actuator: Actuator, pressure_kpa, model: str | None = None, *, eq19_factor: bool = True,
                    order: int = DEFAULT_ORDER) -> np.ndarray:
     """Blocked moment ``M(P, 0)`` in N*mm.
 
@@ -137,10 +147,10 @@ def blocked_moment(actuator: Actuator, pressure_kpa, model: str = "energy", *, e
     >>> round(float(bendpam.blocked_moment(bendpam.physics.presets.be_pam(), 200.0)), 1)
     310.3
     """
-    return _law(actuator, model, eq19_factor, order).blocked_moment(pressure_kpa)
+    return _tested(actuator, pressure_kpa, _law(actuator, model, eq19_factor, order).blocked_moment(pressure_kpa))
 
 
-def tangent_stiffness(actuator: Actuator, pressure_kpa, curvature_per_mm, model: str = "energy", *,
+def tangent_stiffness(actuator: Actuator, pressure_kpa, curvature_per_mm, model: str | None = None, *,
                       eq19_factor: bool = True, order: int = DEFAULT_ORDER) -> np.ndarray:
     """Tangent stiffness ``dM/dk'`` in N*mm^2 (fourth-order central difference of A and B).
 
@@ -148,10 +158,11 @@ def tangent_stiffness(actuator: Actuator, pressure_kpa, curvature_per_mm, model:
     >>> bool(bendpam.tangent_stiffness(bendpam.physics.presets.be_pam(), 150.0, 0.005) < 0)
     True
     """
-    return _law(actuator, model, eq19_factor, order).tangent_stiffness(pressure_kpa, curvature_per_mm)
+    law = _law(actuator, model, eq19_factor, order)
+    return _tested(actuator, pressure_kpa, law.tangent_stiffness(pressure_kpa, curvature_per_mm))
 
 
-def free_branch(actuator: Actuator, model: str = "energy", *, eq19_factor: bool = True,
+def free_branch(actuator: Actuator, model: str | None = None, *, eq19_factor: bool = True,
                 order: int = DEFAULT_ORDER) -> FreeBranch:
     """The free-bending branch of ``actuator``: fold or lock-up pressure and the sampled curve.
 
@@ -163,7 +174,7 @@ def free_branch(actuator: Actuator, model: str = "energy", *, eq19_factor: bool 
     return _law(actuator, model, eq19_factor, order).free_branch()
 
 
-def free_curvature(actuator: Actuator, pressure_kpa, model: str = "energy", *, eq19_factor: bool = True,
+def free_curvature(actuator: Actuator, pressure_kpa, model: str | None = None, *, eq19_factor: bool = True,
                    order: int = DEFAULT_ORDER, xtol: float = 1e-13) -> FreeBending:
     """Free-bending curvature: the root of ``M(P, k') = 0`` on the branch the actuator bends along.
 
@@ -178,7 +189,8 @@ def free_curvature(actuator: Actuator, pressure_kpa, model: str = "energy", *, e
     >>> fb.status.tolist(), round(fb.max_pressure_kpa, 1)
     (['ok', 'no-equilibrium'], 134.2)
     """
-    return _law(actuator, model, eq19_factor, order).free_curvature(pressure_kpa, xtol=xtol)
+    return _tested(actuator, pressure_kpa, _law(actuator, model, eq19_factor, order).free_curvature(pressure_kpa,
+                                                                                                   xtol=xtol))
 
 
 # ------------------------------------------------------------------------------------------------
@@ -219,6 +231,9 @@ def internal_stresses(actuator: Actuator, pressure_kpa, curvature_per_mm, *, n_p
                       order: int = DEFAULT_ORDER, max_memory_gib: float | None = MEMORY_BUDGET_GIB) -> Any:
     """Internal state of the force-balance model (eq 37-48) around the cross-section.
 
+    The stress state exists in the force-balance model only: an actuator whose constants were
+    identified with the energy model warns (:class:`~bendpam.errors.ModelMismatchWarning`).
+
     Parameters
     ----------
     pressure_kpa : float or 1-D array, kPa.
@@ -256,7 +271,7 @@ def internal_stresses(actuator: Actuator, pressure_kpa, curvature_per_mm, *, n_p
     S = np.broadcast_shapes(Pg.shape, k.shape)
     _check_stress_memory(S, P, k, phi.size, max_memory_gib)
     arrays = _stress_arrays(law, Pg, k, phi, S, order)
-    return _stress_dataset(actuator, arrays, P, k, phi)
+    return _tested(actuator, P, _stress_dataset(actuator, arrays, P, k, phi))
 
 
 #: The variables of the stress state that vary around the section (the others are one value per state).
@@ -337,7 +352,7 @@ def _stress_dataset(actuator: Actuator, arrays: dict[str, np.ndarray], P: np.nda
 # ------------------------------------------------------------------------------------------------
 # tables
 # ------------------------------------------------------------------------------------------------
-def prediction_table(actuator: Actuator, pressure_kpa, model: str = "energy", *, eq19_factor: bool = True,
+def prediction_table(actuator: Actuator, pressure_kpa, model: str | None = None, *, eq19_factor: bool = True,
                      order: int = DEFAULT_ORDER) -> Any:
     """Blocked moment, free bending and the structural limits at each pressure, as a :class:`pandas.DataFrame`.
 
@@ -363,7 +378,7 @@ def prediction_table(actuator: Actuator, pressure_kpa, model: str = "energy", *,
     if P.ndim != 1:
         raise InputError(f"pressure_kpa must be a number or a 1-D list of pressures, got shape {P.shape}")
     fb = law.free_curvature(P)
-    lim = limits(actuator, P, model, eq19_factor=eq19_factor, order=order)
+    lim = limits(actuator, P, law.model, eq19_factor=eq19_factor, order=order)  # warns outside the tested range
     return pd.DataFrame(
         {
             "pressure_kpa": P,

@@ -74,7 +74,7 @@ from bendpam.physics.braid import DEFAULT_ORDER
 from bendpam.physics.law import MomentLaw
 from bendpam.physics.limits import OUTPUTS as _LIMIT_OUTPUTS
 from bendpam.physics.limits import case_limits
-from bendpam.physics.models import normalise_model
+from bendpam.physics.models import resolve_model
 from bendpam.validate import instance, plausible
 from bendpam.validate import pressure_kpa as check_pressure
 
@@ -295,7 +295,7 @@ def _block(base, model, names, grids, P, order, eq19, idx_block):
     return out.reshape((*idx_block.shape, P.size, len(_OUTPUTS)))
 
 
-def sweep(base_actuator: Actuator, pressure_kpa, model: str = "energy", *, chunk_cases: int = 256,
+def sweep(base_actuator: Actuator, pressure_kpa, model: str | None = None, *, chunk_cases: int = 256,
           scheduler: str | None = None, workers: int | None = None, compute: bool = True,
           progress: bool | Callable[[int], Any] | None = None, order: int = DEFAULT_ORDER, eq19_factor: bool = True,
           max_memory_gib: float | None = MEMORY_BUDGET_GIB, scheduler_timeout_s: float = SCHEDULER_TIMEOUT_S,
@@ -306,7 +306,8 @@ def sweep(base_actuator: Actuator, pressure_kpa, model: str = "energy", *, chunk
     ----------
     base_actuator : the actuator whose other parameters are kept.
     pressure_kpa : 1-D pressures (kPa).
-    model : ``"energy"`` or ``"force_balance"``.
+    model : ``"energy"``, ``"force_balance"`` or None (default): the base actuator's own model (energy
+        when unknown); another than the actuator's warns (:class:`~bendpam.errors.ModelMismatchWarning`).
     chunk_cases : cases per block (memory bound).
     scheduler : address of a Dask distributed scheduler (e.g. ``"tcp://127.0.0.1:8786"``).
     workers : start a ``LocalCluster`` with this many worker processes (loopback only).
@@ -333,10 +334,11 @@ def sweep(base_actuator: Actuator, pressure_kpa, model: str = "energy", *, chunk
     [[50.1, 77.8], [68.7, 114.2], [80.2, 137.1]]
     """
     instance("base_actuator", base_actuator, Actuator, "a bendpam.Actuator")
-    model = normalise_model(model)
+    model = str(resolve_model(base_actuator, model))  # a plain name: it goes to workers and the attributes
     P = np.atleast_1d(check_pressure(pressure_kpa, limit_kpa=base_actuator.max_pressure_kpa))
     if P.ndim != 1 or P.size == 0:
         raise InputError("pressure_kpa must be a non-empty 1-D list of pressures >= 0 kPa")
+    base_actuator.outside_tested(P)
     grids_d = _grid_values(params)
     names = list(grids_d)
     grids = [grids_d[n] for n in names]

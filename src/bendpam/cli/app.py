@@ -21,6 +21,7 @@ import logging
 import sys
 import traceback
 import warnings
+from contextvars import ContextVar
 from typing import Annotated, Any, Optional
 
 import typer
@@ -88,18 +89,30 @@ def _one_line(exc: BaseException) -> str:
 
 
 def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
-    """``warnings.showwarning`` while a command runs: a PlausibilityWarning is one ``bendpam: warning:`` line."""
-    from bendpam.errors import PlausibilityWarning
+    """``warnings.showwarning`` while a command runs: bendpam's warnings are one ``bendpam: warning:`` line each.
 
-    if issubclass(category, PlausibilityWarning):
+    A :class:`~bendpam.errors.ModelMismatchWarning` or
+    :class:`~bendpam.errors.OutsideTestedRangeWarning` is printed once per command, however many
+    computations of the command raise it.
+    """
+    from bendpam.errors import ModelMismatchWarning, OutsideTestedRangeWarning, PlausibilityWarning
+
+    if issubclass(category, PlausibilityWarning | ModelMismatchWarning | OutsideTestedRangeWarning):
         text = _one_line(message) if isinstance(message, BaseException) else str(message).strip().splitlines()[0]
         if "max_pressure_kpa" in text:
             text += _MAX_PRESSURE_HINT
+        if not issubclass(category, PlausibilityWarning):
+            shown = _SHOWN.get()
+            if text in shown:
+                return
+            _SHOWN.set(shown | {text})
         typer.echo(f"bendpam: warning: {text}", err=True)
     else:
         _SHOW_WARNING(message, category, filename, lineno, file, line)
 
 
+#: The once-per-command warnings already printed by the running command.
+_SHOWN: ContextVar[frozenset[str]] = ContextVar("bendpam_shown_warnings", default=frozenset())
 _SHOW_WARNING = warnings.showwarning
 #: Where a command-line user sets the burst limit (added to a message that names it).
 _MAX_PRESSURE_HINT = (" (max_pressure_kpa is a key of the [actuator] table of an --actuator file; "
@@ -162,6 +175,7 @@ def main(argv: list[str] | None = None) -> int:
     debug = "--debug" in args
     forget_written()
     tokens = (RUN_ARGS.set(list(args)), RUN_COMMAND.set(None), RUN_FORCE.set(False))
+    shown = _SHOWN.set(frozenset())
     try:
         args = _lift_force(args)
         with interrupts(on_signal=quiet_logging), warnings.catch_warnings():
@@ -211,4 +225,5 @@ def main(argv: list[str] | None = None) -> int:
         RUN_ARGS.reset(tokens[0])
         RUN_COMMAND.reset(tokens[1])
         RUN_FORCE.reset(tokens[2])
+        _SHOWN.reset(shown)
     return 0

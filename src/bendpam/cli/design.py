@@ -21,7 +21,6 @@ import typer
 from bendpam.cli.options import (
     ActuatorOpt,
     FigureFormatOpt,
-    Model,
     ModelOpt,
     MultiValueCommand,
     PresetOpt,
@@ -31,7 +30,7 @@ from bendpam.cli.options import (
     echo_wrote,
     figure_format,
     load_actuator,
-    model_name,
+    model_for,
     parse_values,
     pressures_kpa,
 )
@@ -111,7 +110,7 @@ def _length(act, l0_mm):
 def finger_cmd(
     preset: PresetOpt = None,
     actuator: ActuatorOpt = None,
-    model: ModelOpt = Model.energy,
+    model: ModelOpt = None,
     pressure_kpa: PressureOpt = None,
     l0_mm: L0Opt = None,
     tip_force_n: Annotated[Optional[str], typer.Option("--tip-force-n", help="Tip force FX,FY (N).")] = None,
@@ -140,7 +139,7 @@ def finger_cmd(
     act = _length(load_actuator(preset, actuator, model), l0_mm)
     P = pressures_kpa(pressure_kpa)
     _budget(len(P), "--pressure-kpa")
-    mname = model_name(model)
+    mname = model_for(act, model)
     plot = _plot_target(plot, fig_format)
     bend_key = bend.strip().lower()
     if bend_key not in ("ccw", "cw"):
@@ -228,7 +227,7 @@ _GRASP_UNITS = {"grip_force_n": "N (whole gripper: peak load of the quasi-static
 def grasp_cmd(
     preset: PresetOpt = None,
     actuator: ActuatorOpt = None,
-    model: ModelOpt = Model.energy,
+    model: ModelOpt = None,
     diameter_mm: Annotated[
         Optional[list[str]],
         typer.Option("--diameter-mm", help="Sphere diameter(s), mm: '80 120 160', '80,120' or '80:280:6'."),
@@ -278,7 +277,7 @@ def grasp_cmd(
             raise UserError(f"--diameter-mm: {d:g} mm is not a positive diameter")
     P = pressures_kpa(pressure_kpa, None)
     _budget(len(P) * len(D), "--pressure-kpa x --diameter-mm")
-    mname = model_name(model)
+    mname = model_for(act, model)
     plot = _plot_target(plot, fig_format)
     gr = Gripper(act, mname, fingers=fingers,
                  base_radius_mm=DEFAULT_BASE_RADIUS_MM if base_radius_mm is None else base_radius_mm,
@@ -321,7 +320,7 @@ _HOLDING = ("pressure_kpa", "angle_deg", "holds_horizontal", "capacity_g", "equi
 def wrist_cmd(
     preset: PresetOpt = None,
     actuator: ActuatorOpt = None,
-    model: ModelOpt = Model.energy,
+    model: ModelOpt = None,
     pressure_kpa: PressureOpt = None,
     direction_deg: Annotated[
         Optional[list[str]],
@@ -351,7 +350,7 @@ def wrist_cmd(
     P = pressures_kpa(pressure_kpa)
     dirs = parse_values(direction_deg, "--direction-deg") if direction_deg else [0.0, 90.0, 180.0, 270.0]
     _budget(len(P) * len(dirs), "--pressure-kpa x --direction-deg")
-    mname = model_name(model)
+    mname = model_for(act, model)
     plot = _plot_target(plot, fig_format)
     w = Wrist(act, mname, radius_mm=radius_mm, length_mm=length_mm, lateral_stiffness_nmm2=lateral_stiffness,
               column_stiffness_nmm2=column_stiffness)

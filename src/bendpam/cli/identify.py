@@ -12,7 +12,6 @@ from bendpam.cli.app import app
 from bendpam.cli.options import (
     ActuatorOpt,
     FigureFormatOpt,
-    Model,
     ModelOpt,
     PresetOpt,
     QuietOpt,
@@ -60,7 +59,7 @@ def fit(
     processed_dir: Annotated[Path, typer.Argument(help="Output folder of `bendpam process`.", show_default=False)],
     preset: PresetOpt = None,
     actuator: ActuatorOpt = None,
-    model: ModelOpt = Model.energy,
+    model: ModelOpt = None,
     free: Annotated[str, typer.Option("--free", help="Parameters to identify: alpha0,C10,C01,P_start,E_f,R0_start.")]
     = "alpha0,C10,C01",
     tension: Annotated[Optional[Path], typer.Option(
@@ -107,11 +106,8 @@ def fit(
                       admissible_range=admissible_range)
         bar.advance(0, description="fit (writing)")
         with output_set(out, [processed_dir, actuator, tension]) as o:
-            res.save(o.staging)
-            if tfit is not None:
-                obj = json.loads((o.staging / "fit.json").read_text())
-                obj["tension"] = tfit.to_dict()
-                o.write_json("fit.json", obj)
+            res.save(o.staging, processed=Path(processed_dir).resolve().name,
+                     extra={"tension": tfit.to_dict()} if tfit is not None else None)
             if figure:  # matplotlib is imported only when a figure is drawn
                 from bendpam.present.figures import figure7, save_figure
 

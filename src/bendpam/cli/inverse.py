@@ -13,13 +13,12 @@ import typer
 from bendpam.cli.app import app
 from bendpam.cli.options import (
     ActuatorOpt,
-    Model,
     ModelOpt,
     PresetOpt,
     UserError,
     echo_wrote,
     load_actuator,
-    model_name,
+    model_for,
     output_set,
     pressure_kpa,
     pressures_kpa,
@@ -43,7 +42,7 @@ _VARY_HELP = ("A design variable NAME=LOW:HIGH, an actuator parameter (alpha0_de
 def design_cmd(
     preset: PresetOpt = None,
     actuator: ActuatorOpt = None,
-    model: ModelOpt = Model.energy,
+    model: ModelOpt = None,
     target: Annotated[Optional[list[str]], typer.Option("--target", metavar="NAME=VALUE@P", help=_TARGET_HELP)]
     = None,
     vary: Annotated[Optional[list[str]], typer.Option("--vary", metavar="NAME=LOW:HIGH", help=_VARY_HELP)] = None,
@@ -97,7 +96,7 @@ def design_cmd(
         raise UserError(f"--min-margin: {min_margin:g} must be a safety factor >= 1")
     if pareto and len(targets) != 2:
         raise UserError(f"--pareto needs exactly two --target; {len(targets)} given")
-    res = design_actuator(act, targets, variables, model=model_name(model), max_pressure_kpa=max_pressure_kpa,
+    res = design_actuator(act, targets, variables, model=model_for(act, model), max_pressure_kpa=max_pressure_kpa,
                           min_margin=min_margin, n_coarse=n_coarse, n_starts=starts, pareto=pareto,
                           scheduler=scheduler, seed=seed, progress=not quiet)
     if out is not None:

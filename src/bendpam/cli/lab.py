@@ -13,7 +13,6 @@ from bendpam.cli.options import (
     ActuatorOpt,
     FigureFormatOpt,
     Format,
-    Model,
     ModelOpt,
     MultiValueCommand,
     PresetOpt,
@@ -24,7 +23,7 @@ from bendpam.cli.options import (
     echo_wrote,
     fmt_num,
     load_actuator,
-    model_name,
+    model_for,
     output_set,
     parse_values,
     pressures_kpa,
@@ -227,7 +226,7 @@ def _print_table2(summ: dict) -> None:
 def simulate_test_cmd(
     preset: PresetOpt = None,
     actuator: ActuatorOpt = None,
-    model: ModelOpt = Model.energy,
+    model: ModelOpt = None,
     pressure_kpa: PressureOpt = None,
     out: Annotated[
         Optional[Path], typer.Option("--out", help="Output folder for the raw files and truth.json.")] = None,
@@ -273,7 +272,7 @@ def simulate_test_cmd(
     fx = Fixture.from_string(fixture, L0_mm=act.L0_mm, name="--fixture")
     with output_set(out, [actuator]) as o:
         try:
-            truth = simulate_tests(act, P, o.staging, model_name(model), dialect=fmt.value, fixture=fx, settings=st)
+            truth = simulate_tests(act, P, o.staging, model_for(act, model), dialect=fmt.value, fixture=fx, settings=st)
         except InputError as exc:  # the library names the settings; this command's options say them as flags
             raise UserError(_SETTING_FLAGS.sub(lambda m: _FLAGS[m.group(0)], str(exc))) from None
     for t in truth["pressures"]:

@@ -57,6 +57,7 @@ __all__ = [
     "fmt_num",
     "format_prediction_table",
     "load_actuator",
+    "model_for",
     "model_name",
     "output_file",
     "output_format",
@@ -120,7 +121,9 @@ PresetOpt = Annotated[Optional[Preset], typer.Option("--preset", help="Built-in 
 ActuatorOpt = Annotated[
     Optional[Path], typer.Option("--actuator", help="Actuator TOML file (see `bendpam actuator --preset be-pam`).")
 ]
-ModelOpt = Annotated[Model, typer.Option("--model", help="Moment model.")]
+ModelOpt = Annotated[Optional[Model], typer.Option(
+    "--model", help="Moment model (default: the actuator's own, the model its constants were identified with; "
+    "energy for a preset).", show_default=False)]
 PressureOpt = Annotated[
     Optional[list[str]],
     typer.Option("--pressure-kpa", metavar="KPA...", help=f"Gauge pressure(s) in kPa: {RANGE_HELP}."),
@@ -257,21 +260,38 @@ def pressures_kpa(first: list[str] | None, more: list[str] | None = None, name: 
     return values
 
 
-def model_name(model: Model) -> str:
-    """The library's name of a ``--model`` choice.
+def model_name(model: Model | None) -> str | None:
+    """The library's name of a ``--model`` choice (None when not given: the actuator's own model).
 
-    >>> model_name(Model.force_balance)
-    'force_balance'
+    >>> model_name(Model.force_balance), model_name(None)
+    ('force_balance', None)
     """
     from bendpam.physics.models import normalise_model
 
-    return normalise_model(model.value)
+    return None if model is None else normalise_model(model.value)
 
 
-def load_actuator(preset: Preset | None, actuator: Path | None, model: Model) -> Actuator:
-    """The actuator of ``--preset`` or ``--actuator`` (exactly one of them).
+def model_for(act: Actuator, model: Model | None) -> str:
+    """The model a command evaluates ``act`` with: ``--model``, else the actuator's own (energy when unknown).
 
-    >>> load_actuator(Preset.be_pam, None, Model.energy).alpha0_deg
+    A ``--model`` other than the one the actuator's constants were identified with warns once
+    (``bendpam: warning: ...``); the name returned is handed to the library, which does not warn again.
+
+    >>> from bendpam.physics import presets
+    >>> model_for(presets.be_pam("force_balance"), None), model_for(presets.be_pam(), Model.energy)
+    ('force_balance', 'energy')
+    """
+    from bendpam.physics.models import resolve_model
+
+    return resolve_model(act, model_name(model))
+
+
+def load_actuator(preset: Preset | None, actuator: Path | None, model: Model | None) -> Actuator:
+    """The actuator of ``--preset`` (with ``--model``'s Table 3 constants, energy by default) or ``--actuator``.
+
+    Exactly one of them.  Use :func:`model_for` for the model to evaluate it with.
+
+    >>> load_actuator(Preset.be_pam, None, None).alpha0_deg
     69.7
     """
     if preset is not None and actuator is not None:
@@ -282,13 +302,9 @@ def load_actuator(preset: Preset | None, actuator: Path | None, model: Model) ->
     from bendpam.physics.actuator import Actuator
 
     if preset is not None:
-        return presets.get(preset.value, model_name(model))
+        return presets.get(preset.value, model_name(model) or "energy")
     assert actuator is not None  # exactly one of preset and actuator was checked above
-    act = Actuator.from_toml(actuator)
-    if act.model and act.model != model_name(model):
-        echo(f"bendpam: warning: {actuator}: its constants were identified with the {act.model.replace('_', '-')} "
-             f"model; using them with the {model.value} model", err=True)
-    return act
+    return Actuator.from_toml(actuator)
 
 
 def fmt_num(x, fmt: str) -> str:

@@ -27,7 +27,7 @@ from bendpam.cli.options import (
     fmt_num,
     format_prediction_table,
     load_actuator,
-    model_name,
+    model_for,
     output_file,
     output_format,
     pressures_kpa,
@@ -47,7 +47,7 @@ def _data_or_figure(out: Path, fmt, data_formats: tuple[str, ...]) -> str:
 def predict(
     preset: PresetOpt = None,
     actuator: ActuatorOpt = None,
-    model: ModelOpt = Model.energy,
+    model: ModelOpt = None,
     pressure_kpa: PressureOpt = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object instead of a table.")] = False,
     cycle: Annotated[
@@ -69,7 +69,7 @@ def predict(
 
     act = load_actuator(preset, actuator, model)
     P = pressures_kpa(pressure_kpa)
-    mname = model_name(model)
+    mname = model_for(act, model)
     df = prediction_table(act, P, mname)
     br = MomentLaw.of(act, mname).free_branch()
     loop = _loop_model(actuator, loop_law, loop_a0_nmm, loop_a1_nmm_per_kpa, loop_angle_deg) if cycle else None
@@ -175,7 +175,7 @@ def _cycle_json(c) -> dict:
 def curve(
     preset: PresetOpt = None,
     actuator: ActuatorOpt = None,
-    model: ModelOpt = Model.energy,
+    model: ModelOpt = None,
     pressure_kpa: PressureOpt = None,
     out: Annotated[
         Optional[Path], typer.Option("--out", help="Output FILE.csv, or a figure FILE.png/.pdf/.svg.")] = None,
@@ -195,7 +195,7 @@ def curve(
     P = np.asarray(pressures_kpa(pressure_kpa))
     if P.size * points > 10_000_000:
         raise UserError(f"--pressure-kpa x --points = {P.size * points} curve points; at most 10000000")
-    mname = model_name(model)
+    mname = model_for(act, model)
     from bendpam.present.figures import moment_curvature_figure, moment_curves, save_figure
 
     with output_file(out, [actuator]) as f:
@@ -243,7 +243,7 @@ def stresses(
 def actuator_cmd(
     preset: PresetOpt = None,
     actuator: ActuatorOpt = None,
-    model: ModelOpt = Model.energy,
+    model: ModelOpt = None,
     out: Annotated[Optional[Path], typer.Option("--out", help="Write the actuator as TOML here.")] = None,
 ):
     """Show an actuator (TOML, derived values, lock-up limits) or save it as an editable TOML file."""

@@ -13,14 +13,13 @@ from bendpam.cli.app import app
 from bendpam.cli.options import (
     RANGE_HELP,
     ActuatorOpt,
-    Model,
     ModelOpt,
     PresetOpt,
     QuietOpt,
     UserError,
     echo_wrote,
     load_actuator,
-    model_name,
+    model_for,
     output_file,
     output_format,
     parse_values,
@@ -92,7 +91,7 @@ def parse_param(text: str) -> tuple[str, list[float]]:
 def sweep_cmd(
     preset: PresetOpt = None,
     actuator: ActuatorOpt = None,
-    model: ModelOpt = Model.energy,
+    model: ModelOpt = None,
     param: Annotated[
         Optional[list[str]],
         typer.Option("--param", metavar="NAME=VALUES",
@@ -150,7 +149,7 @@ def sweep_cmd(
     from bendpam.infra.progress import Progress
 
     with Progress(n_cases, "sweep", quiet=quiet or not progress) as bar:
-        ds = sweep(act, P, model_name(model), chunk_cases=chunk_cases, scheduler=scheduler, workers=workers,
+        ds = sweep(act, P, model_for(act, model), chunk_cases=chunk_cases, scheduler=scheduler, workers=workers,
                    progress=bar.advance, max_memory_gib=max_memory_gib, **grids)
     if out is not None:
         from bendpam.sweeps import write_sweep

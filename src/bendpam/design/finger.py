@@ -87,7 +87,7 @@ from bendpam.errors import InputError, NoEquilibrium
 from bendpam.infra.accessors import figure
 from bendpam.physics.actuator import Actuator
 from bendpam.physics.law import MomentLaw, StableBranch
-from bendpam.physics.models import normalise_model
+from bendpam.physics.models import resolve_model
 from bendpam.validate import number
 
 if TYPE_CHECKING:
@@ -112,7 +112,7 @@ __all__ = [
 # ------------------------------------------------------------------------------------------------
 # the moment law on its stable branch
 # ------------------------------------------------------------------------------------------------
-def stable_branch(actuator: Actuator, pressure_kpa, model: str = "energy",
+def stable_branch(actuator: Actuator, pressure_kpa, model: str | None = None,
                   friction_nmm: float = 0.0) -> StableBranch:
     """The stable branch of the moment law at ``pressure_kpa`` (kPa): see :class:`bendpam.StableBranch`.
 
@@ -130,7 +130,7 @@ def stable_branch(actuator: Actuator, pressure_kpa, model: str = "energy",
     """
     if not isinstance(actuator, Actuator):
         raise TypeError(f"actuator must be a bendpam.Actuator, got {type(actuator).__name__}")
-    P = checked_pressure_kpa(pressure_kpa)
+    P = checked_pressure_kpa(pressure_kpa, actuator=actuator)
     fr = number("friction_nmm", friction_nmm, unit="N*mm")
     with pressures_checked():
         return MomentLaw.of(actuator, model).stable_branch(P, fr)
@@ -147,7 +147,8 @@ class Finger:
     ----------
     actuator : Actuator
         The actuator; its ``L0_mm`` is the finger's active length.
-    model : {"energy", "force_balance"}
+    model : {"energy", "force_balance"} or None
+        None (default): the actuator's own model (energy when unknown); another than the actuator's warns.
     base_xy_mm : (float, float)
         Position of the frame line's base, mm.
     base_angle_deg : float
@@ -180,7 +181,7 @@ class Finger:
     """
 
     actuator: Actuator
-    model: str = "energy"
+    model: str | None = None
     base_xy_mm: tuple[float, float] = (0.0, 0.0)
     base_angle_deg: float = 0.0
     bend: int = 1
@@ -197,7 +198,7 @@ class Finger:
         if self.actuator.bend_sign == 0:
             raise InputError(f"alpha0_deg = {self.actuator.alpha0_deg:g} deg is the neutral braid angle: "
                              "the actuator does not bend, so it cannot be a finger")
-        s(self, "model", normalise_model(self.model))
+        s(self, "model", resolve_model(self.actuator, self.model))
         s(self, "base_xy_mm", checked_pair("base_xy_mm", self.base_xy_mm, "mm"))
         s(self, "base_angle_deg", number("base_angle_deg", self.base_angle_deg, -720.0, 720.0, unit="deg"))
         b = self.bend
@@ -533,7 +534,7 @@ def solve_finger(finger: Finger, pressure_kpa, loads: FingerLoads | None = None)
     (True, True)
     """
     loads = check_finger(finger, loads)
-    P = checked_pressure_kpa(pressure_kpa)
+    P = checked_pressure_kpa(pressure_kpa, actuator=finger.actuator)
     with pressures_checked():
         return _solve_finger(finger, P, loads)
 
@@ -616,7 +617,7 @@ def finger_sweep(finger: Finger, pressures_kpa, loads: FingerLoads | None = None
     import pandas as pd
 
     loads = check_finger(finger, loads)
-    P = checked_pressures_kpa(pressures_kpa)
+    P = checked_pressures_kpa(pressures_kpa, actuator=finger.actuator)
     with pressures_checked():
         shapes = [_solve_finger(finger, float(p), loads) for p in P]
     return pd.DataFrame({
@@ -763,7 +764,7 @@ def free_tip_trajectory(finger: Finger, pressures_kpa):
 
     if not isinstance(finger, Finger):
         raise TypeError(f"finger must be a bendpam.design.Finger, got {type(finger).__name__}")
-    P = checked_pressures_kpa(pressures_kpa)
+    P = checked_pressures_kpa(pressures_kpa, actuator=finger.actuator)
     with pressures_checked():
         fb = finger.law.free_curvature(P)
     k = fb.curvature_per_mm

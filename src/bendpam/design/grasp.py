@@ -110,7 +110,7 @@ def solve_grasp(gripper: Gripper, diameter_mm, pressure_kpa) -> Grasp:
     """
     _check_gripper(gripper)
     D = number("diameter_mm", diameter_mm, 0.0, 1e5, lo_open=True, unit="mm")
-    P = checked_pressure_kpa(pressure_kpa)
+    P = checked_pressure_kpa(pressure_kpa, actuator=gripper.actuator)
     with pressures_checked():
         return pull_grasps(gripper, [grasp_path(gripper, D, [P])])[0][0]
 
@@ -145,7 +145,7 @@ def solve_grasps(gripper: Gripper, diameters_mm, pressures_kpa) -> list[list[Gra
     """
     _check_gripper(gripper)
     Ds = _diameters_mm(diameters_mm)
-    Ps = checked_pressures_kpa(pressures_kpa)
+    Ps = checked_pressures_kpa(pressures_kpa, actuator=gripper.actuator)
     with pressures_checked():
         return pull_grasps(gripper, [grasp_path(gripper, float(D), [float(p) for p in Ps]) for D in Ds])
 

@@ -21,7 +21,7 @@ from bendpam.design.parts import json_number
 from bendpam.errors import InputError
 from bendpam.physics.actuator import Actuator
 from bendpam.physics.law import MomentLaw
-from bendpam.physics.models import normalise_model
+from bendpam.physics.models import resolve_model
 from bendpam.validate import number
 
 if TYPE_CHECKING:
@@ -55,7 +55,8 @@ class Gripper:
     actuator : Actuator
         The finger actuator; ``L0_mm`` is the finger's active length (the paper's grippers: 130 mm,
         ``actuator.replace(L0_mm=130)``).
-    model : {"energy", "force_balance"}
+    model : {"energy", "force_balance"} or None
+        None (default): the actuator's own model (energy when unknown); another than the actuator's warns.
     fingers : int
         Number of fingers, in [2, 12] (default 3).
     base_radius_mm : float
@@ -93,7 +94,7 @@ class Gripper:
     """
 
     actuator: Actuator
-    model: str = "energy"
+    model: str | None = None
     fingers: int = 3
     base_radius_mm: float = DEFAULT_BASE_RADIUS_MM
     fingertip_mm: float = DEFAULT_FINGERTIP_MM
@@ -107,7 +108,7 @@ class Gripper:
         s = object.__setattr__
         if not isinstance(self.actuator, Actuator):
             raise TypeError(f"actuator must be a bendpam.Actuator, got {type(self.actuator).__name__}")
-        s(self, "model", normalise_model(self.model))
+        s(self, "model", resolve_model(self.actuator, self.model))
         nf = self.fingers
         if isinstance(nf, bool) or not isinstance(nf, int | np.integer) or not 2 <= int(nf) <= 12:
             raise InputError(f"fingers = {nf!r} is outside the allowed range [2, 12] (an integer)")

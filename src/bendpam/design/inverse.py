@@ -82,6 +82,7 @@ from typing import Any
 import numpy as np
 
 from bendpam.design.finger import Finger
+from bendpam.design.parts import pressures_checked
 from bendpam.design.problem import MARGIN_CAP, DesignProblem
 from bendpam.design.result import DesignResult, ParetoFront, fmt_margin
 from bendpam.design.targets import TOL, Target, parse_targets, parse_variables
@@ -91,7 +92,7 @@ from bendpam.infra.accessors import figure
 from bendpam.infra.progress import Progress
 from bendpam.infra.scheduler import parse_scheduler_address, probe_scheduler
 from bendpam.physics.actuator import Actuator
-from bendpam.physics.models import normalise_model
+from bendpam.physics.models import resolve_model
 from bendpam.predict import blocked_moment, free_branch, free_curvature, tangent_stiffness
 from bendpam.sweeps import evaluate_cases, sweep
 
@@ -213,7 +214,7 @@ def _progress(total: int, description: str, show: bool | None) -> Any:
     return Progress(total, description, quiet=not show)
 
 
-def design_actuator(base: Actuator, targets: Iterable[Target | str], vary, *, model: str = "energy",
+def design_actuator(base: Actuator, targets: Iterable[Target | str], vary, *, model: str | None = None,
                     max_pressure_kpa: float | None = None, min_margin: float = 1.0, n_coarse: int = 2048,
                     n_starts: int = 4, pareto: bool | None = None, scheduler: str | None = None, seed: int = 0,
                     progress: bool | None = None) -> DesignResult:
@@ -228,7 +229,8 @@ def design_actuator(base: Actuator, targets: Iterable[Target | str], vary, *, mo
         negative blocked moment is met by a positive value).
     vary : Variable objects, texts ``NAME=LOW:HIGH`` or a mapping ``{name: (low, high)}`` of
         :data:`DESIGN_VARIABLES` (units in the names).
-    model : ``"energy"`` or ``"force_balance"``.
+    model : ``"energy"``, ``"force_balance"`` or None (default): the base actuator's own model (energy
+        when unknown); another than the actuator's warns (:class:`~bendpam.errors.ModelMismatchWarning`).
     max_pressure_kpa : the operating pressure (kPa): every margin must hold up to it, and the
         fold or lock-up pressure must exceed it by ``min_margin``.  Default: the highest target
         pressure.
@@ -254,21 +256,16 @@ def design_actuator(base: Actuator, targets: Iterable[Target | str], vary, *, mo
     (True, 79.87, 400.0)
     """
     t_start = time.perf_counter()
-    if not isinstance(base, Actuator):
-        raise TypeError(f"base must be a bendpam.Actuator, got {type(base).__name__}")
-    model = normalise_model(model)
-    tg = parse_targets(targets)
-    variables = parse_variables(base, vary)
-    n_coarse, n_starts, want_pareto = _checked_search(tg, max_pressure_kpa, min_margin, n_coarse, n_starts, pareto)
-    scheduler = _checked_scheduler(scheduler)
-    prob = DesignProblem(base, model, tg, variables, max_pressure_kpa, float(min_margin), int(seed))
-    n = len(variables)
+    prob, n_coarse, n_starts, want_pareto, scheduler = _problem(base, targets, vary, model, max_pressure_kpa,
+                                                                 min_margin, n_coarse, n_starts, pareto,
+                                                                 scheduler, seed)
+    tg, n = prob.targets, len(prob.variables)
     all_t = list(range(len(tg)))
 
     m = math.ceil(math.log2(n_coarse))
     n_map = (1 << m) if scheduler is None else max(2, round(n_coarse ** (1.0 / n))) ** n
     # progress in designs: the coarse map's, then _BLOCK per local search and per final stage
-    with _progress(n_map + _BLOCK * (n_starts + 2), "design", progress) as bar:
+    with _progress(n_map + _BLOCK * (n_starts + 2), "design", progress) as bar, pressures_checked():
         # 1. the coarse map, ranked
         U, X, Q, MG, method = _coarse_map(prob, m, n_coarse, scheduler, seed, bar)
         tip = [i for i, t in enumerate(tg) if t.quantity == "blocked_tip_force_n"]
@@ -288,11 +285,32 @@ def design_actuator(base: Actuator, targets: Iterable[Target | str], vary, *, mo
         front = _pareto(prob, U, Q, MG, seed) if want_pareto else None
         bar.advance(_BLOCK, "design: done")
 
-    return _result(prob, x_best, binding, detail, front,
-                   dict(X=X, quantities=Q, violation=viol, min_margin=_min_margin(MG), method=method),
-                   dict(seed=int(seed), n_coarse=len(X), n_starts=len(starts), coarse_method=method,
-                        evaluations=int(prob.n_evaluations), scheduler=scheduler,
-                        elapsed_s=round(time.perf_counter() - t_start, 3)))
+    with pressures_checked():  # checked above: the designs' own predictions do not warn again
+        return _result(prob, x_best, binding, detail, front,
+                       dict(X=X, quantities=Q, violation=viol, min_margin=_min_margin(MG), method=method),
+                       dict(seed=int(seed), n_coarse=len(X), n_starts=len(starts), coarse_method=method,
+                            evaluations=int(prob.n_evaluations), scheduler=scheduler,
+                            elapsed_s=round(time.perf_counter() - t_start, 3)))
+
+
+def _problem(base, targets, vary, model, max_pressure_kpa, min_margin, n_coarse, n_starts, pareto, scheduler,
+             seed) -> tuple[DesignProblem, int, int, bool, Any]:
+    """:func:`design_actuator`'s arguments checked: the problem, the search sizes, the Pareto flag, the scheduler.
+
+    The model is the base actuator's unless ``model`` says otherwise (then it warns once); a target or
+    operating pressure outside a fitted base actuator's tested range warns once here.
+    """
+    if not isinstance(base, Actuator):
+        raise TypeError(f"base must be a bendpam.Actuator, got {type(base).__name__}")
+    model = resolve_model(base, model)
+    tg = parse_targets(targets)
+    variables = parse_variables(base, vary)
+    n_coarse, n_starts, want_pareto = _checked_search(tg, max_pressure_kpa, min_margin, n_coarse, n_starts, pareto)
+    base.outside_tested([t.pressure_kpa for t in tg if t.pressure_kpa is not None]
+                        + ([] if max_pressure_kpa is None else [max_pressure_kpa]))  # once, outside the tests
+    scheduler = _checked_scheduler(scheduler)
+    prob = DesignProblem(base, model, tg, variables, max_pressure_kpa, float(min_margin), int(seed))
+    return prob, n_coarse, n_starts, want_pareto, scheduler
 
 
 def _checked_search(tg: tuple[Target, ...], max_pressure_kpa, min_margin, n_coarse, n_starts,
@@ -636,6 +654,45 @@ def _achieved(prob: DesignProblem, act: Actuator) -> np.ndarray:
     return out
 
 
+#: The factors on P_start of the deadband study (:func:`_deadband`): the deadband moved by -20 % and +20 %.
+DEADBAND_FACTORS = (0.8, 1.2)
+
+
+def _deadband(prob: DesignProblem, act: Actuator) -> dict[str, Any]:
+    """What the design delivers if its deadband ``P_start`` is not the one assumed (x 0.8 and x 1.2).
+
+    The search keeps the base actuator's ``P_start`` (and its prestrain ratio ``R0_start / R0``) while it
+    varies the geometry; the threshold of a real bladder moves with it (docs/design.md, "The deadband").
+    Each target is recomputed with the public prediction functions at ``P_start * factor``.
+    """
+    import warnings
+
+    values = np.array([t.value for t in prob.targets])
+    rows: list[dict[str, Any]] = []
+    for f in DEADBAND_FACTORS:
+        row: dict[str, Any] = {"factor": f, "P_start_kpa": act.P_start_kpa * f}
+        try:
+            with warnings.catch_warnings():  # the design's own warnings were given once already
+                warnings.simplefilter("ignore")
+                ach = _achieved(prob, act.replace(P_start_kpa=act.P_start_kpa * f))
+        except BendpamError as exc:
+            rows.append({**row, "achieved": None, "relative_error": None, "met": None, "note": str(exc)})
+            continue
+        with np.errstate(invalid="ignore", divide="ignore"):
+            rel = ach / values - 1.0
+        met = [bool(abs(float(t.miss(np.array([a]))[0])) <= TOL) for t, a in zip(prob.targets, ach, strict=True)]
+        rows.append({**row, "achieved": [float(a) for a in ach], "relative_error": [float(e) for e in rel],
+                     "met": met, "note": ""})
+    varied = any(v.name == "P_start_kpa" for v in prob.variables)
+    return {"P_start_kpa": act.P_start_kpa, "R0_start_mm": act.R0_start_mm, "assumed": not varied,
+            "meaning": ("P_start is a design variable; the rows show the targets if the built actuator's "
+                        "threshold differs from it by -20 % / +20 %" if varied else
+                        "P_start is the base actuator's and R0_start keeps its ratio R0_start / R0: both assumed, "
+                        "not modelled from the bladder and sleeve geometry; the rows show the targets if the "
+                        "deadband moves by -20 % / +20 %"),
+            "moved": rows}
+
+
 def _sensitivities(prob: DesignProblem, x: np.ndarray) -> dict[str, dict[str, float]]:
     """``d ln q / d ln x`` of each target quantity (and the smallest margin) by central differences."""
     n = x.size
@@ -723,7 +780,8 @@ def _result(prob: DesignProblem, x: np.ndarray, binding, detail: str, front, coa
         achieved=achieved, relative_error=rel, met=met, feasible=feasible, message=message, binding=tuple(binding),
         active=tuple(active), closest=None if feasible else dict(values), margins=margins, margins_by_pressure=by_p,
         min_margin=mmin, min_margin_required=prob.min_margin, max_pressure_kpa=prob.p_op,
-        sensitivities=_sensitivities(prob, x), coarse=coarse, pareto=front, search=search)
+        sensitivities=_sensitivities(prob, x), coarse=coarse, pareto=front, search=search,
+        deadband=_deadband(prob, act))
 
 
 # ------------------------------------------------------------------------------------------------

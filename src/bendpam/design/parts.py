@@ -3,8 +3,9 @@
 Every public function of :mod:`bendpam.design` validates its pressures once, here
 (:func:`checked_pressure_kpa`, :func:`checked_pressures_kpa`), and then runs its numerics inside
 :func:`pressures_checked` so that the law, evaluated many times at the same pressures, does not
-repeat the :class:`~bendpam.validate.UnitWarning` of a pressure that looks like MPa.  The warning
-is reported at the user's call (the first frame outside :mod:`bendpam.design`).
+repeat the :class:`~bendpam.validate.UnitWarning` of a pressure that looks like MPa, nor the
+:class:`~bendpam.errors.OutsideTestedRangeWarning` of a fitted actuator used outside its tested
+pressures.  The warning is reported at the user's call (the first frame outside :mod:`bendpam.design`).
 
 Units: kPa for every pressure, N for forces, g for masses (weights with g = 9.80665 m/s^2).
 """
@@ -20,7 +21,7 @@ from types import FrameType
 
 import numpy as np
 
-from bendpam.errors import InputError
+from bendpam.errors import InputError, OutsideTestedRangeWarning
 from bendpam.validate import UnitWarning
 from bendpam.validate import pressure_kpa as _check_pressures
 
@@ -90,11 +91,13 @@ def _numeric_pressures(value, name: str) -> np.ndarray:
     return p
 
 
-def checked_pressure_kpa(value, name: str = "pressure_kpa") -> float:
+def checked_pressure_kpa(value, name: str = "pressure_kpa", actuator=None) -> float:
     """One gauge pressure in kPa as a float (:func:`bendpam.validate.pressure_kpa`, and a single value).
 
     A negative, non-finite or non-numeric value raises :class:`~bendpam.errors.InputError`; a
     nonzero value below 5 kPa warns with :class:`~bendpam.validate.UnitWarning` (MPa passed as kPa?).
+    With ``actuator``, a pressure outside its tested range warns
+    (:class:`~bendpam.errors.OutsideTestedRangeWarning`).
 
     >>> checked_pressure_kpa(150)
     150.0
@@ -106,10 +109,12 @@ def checked_pressure_kpa(value, name: str = "pressure_kpa") -> float:
     p = _numeric_pressures(value, name)
     if p.size != 1:
         raise InputError(f"{name} has {p.size} values; give one pressure (kPa)")
+    if actuator is not None:
+        actuator.outside_tested(p)
     return float(p.reshape(()))
 
 
-def checked_pressures_kpa(value, name: str = "pressures_kpa") -> np.ndarray:
+def checked_pressures_kpa(value, name: str = "pressures_kpa", actuator=None) -> np.ndarray:
     """Gauge pressures in kPa as a 1-D float array (at least one), validated as :func:`checked_pressure_kpa`.
 
     >>> checked_pressures_kpa(150).tolist(), checked_pressures_kpa([100, 150]).tolist()
@@ -118,6 +123,8 @@ def checked_pressures_kpa(value, name: str = "pressures_kpa") -> np.ndarray:
     p = np.atleast_1d(_numeric_pressures(value, name)).ravel()
     if p.size == 0:
         raise InputError(f"{name} is empty; give at least one pressure (kPa)")
+    if actuator is not None:
+        actuator.outside_tested(p)
     return p
 
 
@@ -125,9 +132,10 @@ def checked_pressures_kpa(value, name: str = "pressures_kpa") -> np.ndarray:
 def pressures_checked() -> Iterator[None]:
     """Run the numerics of a public function whose pressures were already validated.
 
-    The entry point validates (and warns about a suspected MPa value) once; inside, the law is
-    evaluated many times at the same pressures and must not repeat the
-    :class:`~bendpam.validate.UnitWarning`.
+    The entry point validates (and warns about a suspected MPa value, or a pressure outside the
+    actuator's tested range) once; inside, the law is evaluated many times at the same pressures
+    and must not repeat the :class:`~bendpam.validate.UnitWarning` or the
+    :class:`~bendpam.errors.OutsideTestedRangeWarning`.
 
     >>> import warnings
     >>> with warnings.catch_warnings():
@@ -137,6 +145,7 @@ def pressures_checked() -> Iterator[None]:
     """
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UnitWarning)
+        warnings.simplefilter("ignore", OutsideTestedRangeWarning)
         yield
 
 

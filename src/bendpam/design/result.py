@@ -99,6 +99,13 @@ class DesignResult:
         ``min_margin`` (N,), and ``method`` (``"sobol"`` or ``"grid"``).
     pareto : the :class:`ParetoFront` (two targets) or None.
     search : seed, sizes, evaluations and the elapsed time.
+    deadband : the deadband study: ``P_start_kpa`` and ``R0_start_mm`` of the design, ``assumed``
+        (True: the search kept the base actuator's P_start and prestrain ratio, not modelled from the
+        geometry) and ``moved``, one
+        row per factor 0.8 and 1.2 on ``P_start``: ``achieved``, ``relative_error`` and ``met`` per target.
+
+    Infinite margins mean no demand (or no limit given): ``margins`` holds ``inf``; :meth:`to_dict`
+    writes the string ``"inf"`` and says which in ``margin_notes``.
 
     Examples
     --------
@@ -132,9 +139,18 @@ class DesignResult:
     coarse: dict[str, Any] = field(repr=False)
     pareto: ParetoFront | None = field(repr=False)
     search: dict[str, Any] = field(default_factory=dict)
+    deadband: dict[str, Any] | None = None
+
+    def _margin_notes(self) -> dict[str, str]:
+        """Why each infinite margin is infinite: ``"no demand"`` or ``"no limit given"``."""
+        no_limit = {"frame_strength_margin": self.actuator.frame_strength_mpa is None,
+                    "bladder_stretch_margin": self.actuator.bladder_stretch_limit is None}
+        return {k: "no limit given" if no_limit.get(k) else "no demand"
+                for k, v in self.margins.items() if v == math.inf}
 
     def to_dict(self) -> dict[str, Any]:
-        """design.json's content (units in the key names; ``null`` = infinite or not defined)."""
+        """design.json's content (units in the key names; a margin ``"inf"``: no demand or no limit, see
+        ``margin_notes``; ``null`` = not defined)."""
         return {
             "bendpam_version": __version__,
             "model": self.model,
@@ -151,9 +167,11 @@ class DesignResult:
                           for v in self.variables],
             "closest_design": self.closest,
             "constraints": {"min_margin": self.min_margin_required, "max_pressure_kpa": self.max_pressure_kpa},
-            "margins": dict(self.margins),
-            "min_margin": self.min_margin,
-            "margins_by_pressure": [{"pressure_kpa": p, **m} for p, m in self.margins_by_pressure.items()],
+            "margins": {k: _margin_json(v) for k, v in self.margins.items()},
+            "margin_notes": self._margin_notes(),
+            "min_margin": _margin_json(self.min_margin),
+            "margins_by_pressure": [{"pressure_kpa": p, **{k: _margin_json(v) for k, v in m.items()}}
+                                    for p, m in self.margins_by_pressure.items()],
             "sensitivities": {"meaning": "d ln(quantity) / d ln(variable) at the design", **self.sensitivities},
             "actuator": self.actuator.to_dict(),
             "pareto": None if self.pareto is None else {
@@ -161,7 +179,9 @@ class DesignResult:
                 "better": ["larger" if t.larger_is_better else "smaller" for t in self.pareto.targets],
                 "file": "pareto.csv"},
             "search": dict(self.search),
-            "null_means": "infinite (no demand, no limit, an unbounded free-bending branch) or not defined",
+            "deadband": self.deadband,
+            "inf_means": "a margin with no demand (or no limit given; see margin_notes)",
+            "null_means": "not defined (or infinite, for a value that is not a margin)",
         }
 
     def to_json(self) -> str:
@@ -219,10 +239,42 @@ class DesignResult:
         if self.active:
             lines.append(f"  at their limit: {', '.join(self.active)}")
         lines.append(f"  {self.message}")
+        lines.extend(self._deadband_lines())
         return "\n".join(lines)
+
+    def _deadband_lines(self) -> list[str]:
+        """The summary's account of the deadband: assumed, and the targets if it moves by -20 % / +20 %."""
+        db = self.deadband
+        if not db:
+            return []
+        how = "assumed (the base actuator's; not modelled from the geometry)" if db["assumed"] else "designed"
+        lines = [f"  deadband P_start = {db['P_start_kpa']:.4g} kPa {how}; if it moves:"]
+        for row in db["moved"]:
+            head = f"    x{row['factor']:g} ({row['P_start_kpa']:.4g} kPa): "
+            if row["achieved"] is None:
+                lines.append(head + f"no answer ({row['note']})")
+                continue
+            parts = [f"{t.text} -> {_fmt_q(a)} ({_fmt_pct(e)}, {'ok' if m else 'MISSED'})"
+                     for t, a, e, m in zip(self.targets, row["achieved"], row["relative_error"], row["met"],
+                                           strict=True)]
+            lines.append(head + "; ".join(parts))
+        return lines
 
     def __str__(self) -> str:
         return self.summary()
+
+
+def _margin_json(v: float) -> float | str | None:
+    """A margin for JSON: the number, ``"inf"`` (no demand or no limit) or None (not defined)."""
+    return "inf" if v == math.inf else (float(v) if np.isfinite(v) else None)
+
+
+def _fmt_q(a: float) -> str:
+    return f"{a:.5g}" if np.isfinite(a) else ("inf" if a == np.inf else "none")
+
+
+def _fmt_pct(e: float) -> str:
+    return f"{100 * e:+.1f} %" if np.isfinite(e) else "—"
 
 
 def fmt_margin(v: float) -> str:

@@ -127,7 +127,7 @@ def blocked_tip_force(finger: Finger, pressure_kpa, target_xy_mm=None, direction
     -2.053
     """
     loads = check_finger(finger, loads)
-    P = checked_pressure_kpa(pressure_kpa)
+    P = checked_pressure_kpa(pressure_kpa, actuator=finger.actuator)
     if target_xy_mm is None:
         target = _straight_tip(finger)
         if direction_deg is None:
@@ -265,7 +265,7 @@ def tip_stiffness(finger: Finger, pressure_kpa, loads: FingerLoads | None = None
     True
     """
     loads = check_finger(finger, loads)
-    P = checked_pressure_kpa(pressure_kpa)
+    P = checked_pressure_kpa(pressure_kpa, actuator=finger.actuator)
     with pressures_checked():
         sh = solve_finger(finger, P, loads)
     br = sh.branch
@@ -321,7 +321,7 @@ def linear_tip_compliance(finger: Finger, pressure_kpa) -> np.ndarray:
     26.96
     """
     check_finger(finger, None)
-    P = checked_pressure_kpa(pressure_kpa)
+    P = checked_pressure_kpa(pressure_kpa, actuator=finger.actuator)
     law = finger.law
     with pressures_checked():
         fb = law.free_curvature(P)

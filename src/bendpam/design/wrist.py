@@ -58,7 +58,7 @@ from bendpam.infra.accessors import figure
 from bendpam.physics import presets
 from bendpam.physics.actuator import Actuator
 from bendpam.physics.law import MomentLaw, StableBranch
-from bendpam.physics.models import normalise_model
+from bendpam.physics.models import normalise_model, resolve_model
 from bendpam.validate import number
 
 __all__ = [
@@ -92,7 +92,8 @@ class Wrist:
     ----------
     actuator : Actuator
         The actuators (default: the paper's BC-PAM with the model's constants).
-    model : {"energy", "force_balance"}
+    model : {"energy", "force_balance"} or None
+        None (default): the actuator's own model (energy when unknown); another than the actuator's warns.
     radius_mm : float
         Mounting radius of the actuators around the column axis, mm (default 20: four tubes of
         17 mm diameter around a thin column).  Geometry only (see the module docstring).
@@ -114,7 +115,7 @@ class Wrist:
     """
 
     actuator: Actuator | None = None
-    model: str = "energy"
+    model: str | None = None
     radius_mm: float = DEFAULT_RADIUS_MM
     length_mm: float | None = None
     lateral_stiffness_nmm2: float | None = None
@@ -123,11 +124,11 @@ class Wrist:
 
     def __post_init__(self):
         s = object.__setattr__
-        s(self, "model", normalise_model(self.model))
         if self.actuator is None:
-            s(self, "actuator", presets.bc_pam(self.model))
+            s(self, "actuator", presets.bc_pam(normalise_model(self.model or "energy")))
         if not isinstance(self.actuator, Actuator):
             raise TypeError(f"actuator must be a bendpam.Actuator, got {type(self.actuator).__name__}")
+        s(self, "model", resolve_model(self.actuator, self.model))
         if self.actuator.bend_sign == 0:
             raise InputError("the actuator has the neutral braid angle (54.74 deg): it does not bend")
         s(self, "radius_mm", number("radius_mm", self.radius_mm, 0.0, 1e3, unit="mm"))
@@ -385,6 +386,7 @@ def wrist_bend(wrist: Wrist, pressures_kpa=None, *, direction_deg=None, pressure
         raise InputError("give either the four pressures_kpa or direction_deg and pressure_kpa, not both")
     else:
         P = _four_pressures_kpa(pressures_kpa)
+    wrist._actuator.outside_tested(P[P > 0])  # an actuator left unpressurised is not an extrapolation
     return _bend(wrist, P)
 
 
@@ -498,7 +500,7 @@ def wrist_hold(wrist: Wrist, pressure_kpa, *, load_g: float = BOTTLE_G, lever_mm
     (False, True)
     """
     _check_wrist(wrist)
-    P = checked_pressure_kpa(pressure_kpa)
+    P = checked_pressure_kpa(pressure_kpa, actuator=wrist._actuator)
     mL = number("load_g", load_g, 0.0, unit="g")
     lev = number("lever_mm", lever_mm, 0.0, unit="mm")
     mh = number("hand_mass_g", hand_mass_g, 0.0, unit="g")
@@ -555,7 +557,7 @@ def wrist_sweep(wrist: Wrist, pressures_kpa, directions_deg=(0.0, 90.0, 180.0, 2
     import pandas as pd
 
     _check_wrist(wrist)
-    Ps = checked_pressures_kpa(pressures_kpa)
+    Ps = checked_pressures_kpa(pressures_kpa, actuator=wrist._actuator)
     dirs = [number("directions_deg", d, -720.0, 720.0, unit="deg")
             for d in np.atleast_1d(np.asarray(directions_deg, dtype=object)).ravel()]
     rows = []

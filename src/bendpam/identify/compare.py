@@ -18,7 +18,7 @@ __all__ = ["type_comparison"]
 _SIDES = {1: (NEUTRAL_ANGLE_DEG + 0.05, 85.0), -1: (15.0, NEUTRAL_ANGLE_DEG - 0.05)}
 
 
-def _side_fit(processed, actuator: Actuator, model: str, free, sign: int):
+def _side_fit(processed, actuator: Actuator, model: str | None, free, sign: int):
     """A quick fit with alpha0 anywhere on one side of 54.74 deg (``sign``) and P_start free, or None."""
     rng = _SIDES[sign]
     names = list(dict.fromkeys(["alpha0", *free, "P_start"]))
@@ -30,7 +30,7 @@ def _side_fit(processed, actuator: Actuator, model: str, free, sign: int):
         return None
 
 
-def type_comparison(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C10", "C01")):
+def type_comparison(processed, actuator: Actuator, model: str | None = None, free=("alpha0", "C10", "C01")):
     """Fit both actuator types with the same freedom: ``(same, other)`` FitResults (None where a fit fails).
 
     Both fits free alpha0 across their whole side of 54.74 deg and P_start besides ``free``, so that

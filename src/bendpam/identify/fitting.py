@@ -95,6 +95,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
+from datetime import UTC, datetime
 
 import numpy as np
 
@@ -121,12 +122,13 @@ from bendpam.identify.result import (
     Profile,
 )
 from bendpam.identify.uncertainty import Uncertainty, material_fit, sandwich_covariance
-from bendpam.physics.actuator import NEUTRAL_ANGLE_DEG, Actuator
+from bendpam.physics.actuator import NEUTRAL_ANGLE_DEG, Actuator, FitIdentity
 from bendpam.physics.braid import DEFAULT_ORDER
 from bendpam.physics.law import MomentLaw
 from bendpam.physics.material import admissible_shape_range
-from bendpam.physics.models import normalise_model
+from bendpam.physics.models import resolve_model
 from bendpam.validate import PLAUSIBLE
+from bendpam.version import __version__
 
 __all__ = ["PAPER_START", "fit", "parse_free"]
 
@@ -392,7 +394,7 @@ def _loop_law(hysteresis, hysteresis_law: str, processed) -> str | None:
     return key
 
 
-def fit(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C10", "C01"), *,
+def fit(processed, actuator: Actuator, model: str | None = None, free=("alpha0", "C10", "C01"), *,
         bounds: dict[str, tuple[float, float]] | None = None, tension=None, tension_data=None,
         order: int = DEFAULT_ORDER, eq19_factor: bool = True, grid_alpha: int = 41, grid_r0: int = 9,
         corr_flag: float = LIMITS.correlation,
@@ -409,7 +411,8 @@ def fit(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C
     ----------
     processed : :class:`bendpam.lab.processing.ProcessedSet` (or ``load_processed(dir)``).
     actuator : the nominal actuator (geometry, and the values of the parameters held fixed).
-    model : ``"energy"`` or ``"force_balance"``.
+    model : ``"energy"``, ``"force_balance"`` or None (default): the start actuator's own model (energy when
+        unknown).  Fitting the other model from its constants is deliberate and does not warn.
     free : names among alpha0, C10, C01, P_start, E_f, R0_start (aliases such as ``alpha0_deg`` work).
     bounds : overrides of the default bounds, ``{name: (lo, hi)}`` in the parameter's unit;
         ``"shape"`` narrows the admissible shapes C01/(C10 + C01).
@@ -459,7 +462,7 @@ def fit(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C
     (True, True)
     """
     t0 = time.perf_counter()
-    model = normalise_model(model)
+    model = resolve_model(actuator, model, warn=False)  # fitting another model from these constants is deliberate
     free = parse_free(free)
     if tension is not None:
         actuator = actuator.replace(C10_kpa=tension.C10_kpa, C01_kpa=tension.C01_kpa)
@@ -846,6 +849,9 @@ def _result(processed, actuator: Actuator, run: _Run, unc: Uncertainty, tension,
         message += (f"; fitted with the {law} loop model on both branches (the tests show a loop, median "
                     f"energy-loss ratio {100 * ratio:.1f} %)")
     P = np.array([r.pressure_kpa for r in processed.results], dtype=float)
+    # the fitted actuator remembers where it was tested and which fit made it (save() adds fit.json's hash)
+    fitted = fitted.replace(tested_pressure_kpa=(float(P.min()), float(P.max())), fit_identity=FitIdentity(
+        date=datetime.now(UTC).strftime("%Y-%m-%dT%H:%M:%SZ"), version=__version__))
     return FitResult(
         model=model, actuator=fitted, parameters=params, correlation=unc.corr, correlation_names=unc.names,
         metrics=metrics, converged=run.converged, message=message, nfev=run.nfev, time_s=time.perf_counter() - t0,

@@ -16,12 +16,12 @@ from bendpam.identify.result import Metrics
 from bendpam.physics.actuator import Actuator
 from bendpam.physics.braid import DEFAULT_ORDER
 from bendpam.physics.law import MomentLaw
-from bendpam.physics.models import normalise_model
+from bendpam.physics.models import resolve_model
 
 __all__ = ["branch_nrmse", "predicted_loss_ratios", "score"]
 
 def score(
-    processed, actuator: Actuator, model: str = "energy", *, loop=None, order: int = DEFAULT_ORDER,
+    processed, actuator: Actuator, model: str | None = None, *, loop=None, order: int = DEFAULT_ORDER,
     eq19_factor: bool = True,
 ) -> Metrics:
     """Metrics of eq 53-55 (and plain RMSEs) of ``actuator`` against processed data, without fitting.
@@ -54,7 +54,7 @@ def score(
     >>> m.nrmse_cycles < 0.05, m.no_equilibrium_kpa
     (True, [])
     """
-    model = normalise_model(model)
+    model = resolve_model(actuator, model)
     d = fit_data(processed, "all")
     s = actuator.bend_sign or 1
     if loop is None:
@@ -104,7 +104,7 @@ def score(
 
 
 
-def predicted_loss_ratios(processed, actuator: Actuator, loop, model: str = "energy", *, order: int = DEFAULT_ORDER,
+def predicted_loss_ratios(processed, actuator: Actuator, loop, model: str | None = None, *, order: int = DEFAULT_ORDER,
                           eq19_factor: bool = True) -> list[dict]:
     """Energy-loss ratio of each test, measured (processing) and predicted (the loop's free cycle).
 
@@ -131,7 +131,7 @@ def predicted_loss_ratios(processed, actuator: Actuator, loop, model: str = "ene
              "predicted": c.energy_loss_ratio} for r, c in zip(processed.results, cycles, strict=True)]
 
 
-def branch_nrmse(processed, actuator: Actuator, loop, model: str = "energy", *, order: int = DEFAULT_ORDER,
+def branch_nrmse(processed, actuator: Actuator, loop, model: str | None = None, *, order: int = DEFAULT_ORDER,
                  eq19_factor: bool = True) -> float:
     """eq-53-style NRMSE of both branches (loading and unloading) against the loop model (:func:`score`).
 

@@ -11,20 +11,20 @@ prediction with its uncertainty :class:`Band`.
 
 from __future__ import annotations
 
+import hashlib
 import json
 import math
-import warnings
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
-from bendpam.errors import FileFormatError, InputError
+from bendpam.errors import FileFormatError, InputError, OutsideTestedRangeWarning
 from bendpam.infra.accessors import figure
 from bendpam.infra.atomic import atomic_write_text, json_safe
 from bendpam.infra.budgets import read_input_bytes
 from bendpam.infra.manifest import verify_input
-from bendpam.physics.actuator import Actuator
+from bendpam.physics.actuator import Actuator, FitIdentity, outside_tested_range
 from bendpam.physics.law import MomentLaw
 
 __all__ = [
@@ -76,16 +76,10 @@ def parameter_unit(name: str) -> str:
     return (PARAMETERS.get(name) or HYST_PARAMETERS[name])[1]
 
 
-class ExtrapolationWarning(UserWarning):
-    """A prediction outside the pressures the fit was identified on.
+#: The warning of a prediction outside the tested pressures: :class:`bendpam.errors.OutsideTestedRangeWarning`
+#: (the name of 0.3, kept as an alias).
+ExtrapolationWarning = OutsideTestedRangeWarning
 
-    >>> import warnings
-    >>> with warnings.catch_warnings(record=True) as caught:
-    ...     warnings.simplefilter("always")
-    ...     warnings.warn("300 kPa is outside the tested range", ExtrapolationWarning)
-    >>> caught[0].category.__name__
-    'ExtrapolationWarning'
-    """
 
 @dataclass
 class Parameter:
@@ -430,23 +424,13 @@ class FitResult:
         return None if self.hysteresis is None else self.hysteresis.loop()
 
     def _warn_outside(self, pressure_kpa) -> np.ndarray:
-        P = np.asarray(pressure_kpa, dtype=float)
-        lo, hi = self.pressure_range_kpa
-        out = np.zeros(P.shape, dtype=bool)
-        if math.isfinite(lo) and math.isfinite(hi):
-            out = (P < lo) | (P > hi)
-            if np.any(out):
-                bad = P[out]
-                warnings.warn(
-                    f"pressure {float(bad.flat[0]):g} kPa is outside the tested range [{lo:g}, {hi:g}] kPa: the "
-                    "prediction is an extrapolation (FitResult.band gives its uncertainty)",
-                    ExtrapolationWarning, stacklevel=3)
-        return out
+        """Which pressures are outside the tested range; one :class:`OutsideTestedRangeWarning` if any are."""
+        return outside_tested_range(self.pressure_range_kpa, pressure_kpa, self.actuator.name or self.actuator.kind)
 
     def predict(self, pressure_kpa, curvature_per_mm) -> np.ndarray:
         """The fitted model's quasi-static moment ``M(P, k')`` (N*mm), broadcasting (signed as the paper).
 
-        Pressures outside the tested range raise an :class:`ExtrapolationWarning`.
+        Pressures outside the tested range raise an :class:`~bendpam.errors.OutsideTestedRangeWarning`.
         """
         self._warn_outside(pressure_kpa)
         return MomentLaw.of(self.actuator, self.model).moment(pressure_kpa, curvature_per_mm)
@@ -543,12 +527,26 @@ class FitResult:
         """:meth:`to_dict` as JSON text (non-finite numbers as null)."""
         return json.dumps(json_safe(self.to_dict()), indent=2, allow_nan=False)
 
-    def save(self, out_dir) -> dict[str, str]:
-        """Write ``fit.json`` and ``fitted_actuator.toml`` atomically into the folder ``out_dir``."""
+    def save(self, out_dir, *, processed: str = "", extra: dict | None = None) -> dict[str, str]:
+        """Write ``fit.json`` and ``fitted_actuator.toml`` atomically into the folder ``out_dir``.
+
+        The actuator file records the tested pressure range and the fit's identity
+        (:class:`~bendpam.physics.actuator.FitIdentity`: the SHA-256 of the ``fit.json`` written beside it,
+        ``processed``, the name of the processed test set, the date and bendpam's version).
+        ``extra``: more top-level entries of ``fit.json`` (e.g. a tension fit), written before it is hashed.
+        """
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
-        atomic_write_text(out / "fit.json", self.to_json())
-        text = self.actuator.to_toml()
+        text = self.to_json() if not extra else json.dumps(json_safe({**self.to_dict(), **extra}), indent=2,
+                                                                   allow_nan=False)
+        atomic_write_text(out / "fit.json", text)
+        ident = self.actuator.fit_identity or FitIdentity()
+        ident = replace(ident, fit_json_sha256=hashlib.sha256(text.encode("utf-8")).hexdigest(),
+                        processed=processed or ident.processed)
+        act = self.actuator.replace(fit_identity=ident)
+        if act.tested_pressure_kpa is None and all(math.isfinite(v) for v in self.pressure_range_kpa):
+            act = act.replace(tested_pressure_kpa=self.pressure_range_kpa)
+        text = act.to_toml()
         loop = self.loop
         if loop is not None:
             import tomli_w

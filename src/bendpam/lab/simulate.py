@@ -37,7 +37,7 @@ from bendpam.infra.atomic import atomic_write_text
 from bendpam.physics.braid import curvature_limits
 from bendpam.physics.fixture import PAPER_FIXTURE, Fixture
 from bendpam.physics.hysteresis import LAWS, make_law
-from bendpam.physics.models import normalise_model
+from bendpam.physics.models import resolve_model
 from bendpam.predict import blocked_moment, free_curvature, moment
 from bendpam.validate import number
 
@@ -127,7 +127,7 @@ def _signed(actuator):
     return actuator.bend_sign or 1
 
 
-def simulate_test(actuator, pressure_kpa: float, model: str = "energy", *, fixture: Fixture = PAPER_FIXTURE,
+def simulate_test(actuator, pressure_kpa: float, model: str | None = None, *, fixture: Fixture = PAPER_FIXTURE,
                   settings: SimulationSettings | None = None, rng: np.random.Generator | None = None):
     """Simulate one cyclic test.  Returns ``(data, truth)``.
 
@@ -144,7 +144,7 @@ def simulate_test(actuator, pressure_kpa: float, model: str = "energy", *, fixtu
     (204.3, 0.00729)
     """
     st = settings or SimulationSettings()
-    model = normalise_model(model)
+    model = resolve_model(actuator, model)
     rng = rng if rng is not None else np.random.default_rng(st.seed)
     P, Mb, A, law, m_qs = _setup(actuator, pressure_kpa, model, st)
     k_f, s_f = _free_state(actuator, P, pressure_kpa, model, fixture, law, A, st, m_qs)
@@ -316,7 +316,7 @@ def _truth(actuator, P, model, fixture, law, A, s_f, cycles, m_qs):
             "cycles_blocked_moment_nmm": bms, "cycles_energy_loss_ratio": ratios}
 
 
-def simulate_tests(actuator, pressures_kpa, out_dir, model: str = "energy", *, dialect: str = "csv",
+def simulate_tests(actuator, pressures_kpa, out_dir, model: str | None = None, *, dialect: str = "csv",
                    fixture: Fixture = PAPER_FIXTURE, settings: SimulationSettings | None = None,
                    prefix: str | None = None) -> dict:
     """Simulate tests at several pressures and write one raw file each plus ``truth.json``.
@@ -342,7 +342,7 @@ def simulate_tests(actuator, pressures_kpa, out_dir, model: str = "energy", *, d
     from bendpam.lab.writers import write_test
 
     st = settings or SimulationSettings()
-    model = normalise_model(model)
+    model = resolve_model(actuator, model)
     if dialect not in DIALECT_SUFFIX:
         raise InputError(f"format {dialect!r} is not known; choose one of: {', '.join(DIALECT_SUFFIX)}")
     pressures_kpa = [float(p) for p in pressures_kpa]

@@ -22,13 +22,14 @@ from typing import Any
 import numpy as np
 import tomli_w
 
-from bendpam.errors import FileFormatError, InputError
+from bendpam.errors import FileFormatError, InputError, OutsideTestedRangeWarning, warn_user
 from bendpam.infra.atomic import atomic_write_text
 from bendpam.infra.budgets import loads_toml, read_input_bytes
 from bendpam.physics.material import MooneyRivlin
 from bendpam.validate import DEFAULT_MAX_PRESSURE_KPA, PLAUSIBLE, did_you_mean, float_array, number, plausible
 
-__all__ = ["NEUTRAL_ANGLE_DEG", "Actuator", "ModelParams", "bladder_area_mm2", "frame_inertia_mm4", "t0_start_mm"]
+__all__ = ["NEUTRAL_ANGLE_DEG", "Actuator", "FitIdentity", "ModelParams", "bladder_area_mm2", "frame_inertia_mm4",
+           "outside_tested_range", "t0_start_mm"]
 
 #: The braid angle at which a McKibben sleeve has maximum volume, arctan(sqrt 2) = 54.7356 deg.
 NEUTRAL_ANGLE_DEG = math.degrees(math.atan(math.sqrt(2.0)))
@@ -71,7 +72,8 @@ def frame_inertia_mm4(width_mm, thickness_mm):
 
 
 #: Actuator fields that are not inputs of the models (labels and the limits of :mod:`bendpam.physics.limits`).
-_NOT_MODEL_PARAMS = ("name", "model", "frame_strength_mpa", "bladder_stretch_limit")
+_NOT_MODEL_PARAMS = ("name", "model", "frame_strength_mpa", "bladder_stretch_limit", "tested_pressure_kpa",
+                     "fit_identity")
 
 #: The hard limits of the numeric fields (the models' domain): (lo, hi, lo open, hi open, unit); ``t0_mm``
 #: and ``R0_start_mm`` are bounded by ``R0_mm``.  The plausible ranges inside them: :data:`bendpam.validate.PLAUSIBLE`.
@@ -93,6 +95,101 @@ _HARD = {
 def _suggest(key: str, known) -> str:
     """``'alpha_deg' (did you mean 'alpha0_deg'?); known: ...`` for an unknown key."""
     return f"{key!r}{did_you_mean(key, known)}; known: {', '.join(known)}"
+
+
+@dataclass(frozen=True)
+class FitIdentity:
+    """Where a fitted actuator's constants came from: the fit that wrote it.
+
+    Attributes
+    ----------
+    fit_json_sha256 : SHA-256 (hex) of the ``fit.json`` written beside the actuator ("" before it is saved).
+    processed : the processed test set the fit was made on (the folder's name; "" when unknown).
+    date : when the fit was made, ISO 8601 UTC (``2026-11-25T18:30:00Z``).
+    version : the bendpam version that made it.
+
+    >>> ident = FitIdentity(processed="be-tests", date="2026-11-25T18:30:00Z", version="0.4.0")
+    >>> FitIdentity.from_dict(ident.to_dict()) == ident, ident.describe()
+    (True, "fit of 'be-tests' on 2026-11-25T18:30:00Z (bendpam 0.4.0)")
+    """
+
+    fit_json_sha256: str = ""
+    processed: str = ""
+    date: str = ""
+    version: str = ""
+
+    def __post_init__(self) -> None:
+        for f in dataclasses.fields(self):
+            if not isinstance(getattr(self, f.name), str):
+                raise InputError(f"fit_identity.{f.name} = {getattr(self, f.name)!r} must be a string")
+
+    def to_dict(self) -> dict[str, str]:
+        """The fields as a plain dict (the ``[actuator.fit_identity]`` table of an actuator file)."""
+        return dataclasses.asdict(self)
+
+    @classmethod
+    def from_dict(cls, data: Any, source: str = "fit_identity") -> FitIdentity:
+        """From :meth:`to_dict`'s dict; an unknown key or a value that is not a string is one InputError line."""
+        if isinstance(data, FitIdentity):
+            return data
+        if not isinstance(data, dict):
+            raise InputError(f"{source}: expected a table (fit_json_sha256, processed, date, version), "
+                             f"got {type(data).__name__}")
+        known = [f.name for f in dataclasses.fields(cls)]
+        unknown = [k for k in data if k not in known]
+        if unknown:
+            raise InputError(f"{source}: unknown key {_suggest(unknown[0], known)}")
+        return cls(**data)
+
+    def describe(self) -> str:
+        """One line for messages: what was fitted, when, by which version."""
+        what = f"fit of {self.processed!r}" if self.processed else "fit"
+        when = f" on {self.date}" if self.date else ""
+        ver = f" (bendpam {self.version})" if self.version else ""
+        sha = f", fit.json sha256 {self.fit_json_sha256[:12]}" if self.fit_json_sha256 else ""
+        return f"{what}{when}{ver}{sha}"
+
+
+def _tested_pair(value: Any) -> tuple[float, float] | None:
+    """``tested_pressure_kpa`` checked: None, or two finite pressures ``0 <= lo <= hi`` (kPa)."""
+    if value is None:
+        return None
+    msg = f"tested_pressure_kpa = {value!r} must be two pressures [lowest, highest] in kPa with 0 <= lowest <= highest"
+    if isinstance(value, str | bytes | dict) or not hasattr(value, "__len__") or len(value) != 2:
+        raise InputError(msg)
+    lo = number("tested_pressure_kpa[0]", value[0], 0.0, unit="kPa")
+    hi = number("tested_pressure_kpa[1]", value[1], 0.0, unit="kPa")
+    if lo > hi:
+        raise InputError(msg)
+    return (lo, hi)
+
+
+def outside_tested_range(tested_kpa: tuple[float, float] | None, pressure_kpa, label: str = "") -> np.ndarray:
+    """Which pressures lie outside the tested range ``tested_kpa`` (kPa); warns once if any do.
+
+    The one check of a fitted actuator (or a fit) used where it was not tested: an
+    :class:`~bendpam.errors.OutsideTestedRangeWarning` line names the first such pressure and the range.
+    ``tested_kpa`` None (or not finite): nothing is outside.  A tolerance of 1e-9 kPa absorbs round-off.
+
+    >>> import warnings
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     outside_tested_range((100.0, 200.0), [150.0, 250.0], "my PAM").tolist()
+    [False, True]
+    >>> str(caught[0].message)
+    'pressure 250 kPa is outside the tested range [100, 200] kPa of my PAM (the prediction is an extrapolation)'
+    """
+    P = np.asarray(pressure_kpa, dtype=float)
+    out = np.zeros(P.shape, dtype=bool)
+    if tested_kpa is None or not all(math.isfinite(v) for v in tested_kpa):
+        return out
+    lo, hi = tested_kpa
+    out = (P < lo - 1e-9) | (P > hi + 1e-9)
+    if np.any(out):
+        of = f" of {label}" if label else ""
+        warn_user(f"pressure {float(P[out].flat[0]):g} kPa is outside the tested range [{lo:g}, {hi:g}] kPa{of} "
+                  "(the prediction is an extrapolation)", OutsideTestedRangeWarning)
+    return out
 
 
 @dataclass(frozen=True)
@@ -232,6 +329,13 @@ class Actuator:
         The burst limit, kPa (default 2000 = 2 MPa, more than any pneumatic PAM holds): every
         function that takes this actuator and pressures refuses a pressure above it.  Raise it for
         a hydraulic muscle (up to 100 MPa).
+    tested_pressure_kpa : (float, float), optional
+        The lowest and highest pressure (kPa) of the tests these constants were identified on
+        (``bendpam fit`` writes it).  Predictions outside it warn
+        (:class:`~bendpam.errors.OutsideTestedRangeWarning`); ``None`` (default): not a fitted actuator.
+    fit_identity : FitIdentity, optional
+        The fit that wrote these constants (``fit.json``'s SHA-256, the processed set, date, version);
+        a dict of those keys is accepted.
 
     Every numeric field must also lie in its physical plausibility range
     (:data:`bendpam.validate.PLAUSIBLE`, docs/plausibility.md): a braid angle of 10 to 88 deg,
@@ -276,6 +380,8 @@ class Actuator:
     frame_strength_mpa: float | None = None
     bladder_stretch_limit: float | None = None
     max_pressure_kpa: float = DEFAULT_MAX_PRESSURE_KPA
+    tested_pressure_kpa: tuple[float, float] | None = None
+    fit_identity: FitIdentity | None = None
 
     # derived, filled in __post_init__
     _material: MooneyRivlin = field(init=False, repr=False, compare=False, hash=False)
@@ -296,6 +402,8 @@ class Actuator:
             s(self, "R0_start_mm", self.R0_mm)
         else:
             s(self, "R0_start_mm", number("R0_start_mm", self.R0_start_mm, self.R0_mm, unit="mm"))
+        if type(self.model) is not str and isinstance(self.model, str):
+            s(self, "model", str(self.model))  # a plain name (a resolved model name is a str subclass)
         if self.model not in ("", "energy", "force_balance"):
             raise InputError(f"model = {self.model!r}: the model the constants were identified with must be "
                              "'energy', 'force_balance' or '' (unknown)")
@@ -307,6 +415,9 @@ class Actuator:
         if self.bladder_stretch_limit is not None:
             s(self, "bladder_stretch_limit",
               number("bladder_stretch_limit", self.bladder_stretch_limit, 1.0, lo_open=True))  # a stretch: no unit
+        s(self, "tested_pressure_kpa", _tested_pair(self.tested_pressure_kpa))
+        if self.fit_identity is not None:
+            s(self, "fit_identity", FitIdentity.from_dict(self.fit_identity))
         values = {f: getattr(self, f) for f in PLAUSIBLE if getattr(self, f, None) is not None}
         for name, value in values.items():  # physical plausibility (docs/plausibility.md), after the hard limits
             plausible(name, value, values)
@@ -370,9 +481,22 @@ class Actuator:
         return tuple(f.name for f in dataclasses.fields(cls) if f.init)
 
     def to_dict(self) -> dict[str, Any]:
-        """The init fields as a plain dict (units in the names), plus derived values under ``derived``."""
+        """The init fields as a plain dict (units in the names): plain numbers, strings, lists and dicts."""
         d = {n: getattr(self, n) for n in self.field_names()}
+        if self.tested_pressure_kpa is not None:
+            d["tested_pressure_kpa"] = list(self.tested_pressure_kpa)
+        if self.fit_identity is not None:
+            d["fit_identity"] = self.fit_identity.to_dict()
         return d
+
+    def outside_tested(self, pressure_kpa) -> np.ndarray:
+        """Which of ``pressure_kpa`` lie outside :attr:`tested_pressure_kpa`; warns once if any do.
+
+        >>> import bendpam
+        >>> bendpam.physics.presets.be_pam().outside_tested([100.0, 300.0]).tolist()   # not fitted: no range
+        [False, False]
+        """
+        return outside_tested_range(self.tested_pressure_kpa, pressure_kpa, self.name or self.kind)
 
     def derived(self) -> dict[str, float]:
         """Derived quantities, units in the names."""

@@ -23,7 +23,7 @@ from bendpam.physics.law import MomentLaw, MomentTable
 __all__ = ["MomentTable", "moment_table"]
 
 
-def moment_table(actuator: Actuator, model: str = "energy", *, eq19_factor: bool = True,
+def moment_table(actuator: Actuator, model: str | None = None, *, eq19_factor: bool = True,
                  tol: float = 1e-6) -> MomentTable:
     """The cached :class:`MomentTable` of ``actuator`` and ``model`` (built on first use).
 

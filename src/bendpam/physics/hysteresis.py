@@ -333,7 +333,7 @@ class LoopModel:
         st = force_balance.stress_state(actuator.params, pa_b, k_b, np.zeros(1))
         return self.a0_nmm + self.a1_nmm_per_kpa * np.maximum(st["P_e"] * 1e3, 0.0)
 
-    def moment_path(self, actuator, pressure_kpa, curvature_path_per_mm, model: str = "energy", z0: float = 0.0):
+    def moment_path(self, actuator, pressure_kpa, curvature_path_per_mm, model: str | None = None, z0: float = 0.0):
         """``M`` (N*mm) along a sampled curvature path (1/mm) at ``pressure_kpa``, from state ``z0``."""
         from bendpam.physics.law import MomentLaw
 
@@ -379,7 +379,7 @@ def _cycle_branches(actuator, loop: LoopModel, law, P, k_free, k):
     return Mqs - amp * z_load, Mqs - amp * z_unl
 
 
-def loop_branches(actuator, loop: LoopModel, pressure_kpa, k_free, k, model: str = "energy", *,
+def loop_branches(actuator, loop: LoopModel, pressure_kpa, k_free, k, model: str | None = None, *,
                   order: int = DEFAULT_ORDER, eq19_factor: bool = True):
     """Steady-cycle branches between the blocked state and ``k_free`` (magnitudes, 1/mm).
 
@@ -434,7 +434,7 @@ _NO_CYCLE = "the unloading branch does not reach zero moment before lock-up: no 
 _FLAT = "the actuator does not bend at this pressure (the cycle collapses onto the straight state)"
 
 
-def predict_cycles(actuator, loop: LoopModel, pressures_kpa, model: str = "energy", *, n: int = 201,
+def predict_cycles(actuator, loop: LoopModel, pressures_kpa, model: str | None = None, *, n: int = 201,
                    order: int = DEFAULT_ORDER, eq19_factor: bool = True) -> list[Cycle]:
     """The loops free-bending cycles trace at several pressures: blocked -> free -> blocked.
 
@@ -451,7 +451,8 @@ def predict_cycles(actuator, loop: LoopModel, pressures_kpa, model: str = "energ
     actuator : the :class:`~bendpam.Actuator`.
     loop : the :class:`LoopModel`.
     pressures_kpa : gauge pressures, kPa (scalar or 1-D).
-    model : ``"energy"`` or ``"force_balance"``.
+    model : ``"energy"``, ``"force_balance"`` or None (default): the actuator's own model (energy when
+        unknown); another than the actuator's warns (:class:`~bendpam.errors.ModelMismatchWarning`).
     n : points of each returned branch, from 0 to the free curvature.
 
     Returns
@@ -538,7 +539,7 @@ def _cycles(actuator, loop: LoopModel, law, P: np.ndarray, kf: np.ndarray, flat:
     return out
 
 
-def predict_cycle(actuator, loop: LoopModel, pressure_kpa: float, model: str = "energy", *, n: int = 201,
+def predict_cycle(actuator, loop: LoopModel, pressure_kpa: float, model: str | None = None, *, n: int = 201,
                   order: int = DEFAULT_ORDER, eq19_factor: bool = True) -> Cycle:
     """The loop a free-bending cycle traces at ``pressure_kpa``: :func:`predict_cycles` at one pressure.
 

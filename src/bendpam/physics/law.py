@@ -66,7 +66,7 @@ from bendpam.physics.branch import (
     describe_branch,
     solve_free,
 )
-from bendpam.physics.models import energy, force_balance, normalise_model
+from bendpam.physics.models import energy, force_balance, resolve_model
 from bendpam.physics.roots import bracketed_newton
 from bendpam.physics.sections import MPA_PER_KPA
 from bendpam.physics.stable import StableBranch, stable_branch
@@ -107,8 +107,10 @@ class MomentLaw:
     actuator : Actuator or ModelParams
         One actuator, or a block of actuator cases (a :class:`~bendpam.ModelParams` whose fields
         are arrays of one shape; sweeps and design searches build these).
-    model : {"energy", "force_balance"}
-        ``"force-balance"`` is accepted too.
+    model : {"energy", "force_balance"} or None
+        ``"force-balance"`` is accepted too.  None (default): the actuator's own
+        :attr:`~bendpam.Actuator.model` (energy when unknown, and for a block of cases); another model
+        than the actuator's warns (:class:`~bendpam.errors.ModelMismatchWarning`).
     eq19_factor : bool
         Energy model only: keep eq 19's ``(1 + k'R)`` factor (default, as printed; see
         docs/paper-reading.md item 7).  Ignored by the force-balance model, which has no such factor.
@@ -136,7 +138,7 @@ class MomentLaw:
     134.2
     """
 
-    def __init__(self, actuator: Actuator | ModelParams, model: str = "energy", *, eq19_factor: bool = True,
+    def __init__(self, actuator: Actuator | ModelParams, model: str | None = None, *, eq19_factor: bool = True,
                  order: int = DEFAULT_ORDER):
         instance("actuator", actuator, (Actuator, ModelParams), _ACTUATOR + " or a ModelParams block of cases")
         if isinstance(actuator, Actuator):
@@ -147,7 +149,7 @@ class MomentLaw:
             self.params = _checked_cases(actuator)
         #: The burst limit (kPa): pressures above it are refused (the smallest of a block of cases).
         self.max_pressure_kpa = float(np.min(self.params.max_pressure_kpa))
-        self.model = normalise_model(model)
+        self.model = resolve_model(actuator, model)
         self.eq19_factor = boolean("eq19_factor", eq19_factor)
         self.order = quadrature_order(order)
         self.is_cases = self.params.shape != ()
@@ -157,11 +159,11 @@ class MomentLaw:
             self._opts["eq19_factor"] = self.eq19_factor
 
     @classmethod
-    def of(cls, actuator: Actuator, model: str = "energy", *, eq19_factor: bool = True,
+    def of(cls, actuator: Actuator, model: str | None = None, *, eq19_factor: bool = True,
            order: int = DEFAULT_ORDER) -> MomentLaw:
         """The shared (cached) law of ``actuator``: its branch and table are built once."""
         instance("actuator", actuator, Actuator, _ACTUATOR)
-        return _cached_law(actuator, normalise_model(model), boolean("eq19_factor", eq19_factor),
+        return _cached_law(actuator, resolve_model(actuator, model), boolean("eq19_factor", eq19_factor),
                            quadrature_order(order))
 
     def __repr__(self) -> str:

@@ -31,7 +31,8 @@ bendpam computes
    ``bladder_stretch_limit``.
 
 Every margin is a safety factor, capacity / demand: ``>= 1`` within the limit, ``inf`` when
-there is no demand (a frame in tension cannot buckle) or no limit is given.  ``min_margin`` is the
+there is no demand (a frame in tension cannot buckle; a demand below ``1e-9`` of the capacity is
+round-off and counts as none) or no limit is given.  ``min_margin`` is the
 smallest; the margins reported per pressure are the worse of the two states.
 
 Buckling model (Hetényi's beam on an elastic foundation)
@@ -256,11 +257,18 @@ def _broadcasts_to(shape: tuple[int, ...], target: tuple[int, ...]) -> bool:
         return False
 
 
+#: A demand below this fraction of the capacity is round-off, not a demand: its margin is inf ("no demand").
+NO_DEMAND = 1e-9
+
+
 def _ratio(capacity, demand):
-    """Safety factor ``capacity / demand``: inf where the demand is <= 0; NaN where the demand is NaN."""
+    """Safety factor ``capacity / demand``: inf where there is no demand (``demand <= NO_DEMAND * capacity``,
+    round-off included, so never a stand-in like 1e15); NaN where the demand is NaN."""
     d = np.asarray(demand, dtype=float)
+    c = np.asarray(capacity, dtype=float)
+    some = d > NO_DEMAND * np.abs(c)
     with np.errstate(divide="ignore", invalid="ignore"):
-        r = np.where(d > 0.0, capacity / np.where(d > 0.0, d, 1.0), np.inf)
+        r = np.where(some, c / np.where(some, d, 1.0), np.inf)
     return np.where(np.isnan(d), np.nan, r)
 
 
@@ -618,7 +626,7 @@ def _flag_frame_strain(actuator: Actuator, P: np.ndarray, k_free: np.ndarray) ->
                       "which no frame material stays near there", PlausibilityWarning, stacklevel=3)
 
 
-def limits(actuator: Actuator, pressure_kpa, model: str = "energy", *, eq19_factor: bool = True,
+def limits(actuator: Actuator, pressure_kpa, model: str | None = None, *, eq19_factor: bool = True,
            order: int = DEFAULT_ORDER) -> Limits:
     """The structural limits of ``actuator`` at each pressure: see the module docstring and :class:`Limits`.
 
@@ -627,7 +635,8 @@ def limits(actuator: Actuator, pressure_kpa, model: str = "energy", *, eq19_fact
     actuator : Actuator
         Its optional ``frame_strength_mpa`` and ``bladder_stretch_limit`` are the limits checked.
     pressure_kpa : float or 1-D array, kPa (gauge).
-    model : {"energy", "force_balance"}: the model whose free-bending curvature is used.
+    model : {"energy", "force_balance"} or None: the model whose free-bending curvature is used; None
+        (default): the actuator's own (energy when unknown); another than the actuator's warns.
 
     Examples
     --------
@@ -642,6 +651,7 @@ def limits(actuator: Actuator, pressure_kpa, model: str = "energy", *, eq19_fact
     if P.ndim > 1:
         raise InputError(f"pressure_kpa must be a number or a 1-D list of pressures, got shape {P.shape}")
     P = np.atleast_1d(P)
+    actuator.outside_tested(P)
     tab = law.branches()
     k, u = law.free_state_array(P, table=tab)
     r = case_limits(law, P, k, tab, free_u=u, frame_strength_mpa=actuator.frame_strength_mpa,
@@ -653,7 +663,7 @@ def limits(actuator: Actuator, pressure_kpa, model: str = "energy", *, eq19_fact
     p_max = float(r["max_pressure_kpa"][0])
     lines = violation_lines(P, one, blocked, free, kind, p_max)
     _flag_frame_strain(actuator, P, free["curvature_per_mm"])
-    return Limits(model=law.model, pressure_kpa=P, **one, max_pressure_kpa=p_max, branch_end=kind,
+    return Limits(model=str(law.model), pressure_kpa=P, **one, max_pressure_kpa=p_max, branch_end=kind,
                   frame_strength_mpa=actuator.frame_strength_mpa, bladder_stretch_limit=actuator.bladder_stretch_limit,
                   violations=tuple(t for _, t in lines), blocked=blocked, free=free,
                   violation_index=tuple(i for i, _ in lines))

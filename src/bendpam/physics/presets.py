@@ -34,7 +34,8 @@ _TABLE3 = {
     ("bc-pam", "force_balance"): (36.60, 1499.9, -1169.9),
 }
 
-_START = {"be-pam": dict(P_start_kpa=68.0, R0_start_mm=10.1), "bc-pam": dict(P_start_kpa=32.0, R0_start_mm=8.6)}
+_START: dict[str, dict[str, float]] = {"be-pam": dict(P_start_kpa=68.0, R0_start_mm=10.1),
+                                       "bc-pam": dict(P_start_kpa=32.0, R0_start_mm=8.6)}
 
 
 def _make(which: str, model: str) -> Actuator:
@@ -47,8 +48,8 @@ def _make(which: str, model: str) -> Actuator:
         C01_kpa=c01,
         name=f"{label} (paper, {m.replace('_', '-')} constants)",
         model=m,
-        **_TABLE1,
-        **_START[which],
+        **_TABLE1,  # type: ignore[arg-type]
+        **_START[which],  # type: ignore[arg-type]
     )
 
 

@@ -8,10 +8,13 @@ themselves as ``"figure4"`` and ``"figure7"`` (:mod:`bendpam.infra.accessors`), 
 
 from __future__ import annotations
 
+import warnings
+
 import matplotlib
 import numpy as np
 from matplotlib.collections import LineCollection
 
+from bendpam.errors import OutsideTestedRangeWarning
 from bendpam.infra.accessors import register
 from bendpam.physics.hysteresis import loop_branches, predict_cycles
 from bendpam.predict import free_curvature, moment
@@ -232,11 +235,13 @@ def figure7(processed, fit_result, title: str = ""):
     act, model = fit_result.actuator, fit_result.model
     fig = new_figure((DOUBLE_COLUMN_IN, 3.0))
     axes = fig.subplots(1, 3)
-    _fit_curves_panel(axes[0], processed, fit_result)
     P, bm, kf = _means(processed)
     Pm = np.linspace(min(P.min(), act.P_start_kpa), P.max() * 1.05, 100)
-    cycles = _fit_blocked_panel(axes[1], P, bm, Pm, fit_result)
-    _fit_free_panel(axes[2], P, kf, Pm, fit_result, cycles)
+    with warnings.catch_warnings():  # the model's lines run from P_start past the tested pressures on purpose
+        warnings.simplefilter("ignore", OutsideTestedRangeWarning)
+        _fit_curves_panel(axes[0], processed, fit_result)
+        cycles = _fit_blocked_panel(axes[1], P, bm, Pm, fit_result)
+        _fit_free_panel(axes[2], P, kf, Pm, fit_result, cycles)
     fig.suptitle(wrap_text(title or f"{act.name or act.kind}: {model.replace('_', '-')} model fit, NRMSE of the "
                            f"cycles {100 * fit_result.metrics.nrmse_cycles:.2f} %", DOUBLE_COLUMN_IN, 9))
     fig.tight_layout()

@@ -12,6 +12,7 @@ from matplotlib.ticker import MaxNLocator
 
 from bendpam.errors import InputError
 from bendpam.physics.braid import curvature_limits
+from bendpam.physics.models import resolve_model
 from bendpam.predict import active_pressure_kpa, free_curvature, internal_stresses, moment
 from bendpam.present.figures.style import DOUBLE_COLUMN_IN, figure_size, new_figure, styled, wrap_text
 
@@ -25,7 +26,8 @@ __all__ = [
 ]
 
 
-def curve_range(actuator, pressures_kpa, model: str = "energy", k_max: float | None = None, n: int = 200) -> np.ndarray:
+def curve_range(actuator, pressures_kpa, model: str | None = None, k_max: float | None = None,
+                n: int = 200) -> np.ndarray:
     """Curvature grid (1/mm) from 0 toward the bending direction, to ``k_max`` (magnitude).
 
     The default end is 15 % past the largest free-bending curvature at the given pressures (or past
@@ -61,7 +63,7 @@ def curve_range(actuator, pressures_kpa, model: str = "energy", k_max: float | N
     return sgn * np.linspace(0.0, end, int(n))
 
 
-def moment_curves(actuator, pressures_kpa, model: str = "energy", k_max: float | None = None, n: int = 200):
+def moment_curves(actuator, pressures_kpa, model: str | None = None, k_max: float | None = None, n: int = 200):
     """Moment-curvature curves: returns ``(k, M)`` with ``M`` of shape (n_pressures, n), N*mm.
 
     Examples
@@ -72,13 +74,14 @@ def moment_curves(actuator, pressures_kpa, model: str = "energy", k_max: float |
     ([0.0, 0.0078, 0.0156], [[75.2, -94.1, -199.9], [310.3, 108.8, -31.6]])
     """
     P = np.atleast_1d(np.asarray(pressures_kpa, dtype=float))
+    model = resolve_model(actuator, model)
     k = curve_range(actuator, P, model, k_max, n)
     return k, moment(actuator, P[:, None], k[None, :], model)
 
 
 @styled
-def plot_moment_curvature(ax, actuator, pressures_kpa, model: str = "energy", k_max: float | None = None, n: int = 200,
-                          title: str | None = None):
+def plot_moment_curvature(ax, actuator, pressures_kpa, model: str | None = None, k_max: float | None = None,
+                          n: int = 200, title: str | None = None):
     """Draw M(P, k') curves and the free-bending points on ``ax``.  Returns ``ax``.
 
     Examples
@@ -90,6 +93,7 @@ def plot_moment_curvature(ax, actuator, pressures_kpa, model: str = "energy", k_
     ['100 kPa', '200 kPa']
     """
     P = np.atleast_1d(np.asarray(pressures_kpa, dtype=float))
+    model = resolve_model(actuator, model)
     k, M = moment_curves(actuator, P, model, k_max, n)
     fb = free_curvature(actuator, P, model)
     colors = matplotlib.colormaps["viridis"](np.linspace(0.0, 0.9, P.size))
@@ -111,7 +115,7 @@ def plot_moment_curvature(ax, actuator, pressures_kpa, model: str = "energy", k_
 
 
 @styled
-def moment_curvature_figure(actuator, pressures_kpa, model: str = "energy", k_max: float | None = None,
+def moment_curvature_figure(actuator, pressures_kpa, model: str | None = None, k_max: float | None = None,
                             n: int = 200, title: str | None = None):
     """A single-column figure of :func:`plot_moment_curvature` (the figure of ``bendpam curve``).
 

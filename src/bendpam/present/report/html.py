@@ -327,7 +327,7 @@ def _actuator_context(actuator, fits: Mapping) -> dict:
                  + [_td(f"{act.kind} ({sense[int(act.bend_sign)]})", None, None, "") for _, act in cols],
                  "Type", tail=Markup("<td></td>"))]
     for c_key in dicts[0][1]:
-        if c_key in ("name", "model"):
+        if c_key in ("name", "model", "tested_pressure_kpa", "fit_identity"):  # labels, not parameters
             continue
         sym = symbol(c_key)
         rows.append(_Row([_td(plain_html(sym.meaning), None, None, "meaning", raw=True)]
