@@ -10,7 +10,6 @@ separate tokens (``--diameter-mm 80 120 160``), comma lists (``80,120,160``) or 
 """
 
 # no ``from __future__ import annotations``: Typer reads the annotations of the command functions.
-import json
 import math
 from pathlib import Path
 from typing import Annotated, Any, Optional
@@ -34,6 +33,7 @@ from bendpam.cli.options import (
     model_name,
     parse_values,
     pressures_kpa,
+    print_json,
 )
 from bendpam.cli.options import fmt_num as _fmt
 
@@ -48,7 +48,7 @@ L0Opt = Annotated[Optional[float], typer.Option("--l0-mm", help="Active length L
 
 
 def _record(row: dict[str, Any]) -> dict[str, Any]:
-    """A table row as a JSON record: numbers as floats (null where not finite), empty notes as null."""
+    """A table row as a JSON record: numbers as floats (NaN as null, infinity kept), empty notes as null."""
     out: dict[str, Any] = {}
     for k, v in row.items():
         if isinstance(v, bool | np.bool_):
@@ -61,7 +61,7 @@ def _record(row: dict[str, Any]) -> dict[str, Any]:
             except (TypeError, ValueError):
                 out[k] = None
             else:
-                out[k] = f if math.isfinite(f) else None
+                out[k] = None if math.isnan(f) else f  # infinity: "inf" in the JSON (print_json)
     return out
 
 
@@ -171,7 +171,7 @@ def finger_cmd(
                "units": {"tip_x_mm": "mm", "tip_angle_deg": "deg (tangent at the tip, from +x)",
                          "bend_angle_deg": "deg (tip rotation in the bending direction)"},
                "results": rows}
-        typer.echo(json.dumps(obj, indent=2))
+        print_json(obj)
     else:
         typer.echo(f"{act.name or act.kind}, L0 = {act.L0_mm:g} mm — {mname.replace('_', '-')} model")
         _print_finger_rows(rows, blocked)
@@ -291,7 +291,7 @@ def grasp_cmd(
         _save_plot(lambda ax: plot_grasp(ds, ax=ax), plot, fig_format)
     rows = [g.to_dict() for row in grasps for g in row]
     if as_json:
-        typer.echo(json.dumps({**gr.to_dict(), "units": _GRASP_UNITS, "results": rows}, indent=2))
+        print_json({**gr.to_dict(), "units": _GRASP_UNITS, "results": rows})
         return
     _print_grasps(gr, rows)
     if plot is not None:
@@ -371,7 +371,7 @@ def wrist_cmd(
                         "load_moment_nmm": holds[0].load_moment_nmm if holds else None,
                         "pressure_needed_kpa": holds[0].to_dict()["pressure_needed_kpa"] if holds else None},
                "results": results, "holding": holding}
-        typer.echo(json.dumps(obj, indent=2))
+        print_json(obj)
         return
     typer.echo(f"wrist of four {act.name or act.kind}, L = {w.length_mm:g} mm, radius {w.radius_mm:g} mm, "
                f"lateral stiffness {w.lateral_stiffness_nmm2:.4g} N·mm² — {mname.replace('_', '-')} model")

@@ -28,6 +28,7 @@ from bendpam.cli.options import (
     output_set,
     parse_values,
     pressures_kpa,
+    print_json,
 )
 from bendpam.errors import InputError
 
@@ -68,16 +69,13 @@ def inspect(
     as_json: Annotated[bool, typer.Option("--json", help="Print a JSON list, one object per file.")] = False,
 ):
     """What the reader understood of each file (format, encoding, channels, units, values), before processing."""
-    import json
-
-    from bendpam.infra.outputs import json_safe
     from bendpam.lab import format_inspection, inspect_file
 
     paths = collect_raw_files(files)
     infos = [inspect_file(p, pressure_kpa=pressure_kpa, columns=columns, rate_hz=rate_hz, repair=repair)
              for p in paths]
     if as_json:
-        typer.echo(json.dumps(json_safe(infos), indent=2, allow_nan=False, ensure_ascii=False))
+        print_json(infos)
     else:
         for info in infos:
             typer.echo(format_inspection(info))
@@ -222,6 +220,8 @@ def simulate_test_cmd(
         float, typer.Option("--stroke-offset-mm", help="Machine stroke at the blocked state (mm).")] = 0.0,
     fixture: FixtureOpt = "35,2.5,4",
     seed: Annotated[Optional[int], typer.Option("--seed", help="Random seed.")] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="Print truth.json (the true values) instead of one "
+                                          "line per file.")] = False,
 ):
     """Write the raw files a testing machine would record for a model actuator (a virtual test)."""
     from bendpam.lab.simulate import SimulationSettings, simulate_tests
@@ -242,6 +242,9 @@ def simulate_test_cmd(
             truth = simulate_tests(act, P, o.staging, model_name(model), dialect=fmt.value, fixture=fx, settings=st)
         except InputError as exc:  # the library names the settings; this command's options say them as flags
             raise UserError(_SETTING_FLAGS.sub(lambda m: _FLAGS[m.group(0)], str(exc))) from None
+    if as_json:
+        print_json(truth)
+        return
     for t in truth["pressures"]:
         typer.echo(
             f"{t['file']}: {t['samples']} samples, blocked {t['blocked_moment_nmm']:.2f} N·mm, "

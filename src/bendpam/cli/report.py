@@ -26,7 +26,7 @@ def register(app: typer.Typer) -> None:
     """
     if any(getattr(c, "name", None) == "report" for c in app.registered_commands):
         return
-    from bendpam.cli.options import ActuatorOpt, PresetOpt, QuietOpt
+    from bendpam.cli.options import RANGE_HELP, ActuatorOpt, PresetOpt, QuietOpt
 
     @app.command("report")
     def report(
@@ -36,7 +36,7 @@ def register(app: typer.Typer) -> None:
         out: Annotated[Optional[Path], typer.Option("--out", help="The HTML report to write (report.html).")] = None,
         pressure_kpa: Annotated[
             Optional[list[str]],
-            typer.Option("--pressure-kpa", help="Pressure of each file in kPa, comma-separated, in file order "
+            typer.Option("--pressure-kpa", help=f"Pressure of each file in kPa, in file order: {RANGE_HELP} "
                          "(default: each file's metadata or filename)."),
         ] = None,
         l0_mm: Annotated[
@@ -49,8 +49,8 @@ def register(app: typer.Typer) -> None:
         ] = "alpha0,C10,C01",
         model: Annotated[
             Optional[list[str]],
-            typer.Option("--model", help="Model(s) to fit: energy, force-balance (repeat or comma-separate; "
-                         "default both)."),
+            typer.Option("--model", help="Model(s) to fit: energy, force-balance ('energy force-balance', "
+                         "'energy,force-balance' or repeated; default both)."),
         ] = None,
         quiet: QuietOpt = False,
         progress: Annotated[bool, typer.Option("--progress/--no-progress", hidden=True,

@@ -679,13 +679,13 @@ class FingerLimits:
     sections: dict[str, np.ndarray] = field(repr=False, compare=False)
 
     def to_dict(self) -> dict[str, Any]:
-        """The worst section's numbers as a JSON-ready dict (margins: null where infinite, no demand or no limit).
+        """The worst section's numbers as a JSON-ready dict (margins: "inf" where there is no demand or no limit).
 
         >>> import bendpam
         >>> from bendpam.design import Finger, solve_finger
         >>> d = solve_finger(Finger(bendpam.physics.presets.be_pam()), 150.0).limits().to_dict()
         >>> round(d["lockup_margin"], 1), d["buckling_margin"], d["violations"]
-        (4.1, None, [])
+        (4.1, 'inf', [])
         """
         return {k: json_number(getattr(self, k)) for k in (
             "frame_axial_force_n", "frame_stress_mpa", "frame_strength_margin", "buckling_margin", "lockup_margin",

@@ -134,7 +134,7 @@ class DesignResult:
     search: dict[str, Any] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
-        """design.json's content (units in the key names; ``null`` = infinite or not defined)."""
+        """design.json's content (units in the key names; ``null`` = not defined, ``"inf"`` = infinite)."""
         return {
             "bendpam_version": __version__,
             "model": self.model,
@@ -161,7 +161,8 @@ class DesignResult:
                 "better": ["larger" if t.larger_is_better else "smaller" for t in self.pareto.targets],
                 "file": "pareto.csv"},
             "search": dict(self.search),
-            "null_means": "infinite (no demand, no limit, an unbounded free-bending branch) or not defined",
+            "null_means": "not defined (missing); infinity (no demand, no limit, an unbounded free-bending branch) "
+                          "is the string \"inf\"",
         }
 
     def to_json(self) -> str:
