@@ -104,8 +104,8 @@ def test_report_all_forms_reach_the_report(capsys, tmp_path, raw_files, monkeypa
     monkeypatch.setattr(rep, "build_report", fake)
     models = {"tokens": ["energy", "force-balance"], "commas": ["energy,force-balance"],
               "range": ["energy", "--model", "force-balance"]}[form]
-    code, _, err = run(capsys, "report", *raw_files, "--preset", "be-pam", "--pressure-kpa", *FORMS[form], "--model", *models,
-        "--out", tmp_path / "r.html")
+    code, _, err = run(capsys, "report", *raw_files, "--preset", "be-pam", "--pressure-kpa", *FORMS[form],
+                       "--model", *models, "--out", tmp_path / "r.html")
     assert code == 2 and "stop here" in err
     assert seen == {"models": ["energy", "force-balance"], "pressure_kpa": EXPECTED}
 
