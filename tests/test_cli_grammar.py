@@ -210,3 +210,14 @@ def test_force_after_the_command_replaces_a_foreign_file(capsys, tmp_path):
     f2 = tmp_path / "b.toml"
     f2.write_text("x\n")
     assert run(capsys, "--force", "actuator", "--preset", "be-pam", "--out", f2)[0] == 0
+
+
+def test_shell_completion_is_available(capsys, monkeypatch):
+    code, out, _ = run(capsys, "--help")
+    assert code == 0 and "--install-completion" in out and "--show-completion" in out
+    monkeypatch.setenv("_BENDPAM_COMPLETE", "complete_bash")
+    monkeypatch.setenv("COMP_WORDS", "bendpam predict --pres")
+    monkeypatch.setenv("COMP_CWORD", "2")
+    with pytest.raises(SystemExit):
+        main(["predict", "--pres"])
+    assert {"--preset", "--pressure-kpa"} <= set(capsys.readouterr().out.split())

@@ -32,7 +32,7 @@ __all__ = ["ISSUES_URL", "app", "main"]
 ISSUES_URL = "the bendpam issue tracker (include the command line and bendpam --version)"
 
 app = typer.Typer(
-    add_completion=False,
+    add_completion=True,  # --install-completion / --show-completion (README "Command line")
     no_args_is_help=True,
     pretty_exceptions_enable=False,
     rich_markup_mode=None,
