@@ -85,6 +85,7 @@ from bendpam.design.parts import (
 from bendpam.design.rod import NEWTON_TOL, Rod, complex_jacobian, continuation, newton, sinc
 from bendpam.errors import InputError, NoEquilibrium
 from bendpam.infra.accessors import figure
+from bendpam.infra.display import summary_html, summary_text
 from bendpam.physics.actuator import Actuator
 from bendpam.physics.law import MomentLaw, StableBranch
 from bendpam.physics.models import normalise_model
@@ -426,6 +427,21 @@ class FingerShape:
         nan = np.full(rod.n, np.nan)
         return cls(rod.f, loads, P, rod.s.copy(), nan, nan.copy(), nan.copy(), nan.copy(), nan.copy(),
                    (math.nan, math.nan), math.nan, False, False, math.nan, lam, note, limit, branch)
+
+    def _summary(self) -> tuple[str, list[tuple[str, Any]], list[str], list[list[Any]]]:
+        d = self.to_dict()
+        return (f"FingerShape at {self.pressure_kpa:g} kPa ({'equilibrium' if self.equilibrium else 'no equilibrium'}"
+                f"{', ' + self.note if self.note else ''})",
+                [(k, d[k]) for k in ("tip_x_mm", "tip_y_mm", "tip_angle_deg", "bend_angle_deg", "base_moment_nmm",
+                                     "residual_nmm")], [], [])
+
+    def __repr__(self) -> str:
+        """A short summary: the tip pose and the base moment (the arrays are in :meth:`to_dataframe`)."""
+        return summary_text(*self._summary())
+
+    def _repr_html_(self) -> str:
+        """The summary of :meth:`__repr__` for a notebook (HTML)."""
+        return summary_html(*self._summary())
 
     def limits(self) -> FingerLimits:
         """The structural limits along this shape, worst section (:func:`finger_limits`)."""

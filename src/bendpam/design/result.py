@@ -12,6 +12,7 @@ import numpy as np
 from bendpam.design.targets import Target, Variable
 from bendpam.infra.accessors import figure
 from bendpam.infra.atomic import atomic_write_text
+from bendpam.infra.display import summary_html, summary_text
 from bendpam.infra.outputs import to_json
 from bendpam.physics.actuator import Actuator
 from bendpam.version import __version__
@@ -221,6 +222,22 @@ class DesignResult:
             lines.append(f"  at their limit: {', '.join(self.active)}")
         lines.append(f"  {self.message}")
         return "\n".join(lines)
+
+    def _summary(self) -> tuple[str, list[tuple[str, Any]], list[str], list[list[Any]]]:
+        items: list[tuple[str, Any]] = [("smallest margin", self.min_margin),
+                                        ("required margin", self.min_margin_required)]
+        items += [(f"target {t.text}", f"{a:.4g} ({'met' if ok else 'not met'})")
+                  for t, a, ok in zip(self.targets, self.achieved, self.met, strict=True)]
+        return (f"DesignResult: {'feasible' if self.feasible else 'NOT feasible'} ({self.model.replace('_', '-')} "
+                "model)", items, ["variable", "value"], [[k, v] for k, v in self.values.items()])
+
+    def __repr__(self) -> str:
+        """A short summary: feasible or not, the targets, the design's variables (``str()`` explains)."""
+        return summary_text(*self._summary())
+
+    def _repr_html_(self) -> str:
+        """The summary of :meth:`__repr__` for a notebook (HTML)."""
+        return summary_html(*self._summary())
 
     def __str__(self) -> str:
         return self.summary()

@@ -121,6 +121,7 @@ from bendpam.identify.result import (
     Profile,
 )
 from bendpam.identify.uncertainty import Uncertainty, material_fit, sandwich_covariance
+from bendpam.lab.processed import as_processed
 from bendpam.physics.actuator import NEUTRAL_ANGLE_DEG, Actuator
 from bendpam.physics.braid import DEFAULT_ORDER
 from bendpam.physics.law import MomentLaw
@@ -407,7 +408,7 @@ def fit(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C
 
     Parameters
     ----------
-    processed : :class:`bendpam.lab.processing.ProcessedSet` (or ``load_processed(dir)``).
+    processed : :class:`bendpam.lab.processing.ProcessedSet`, or the folder it was written to (str or Path).
     actuator : the nominal actuator (geometry, and the values of the parameters held fixed).
     model : ``"energy"`` or ``"force_balance"``.
     free : names among alpha0, C10, C01, P_start, E_f, R0_start (aliases such as ``alpha0_deg`` work).
@@ -463,6 +464,7 @@ def fit(processed, actuator: Actuator, model: str = "energy", free=("alpha0", "C
     free = parse_free(free)
     if tension is not None:
         actuator = actuator.replace(C10_kpa=tension.C10_kpa, C01_kpa=tension.C01_kpa)
+    processed = as_processed(processed)  # a ProcessedSet, or the folder it was written to
     run = _prepare(processed, actuator, model, free, bounds, tension_data, fit_range, hysteresis, hysteresis_law,
                    admissible_range, order, eq19_factor)
     _search_stages(run, grid_alpha, grid_r0, tension_data)
