@@ -154,8 +154,10 @@ def finger_cmd(
     _, shapes = finger_sweep(finger, P, loads)
     lims = [sh.limits() if sh.equilibrium else None for sh in shapes]  # worst section along the finger
     held = [blocked_tip_force(finger, p, loads=loads) for p in P] if blocked else None
-    if plot is not None:
-        _save_plot(lambda ax: plot_finger_shapes(shapes, ax=ax, title=f"{act.name or act.kind}, "
+    if plot is not None:  # with a load, the free shapes beside the loaded ones
+        loaded = any(F) or tip_moment_nmm or tip_mass_g or mass_per_length
+        free = finger_sweep(finger, P, FingerLoads())[1] if loaded else None
+        _save_plot(lambda ax: plot_finger_shapes(shapes, ax=ax, free=free, title=f"{act.name or act.kind}, "
                                                  f"L0 = {act.L0_mm:g} mm"), plot, fig_format, aspect=0.9)
     rows = []
     for i, (sh, lm) in enumerate(zip(shapes, lims, strict=True)):

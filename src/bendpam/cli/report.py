@@ -105,7 +105,7 @@ def _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, m
     fx = Fixture.from_string(fixture, L0_mm=act.L0_mm if l0_mm is None else l0_mm, name="--fixture")
     with output_file(out, [*files, actuator]) as f:
         res = build_report(files, act, f.path, models=[m.value for m in models], free=free, pressure_kpa=pressures,
-                           fixture=fx, progress=progress)
+                           fixture=fx, progress=progress, shown_as=str(out))
 
     summ = res.summary
     for row in res.table2:

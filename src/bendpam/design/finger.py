@@ -809,10 +809,11 @@ def free_tip_trajectory(finger: Finger, pressures_kpa):
 # ------------------------------------------------------------------------------------------------
 # figure (drawn by bendpam.present.figures.design, reached by name)
 # ------------------------------------------------------------------------------------------------
-def plot_finger_shapes(shapes, ax=None, title: str | None = None):
+def plot_finger_shapes(shapes, ax=None, title: str | None = None, free=None):
     """Draw finger shapes (frame line, fingertip, tip point) on ``ax``; returns the figure.
 
-    Shapes without equilibrium are drawn dashed from their last equilibrium (``limit``) if any.
+    Shapes without equilibrium are drawn dashed from their last equilibrium (``limit``) if any;
+    ``free``, the unloaded shapes at the same pressures, are drawn dotted beside them.
     The figure is :func:`bendpam.present.figures.design.plot_finger_shapes`, loaded on first use.
 
     Examples
@@ -825,4 +826,4 @@ def plot_finger_shapes(shapes, ax=None, title: str | None = None):
     1
     >>> plt.close(fig)
     """
-    return figure("finger_shapes")(shapes, ax=ax, title=title)
+    return figure("finger_shapes")(shapes, ax=ax, title=title, free=free)

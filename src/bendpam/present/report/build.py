@@ -94,6 +94,7 @@ def build_report(
     fixture: Fixture | str | None = None,
     processing_options=None,
     progress: bool = True,
+    shown_as: str | None = None,
 ) -> Report:
     """Raw test files -> processing -> fits -> checks -> ONE self-contained HTML page at ``out_html``.
 
@@ -112,6 +113,8 @@ def build_report(
         actuator) or None (the paper's fixture with the actuator's L0).
     processing_options : a :class:`~bendpam.lab.processing.ProcessingOptions`, a dict of its fields, or None.
     progress : report progress on stderr (:class:`bendpam.infra.progress.Progress`); False writes nothing.
+    shown_as : the name progress gives the page (default: ``out_html``'s name; a caller writing through a
+        temporary file gives the target's).
 
     Returns
     -------
@@ -146,7 +149,7 @@ def build_report(
         loops = has_loop(processed)
         hyst, separate, hyst_error = _loop_fit(processed, actuator, fits, free_names, loops, bar)
         figures, notes, stresses = draw_figures(processed, actuator, fits, model_names, hyst, separate, bar)
-        bar.advance(0, description=f"report: writing {out.name}")
+        bar.advance(0, description=f"report: writing {shown_as or out.name}")
         inputs_info = [_input_info(t) for t in tests]
         page = render_page(
             actuator=actuator, summary=summary, fits=fits, figures=figures, inputs_info=inputs_info, fixture=fx,
