@@ -10,7 +10,7 @@ bendpam predict --preset be-pam --pressure-kpa 100 150 200
 bendpam actuator --preset be-pam --out be.toml
 
 # 2. A virtual cyclic test (four-point bending, 5 pressures) written as Zwick testXpert exports
-bendpam simulate-test --actuator be.toml --pressure-kpa 100:200:5 --out raw-be --format testxpert --seed 1
+bendpam simulate-test --actuator be.toml --pressure-kpa 100:200:5 --out raw-be --table-format testxpert --seed 1
 
 # 3. What the reader understands of the files, then Table 2 quantities and Figure 4
 bendpam inspect raw-be

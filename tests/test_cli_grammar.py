@@ -221,3 +221,42 @@ def test_shell_completion_is_available(capsys, monkeypatch):
     with pytest.raises(SystemExit):
         main(["predict", "--pres"])
     assert {"--preset", "--pressure-kpa"} <= set(capsys.readouterr().out.split())
+
+
+# ---- --format is the figure format; tables have --table-format ----------------------------------
+def test_format_is_the_figure_format_on_every_command(capsys):
+    group, names = _commands()
+    for name in names:
+        code, out, _ = run(capsys, name, "--help")
+        for line in out.splitlines():
+            if re.match(r"^\s+--format\s", line):
+                assert line.split()[1] == "[png|pdf|svg]", (name, line)
+    for name in ("sweep", "simulate-test"):
+        assert "--table-format" in run(capsys, name, "--help")[1]
+    assert "--format" in run(capsys, "design", "--help")[1]
+
+
+def test_simulate_test_table_format_and_the_old_spelling(capsys, tmp_path):
+    args = ["simulate-test", "--preset", "be-pam", "--pressure-kpa", "150", "--cycles", "1", "--rate-hz", "5"]
+    code, _, err = run(capsys, *args, "--out", tmp_path / "a", "--table-format", "testxpert")
+    assert code == 0 and err == "", err
+    assert [p.name for p in (tmp_path / "a").glob("*.txt")] == ["be-pam_150kPa.txt"]
+    code, _, err = run(capsys, *args, "--out", tmp_path / "b", "--format", "testxpert")
+    assert code == 0
+    assert err.splitlines() == ["bendpam: warning: simulate-test --format testxpert is deprecated (--format is the "
+                                "figure format); use --table-format testxpert"]
+    assert [p.name for p in (tmp_path / "b").glob("*.txt")] == ["be-pam_150kPa.txt"]
+    code, _, err = run(capsys, *args, "--out", tmp_path / "c", "--format", "mts", "--table-format", "csv")
+    assert code == 2 and "not both" in err
+
+
+def test_design_figure_format(capsys, tmp_path):
+    code, _, err = run(capsys, "design", "--preset", "be-pam", "--target", "blocked_moment_nmm=400@200", "--vary",
+                       "alpha0_deg=60:80", "--n-coarse", "16", "--starts", "1", "--out", tmp_path / "d", "--format",
+                       "svg", "--quiet")
+    assert code == 0, err
+    assert (tmp_path / "d" / "coarse_map.svg").read_text().lstrip().startswith(("<?xml", "<svg"))
+    assert not (tmp_path / "d" / "coarse_map.png").exists()
+    code, _, err = run(capsys, "design", "--preset", "be-pam", "--target", "blocked_moment_nmm=400@200", "--vary",
+                       "alpha0_deg=60:80", "--format", "pdf")
+    assert code == 2 and "--out" in err

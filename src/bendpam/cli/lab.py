@@ -21,6 +21,7 @@ from bendpam.cli.options import (
     QuietOpt,
     UserError,
     collect_raw_files,
+    deprecated_format,
     echo_wrote,
     fmt_num,
     load_actuator,
@@ -195,7 +196,12 @@ def simulate_test_cmd(
     pressure_kpa: PressureOpt = None,
     out: Annotated[
         Optional[Path], typer.Option("--out", help="Output folder for the raw files and truth.json.")] = None,
-    fmt: Annotated[Format, typer.Option("--format", help="Export dialect to write.")] = Format.csv,
+    table_fmt: Annotated[Optional[Format], typer.Option(
+        "--table-format", help="Export dialect of the raw files: csv, testxpert, bluehill or mts (default csv).")]
+    = None,
+    fmt: Annotated[Optional[Format], typer.Option(
+        "--format", hidden=True, help="Deprecated spelling of --table-format (--format is the figure format).")]
+    = None,
     noise_n: Annotated[float, typer.Option("--noise-n", help="Force noise, standard deviation (N).")] = 0.05,
     noise_stroke_mm: Annotated[float, typer.Option("--noise-stroke-mm", help="Stroke noise, standard deviation (mm).")]
     = 0.002,
@@ -229,6 +235,7 @@ def simulate_test_cmd(
 
     if out is None:
         raise UserError("give an output folder with --out DIR")
+    dialect = deprecated_format(fmt, table_fmt, "simulate-test") or Format.csv
     act = load_actuator(preset, actuator, model)
     P = pressures_kpa(pressure_kpa)
     st = SimulationSettings(cycles=cycles, speed_mm_min=speed_mm_min, rate_hz=rate_hz, noise_n=noise_n,
@@ -239,7 +246,7 @@ def simulate_test_cmd(
     fx = Fixture.from_string(fixture, L0_mm=act.L0_mm, name="--fixture")
     with output_set(out, [actuator]) as o:
         try:
-            truth = simulate_tests(act, P, o.staging, model_name(model), dialect=fmt.value, fixture=fx, settings=st)
+            truth = simulate_tests(act, P, o.staging, model_name(model), dialect=dialect.value, fixture=fx, settings=st)
         except InputError as exc:  # the library names the settings; this command's options say them as flags
             raise UserError(_SETTING_FLAGS.sub(lambda m: _FLAGS[m.group(0)], str(exc))) from None
     if as_json:

@@ -56,6 +56,7 @@ __all__ = [
     "collect_raw_files",
     "command_inputs",
     "command_line",
+    "deprecated_format",
     "echo",
     "echo_wrote",
     "figure_format",
@@ -111,7 +112,7 @@ class Preset(str, Enum):
 
 
 class Format(str, Enum):
-    """The export dialects of ``simulate-test --format``.
+    """The export dialects of ``simulate-test --table-format``.
 
     >>> Format("mts").value
     'mts'
@@ -674,8 +675,27 @@ QuietOpt = Annotated[
     bool, typer.Option("--quiet", "-q", help="No progress on stderr (neither the bar nor the progress lines).")
 ]
 
+def deprecated_format(old: Any, new: Any, command: str, *, new_name: str = "--table-format") -> Any:
+    """The value of ``new_name``, or of the old ``--format`` spelling with a one-line note on stderr.
+
+    ``--format`` means the figure format on every command; where it meant a table's format it is
+    still accepted for one release (0.4) with this note.
+
+    >>> deprecated_format(None, "csv", "sweep")
+    'csv'
+    """
+    if old is None:
+        return new
+    value = getattr(old, "value", old)
+    if new is not None and getattr(new, "value", new) != value:
+        raise UserError(f"give either {new_name} {getattr(new, 'value', new)} or --format {value}, not both")
+    echo(f"bendpam: warning: {command} --format {value} is deprecated (--format is the figure format); use "
+         f"{new_name} {value}", err=True)
+    return old
+
+
 def output_format(path: Path | None, fmt: str | Enum | None, formats: tuple[str, ...], *, option: str = "--out",
-                  default: str | None = None) -> str | None:
+                  default: str | None = None, format_option: str = "--format") -> str | None:
     """The format of an output file from ``--format`` or the suffix of ``path`` (:func:`bendpam.validate.file_format`).
 
     Returns None when ``path`` is None.
@@ -685,7 +705,7 @@ def output_format(path: Path | None, fmt: str | Enum | None, formats: tuple[str,
     """
     if path is None:
         return None
-    return file_format(path, fmt, formats, option=option, format_option="--format", default=default)
+    return file_format(path, fmt, formats, option=option, format_option=format_option, default=default)
 
 
 def figure_format(path: Path | None, fmt: str | Enum | None, option: str = "--out") -> str | None:

@@ -170,8 +170,10 @@ class DesignResult:
         """design.json's text (:meth:`to_dict` as JSON)."""
         return to_json(self.to_dict())
 
-    def save(self, out_dir, *, figures: bool = True) -> dict[str, str]:
+    def save(self, out_dir, *, figures: bool = True, figure_format: str = "png") -> dict[str, str]:
         """Write design.json, design.toml, coarse_map.csv, pareto.csv and figures into ``out_dir``.
+
+        ``figure_format``: png, pdf or svg (the figures ``coarse_map`` and ``pareto`` get its suffix).
 
         Each file is written atomically (for a whole set, use :class:`bendpam.infra.outputs.OutputSet`,
         as ``bendpam design --out`` does).  Returns ``{file name: path}``.
@@ -197,11 +199,10 @@ class DesignResult:
             put("pareto.csv", self.pareto.to_csv())
         if figures:  # drawn and saved by bendpam.present.figures, reached by name
             save_figure = figure("save_figure")
-            save_figure(figure("coarse_map")(self), out / "coarse_map.png")
-            files["coarse_map.png"] = str(out / "coarse_map.png")
-            if self.pareto is not None:
-                save_figure(figure("pareto")(self), out / "pareto.png")
-                files["pareto.png"] = str(out / "pareto.png")
+            for name in ("coarse_map", "pareto") if self.pareto is not None else ("coarse_map",):
+                target = out / f"{name}.{figure_format}"
+                save_figure(figure(name)(self), target, format=figure_format)
+                files[target.name] = str(target)
         return files
 
     def summary(self) -> str:
