@@ -179,7 +179,7 @@ def _commands():
 
 #: Commands that print results (a table, values, a summary): each has --json.
 PRINTING = {"actuator", "demo", "design", "finger", "fit", "fit-material", "grasp", "inspect", "predict",
-            "process", "simulate-test", "wrist"}
+            "process", "report", "simulate-test", "wrist"}
 
 
 def test_every_command_has_readable_help_json_and_force(capsys):
@@ -260,3 +260,16 @@ def test_design_figure_format(capsys, tmp_path):
     code, _, err = run(capsys, "design", "--preset", "be-pam", "--target", "blocked_moment_nmm=400@200", "--vary",
                        "alpha0_deg=60:80", "--format", "pdf")
     assert code == 2 and "--out" in err
+
+
+@pytest.mark.slow
+def test_report_json(capsys, tmp_path, raw_files):
+    out = tmp_path / "r.html"
+    code, text, err = run(capsys, "report", *raw_files, "--preset", "be-pam", "--model", "energy", "--out", out,
+                          "--json", "-q")
+    assert code == 0, err
+    obj = strict(text)
+    assert obj["report"] == str(out) and out.stat().st_size > 10_000
+    assert [r["pressure_kpa"] for r in obj["table2"]["pressures"]] == EXPECTED
+    assert set(obj["fits"]) == {"energy"} and obj["fits"]["energy"]["converged"] is True
+    assert abs(obj["fits"]["energy"]["parameters"]["alpha0_deg"]["value"] - 69.7) < 1.0

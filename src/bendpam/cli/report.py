@@ -53,6 +53,9 @@ def register(app: typer.Typer) -> None:
                          "'energy,force-balance' or repeated; default both)."),
         ] = None,
         quiet: QuietOpt = False,
+        as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object (Table 2, the deadband, each "
+                                              "model's parameters and NRMSEs, the warnings) instead of lines.")]
+        = False,
         progress: Annotated[bool, typer.Option("--progress/--no-progress", hidden=True,
                                                help="Same as --quiet (--no-progress).")] = True,
     ):
@@ -61,10 +64,12 @@ def register(app: typer.Typer) -> None:
         The page warns at the top when a fit is poor or the data do not match the actuator, and
         prints cleanly to PDF from a browser.
         """
-        _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, model, progress and not quiet)
+        _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, model, progress and not quiet,
+                as_json)
 
 
-def _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, model, progress) -> None:
+def _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, model, progress,
+            as_json=False) -> None:
     from bendpam.cli.options import (
         Model,
         UserError,
@@ -108,6 +113,9 @@ def _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, m
                            fixture=fx, progress=progress, shown_as=str(out))
 
     summ = res.summary
+    if as_json:
+        _print_json(res, out)
+        return
     for row in res.table2:
         typer.echo(f"{row['pressure_kpa']:>6} kPa  {row['cycles']} cycles  blocked moment (N·mm) "
                    f"{row['blocked_moment_nmm']}  free curvature (1/mm) {row['free_curvature_per_mm']}  "
@@ -124,3 +132,14 @@ def _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, m
     n_w = sum(w.severity == "warning" for w in res.warnings)
     box = f", {n_w} warning(s) and {len(res.warnings) - n_w} caution(s) at the top" if res.warnings else ""
     echo_wrote(f"wrote {out} ({res.bytes / 1024:.0f} KiB, {len(res.figures)} figures{box})")
+
+
+def _print_json(res, out) -> None:
+    """``report --json``: the report's numbers as one JSON object."""
+    from bendpam.cli.options import print_json
+
+    fits = {m: {k: d[k] for k in ("model", "parameters", "nrmse", "converged", "flags") if k in d}
+            for m, d in ((m, f.to_dict()) for m, f in res.fits.items())}
+    print_json({"report": str(out), "table2": res.summary, "fits": fits, "failed": dict(res.failed),
+                "warnings": [{"severity": w.severity, "kind": w.kind, "title": w.title} for w in res.warnings],
+                "notes": list(res.notes)})
