@@ -34,6 +34,15 @@ def strict(text: str):
     return json.loads(text, parse_constant=refuse)
 
 
+def test_free_takes_several_names(capsys, tmp_path):
+    # the names join the option; the folder after them stays the argument (here one that does not exist)
+    code, _, err = run(capsys, "fit", "--free", "alpha0", "C10", "C01", tmp_path / "nothing", "--preset", "be-pam",
+                       "--out", tmp_path / "f")
+    assert code == 2 and "nothing" in err and "unexpected extra argument" not in err, err
+    assert join_list_values(["--free", "alpha0", "C10,C01", "proc"], {"--free": frozenset({"alpha0", "C10", "C01"})}) \
+        == ["--free", "alpha0,C10,C01", "proc"]
+
+
 def test_join_list_values_stops_at_files_and_options():
     rules = {"--pressure-kpa": None, "--model": frozenset({"energy", "force-balance"})}
     assert join_list_values(["--pressure-kpa", "100", "-5", "1e2", "raw", "x.csv"], rules) == \

@@ -143,13 +143,16 @@ LIST_OPTIONS: dict[str, frozenset[str] | None] = {
     "--direction-deg": None,
     "--param": None,
     "--model": frozenset({"energy", "force-balance", "force_balance"}),
+    "--free": frozenset({"alpha0", "C10", "C01", "P_start", "E_f", "R0_start"}),  # identify.result.PARAMETERS
 }
+#: List options whose one value is a comma list (the values that follow join it with commas).
+COMMA_LIST_OPTIONS = ("--free",)
 #: Kept for older imports: the options of :data:`LIST_OPTIONS`.
 MULTI_VALUE_OPTIONS = tuple(LIST_OPTIONS)
 _NUMBER = r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?"
 _VALUES = re.compile(rf"{_NUMBER}(?:[,:]{_NUMBER})*,?")
 #: Metavars of options whose values have a shape of their own (every other one is derived from its type).
-METAVARS = {"--fixture": "D,R,T", "--tip-force-n": "FX,FY", "--free": "NAMES", "--scheduler": "ADDRESS",
+METAVARS = {"--fixture": "D,R,T", "--tip-force-n": "FX,FY", "--free": "NAMES...", "--scheduler": "ADDRESS",
             "--fit-range": "developed|all", "--loop-law": "pi|dahl", "--hysteresis-law": "pi|dahl",
             "--bend": "ccw|cw", "--plot-var": "NAME", "--plot-x": "NAME", "--plot-y": "NAME",
             "--pressure-kpa": "KPA...", "--diameter-mm": "MM...", "--direction-deg": "DEG...", "--model": "MODEL...",
@@ -168,7 +171,8 @@ FORCE_HELP = ("Replace an output that bendpam did not write, or that another ben
 def _list_rules(param: Any) -> dict[str, frozenset[str] | None]:
     """``{option: continuation rule}`` of ``param`` if it is a list option of its command, else ``{}``."""
     names = [o for o in getattr(param, "opts", ()) if o in LIST_OPTIONS]
-    if not names or not (getattr(param, "multiple", False) or getattr(param, "nargs", 1) == -1):
+    listed = getattr(param, "multiple", False) or getattr(param, "nargs", 1) == -1
+    if not names or not (listed or names[0] in COMMA_LIST_OPTIONS):
         return {}
     return {o: LIST_OPTIONS[names[0]] for o in param.opts}
 
@@ -177,7 +181,8 @@ def _continues(token: str, rule: frozenset[str] | None) -> bool:
     """Whether ``token`` is one more value of a list option with the continuation ``rule``."""
     if rule is None:
         return bool(_VALUES.fullmatch(token))
-    return all(part in rule for part in token.lower().split(",") if part) and token.strip(",") != ""
+    names = {r.lower() for r in rule}
+    return all(part in names for part in token.lower().split(",") if part) and token.strip(",") != ""
 
 
 def join_list_values(args: list[str], rules: dict[str, frozenset[str] | None]) -> list[str]:

@@ -45,7 +45,8 @@ def register(app: typer.Typer) -> None:
         ] = None,
         fixture: Annotated[str, typer.Option("--fixture", help="Fixture geometry d,r,t in mm.")] = "35,2.5,4",
         free: Annotated[
-            str, typer.Option("--free", help="Parameters to identify: alpha0,C10,C01,P_start,E_f,R0_start.")
+            str, typer.Option("--free", help="Parameters to identify, of alpha0, C10, C01, P_start, E_f, R0_start: "
+                              "'alpha0 C10 C01' or 'alpha0,C10,C01'.")
         ] = "alpha0,C10,C01",
         model: Annotated[
             Optional[list[str]],
