@@ -93,8 +93,7 @@ def build_report(
     pressure_kpa=None,
     fixture: Fixture | str | None = None,
     processing_options=None,
-    progress: bool = True,
-    shown_as: str | None = None,
+    progress: bool = True, shown_as: str | None = None,
 ) -> Report:
     """Raw test files -> processing -> fits -> checks -> ONE self-contained HTML page at ``out_html``.
 
@@ -113,8 +112,7 @@ def build_report(
         actuator) or None (the paper's fixture with the actuator's L0).
     processing_options : a :class:`~bendpam.lab.processing.ProcessingOptions`, a dict of its fields, or None.
     progress : report progress on stderr (:class:`bendpam.infra.progress.Progress`); False writes nothing.
-    shown_as : the name progress gives the page (default: ``out_html``'s name; a caller writing through a
-        temporary file gives the target's).
+    shown_as : the page's name in the progress lines (default ``out_html``'s; a temporary file's caller: the target).
 
     Returns
     -------
