@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The README's story, in order, in one empty folder: predict -> simulate a test -> inspect and
-# process -> fit -> report -> a finger -> a design from targets -> a sweep.  Run it as `bash examples/walkthrough.sh` from an
-# empty folder; tests/test_walkthrough.py runs it and checks what it writes.
+# process -> fit -> report -> a finger -> a design from targets -> a sweep.  Run it from an empty folder as
+# `bash PATH/TO/bendpam/examples/walkthrough.sh` (it writes into the folder it runs in); tests/test_walkthrough.py
+# runs it and checks what it writes, and that the numbers README.md and docs/tutorial.md quote are what it prints.
 set -euo pipefail
 
 # 1. Predict the paper's BE-PAM, and save it as an editable actuator file
@@ -9,7 +10,7 @@ bendpam predict --preset be-pam --pressure-kpa 100 150 200
 bendpam actuator --preset be-pam --out be.toml
 
 # 2. A virtual cyclic test (four-point bending, 5 pressures) written as Zwick testXpert exports
-bendpam simulate-test --actuator be.toml --pressure-kpa 100:200:5 --out raw-be --format testxpert --seed 1
+bendpam simulate-test --actuator be.toml --pressure-kpa 100:200:5 --out raw-be --table-format testxpert --seed 1
 
 # 3. What the reader understands of the files, then Table 2 quantities and Figure 4
 bendpam inspect raw-be
@@ -20,7 +21,7 @@ bendpam fit processed-be --actuator be.toml --out fit-be
 bendpam predict --actuator fit-be/fitted_actuator.toml --pressure-kpa 100 150 200
 
 # 5. A test with a pronounced friction loop (fitted with both branches by default), and the predicted cycle
-bendpam simulate-test --preset be-pam --pressure-kpa 100:200:5 --out raw-loop --hysteresis 0.05 \
+bendpam simulate-test --preset be-pam --pressure-kpa 100:200:5 --out raw-loop --hysteresis 0.10 \
     --hysteresis-law pi --hysteresis-angle-deg 12 --seed 2
 bendpam process raw-loop --out processed-loop
 bendpam fit processed-loop --preset be-pam --out fit-loop

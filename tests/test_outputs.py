@@ -675,17 +675,17 @@ def test_write_json_and_manifest_are_strict(tmp_path):
     assert "NaN" not in text and "Infinity" not in text
     assert strict_loads(text) == {
         "nan": None,
-        "inf": None,
-        "ninf": None,
+        "inf": "inf",  # infinity is a string, null means missing (docs/formats.md)
+        "ninf": "-inf",
         "np": None,
-        "arr": [1.0, None, None],
+        "arr": [1.0, None, "inf"],
         "nested": [{"x": 2.5}, [3, True]],
         "7": "numpy key",
         "-inf": "inf key",
         "p": str(tmp_path / "p"),
     }
     strict_loads((tmp_path / "out" / "manifest.json").read_text())
-    assert json_safe(np.float64("inf")) is None and json_safe(np.array(2.0)) == 2.0
+    assert json_safe(np.float64("inf")) == "inf" and json_safe(np.array(2.0)) == 2.0
     with pytest.raises(ValueError):  # the strictness is real
         json.dumps(float("nan"), allow_nan=False)
 

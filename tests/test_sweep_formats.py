@@ -116,7 +116,7 @@ def test_missing_pyarrow_is_one_line_naming_the_extra(ds, tmp_path, monkeypatch,
 # ------------------------------------------------------------------------------------------------
 def test_cli_writes_every_format_with_the_same_values(tmp_path, capsys):
     for name in ("s.nc", "s.csv", "s.parquet", "table"):
-        extra = ["--format", "csv"] if name == "table" else []
+        extra = ["--table-format", "csv"] if name == "table" else []
         code, out, err = run(capsys, *ARGS, "--out", tmp_path / name, *extra, "-q")
         assert code == 0, err
         assert err == ""  # --quiet
@@ -129,18 +129,26 @@ def test_cli_writes_every_format_with_the_same_values(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("extra,word", [
-    (["--out", "s.csv", "--format", "parquet"], "--format"),   # suffix and --format disagree
+    (["--out", "s.csv", "--table-format", "parquet"], "--table-format"),  # suffix and --table-format disagree
     (["--out", "s.xlsx"], ".xlsx"),                          # not a sweep format
     (["--out", "s.png"], ".png"),                            # a figure is --plot
     (["--out", "s.nc", "--format", "pdf"], "--plot"),         # a figure format without --plot
-    (["--plot", "p.png", "--format", "csv"], "--out"),        # a data format without --out
-    (["--out", "s"], "--format"),                            # no format at all
+    (["--plot", "p.png", "--table-format", "csv"], "--out"),  # a data format without --out
+    (["--out", "s"], "--table-format"),                      # no format at all
 ])
 def test_cli_format_errors_exit_2(tmp_path, capsys, monkeypatch, extra, word):
     monkeypatch.chdir(tmp_path)
     code, out, err = run(capsys, *ARGS, *extra)
     assert code == 2 and word in err and err.count("\n") == 1, err
     assert list(tmp_path.iterdir()) == []
+
+
+def test_cli_old_format_spelling_still_works_with_a_note(tmp_path, capsys):
+    code, out, err = run(capsys, *ARGS, "--out", tmp_path / "table", "--format", "csv", "-q")
+    assert code == 0, err
+    assert err.splitlines() == ["bendpam: warning: sweep --format csv is deprecated (--format is the figure format); "
+                                "use --table-format csv"]
+    assert len(pd.read_csv(tmp_path / "table")) == 24
 
 
 def test_cli_progress_lines_on_stderr_unless_quiet(tmp_path, capsys, monkeypatch):

@@ -26,14 +26,14 @@ from typing import Annotated, Any, Optional
 
 import typer
 
-from bendpam.cli.options import RUN_ARGS, RUN_COMMAND, RUN_FORCE, WROTE_LINES
+from bendpam.cli.options import FORCE_HELP, RUN_ARGS, RUN_COMMAND, RUN_FORCE, WROTE_LINES
 
 __all__ = ["ISSUES_URL", "app", "main"]
 
 ISSUES_URL = "the bendpam issue tracker (include the command line and bendpam --version)"
 
 app = typer.Typer(
-    add_completion=False,
+    add_completion=True,  # --install-completion / --show-completion (README "Command line")
     no_args_is_help=True,
     pretty_exceptions_enable=False,
     rich_markup_mode=None,
@@ -54,18 +54,14 @@ def _version(value: bool) -> None:
         raise typer.Exit(0)
 
 
-FORCE_HELP = ("Replace an output that bendpam did not write, or that another bendpam command wrote: the old "
-              "folder is moved aside to NAME.moved-aside-TIME, never deleted (the home folder, the current folder "
-              "and the inputs are refused all the same).  Also accepted after the command's name.")
-
-
 @app.callback()
 def _root(
     ctx: typer.Context,
     version: Annotated[Optional[bool], typer.Option("--version", callback=_version, is_eager=True,
                                                     help="Print the version and exit.")] = None,
     debug: Annotated[bool, typer.Option("--debug", help="Print the traceback of an internal error.")] = False,
-    force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False,
+    force: Annotated[bool, typer.Option("--force", help=FORCE_HELP + "  Every command that writes also takes it "
+                                        "after its name (see its --help).")] = False,
 ) -> None:
     """bendpam: models, tests and design tools for bending pneumatic artificial muscles."""
     RUN_COMMAND.set(ctx.invoked_subcommand)

@@ -10,7 +10,6 @@ separate tokens (``--diameter-mm 80 120 160``), comma lists (``80,120,160``) or 
 """
 
 # no ``from __future__ import annotations``: Typer reads the annotations of the command functions.
-import json
 import math
 from pathlib import Path
 from typing import Annotated, Any, Optional
@@ -33,6 +32,7 @@ from bendpam.cli.options import (
     model_for,
     parse_values,
     pressures_kpa,
+    print_json,
 )
 from bendpam.cli.options import fmt_num as _fmt
 
@@ -47,7 +47,7 @@ L0Opt = Annotated[Optional[float], typer.Option("--l0-mm", help="Active length L
 
 
 def _record(row: dict[str, Any]) -> dict[str, Any]:
-    """A table row as a JSON record: numbers as floats (null where not finite), empty notes as null."""
+    """A table row as a JSON record: numbers as floats (NaN as null, infinity kept), empty notes as null."""
     out: dict[str, Any] = {}
     for k, v in row.items():
         if isinstance(v, bool | np.bool_):
@@ -60,7 +60,7 @@ def _record(row: dict[str, Any]) -> dict[str, Any]:
             except (TypeError, ValueError):
                 out[k] = None
             else:
-                out[k] = f if math.isfinite(f) else None
+                out[k] = None if math.isnan(f) else f  # infinity: "inf" in the JSON (print_json)
     return out
 
 
@@ -153,8 +153,10 @@ def finger_cmd(
     _, shapes = finger_sweep(finger, P, loads)
     lims = [sh.limits() if sh.equilibrium else None for sh in shapes]  # worst section along the finger
     held = [blocked_tip_force(finger, p, loads=loads) for p in P] if blocked else None
-    if plot is not None:
-        _save_plot(lambda ax: plot_finger_shapes(shapes, ax=ax, title=f"{act.name or act.kind}, "
+    if plot is not None:  # with a load, the free shapes beside the loaded ones
+        loaded = any(F) or tip_moment_nmm or tip_mass_g or mass_per_length
+        free = finger_sweep(finger, P, FingerLoads())[1] if loaded else None
+        _save_plot(lambda ax: plot_finger_shapes(shapes, ax=ax, free=free, title=f"{act.name or act.kind}, "
                                                  f"L0 = {act.L0_mm:g} mm"), plot, fig_format, aspect=0.9)
     rows = []
     for i, (sh, lm) in enumerate(zip(shapes, lims, strict=True)):
@@ -170,7 +172,7 @@ def finger_cmd(
                "units": {"tip_x_mm": "mm", "tip_angle_deg": "deg (tangent at the tip, from +x)",
                          "bend_angle_deg": "deg (tip rotation in the bending direction)"},
                "results": rows}
-        typer.echo(json.dumps(obj, indent=2))
+        print_json(obj)
     else:
         typer.echo(f"{act.name or act.kind}, L0 = {act.L0_mm:g} mm — {mname.replace('_', '-')} model")
         _print_finger_rows(rows, blocked)
@@ -290,7 +292,7 @@ def grasp_cmd(
         _save_plot(lambda ax: plot_grasp(ds, ax=ax), plot, fig_format)
     rows = [g.to_dict() for row in grasps for g in row]
     if as_json:
-        typer.echo(json.dumps({**gr.to_dict(), "units": _GRASP_UNITS, "results": rows}, indent=2))
+        print_json({**gr.to_dict(), "units": _GRASP_UNITS, "results": rows})
         return
     _print_grasps(gr, rows)
     if plot is not None:
@@ -370,7 +372,7 @@ def wrist_cmd(
                         "load_moment_nmm": holds[0].load_moment_nmm if holds else None,
                         "pressure_needed_kpa": holds[0].to_dict()["pressure_needed_kpa"] if holds else None},
                "results": results, "holding": holding}
-        typer.echo(json.dumps(obj, indent=2))
+        print_json(obj)
         return
     typer.echo(f"wrist of four {act.name or act.kind}, L = {w.length_mm:g} mm, radius {w.radius_mm:g} mm, "
                f"lateral stiffness {w.lateral_stiffness_nmm2:.4g} N·mm² — {mname.replace('_', '-')} model")

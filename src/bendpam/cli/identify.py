@@ -60,7 +60,8 @@ def fit(
     preset: PresetOpt = None,
     actuator: ActuatorOpt = None,
     model: ModelOpt = None,
-    free: Annotated[str, typer.Option("--free", help="Parameters to identify: alpha0,C10,C01,P_start,E_f,R0_start.")]
+    free: Annotated[str, typer.Option("--free", help="Parameters to identify, of alpha0, C10, C01, P_start, E_f, "
+                                      "R0_start: 'alpha0 C10 C01' or 'alpha0,C10,C01'.")]
     = "alpha0,C10,C01",
     tension: Annotated[Optional[Path], typer.Option(
         "--tension", help="Bladder tension-test export: fitted together with the curves (one likelihood).")] = None,

@@ -13,6 +13,7 @@ import typer
 from bendpam.cli.app import app
 from bendpam.cli.options import (
     ActuatorOpt,
+    FigureFormatOpt,
     ModelOpt,
     PresetOpt,
     UserError,
@@ -64,6 +65,7 @@ def design_cmd(
                                                 "coarse_map.csv, pareto.csv, figures.")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print design.json's content.")] = False,
     quiet: Annotated[bool, typer.Option("--quiet", help="No progress report.")] = False,
+    fig_format: FigureFormatOpt = None,
 ):
     """Inverse design: actuator parameters within ranges that meet targets at pressures, with safety margins.
 
@@ -74,6 +76,8 @@ def design_cmd(
     from bendpam.design.targets import parse_targets, parse_variables
     from bendpam.infra.outputs import to_json
 
+    if fig_format is not None and out is None:
+        raise UserError(f"--format {fig_format.value}: the figures are written into --out; give --out DIR")
     if not target:
         raise UserError("give at least one --target, e.g. --target blocked_moment_nmm=400@200")
     if not vary:
@@ -101,7 +105,7 @@ def design_cmd(
                           scheduler=scheduler, seed=seed, progress=not quiet)
     if out is not None:
         with output_set(out, [actuator]) as o:
-            files = res.save(o.staging)
+            files = res.save(o.staging, figure_format=fig_format.value if fig_format is not None else "png")
     if as_json:
         typer.echo(to_json(res.to_dict()), nl=False)
         return

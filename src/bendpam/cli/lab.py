@@ -20,6 +20,7 @@ from bendpam.cli.options import (
     QuietOpt,
     UserError,
     collect_raw_files,
+    deprecated_format,
     echo_wrote,
     fmt_num,
     load_actuator,
@@ -27,6 +28,7 @@ from bendpam.cli.options import (
     output_set,
     parse_values,
     pressures_kpa,
+    print_json,
 )
 from bendpam.errors import InputError, ProcessingError
 
@@ -67,16 +69,13 @@ def inspect(
     as_json: Annotated[bool, typer.Option("--json", help="Print a JSON list, one object per file.")] = False,
 ):
     """What the reader understood of each file (format, encoding, channels, units, values), before processing."""
-    import json
-
-    from bendpam.infra.outputs import json_safe
     from bendpam.lab import format_inspection, inspect_file
 
     paths = collect_raw_files(files)
     infos = [inspect_file(p, pressure_kpa=pressure_kpa, columns=columns, rate_hz=rate_hz, repair=repair)
              for p in paths]
     if as_json:
-        typer.echo(json.dumps(json_safe(infos), indent=2, allow_nan=False, ensure_ascii=False))
+        print_json(infos)
     else:
         for info in infos:
             typer.echo(format_inspection(info))
@@ -230,7 +229,12 @@ def simulate_test_cmd(
     pressure_kpa: PressureOpt = None,
     out: Annotated[
         Optional[Path], typer.Option("--out", help="Output folder for the raw files and truth.json.")] = None,
-    fmt: Annotated[Format, typer.Option("--format", help="Export dialect to write.")] = Format.csv,
+    table_fmt: Annotated[Optional[Format], typer.Option(
+        "--table-format", help="Export dialect of the raw files: csv, testxpert, bluehill or mts (default csv).")]
+    = None,
+    fmt: Annotated[Optional[Format], typer.Option(
+        "--format", hidden=True, help="Deprecated spelling of --table-format (--format is the figure format).")]
+    = None,
     noise_n: Annotated[float, typer.Option("--noise-n", help="Force noise, standard deviation (N).")] = 0.05,
     noise_stroke_mm: Annotated[float, typer.Option("--noise-stroke-mm", help="Stroke noise, standard deviation (mm).")]
     = 0.002,
@@ -255,6 +259,8 @@ def simulate_test_cmd(
         float, typer.Option("--stroke-offset-mm", help="Machine stroke at the blocked state (mm).")] = 0.0,
     fixture: FixtureOpt = "35,2.5,4",
     seed: Annotated[Optional[int], typer.Option("--seed", help="Random seed.")] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="Print truth.json (the true values) instead of one "
+                                          "line per file.")] = False,
 ):
     """Write the raw files a testing machine would record for a model actuator (a virtual test)."""
     from bendpam.lab.simulate import SimulationSettings, simulate_tests
@@ -262,6 +268,7 @@ def simulate_test_cmd(
 
     if out is None:
         raise UserError("give an output folder with --out DIR")
+    dialect = deprecated_format(fmt, table_fmt, "simulate-test") or Format.csv
     act = load_actuator(preset, actuator, model)
     P = pressures_kpa(pressure_kpa)
     st = SimulationSettings(cycles=cycles, speed_mm_min=speed_mm_min, rate_hz=rate_hz, noise_n=noise_n,
@@ -272,9 +279,13 @@ def simulate_test_cmd(
     fx = Fixture.from_string(fixture, L0_mm=act.L0_mm, name="--fixture")
     with output_set(out, [actuator]) as o:
         try:
-            truth = simulate_tests(act, P, o.staging, model_for(act, model), dialect=fmt.value, fixture=fx, settings=st)
+            truth = simulate_tests(act, P, o.staging, model_for(act, model), dialect=dialect.value, fixture=fx,
+                                   settings=st)
         except InputError as exc:  # the library names the settings; this command's options say them as flags
             raise UserError(_SETTING_FLAGS.sub(lambda m: _FLAGS[m.group(0)], str(exc))) from None
+    if as_json:
+        print_json(truth)
+        return
     for t in truth["pressures"]:
         typer.echo(
             f"{t['file']}: {t['samples']} samples, blocked {t['blocked_moment_nmm']:.2f} N·mm, "

@@ -10,6 +10,7 @@ from __future__ import annotations
 import contextvars
 import math
 import os
+import re
 import sys
 from collections.abc import Iterable
 from enum import Enum
@@ -17,7 +18,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any, Optional
 
 import typer
-from typer.core import TyperCommand
+from typer.core import TyperArgument, TyperCommand
 
 from bendpam.errors import InputError
 from bendpam.infra.budgets import MAX_OPTION_VALUES, value_limit
@@ -29,6 +30,9 @@ if TYPE_CHECKING:
 
 __all__ = [
     "FIGURE_FORMATS",
+    "FORCE_HELP",
+    "LIST_OPTIONS",
+    "METAVARS",
     "MULTI_VALUE_OPTIONS",
     "RANGE_HELP",
     "RUN_ARGS",
@@ -36,6 +40,7 @@ __all__ = [
     "RUN_FORCE",
     "WROTE_LINES",
     "ActuatorOpt",
+    "BendpamCommand",
     "FigureFormat",
     "FigureFormatOpt",
     "Format",
@@ -51,11 +56,13 @@ __all__ = [
     "collect_raw_files",
     "command_inputs",
     "command_line",
+    "deprecated_format",
     "echo",
     "echo_wrote",
     "figure_format",
     "fmt_num",
     "format_prediction_table",
+    "join_list_values",
     "load_actuator",
     "model_for",
     "model_name",
@@ -66,6 +73,8 @@ __all__ = [
     "positive",
     "pressure_kpa",
     "pressures_kpa",
+    "print_json",
+    "use_bendpam_commands",
 ]
 
 #: The largest number of values one option may expand to in any command (a range like 100:200:30000000 is
@@ -104,7 +113,7 @@ class Preset(str, Enum):
 
 
 class Format(str, Enum):
-    """The export dialects of ``simulate-test --format``.
+    """The export dialects of ``simulate-test --table-format``.
 
     >>> Format("mts").value
     'mts'
@@ -128,42 +137,192 @@ PressureOpt = Annotated[
     Optional[list[str]],
     typer.Option("--pressure-kpa", metavar="KPA...", help=f"Gauge pressure(s) in kPa: {RANGE_HELP}."),
 ]
-#: options whose space-separated values are all collected (rewritten as repeated options)
-MULTI_VALUE_OPTIONS = ("--pressure-kpa", "--diameter-mm", "--direction-deg")
+#: The options that take a list: ``--opt a b c`` (several tokens), ``--opt a,b`` and ranges are one grammar
+#: (:func:`parse_values`).  Value: what a following token must look like to be one more value of the option
+#: (``None``: a number, a comma list or a range; else the names it may be).
+LIST_OPTIONS: dict[str, frozenset[str] | None] = {
+    "--pressure-kpa": None,
+    "--diameter-mm": None,
+    "--direction-deg": None,
+    "--param": None,
+    "--model": frozenset({"energy", "force-balance", "force_balance"}),
+    "--free": frozenset({"alpha0", "C10", "C01", "P_start", "E_f", "R0_start"}),  # identify.result.PARAMETERS
+}
+#: List options whose one value is a comma list (the values that follow join it with commas).
+COMMA_LIST_OPTIONS = ("--free",)
+#: Kept for older imports: the options of :data:`LIST_OPTIONS`.
+MULTI_VALUE_OPTIONS = tuple(LIST_OPTIONS)
+_NUMBER = r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?"
+_VALUES = re.compile(rf"{_NUMBER}(?:[,:]{_NUMBER})*,?")
+#: Metavars of options whose values have a shape of their own (every other one is derived from its type).
+METAVARS = {"--fixture": "D,R,T", "--tip-force-n": "FX,FY", "--free": "NAMES...", "--scheduler": "ADDRESS",
+            "--fit-range": "developed|all", "--loop-law": "pi|dahl", "--hysteresis-law": "pi|dahl",
+            "--bend": "ccw|cw", "--plot-var": "NAME", "--plot-x": "NAME", "--plot-y": "NAME",
+            "--pressure-kpa": "KPA...", "--diameter-mm": "MM...", "--direction-deg": "DEG...", "--model": "MODEL...",
+            "--columns": "time=NAME,stroke=NAME,force=NAME", "--curvature": "PER_MM", "--k-max": "PER_MM"}
+#: The unit ending a float option's name -> its metavar (``--l0-mm MM``).
+_UNIT_METAVARS = {"mm": "MM", "kpa": "KPA", "deg": "DEG", "hz": "HZ", "s": "SECONDS", "n": "NEWTONS", "g": "GRAMS",
+                  "nmm": "NMM", "gib": "GIB", "minutes": "MINUTES", "mm2": "MM2", "nmm2": "NMM2", "mpa": "MPA",
+                  "min": "MM_PER_MIN"}
+#: Parameters of a command that name its outputs (every other path parameter is an input).
+OUTPUT_PARAMS = ("out", "plot")
+FORCE_HELP = ("Replace an output that bendpam did not write, or that another bendpam command wrote: the old "
+              "file or folder is moved aside to NAME.moved-aside-TIME, never deleted (the home folder, the current "
+              "folder and the inputs are refused all the same).")
 
 
-class MultiValueCommand(TyperCommand):
-    """A command in which ``--opt a b c`` means ``--opt a --opt b --opt c`` for the options above.
+def _list_rules(param: Any) -> dict[str, frozenset[str] | None]:
+    """``{option: continuation rule}`` of ``param`` if it is a list option of its command, else ``{}``."""
+    names = [o for o in getattr(param, "opts", ()) if o in LIST_OPTIONS]
+    listed = getattr(param, "multiple", False) or getattr(param, "nargs", 1) == -1
+    if not names or not (listed or names[0] in COMMA_LIST_OPTIONS):
+        return {}
+    return {o: LIST_OPTIONS[names[0]] for o in param.opts}
 
-    >>> "--pressure-kpa" in MultiValueCommand.multi_value_options
+
+def _continues(token: str, rule: frozenset[str] | None) -> bool:
+    """Whether ``token`` is one more value of a list option with the continuation ``rule``."""
+    if rule is None:
+        return bool(_VALUES.fullmatch(token))
+    names = {r.lower() for r in rule}
+    return all(part in names for part in token.lower().split(",") if part) and token.strip(",") != ""
+
+
+def join_list_values(args: list[str], rules: dict[str, frozenset[str] | None]) -> list[str]:
+    """``--opt a b c`` -> ``--opt a,b,c`` for the list options ``rules`` (option -> continuation rule).
+
+    A value joins the option before it while it looks like one (a number, comma list or range, or
+    one of the option's names); anything else (a file, another option, ``--``) ends the list.
+
+    >>> join_list_values(["raw", "--pressure-kpa", "100", "125", "150:200:3", "more"], {"--pressure-kpa": None})
+    ['raw', '--pressure-kpa', '100,125,150:200:3', 'more']
+    >>> join_list_values(["--param", "alpha0_deg=60", "70", "--pressure-kpa=100", "150"],
+    ...                  {"--param": None, "--pressure-kpa": None})
+    ['--param', 'alpha0_deg=60,70', '--pressure-kpa=100,150']
+    """
+    out: list[str] = []
+    rule: frozenset[str] | None = None
+    current = False  # the last token is a list option's value (more may follow)
+    expecting = False  # a list option's own first value comes next (it may start with '-')
+    for i, tok in enumerate(args):
+        if tok == "--":
+            out.extend(args[i:])
+            break
+        if expecting:
+            out.append(tok)
+            expecting, current = False, True
+        elif current and _continues(tok, rule):
+            out[-1] = f"{out[-1].rstrip(',')},{tok}"
+        elif tok.startswith("-") and tok.split("=", 1)[0] in rules:
+            rule = rules[tok.split("=", 1)[0]]
+            expecting, current = "=" not in tok, "=" in tok
+            out.append(tok)
+        else:
+            current = False
+            out.append(tok)
+    return out
+
+
+def _readable_metavar(param: Any) -> str | None:
+    """A metavar a person reads for ``param`` (``KPA...``, ``PATH``, ``N``), or None for a flag."""
+    desc = getattr(param, "type_descriptor", None)
+    opts = [o for o in getattr(param, "opts", ()) if o.startswith("--")]
+    if getattr(param, "is_flag", False) or desc is None:
+        return None
+    if opts and opts[0] in METAVARS and (opts[0] not in LIST_OPTIONS or desc.is_list):
+        return METAVARS[opts[0]]
+    if desc.is_choice and desc.choices:
+        return "[" + "|".join(str(getattr(c, "value", c)) for c in desc.choices) + "]"
+    if desc.is_tuple:
+        return "LO HI" if "range" in (param.name or "") else " ".join(["X"] * max(param.nargs, 1))
+    if desc.is_path or (desc.is_list and "Path" in str(desc.annotation)):
+        return "FILES..." if param.nargs != 1 else (param.name or "path").upper() \
+            if param.param_type_name == "argument" else "PATH"
+    if desc.annotation is int:
+        return "N"
+    if desc.annotation is float:
+        words = opts[0].lstrip("-").split("-") if opts else [param.name or ""]
+        return "NUMBER" if "per" in words else _UNIT_METAVARS.get(words[-1], "NUMBER")
+    return "TEXT..." if desc.is_list else "TEXT"
+
+
+def _force_option() -> Any:
+    """A ``--force`` option for a command (the same as ``bendpam --force``), built by Typer itself."""
+    probe = typer.Typer()
+
+    @probe.command()
+    def _f(force: Annotated[bool, typer.Option("--force", help=FORCE_HELP)] = False) -> None:  # pragma: no cover
+        pass
+
+    param = typer.main.get_command(probe).params[0]
+    param.expose_value = False
+    param.callback = lambda ctx, p, value: RUN_FORCE.set(True) if value else None
+    return param
+
+
+class BendpamCommand(TyperCommand):
+    """Every ``bendpam`` command: one grammar for lists, ``--force`` where it writes, readable metavars.
+
+    * a list option (:data:`LIST_OPTIONS`) takes several tokens: ``--pressure-kpa 100 150 200`` is
+      ``--pressure-kpa 100,150,200`` (:func:`join_list_values`; the values are parsed by :func:`parse_values`);
+    * a command that writes (an ``--out`` or ``--plot`` option) shows and takes ``--force``;
+    * the help names values as a person reads them (``KPA...``, ``PATH``, ``N``, ``FILES...``), never types.
+
+    >>> "--pressure-kpa" in LIST_OPTIONS
     True
     """
 
     multi_value_options = MULTI_VALUE_OPTIONS
 
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        names = {p.name for p in self.params}
+        if names & set(OUTPUT_PARAMS) and not any("--force" in getattr(p, "opts", ()) for p in self.params):
+            at = next((i for i, p in enumerate(self.params) if getattr(p, "opts", None) == ["--help"]),
+                      len(self.params))
+            self.params.insert(at, _force_option())
+        for p in self.params:
+            if p.metavar is None:
+                p.metavar = _readable_metavar(p)
+            if p.param_type_name == "argument" and p.metavar is not None:
+                p.__class__ = _ReadableArgument
+
     def parse_args(self, ctx, args: list[str]) -> list[str]:
-        out: list[str] = []
-        current = None  # the multi-value option whose values are being read
-        expecting = False  # its own first value comes next (it may start with '-')
-        for i, tok in enumerate(args):
-            if tok == "--":
-                out.extend(args[i:])
-                break
-            if expecting:
-                out.append(tok)
-                expecting = False
-            elif tok.startswith("-"):
-                name = tok.split("=", 1)[0]
-                current = name if name in self.multi_value_options else None
-                expecting = current is not None and "=" not in tok
-                out.append(tok)
-            elif current is not None:
-                out.extend([current, tok])
-            else:
-                out.append(tok)
-        return super().parse_args(ctx, out)
+        rules: dict[str, frozenset[str] | None] = {}
+        for p in self.params:
+            rules.update(_list_rules(p))
+        return super().parse_args(ctx, join_list_values(args, rules) if rules else args)
 
 
+class _ReadableArgument(TyperArgument):
+    """An argument shown by its metavar alone (``FILES...``), without Typer's ``{name}`` and ``<type>``."""
+
+    def display_type_rich(self, ctx) -> str | None:
+        return None
+
+    def _rich_display_name(self) -> str:
+        return str(self.metavar)
+
+    def _usage_display_name(self) -> str:
+        return str(self.metavar) if self.required else f"[{self.metavar}]"
+
+
+#: Kept for older imports: every command is a :class:`BendpamCommand`.
+MultiValueCommand = BendpamCommand
+
+
+def use_bendpam_commands(app: typer.Typer) -> None:
+    """Make every command of ``app`` a :class:`BendpamCommand` (one grammar, ``--force``, readable help).
+
+    >>> t = typer.Typer()
+    >>> _ = t.command("x")(lambda: None)
+    >>> use_bendpam_commands(t)
+    >>> t.registered_commands[0].cls is BendpamCommand
+    True
+    """
+    for info in app.registered_commands:
+        if info.cls is None or info.cls is TyperCommand:
+            info.cls = BendpamCommand
 
 
 def echo(text: str = "", err: bool = False) -> None:
@@ -173,6 +332,23 @@ def echo(text: str = "", err: bool = False) -> None:
     wrote out/
     """
     typer.echo(text, err=err)
+
+
+def print_json(obj: Any) -> None:
+    """Print ``obj`` as strict JSON: infinity is the string ``"inf"`` (``"-inf"``), ``null`` means missing.
+
+    >>> print_json({"margin": float("inf"), "angle_deg": float("nan"), "n": 2})
+    {
+      "margin": "inf",
+      "angle_deg": null,
+      "n": 2
+    }
+    """
+    import json
+
+    from bendpam.infra.atomic import json_safe
+
+    typer.echo(json.dumps(json_safe(obj), indent=2, allow_nan=False, ensure_ascii=False))
 
 
 def _too_many(name: str, what: str, limit: int) -> UserError:
@@ -358,6 +534,8 @@ RUN_ARGS: contextvars.ContextVar[list[str] | None] = contextvars.ContextVar("ben
 RUN_COMMAND: contextvars.ContextVar[str | None] = contextvars.ContextVar("bendpam_run_command", default=None)
 #: The ``wrote ...`` lines of the running command, printed once its outputs are committed (:func:`echo_wrote`).
 WROTE_LINES: contextvars.ContextVar[list[str] | None] = contextvars.ContextVar("bendpam_wrote_lines", default=None)
+#: ``--force`` (of the command or of ``bendpam``): replace outputs that bendpam did not write, moving them aside.
+RUN_FORCE: contextvars.ContextVar[bool] = contextvars.ContextVar("bendpam_run_force", default=False)
 
 
 def echo_wrote(text: str) -> None:
@@ -377,10 +555,6 @@ def echo_wrote(text: str) -> None:
         pending.append(text)
 
 
-#: ``bendpam --force``: replace outputs that bendpam did not write, moving them aside.
-RUN_FORCE: contextvars.ContextVar[bool] = contextvars.ContextVar("bendpam_run_force", default=False)
-#: Parameters of a command that name its outputs (every other path parameter is an input).
-OUTPUT_PARAMS = ("out", "plot")
 
 
 def command_line() -> list[str]:
@@ -522,8 +696,27 @@ QuietOpt = Annotated[
     bool, typer.Option("--quiet", "-q", help="No progress on stderr (neither the bar nor the progress lines).")
 ]
 
+def deprecated_format(old: Any, new: Any, command: str, *, new_name: str = "--table-format") -> Any:
+    """The value of ``new_name``, or of the old ``--format`` spelling with a one-line note on stderr.
+
+    ``--format`` means the figure format on every command; where it meant a table's format it is
+    still accepted for one release (0.4) with this note.
+
+    >>> deprecated_format(None, "csv", "sweep")
+    'csv'
+    """
+    if old is None:
+        return new
+    value = getattr(old, "value", old)
+    if new is not None and getattr(new, "value", new) != value:
+        raise UserError(f"give either {new_name} {getattr(new, 'value', new)} or --format {value}, not both")
+    echo(f"bendpam: warning: {command} --format {value} is deprecated (--format is the figure format); use "
+         f"{new_name} {value}", err=True)
+    return old
+
+
 def output_format(path: Path | None, fmt: str | Enum | None, formats: tuple[str, ...], *, option: str = "--out",
-                  default: str | None = None) -> str | None:
+                  default: str | None = None, format_option: str = "--format") -> str | None:
     """The format of an output file from ``--format`` or the suffix of ``path`` (:func:`bendpam.validate.file_format`).
 
     Returns None when ``path`` is None.
@@ -533,7 +726,7 @@ def output_format(path: Path | None, fmt: str | Enum | None, formats: tuple[str,
     """
     if path is None:
         return None
-    return file_format(path, fmt, formats, option=option, format_option="--format", default=default)
+    return file_format(path, fmt, formats, option=option, format_option=format_option, default=default)
 
 
 def figure_format(path: Path | None, fmt: str | Enum | None, option: str = "--out") -> str | None:

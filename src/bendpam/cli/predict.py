@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import math
 import time
 from pathlib import Path
@@ -31,6 +30,7 @@ from bendpam.cli.options import (
     output_file,
     output_format,
     pressures_kpa,
+    print_json,
 )
 from bendpam.cli.options import pressure_kpa as checked_pressure
 from bendpam.physics.limits import OUTPUTS as LIMIT_OUTPUTS
@@ -63,7 +63,6 @@ def predict(
     loop_angle_deg: Annotated[Optional[float], typer.Option("--loop-angle-deg", help="Loop angle (deg).")] = None,
 ):
     """Blocked moment and free bending curvature/angle at each pressure (and, with --cycle, the loop)."""
-    from bendpam.infra.atomic import json_safe
     from bendpam.physics.law import MomentLaw
     from bendpam.predict import prediction_table
 
@@ -102,7 +101,7 @@ def predict(
             ],
             **({"hysteresis": loop.to_dict()} if loop is not None else {}),
         }
-        typer.echo(json.dumps(json_safe(obj), indent=2, allow_nan=False))
+        print_json(obj)
         _warn_limits(df)
         return
     typer.echo(format_prediction_table(df, f"{act.name or act.kind} — {mname.replace('_', '-')} model"))
@@ -245,6 +244,8 @@ def actuator_cmd(
     actuator: ActuatorOpt = None,
     model: ModelOpt = None,
     out: Annotated[Optional[Path], typer.Option("--out", help="Write the actuator as TOML here.")] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object (parameters, derived values, "
+                                          "curvature range) instead of TOML.")] = False,
 ):
     """Show an actuator (TOML, derived values, lock-up limits) or save it as an editable TOML file."""
     from bendpam.physics.braid import curvature_limits
@@ -255,8 +256,13 @@ def actuator_cmd(
         with output_file(out, [actuator]) as f:
             f.write_text(text)
         echo_wrote(f"wrote {out}")
-        return
+        if not as_json:
+            return
     lim = curvature_limits(act)
+    if as_json:
+        print_json({"actuator": act.to_dict(), "derived": act.derived(),
+                    "curvature_range_per_mm": [lim.k_min, lim.k_max]})
+        return
     typer.echo(text.rstrip())
     typer.echo("\n# derived")
     for k, v in act.derived().items():
@@ -270,6 +276,8 @@ def demo(
         "--out", help="Moment-curvature figure to write (.png, .pdf, .svg); default "
         "bendpam-demo/moment-curvature.png (or the --format's suffix).", show_default=False)] = None,
     fig_format: FigureFormatOpt = None,
+    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object of the predictions instead of "
+                                          "tables.")] = False,
 ):
     """Predictions for the paper's BE-PAM and BC-PAM with both models, and a moment-curvature figure."""
     from bendpam.physics import presets
@@ -282,17 +290,28 @@ def demo(
     fmt = figure_format(out, fig_format)
     t0 = time.perf_counter()
     cases = [("be-pam", [100, 125, 150, 175, 200]), ("bc-pam", [40, 60, 80, 100, 120, 140])]
-    items = []
+    items, records = [], []
     for name, P in cases:
         for mname in ("energy", "force_balance"):
             act = presets.get(name, mname)
             df = prediction_table(act, P, mname)
-            typer.echo(format_prediction_table(df, f"\n{act.name} — {mname.replace('_', '-')} model"))
             br = MomentLaw.of(act, mname).free_branch()
+            if as_json:
+                records.append({"actuator": act.name, "model": mname, "max_equilibrium_pressure_kpa":
+                                br.max_pressure_kpa, "branch_end": br.kind, "results": [
+                                    {k: (getattr(r, k) or None) if k == "note" else getattr(r, k) for k in (
+                                        "pressure_kpa", "blocked_moment_nmm", "free_curvature_per_mm",
+                                        "free_angle_deg", "note")} for r in df.itertuples()]})
+                items.append((act, np.asarray(P, dtype=float), mname))
+                continue
+            typer.echo(format_prediction_table(df, f"\n{act.name} — {mname.replace('_', '-')} model"))
             if br.kind == "fold":
                 typer.echo(f"fold: no free-bending equilibrium above {br.max_pressure_kpa:.4g} kPa")
             items.append((act, np.asarray(P, dtype=float), mname))
     out.parent.mkdir(parents=True, exist_ok=True)
     with output_file(out) as f:
         save_figure(demo_figure(items), f.path, format=fmt)
+    if as_json:
+        print_json({"predictions": records, "figure": str(out)})
+        return
     echo_wrote(f"\nwrote {out}  ({time.perf_counter() - t0:.1f} s)")

@@ -26,7 +26,7 @@ def register(app: typer.Typer) -> None:
     """
     if any(getattr(c, "name", None) == "report" for c in app.registered_commands):
         return
-    from bendpam.cli.options import ActuatorOpt, PresetOpt, QuietOpt
+    from bendpam.cli.options import RANGE_HELP, ActuatorOpt, PresetOpt, QuietOpt
 
     @app.command("report")
     def report(
@@ -36,7 +36,7 @@ def register(app: typer.Typer) -> None:
         out: Annotated[Optional[Path], typer.Option("--out", help="The HTML report to write (report.html).")] = None,
         pressure_kpa: Annotated[
             Optional[list[str]],
-            typer.Option("--pressure-kpa", help="Pressure of each file in kPa, comma-separated, in file order "
+            typer.Option("--pressure-kpa", help=f"Pressure of each file in kPa, in file order: {RANGE_HELP} "
                          "(default: each file's metadata or filename)."),
         ] = None,
         l0_mm: Annotated[
@@ -45,14 +45,18 @@ def register(app: typer.Typer) -> None:
         ] = None,
         fixture: Annotated[str, typer.Option("--fixture", help="Fixture geometry d,r,t in mm.")] = "35,2.5,4",
         free: Annotated[
-            str, typer.Option("--free", help="Parameters to identify: alpha0,C10,C01,P_start,E_f,R0_start.")
+            str, typer.Option("--free", help="Parameters to identify, of alpha0, C10, C01, P_start, E_f, R0_start: "
+                              "'alpha0 C10 C01' or 'alpha0,C10,C01'.")
         ] = "alpha0,C10,C01",
         model: Annotated[
             Optional[list[str]],
-            typer.Option("--model", help="Model(s) to fit: energy, force-balance (repeat or comma-separate; "
-                         "default both)."),
+            typer.Option("--model", help="Model(s) to fit: energy, force-balance ('energy force-balance', "
+                         "'energy,force-balance' or repeated; default both)."),
         ] = None,
         quiet: QuietOpt = False,
+        as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object (Table 2, the deadband, each "
+                                              "model's parameters and NRMSEs, the warnings) instead of lines.")]
+        = False,
         progress: Annotated[bool, typer.Option("--progress/--no-progress", hidden=True,
                                                help="Same as --quiet (--no-progress).")] = True,
     ):
@@ -61,10 +65,12 @@ def register(app: typer.Typer) -> None:
         The page warns at the top when a fit is poor or the data do not match the actuator, and
         prints cleanly to PDF from a browser.
         """
-        _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, model, progress and not quiet)
+        _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, model, progress and not quiet,
+                as_json)
 
 
-def _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, model, progress) -> None:
+def _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, model, progress,
+            as_json=False) -> None:
     from bendpam.cli.options import (
         Model,
         UserError,
@@ -105,9 +111,12 @@ def _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, m
     fx = Fixture.from_string(fixture, L0_mm=act.L0_mm if l0_mm is None else l0_mm, name="--fixture")
     with output_file(out, [*files, actuator]) as f:
         res = build_report(files, act, f.path, models=[m.value for m in models], free=free, pressure_kpa=pressures,
-                           fixture=fx, progress=progress)
+                           fixture=fx, progress=progress, shown_as=str(out))
 
     summ = res.summary
+    if as_json:
+        _print_json(res, out)
+        return
     for row in res.table2:
         typer.echo(f"{row['pressure_kpa']:>6} kPa  {row['cycles']} cycles  blocked moment (N·mm) "
                    f"{row['blocked_moment_nmm']}  free curvature (1/mm) {row['free_curvature_per_mm']}  "
@@ -124,3 +133,14 @@ def _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, m
     n_w = sum(w.severity == "warning" for w in res.warnings)
     box = f", {n_w} warning(s) and {len(res.warnings) - n_w} caution(s) at the top" if res.warnings else ""
     echo_wrote(f"wrote {out} ({res.bytes / 1024:.0f} KiB, {len(res.figures)} figures{box})")
+
+
+def _print_json(res, out) -> None:
+    """``report --json``: the report's numbers as one JSON object."""
+    from bendpam.cli.options import print_json
+
+    fits = {m: {k: d[k] for k in ("model", "parameters", "nrmse", "converged", "flags") if k in d}
+            for m, d in ((m, f.to_dict()) for m, f in res.fits.items())}
+    print_json({"report": str(out), "table2": res.summary, "fits": fits, "failed": dict(res.failed),
+                "warnings": [{"severity": w.severity, "kind": w.kind, "title": w.title} for w in res.warnings],
+                "notes": list(res.notes)})

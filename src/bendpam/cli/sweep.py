@@ -17,6 +17,7 @@ from bendpam.cli.options import (
     PresetOpt,
     QuietOpt,
     UserError,
+    deprecated_format,
     echo_wrote,
     load_actuator,
     model_for,
@@ -41,8 +42,16 @@ MaxMinutesOpt = Annotated[float, typer.Option(
     "is refused before any work.")]
 
 
+class TableFormat(str, Enum):
+    """Formats of ``bendpam sweep --table-format``: the data of --out."""
+
+    nc = "nc"
+    csv = "csv"
+    parquet = "parquet"
+
+
 class SweepFormat(str, Enum):
-    """Formats of ``bendpam sweep --format``: data (--out) or figure (--plot)."""
+    """Values ``bendpam sweep --format`` accepts: the figure formats, and (deprecated) the data formats."""
 
     nc = "nc"
     csv = "csv"
@@ -56,16 +65,20 @@ DATA_FORMATS = ("nc", "csv", "parquet")
 FIGURE_FORMATS = ("png", "pdf", "svg")
 
 
-def sweep_formats(out: Path | None, plot: Path | None, fmt: SweepFormat | None) -> tuple[str | None, str | None]:
-    """The formats of --out and --plot: --format applies to the one whose kind it names."""
+def sweep_formats(out: Path | None, plot: Path | None, fmt: SweepFormat | None,
+                  table_fmt: TableFormat | None = None) -> tuple[str | None, str | None]:
+    """The formats of --out (--table-format) and --plot (--format; a data format there is the old spelling)."""
     value = fmt.value if fmt is not None else None
-    if value in DATA_FORMATS and out is None:
-        raise UserError(f"--format {value} is a data format, for --out; there is no --out")
-    if value in FIGURE_FORMATS and plot is None:
-        raise UserError(f"--format {value} is a figure format, for --plot; there is no --plot")
-    data_fmt = output_format(out, value if value in DATA_FORMATS else None, DATA_FORMATS, option="--out")
-    fig_fmt = output_format(plot, value if value in FIGURE_FORMATS else None, FIGURE_FORMATS, option="--plot",
-                            default="png")
+    table = table_fmt.value if table_fmt is not None else None
+    if value in DATA_FORMATS:
+        table = deprecated_format(value, table, "sweep")
+        value = None
+    if table is not None and out is None:
+        raise UserError(f"--table-format {table} is the format of --out; there is no --out")
+    if value is not None and plot is None:
+        raise UserError(f"--format {value} is the figure format of --plot; there is no --plot")
+    data_fmt = output_format(out, table, DATA_FORMATS, option="--out", format_option="--table-format")
+    fig_fmt = output_format(plot, value, FIGURE_FORMATS, option="--plot", default="png")
     return data_fmt, fig_fmt
 
 
@@ -117,8 +130,10 @@ def sweep_cmd(
     plot: Annotated[Optional[Path], typer.Option("--plot", help="Quick figure of one output (.png, .pdf, .svg).")]
     = None,
     fmt: Annotated[Optional[SweepFormat], typer.Option(
-        "--format", help="Format of --out (nc, csv, parquet) or of --plot (png, pdf, svg); default: from the file "
-        "names.")] = None,
+        "--format", metavar="[png|pdf|svg]", help="Figure format of --plot: png, pdf or svg (default: from the "
+        "file name).")] = None,
+    table_fmt: Annotated[Optional[TableFormat], typer.Option(
+        "--table-format", help="Format of --out: nc, csv or parquet (default: from the file name).")] = None,
     plot_var: Annotated[str, typer.Option("--plot-var", help="Output to plot.")] = "free_angle_deg",
     plot_x: Annotated[Optional[str], typer.Option("--plot-x", help="Parameter on the x axis (default: first).")]
     = None,
@@ -140,7 +155,7 @@ def sweep_cmd(
     if out is None and plot is None:
         raise UserError("give --out FILE.nc|.csv|.parquet and/or --plot FILE.png|.pdf|.svg")
     fixed_at = parse_at(at)
-    data_fmt, fig_fmt = sweep_formats(out, plot, fmt)
+    data_fmt, fig_fmt = sweep_formats(out, plot, fmt, table_fmt)
     grids, P, n_cases = sweep_grid(param, pressure_kpa, max_points, chunk_cases)
     check_budgets(len(grids), len(P), n_cases, chunk_cases, data_fmt, bool(scheduler or workers), max_memory_gib,
                   max_minutes)

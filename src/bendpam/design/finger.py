@@ -85,6 +85,7 @@ from bendpam.design.parts import (
 from bendpam.design.rod import NEWTON_TOL, Rod, complex_jacobian, continuation, newton, sinc
 from bendpam.errors import InputError, NoEquilibrium
 from bendpam.infra.accessors import figure
+from bendpam.infra.display import summary_html, summary_text
 from bendpam.physics.actuator import Actuator
 from bendpam.physics.law import MomentLaw, StableBranch
 from bendpam.physics.models import resolve_model
@@ -428,6 +429,21 @@ class FingerShape:
         return cls(rod.f, loads, P, rod.s.copy(), nan, nan.copy(), nan.copy(), nan.copy(), nan.copy(),
                    (math.nan, math.nan), math.nan, False, False, math.nan, lam, note, limit, branch)
 
+    def _summary(self) -> tuple[str, list[tuple[str, Any]], list[str], list[list[Any]]]:
+        d = self.to_dict()
+        return (f"FingerShape at {self.pressure_kpa:g} kPa ({'equilibrium' if self.equilibrium else 'no equilibrium'}"
+                f"{', ' + self.note if self.note else ''})",
+                [(k, d[k]) for k in ("tip_x_mm", "tip_y_mm", "tip_angle_deg", "bend_angle_deg", "base_moment_nmm",
+                                     "residual_nmm")], [], [])
+
+    def __repr__(self) -> str:
+        """A short summary: the tip pose and the base moment (the arrays are in :meth:`to_dataframe`)."""
+        return summary_text(*self._summary())
+
+    def _repr_html_(self) -> str:
+        """The summary of :meth:`__repr__` for a notebook (HTML)."""
+        return summary_html(*self._summary())
+
     def limits(self) -> FingerLimits:
         """The structural limits along this shape, worst section (:func:`finger_limits`)."""
         return finger_limits(self)
@@ -680,13 +696,13 @@ class FingerLimits:
     sections: dict[str, np.ndarray] = field(repr=False, compare=False)
 
     def to_dict(self) -> dict[str, Any]:
-        """The worst section's numbers as a JSON-ready dict (margins: null where infinite, no demand or no limit).
+        """The worst section's numbers as a JSON-ready dict (margins: "inf" where there is no demand or no limit).
 
         >>> import bendpam
         >>> from bendpam.design import Finger, solve_finger
         >>> d = solve_finger(Finger(bendpam.physics.presets.be_pam()), 150.0).limits().to_dict()
         >>> round(d["lockup_margin"], 1), d["buckling_margin"], d["violations"]
-        (4.1, None, [])
+        (4.1, 'inf', [])
         """
         return {k: json_number(getattr(self, k)) for k in (
             "frame_axial_force_n", "frame_stress_mpa", "frame_strength_margin", "buckling_margin", "lockup_margin",
@@ -794,10 +810,11 @@ def free_tip_trajectory(finger: Finger, pressures_kpa):
 # ------------------------------------------------------------------------------------------------
 # figure (drawn by bendpam.present.figures.design, reached by name)
 # ------------------------------------------------------------------------------------------------
-def plot_finger_shapes(shapes, ax=None, title: str | None = None):
+def plot_finger_shapes(shapes, ax=None, title: str | None = None, free=None):
     """Draw finger shapes (frame line, fingertip, tip point) on ``ax``; returns the figure.
 
-    Shapes without equilibrium are drawn dashed from their last equilibrium (``limit``) if any.
+    Shapes without equilibrium are drawn dashed from their last equilibrium (``limit``) if any;
+    ``free``, the unloaded shapes at the same pressures, are drawn dotted beside them.
     The figure is :func:`bendpam.present.figures.design.plot_finger_shapes`, loaded on first use.
 
     Examples
@@ -810,4 +827,4 @@ def plot_finger_shapes(shapes, ax=None, title: str | None = None):
     1
     >>> plt.close(fig)
     """
-    return figure("finger_shapes")(shapes, ax=ax, title=title)
+    return figure("finger_shapes")(shapes, ax=ax, title=title, free=free)

@@ -149,14 +149,18 @@ def pressures_checked() -> Iterator[None]:
         yield
 
 
-def json_number(value) -> float | None:
-    """``value`` as a float for a JSON record, or None where it is not finite (inf, NaN: not defined).
+def json_number(value) -> float | str | None:
+    """``value`` as a float for a JSON record: None where it is not defined (NaN), ``"inf"``/``"-inf"`` where infinite.
+
+    ``float()`` reads the strings back (docs/formats.md, "JSON": ``null`` means missing, never infinite).
 
     >>> json_number(2), json_number(float("nan")), json_number(float("inf"))
-    (2.0, None, None)
+    (2.0, None, 'inf')
     """
     try:
         v = float(value)
     except (TypeError, ValueError):
         return None
-    return v if math.isfinite(v) else None
+    if math.isnan(v):
+        return None
+    return v if math.isfinite(v) else ("inf" if v > 0 else "-inf")

@@ -12,6 +12,7 @@ import numpy as np
 from bendpam.design.targets import Target, Variable
 from bendpam.infra.accessors import figure
 from bendpam.infra.atomic import atomic_write_text
+from bendpam.infra.display import summary_html, summary_text
 from bendpam.infra.outputs import to_json
 from bendpam.physics.actuator import Actuator
 from bendpam.version import __version__
@@ -150,7 +151,7 @@ class DesignResult:
 
     def to_dict(self) -> dict[str, Any]:
         """design.json's content (units in the key names; a margin ``"inf"``: no demand or no limit, see
-        ``margin_notes``; ``null`` = not defined)."""
+        ``margin_notes``; ``null`` = not defined, never infinite)."""
         return {
             "bendpam_version": __version__,
             "model": self.model,
@@ -181,15 +182,18 @@ class DesignResult:
             "search": dict(self.search),
             "deadband": self.deadband,
             "inf_means": "a margin with no demand (or no limit given; see margin_notes)",
-            "null_means": "not defined (or infinite, for a value that is not a margin)",
+            "null_means": "not defined (missing); infinity (no demand, no limit, an unbounded free-bending branch) "
+                          "is the string \"inf\"",
         }
 
     def to_json(self) -> str:
         """design.json's text (:meth:`to_dict` as JSON)."""
         return to_json(self.to_dict())
 
-    def save(self, out_dir, *, figures: bool = True) -> dict[str, str]:
+    def save(self, out_dir, *, figures: bool = True, figure_format: str = "png") -> dict[str, str]:
         """Write design.json, design.toml, coarse_map.csv, pareto.csv and figures into ``out_dir``.
+
+        ``figure_format``: png, pdf or svg (the figures ``coarse_map`` and ``pareto`` get its suffix).
 
         Each file is written atomically (for a whole set, use :class:`bendpam.infra.outputs.OutputSet`,
         as ``bendpam design --out`` does).  Returns ``{file name: path}``.
@@ -215,11 +219,10 @@ class DesignResult:
             put("pareto.csv", self.pareto.to_csv())
         if figures:  # drawn and saved by bendpam.present.figures, reached by name
             save_figure = figure("save_figure")
-            save_figure(figure("coarse_map")(self), out / "coarse_map.png")
-            files["coarse_map.png"] = str(out / "coarse_map.png")
-            if self.pareto is not None:
-                save_figure(figure("pareto")(self), out / "pareto.png")
-                files["pareto.png"] = str(out / "pareto.png")
+            for name in ("coarse_map", "pareto") if self.pareto is not None else ("coarse_map",):
+                target = out / f"{name}.{figure_format}"
+                save_figure(figure(name)(self), target, format=figure_format)
+                files[target.name] = str(target)
         return files
 
     def summary(self) -> str:
@@ -259,6 +262,22 @@ class DesignResult:
                                            strict=True)]
             lines.append(head + "; ".join(parts))
         return lines
+
+    def _summary(self) -> tuple[str, list[tuple[str, Any]], list[str], list[list[Any]]]:
+        items: list[tuple[str, Any]] = [("smallest margin", self.min_margin),
+                                        ("required margin", self.min_margin_required)]
+        items += [(f"target {t.text}", f"{a:.4g} ({'met' if ok else 'not met'})")
+                  for t, a, ok in zip(self.targets, self.achieved, self.met, strict=True)]
+        return (f"DesignResult: {'feasible' if self.feasible else 'NOT feasible'} ({self.model.replace('_', '-')} "
+                "model)", items, ["variable", "value"], [[k, v] for k, v in self.values.items()])
+
+    def __repr__(self) -> str:
+        """A short summary: feasible or not, the targets, the design's variables (``str()`` explains)."""
+        return summary_text(*self._summary())
+
+    def _repr_html_(self) -> str:
+        """The summary of :meth:`__repr__` for a notebook (HTML)."""
+        return summary_html(*self._summary())
 
     def __str__(self) -> str:
         return self.summary()

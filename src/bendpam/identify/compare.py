@@ -60,4 +60,7 @@ def type_comparison(processed, actuator: Actuator, model: str | None = None, fre
     sign = int(actuator.bend_sign)
     if sign == 0:
         return None, None
+    from bendpam.lab.processed import as_processed
+
+    processed = as_processed(processed)  # a ProcessedSet, or the folder it was written to
     return (_side_fit(processed, actuator, model, free, sign), _side_fit(processed, actuator, model, free, -sign))

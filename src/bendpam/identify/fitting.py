@@ -122,6 +122,7 @@ from bendpam.identify.result import (
     Profile,
 )
 from bendpam.identify.uncertainty import Uncertainty, material_fit, sandwich_covariance
+from bendpam.lab.processed import as_processed
 from bendpam.physics.actuator import NEUTRAL_ANGLE_DEG, Actuator, FitIdentity
 from bendpam.physics.braid import DEFAULT_ORDER
 from bendpam.physics.law import MomentLaw
@@ -409,7 +410,7 @@ def fit(processed, actuator: Actuator, model: str | None = None, free=("alpha0",
 
     Parameters
     ----------
-    processed : :class:`bendpam.lab.processing.ProcessedSet` (or ``load_processed(dir)``).
+    processed : :class:`bendpam.lab.processing.ProcessedSet`, or the folder it was written to (str or Path).
     actuator : the nominal actuator (geometry, and the values of the parameters held fixed).
     model : ``"energy"``, ``"force_balance"`` or None (default): the start actuator's own model (energy when
         unknown).  Fitting the other model from its constants is deliberate and does not warn.
@@ -466,6 +467,7 @@ def fit(processed, actuator: Actuator, model: str | None = None, free=("alpha0",
     free = parse_free(free)
     if tension is not None:
         actuator = actuator.replace(C10_kpa=tension.C10_kpa, C01_kpa=tension.C01_kpa)
+    processed = as_processed(processed)  # a ProcessedSet, or the folder it was written to
     run = _prepare(processed, actuator, model, free, bounds, tension_data, fit_range, hysteresis, hysteresis_law,
                    admissible_range, order, eq19_factor)
     _search_stages(run, grid_alpha, grid_r0, tension_data)

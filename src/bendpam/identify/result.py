@@ -16,6 +16,7 @@ import json
 import math
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -23,6 +24,7 @@ from bendpam.errors import FileFormatError, InputError, OutsideTestedRangeWarnin
 from bendpam.infra.accessors import figure
 from bendpam.infra.atomic import atomic_write_text, json_safe
 from bendpam.infra.budgets import read_input_bytes
+from bendpam.infra.display import summary_html, summary_text
 from bendpam.infra.manifest import verify_input
 from bendpam.physics.actuator import Actuator, FitIdentity, outside_tested_range
 from bendpam.physics.law import MomentLaw
@@ -492,8 +494,10 @@ class FitResult:
         return Band(quantity, units[quantity], P, v0, v0 - level * sd, v0 + level * sd, extrap)
 
     def plot(self, processed, title: str = ""):
-        """Figure 7 (a matplotlib Figure): the fitted model against ``processed``."""
-        return figure("figure7")(processed, self, title)
+        """Figure 7 (a matplotlib Figure): the fitted model against ``processed`` (a set or its folder)."""
+        from bendpam.lab.processed import as_processed
+
+        return figure("figure7")(as_processed(processed), self, title)
 
     def to_dict(self) -> dict:
         m = self.metrics.to_dict()
@@ -596,6 +600,28 @@ class FitResult:
         except (OSError, UnicodeDecodeError, json.JSONDecodeError, KeyError, TypeError, ValueError,
                 RecursionError) as exc:
             raise FileFormatError(f"{fj}: not a bendpam fit.json ({type(exc).__name__}: {exc})") from None
+
+    def _summary(self) -> tuple[str, list[tuple[str, object]], list[str], list[list[Any]]]:
+        m = self.metrics
+        items: list[tuple[str, object]] = [
+            ("NRMSE cycles (%)", 100 * m.nrmse_cycles), ("NRMSE blocked moment (%)", 100 * m.nrmse_blocked_moment),
+            ("NRMSE free curvature (%)", None if m.nrmse_free_curvature is None else 100 * m.nrmse_free_curvature),
+            ("curves fitted", "both loop branches (hysteresis-aware)" if self.hysteresis is not None
+             else "mean curves")]
+        items += [("note", f) for f in self.flags[:3]]
+        rows = [[PARAMETERS[n][0], p.value, p.stderr if p.vary else "fixed", PARAMETERS[n][1]]
+                for n, p in self.parameters.items()]
+        return (f"FitResult: {self.model.replace('_', '-')} model "
+                f"({'converged' if self.converged else 'NOT converged'}, {self.nfev} evaluations)", items,
+                ["parameter", "value", "std. error", "unit"], rows)
+
+    def __repr__(self) -> str:
+        """A short summary: the fit's quality and its parameters (``str()`` has every detail)."""
+        return summary_text(*self._summary())
+
+    def _repr_html_(self) -> str:
+        """The summary of :meth:`__repr__` for a notebook (HTML)."""
+        return summary_html(*self._summary())
 
     def __str__(self) -> str:
         lines = [f"{self.model.replace('_', '-')} model fit ({'converged' if self.converged else 'NOT converged'}, "

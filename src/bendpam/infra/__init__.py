@@ -11,5 +11,5 @@ layer may use them.  None imports a POSIX-only module at module level.
 * :mod:`.signals`: SIGINT/SIGTERM as :class:`~.signals.Interrupted`, held sections, honest words;
 * :mod:`.locks`: the portable lock of an output target;
 * :mod:`.fsops`: temporaries, flushing, hashing and the folder swap;
-* :mod:`.atomic`, :mod:`.progress`, :mod:`.accessors`.
+* :mod:`.atomic`, :mod:`.progress`, :mod:`.accessors`, :mod:`.display` (short summaries of results).
 """

@@ -94,15 +94,16 @@ def json_safe(obj: Any) -> Any:
     """``obj`` made fit for strict JSON (``json.dumps(..., allow_nan=False)``).
 
     NumPy scalars become plain Python numbers and NumPy arrays nested lists;
-    non-finite floats (NaN, +-inf) become ``None`` (JSON ``null``); tuples become
+    NaN becomes ``None`` (JSON ``null``: missing) and +-inf the strings ``"inf"`` and ``"-inf"``
+    (``float()`` reads them back; docs/formats.md, "JSON"); tuples become
     lists; paths become strings; NumPy mapping keys become plain, non-finite float
     keys strings.  Anything else is returned unchanged (``json.dumps`` decides).
 
     Examples
     --------
     >>> import numpy as np
-    >>> json_safe({"x": np.float64("nan"), "a": np.arange(2), "t": (1, 2.5)})
-    {'x': None, 'a': [0, 1], 't': [1, 2.5]}
+    >>> json_safe({"x": np.float64("nan"), "a": np.arange(2), "t": (1, 2.5), "m": -np.inf})
+    {'x': None, 'a': [0, 1], 't': [1, 2.5], 'm': '-inf'}
     """
     if isinstance(obj, dict):
         return {_json_key(k): json_safe(v) for k, v in obj.items()}
@@ -117,7 +118,7 @@ def json_safe(obj: Any) -> Any:
     if hasattr(obj, "item"):  # NumPy scalars and 0-d arrays
         obj = obj.item()
     if isinstance(obj, float):
-        return obj if math.isfinite(obj) else None
+        return obj if math.isfinite(obj) else None if math.isnan(obj) else "inf" if obj > 0 else "-inf"
     return obj
 
 

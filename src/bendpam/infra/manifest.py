@@ -68,7 +68,7 @@ OS_LITTER = re.compile(r"\.DS_Store|\._.*|Thumbs\.db|ehthumbs\.db|desktop\.ini|\
 def to_json(obj: Any, *, indent: int | None = 2) -> str:
     """Strict JSON text of ``obj`` (after :func:`~bendpam.infra.atomic.json_safe`), ending in a newline.
 
-    Non-finite floats become ``null``; ``allow_nan=False`` guarantees that no ``NaN`` or
+    NaN becomes ``null`` (missing) and +-inf ``"inf"``/``"-inf"``; ``allow_nan=False`` guarantees that no ``NaN`` or
     ``Infinity`` token (which is not JSON) can reach a file.
 
     Examples

@@ -510,7 +510,7 @@ class OutputSet(_Output):
         return p
 
     def write_json(self, name: str | os.PathLike[str], obj: Any, *, indent: int | None = 2) -> Path:
-        """Write ``obj`` as strict JSON (see :func:`to_json`; NaN/inf become null)."""
+        """Write ``obj`` as strict JSON (see :func:`to_json`; NaN becomes null, +-inf "inf"/"-inf")."""
         return self.write_text(name, to_json(obj, indent=indent))
 
     # -- leaving -----------------------------------------------------------------------

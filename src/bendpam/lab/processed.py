@@ -14,13 +14,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from bendpam.errors import InputError, ProcessingError
 from bendpam.infra.accessors import figure as figure_by_name
 from bendpam.infra.budgets import check_input_file
+from bendpam.infra.display import summary_html, summary_text
 from bendpam.infra.manifest import verify_input
 from bendpam.physics.fixture import Fixture
 
@@ -33,6 +34,7 @@ __all__ = [
     "PressureResult",
     "ProcessedSet",
     "ProcessingOptions",
+    "as_processed",
     "deadband_fit",
     "load_processed",
     "write_processed",
@@ -265,6 +267,28 @@ class ProcessedSet:
     fixture: Fixture
     options: ProcessingOptions
     files: list[dict] = field(default_factory=list)  # what became of each input file (bendpam.lab.batch)
+
+    def _summary(self) -> tuple[str, list[tuple[str, object]], list[str], list[list[Any]]]:
+        rows = [[r.pressure_kpa, r.n_cycles, float(np.mean(r.blocked_moments)) if r.n_cycles else None,
+                 float(np.mean(r.free_curvatures)) if r.n_cycles else None,
+                 100 * float(np.mean(r.energy_loss_ratios)) if r.n_cycles else None] for r in self.results]
+        try:
+            p0, se = self.deadband()
+            deadband = f"{p0:.4g} ± {se:.2g} kPa"
+        except (ProcessingError, InputError, ValueError):
+            deadband = "not defined"
+        fx = self.fixture
+        return (f"ProcessedSet: {len(self.results)} pressure(s), fixture d, r, t = {fx.d_mm:g}, {fx.r_mm:g}, "
+                f"{fx.t_mm:g} mm", [("deadband", deadband)],
+                ["P (kPa)", "cycles", "M_blocked (N·mm)", "k_free (1/mm)", "loss (%)"], rows)
+
+    def __repr__(self) -> str:
+        """Table 2 in a few lines (one per pressure; the arrays stay in :attr:`results`)."""
+        return summary_text(*self._summary())
+
+    def _repr_html_(self) -> str:
+        """Table 2 as a small HTML table for a notebook."""
+        return summary_html(*self._summary())
 
     @property
     def pressures_kpa(self) -> np.ndarray:
@@ -540,6 +564,27 @@ def _read_curves(nc):
     with xr.open_dataset(nc) as ds:
         ds = ds.load()
         return _Curves({k: ds[k].values for k in ds.variables}, dict(ds.attrs))
+
+
+def as_processed(processed) -> ProcessedSet:
+    """``processed`` itself, or the set in a folder (a ``str`` or ``Path``) read by :func:`load_processed`.
+
+    Reading checks the folder's manifest as :func:`load_processed` does; anything else that is not a
+    processed set is refused in one line.
+
+    >>> as_processed(3.5)
+    Traceback (most recent call last):
+    ...
+    bendpam.errors.InputError: expected a processed test set (bendpam.process_tests) or the folder ...
+    """
+    import os
+
+    if isinstance(processed, str | os.PathLike):
+        return load_processed(processed)
+    if not hasattr(processed, "results"):
+        raise InputError("expected a processed test set (bendpam.process_tests) or the folder the processing wrote "
+                         f"(a str or Path); got {type(processed).__name__}")
+    return processed
 
 
 def load_processed(path) -> ProcessedSet:

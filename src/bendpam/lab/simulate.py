@@ -33,7 +33,7 @@ import pandas as pd
 from scipy.optimize import brentq
 
 from bendpam.errors import InputError, NoEquilibrium
-from bendpam.infra.atomic import atomic_write_text
+from bendpam.infra.atomic import atomic_write_text, json_safe
 from bendpam.physics.braid import curvature_limits
 from bendpam.physics.fixture import PAPER_FIXTURE, Fixture
 from bendpam.physics.hysteresis import LAWS, make_law
@@ -383,5 +383,5 @@ def simulate_tests(actuator, pressures_kpa, out_dir, model: str | None = None, *
         "files": files,
         "units": {"moment": "N*mm", "curvature": "1/mm", "pressure": "kPa", "sign": "magnitudes"},
     }
-    atomic_write_text(out / "truth.json", json.dumps(result, indent=2))
+    atomic_write_text(out / "truth.json", json.dumps(json_safe(result), indent=2, allow_nan=False))
     return result

@@ -25,6 +25,7 @@ import tomli_w
 from bendpam.errors import FileFormatError, InputError, OutsideTestedRangeWarning, warn_user
 from bendpam.infra.atomic import atomic_write_text
 from bendpam.infra.budgets import loads_toml, read_input_bytes
+from bendpam.infra.display import summary_html, summary_text
 from bendpam.physics.material import MooneyRivlin
 from bendpam.validate import DEFAULT_MAX_PRESSURE_KPA, PLAUSIBLE, did_you_mean, float_array, number, plausible
 
@@ -455,6 +456,29 @@ class Actuator:
     def frame_stiffness_nmm2(self) -> float:
         """Bending stiffness of the frame E_f I_f, N*mm^2 (eq 16, 27)."""
         return float(self._params.frame_stiffness)
+
+    def _summary(self) -> tuple[str, list[tuple[str, Any]], list[str], list[list[Any]]]:
+        items: list[tuple[str, Any]] = [
+            ("kind", self.kind), ("braid angle alpha0_deg", self.alpha0_deg),
+            ("bladder R0_mm, t0_mm", f"{self.R0_mm:g}, {self.t0_mm:g}"), ("active length L0_mm", self.L0_mm),
+            ("Mooney-Rivlin C10_kpa, C01_kpa", f"{self.C10_kpa:g}, {self.C01_kpa:g}"),
+            ("threshold P_start_kpa", self.P_start_kpa)]
+        if self.model:
+            items.append(("identified with", self.model.replace("_", "-") + " model"))
+        return f"Actuator {self.name or self.kind}", items, [], []
+
+    def __repr__(self) -> str:
+        """A few lines: the name, the kind and the main parameters (``to_toml()`` has them all).
+
+        >>> from bendpam.physics.presets import be_pam
+        >>> print(repr(be_pam()).splitlines()[:3])
+        ['Actuator BE-PAM (paper, energy constants)', '  kind: BE-PAM', '  braid angle alpha0_deg: 69.7']
+        """
+        return summary_text(*self._summary())
+
+    def _repr_html_(self) -> str:
+        """The summary of :meth:`__repr__` for a notebook (HTML)."""
+        return summary_html(*self._summary())
 
     @property
     def kind(self) -> str:

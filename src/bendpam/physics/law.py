@@ -171,6 +171,20 @@ class MomentLaw:
                                                                     if self.actuator else "actuator")
         return f"MomentLaw({what}, model={self.model!r}, eq19_factor={self.eq19_factor}, order={self.order})"
 
+    def _repr_html_(self) -> str:
+        """A short summary for a notebook: the actuator, the model, the quadrature (never the tables).
+
+        >>> import bendpam
+        >>> "energy" in MomentLaw.of(bendpam.physics.presets.be_pam())._repr_html_()
+        True
+        """
+        from bendpam.infra.display import summary_html
+
+        what = f"{self.params.shape} cases" if self.is_cases else (self.actuator.name or self.actuator.kind
+                                                                    if self.actuator else "actuator")
+        return summary_html(f"MomentLaw of {what}", [("model", self.model), ("eq19_factor", self.eq19_factor),
+                                                      ("quadrature order", self.order)])
+
     # ---- the numerics layer -------------------------------------------------------------------
     @property
     def P_start_kpa(self):

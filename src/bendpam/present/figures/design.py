@@ -48,10 +48,11 @@ _MARKERS = ("o", "s", "^", "D", "v", "P", "X", "*", "<", ">", "h", "p")
 
 
 @register("finger_shapes")
-def plot_finger_shapes(shapes, ax=None, title: str | None = None):
+def plot_finger_shapes(shapes, ax=None, title: str | None = None, free=None):
     """Draw finger shapes (frame line, fingertip, tip point) on ``ax``; returns the figure.
 
     Shapes without equilibrium are drawn dashed from their last equilibrium (``limit``) if any.
+    ``free``: the same pressures' unloaded shapes, drawn dotted in the same colours (free and loaded).
 
     Examples
     --------
@@ -71,13 +72,20 @@ def plot_finger_shapes(shapes, ax=None, title: str | None = None):
     colors = matplotlib.colormaps["viridis"](np.linspace(0.0, 0.9, max(len(shapes), 1)))
     for sh, col in zip(shapes, colors, strict=False):
         draw, style = (sh, "-") if sh.equilibrium else (sh.limit, "--")
-        label = f"{sh.pressure_kpa:g} kPa" + ("" if sh.equilibrium else " (no equilibrium)")
+        label = f"{sh.pressure_kpa:g} kPa" + (", loaded" if free else "") + ("" if sh.equilibrium else
+                                                                              " (no equilibrium)")
         if draw is None:
             ax.plot([], [], style, color=col, label=label)
             continue
         ax.plot(draw.x, draw.y, style, color=col, label=label)
         ax.plot([draw.x[-1], draw.tip_xy[0]], [draw.y[-1], draw.tip_xy[1]], style, color=col, lw=3, alpha=0.6)
         ax.plot(*draw.tip_xy, "o", color=col, ms=4)
+    free = list(free or [])
+    for sh, col in zip(free, colors, strict=False):
+        if sh.equilibrium:
+            ax.plot(sh.x, sh.y, ":", color=col, lw=1.2)
+    if free:
+        ax.plot([], [], ":", color="0.3", lw=1.2, label="free (no load)")
     if shapes:
         x0, y0 = shapes[0].finger.base_xy_mm
         ax.plot(x0, y0, "ks", ms=6)

@@ -93,7 +93,7 @@ def build_report(
     pressure_kpa=None,
     fixture: Fixture | str | None = None,
     processing_options=None,
-    progress: bool = True,
+    progress: bool = True, shown_as: str | None = None,
 ) -> Report:
     """Raw test files -> processing -> fits -> checks -> ONE self-contained HTML page at ``out_html``.
 
@@ -112,6 +112,7 @@ def build_report(
         actuator) or None (the paper's fixture with the actuator's L0).
     processing_options : a :class:`~bendpam.lab.processing.ProcessingOptions`, a dict of its fields, or None.
     progress : report progress on stderr (:class:`bendpam.infra.progress.Progress`); False writes nothing.
+    shown_as : the page's name in the progress lines (default ``out_html``'s; a temporary file's caller: the target).
 
     Returns
     -------
@@ -147,7 +148,7 @@ def build_report(
         loops = has_loop(processed)
         hyst, separate, hyst_error = _loop_fit(processed, actuator, fits, free_names, loops, bar)
         figures, notes, stresses = draw_figures(processed, actuator, fits, model_names, hyst, separate, bar)
-        bar.advance(0, description=f"report: writing {out.name}")
+        bar.advance(0, description=f"report: writing {shown_as or out.name}")
         inputs_info = [_input_info(t) for t in tests]
         page = render_page(
             actuator=actuator, summary=summary, fits=fits, figures=figures, inputs_info=inputs_info, fixture=fx,

@@ -40,7 +40,7 @@ from bendpam.present.report.text import (
     symbol,
 )
 
-__all__ = ["render_page"]
+__all__ = ["fits_curves", "render_page"]
 
 
 # ------------------------------------------------------------------------------------------------
@@ -234,7 +234,29 @@ def _fits_context(fits: Mapping, failed: Mapping[str, str]) -> dict:
                    ["Model"] + [Markup(symbol(x).heading()) for x in T3_PARAMS] + [Markup(symbol("mu").heading())]
                    + ["NRMSE loading cycles (%)", "NRMSE blocked moment (%)", "NRMSE free-bending curvature (%)"],
                    rows)
-    return {"table3": table, "table3_marked": marked, "fit_details": [_fit_detail(m, res) for m, res in fits.items()]}
+    return {"table3": table, "table3_marked": marked, "fits_curves": fits_curves(fits),
+            "fit_details": [_fit_detail(m, res) for m, res in fits.items()]}
+
+
+def fits_curves(fits: Mapping) -> str:
+    """What the fits of section 2 were fitted to, in words, from the FitResults (loop model or mean curves).
+
+    >>> from types import SimpleNamespace as NS
+    >>> fits_curves({"energy": NS(hysteresis=None)})
+    'the mean curves (the average of the loading and unloading branches, hysteresis-free, as the paper)'
+    >>> fits_curves({"energy": NS(hysteresis=NS(law="pi"))})[:40]
+    'both branches of every loop with the loo'
+    """
+    with_loop = [m for m, r in fits.items() if getattr(r, "hysteresis", None) is not None]
+    mean = ("the mean curves (the average of the loading and unloading branches, hysteresis-free, as the paper)")
+    if not with_loop:
+        return mean
+    laws = sorted({LAW_LABEL.get(fits[m].hysteresis.law, fits[m].hysteresis.law) for m in with_loop})
+    loop = f"both branches of every loop with the loop model ({' or '.join(laws)}; hysteresis-aware)"
+    if len(with_loop) == len(fits):
+        return loop
+    return (f"{loop} for the {', '.join(MODEL_LABEL.get(m, m) for m in with_loop)} model, and {mean} for the "
+            "others")
 
 
 def _params_table(tid: str, caption: str, params: Mapping) -> _Table:
