@@ -16,8 +16,11 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from bendpam.lab.pressure import PRESSURE_RANGE_KPA, parse_pressure, pressure_from_filename
     from bendpam.lab.rawtest import COLUMNS, DIALECTS, FORMATS, RawTest, check_cycle_count
+    from bendpam.lab.declaration import load_declaration
+    from bendpam.lab.declared import read_declared
     from bendpam.lab.read_error import ReadError
     from bendpam.lab.readers import detect_dialect, format_inspection, inspect_file, parse_columns, read_test
+    from bendpam.lab.suggest import suggest_declaration
     from bendpam.lab.writers import write_test
 
 __all__ = [
@@ -31,10 +34,13 @@ __all__ = [
     "detect_dialect",
     "format_inspection",
     "inspect_file",
+    "load_declaration",
     "parse_columns",
     "parse_pressure",
     "pressure_from_filename",
+    "read_declared",
     "read_test",
+    "suggest_declaration",
     "write_test",
 ]
 
@@ -44,7 +50,8 @@ _FROM = {
     "check_cycle_count": "rawtest", "PRESSURE_RANGE_KPA": "pressure", "parse_pressure": "pressure",
     "pressure_from_filename": "pressure", "ReadError": "read_error", "detect_dialect": "readers",
     "format_inspection": "readers", "inspect_file": "readers", "parse_columns": "readers", "read_test": "readers",
-    "write_test": "writers",
+    "write_test": "writers", "load_declaration": "declaration", "read_declared": "declared",
+    "suggest_declaration": "suggest",
 }  # fmt: skip
 
 
