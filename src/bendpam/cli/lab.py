@@ -8,7 +8,7 @@ from typing import Annotated, Optional
 
 import typer
 
-from bendpam.cli.app import app
+from bendpam.cli.app import app, cli_words
 from bendpam.cli.options import (
     ActuatorOpt,
     FigureFormatOpt,
@@ -38,6 +38,10 @@ ColumnsOpt = Annotated[Optional[str], typer.Option(
          "default: chosen and reported by the reader.")]
 RateOpt = Annotated[Optional[float], typer.Option(
     "--rate-hz", help="Sampling rate (Hz) for a file without a time column (default: from its metadata).")]
+FormatFileOpt = Annotated[Optional[Path], typer.Option(
+    "--format-file", metavar="PATH",
+    help="Read the files by this format declaration (TOML; docs/formats.md), with no detection; "
+         "'bendpam inspect FILE --suggest' drafts one.")]
 RepairOpt = Annotated[bool, typer.Option(
     "--repair", help="Remove isolated spikes and non-increasing samples (reported) instead of refusing the file.")]
 
@@ -65,6 +69,10 @@ def inspect(
     columns: ColumnsOpt = None,
     rate_hz: RateOpt = None,
     repair: RepairOpt = False,
+    format_file: FormatFileOpt = None,
+    suggest: Annotated[bool, typer.Option(
+        "--suggest", help="Print a format declaration that reads each file (what detection found, or the best "
+                          "guesses from its head), to save, edit and give with --format-file.")] = False,
     as_json: Annotated[bool, typer.Option("--json", help="Print a JSON list, one object per file.")] = False,
 ):
     """What the reader understood of each file (format, encoding, channels, units, values), before processing."""
@@ -74,8 +82,18 @@ def inspect(
     from bendpam.lab import format_inspection, inspect_file
 
     paths = collect_raw_files(files)
-    infos = [inspect_file(p, pressure_kpa=pressure_kpa, columns=columns, rate_hz=rate_hz, repair=repair)
-             for p in paths]
+    if suggest:
+        _print_suggestions(paths, as_json)
+        return
+    if format_file is not None:
+        from bendpam.lab import load_declaration
+
+        load_declaration(format_file)  # a bad declaration is one error, not one per file
+    infos = [inspect_file(p, pressure_kpa=pressure_kpa, columns=columns, rate_hz=rate_hz, repair=repair,
+                          format_file=format_file) for p in paths]
+    for info in infos:
+        if "error" in info:
+            info["error"] = cli_words(info["error"])
     if as_json:
         typer.echo(json.dumps(json_safe(infos), indent=2, allow_nan=False, ensure_ascii=False))
     else:
@@ -87,6 +105,20 @@ def inspect(
         for i in bad:
             typer.echo(f"bendpam: error: {i['error']}", err=True)
         raise typer.Exit(2)
+
+
+def _print_suggestions(paths: list[Path], as_json: bool) -> None:
+    """``inspect --suggest``: a declaration per file (TOML text, or a JSON list of {file, declaration})."""
+    import json
+
+    from bendpam.lab import suggest_declaration
+
+    drafts = [(p, suggest_declaration(p)) for p in paths]
+    if as_json:
+        typer.echo(json.dumps([{"file": str(p), "declaration": d} for p, d in drafts], indent=2, ensure_ascii=False))
+        return
+    for i, (_p, d) in enumerate(drafts):
+        typer.echo(("\n" if i else "") + d, nl=False)
 
 
 @app.command()
@@ -111,6 +143,7 @@ def process(
     columns: ColumnsOpt = None,
     rate_hz: RateOpt = None,
     repair: RepairOpt = False,
+    format_file: FormatFileOpt = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print summary.json to stdout.")] = False,
     quiet: QuietOpt = False,
 ):
@@ -123,6 +156,10 @@ def process(
     if out is None:
         raise UserError("give an output folder with --out OUTDIR")
     _check_l0(l0_mm)
+    if format_file is not None:
+        from bendpam.lab import load_declaration
+
+        load_declaration(format_file)  # refused before any file is read
     files = collect_raw_files(inputs)
     pressures = _file_pressures(pressure_kpa, files)
     fx = Fixture.from_string(fixture, L0_mm=l0_mm, name="--fixture")
@@ -137,7 +174,7 @@ def process(
         # processed) when the next one is asked for
         for i, f in enumerate(files):
             raw = read_test(f, pressure_kpa=pressures[i] if pressures else None, columns=columns, rate_hz=rate_hz,
-                            repair=repair)
+                            repair=repair, format_file=format_file)
             if raw.pressure_kpa is None:
                 raise UserError(f"{raw.path}: no pressure: give --pressure-kpa, a 'Pressure' metadata line, "
                                 "or a filename token like 200kPa")

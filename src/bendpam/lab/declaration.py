@@ -52,6 +52,7 @@ from bendpam.lab.read_error import ReadError
 
 __all__ = [
     "BLOCK_MODES",
+    "DECLARATION_HINT",
     "DECLARATION_KEYS",
     "DELIMITER_NAMES",
     "ColumnSpec",
@@ -66,6 +67,10 @@ BLOCK_MODES: tuple[str, ...] = ("one", "concatenate", "split")
 DELIMITER_NAMES: dict[str, str] = {
     "tab": "\t", "\t": "\t", ";": ";", ",": ",", "whitespace": "whitespace", "fixed": "fixed",
 }  # fmt: skip
+#: What a refusal of detection adds, in library words (the command line names its options instead).
+DECLARATION_HINT = (
+    "describe the file's layout in a format declaration (bendpam.lab.suggest_declaration(path) drafts one)"
+)
 _DELIMITERS_SHOWN = '"tab", ";", ",", "whitespace" or "fixed"'
 _THOUSANDS = ("", ",", ".", " ", "'")
 _ROLE_KEYS = ("column", "unit")
@@ -144,7 +149,7 @@ class _Checker:
         self.source = source
 
     def line_of(self, key: str) -> int | None:
-        m = re.search(rf"(?m)^\s*\[?\s*{re.escape(key)}\s*[\]=]", self.text)
+        m = re.search(rf"(?m)^[ \t]*\[?[ \t]*{re.escape(key)}[ \t]*[\]=]", self.text)
         return self.text.count("\n", 0, m.start()) + 1 if m else None
 
     def fail(self, key: str, message: str) -> ReadError:

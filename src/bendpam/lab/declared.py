@@ -41,12 +41,7 @@ from bendpam.lab.pressure import (
 from bendpam.lab.rawtest import COLUMNS, RawTest
 from bendpam.lab.read_error import ReadError, show
 
-__all__ = ["DECLARATION_HINT", "read_declared"]
-
-#: What a refusal of detection adds (library words; the CLI names its option instead).
-DECLARATION_HINT = (
-    "describe the file's layout in a format declaration (bendpam.lab.suggest_declaration(path) drafts one)"
-)
+__all__ = ["read_declared"]
 _CHUNK = 50_000  # lines converted at a time
 _NUMBER = r"[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?"
 _OK, _EMPTY, _BAD = 0, 1, 2

@@ -236,7 +236,7 @@ def with_declaration_hint(exc: ReadError) -> ReadError:
     >>> print(with_declaration_hint(ReadError("file is empty; expected a header row and data rows", "x.csv")))
     x.csv: file is empty; expected a header row and data rows
     """
-    from bendpam.lab.declared import DECLARATION_HINT
+    from bendpam.lab.declaration import DECLARATION_HINT
 
     message = exc.message
     if _NOT_LAYOUT.match(message) or DECLARATION_HINT in message:

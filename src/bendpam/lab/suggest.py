@@ -129,18 +129,21 @@ def _header(lines: list[str], sep: str, first: int, n_cols: int) -> tuple[int | 
         if len(words) < 2 or numeric_cells(cells)[0] * 5 > len(words):
             continue
         cols = [ColumnInfo(j, c, *split_name_unit(c)) for j, c in enumerate(cells) if c]
-        hits = len(choose_channels(cols).chosen)
+        hits = len(choose_channels(cols).chosen) + _units_like(lines, sep, i + 1, first)
         score = (hits, -abs(len(cells) - n_cols), i)
         if best_score is None or score > best_score:
             best, best_score = i, score
     if best is None:
         return None, None
-    nxt = best + 1
-    if nxt < first:
-        cells = [c for c in _cells(lines[nxt], sep) if c]
-        if cells and all(is_unit_token(c) for c in cells):
-            return best, nxt
-    return best, None
+    return best, best + 1 if _units_like(lines, sep, best + 1, first) else None
+
+
+def _units_like(lines: list[str], sep: str, i: int, first: int) -> bool:
+    """Is line ``i`` (0-based, above the numbers) a units row?"""
+    if i >= first:
+        return False
+    cells = [c for c in _cells(lines[i], sep) if c]
+    return bool(cells) and all(is_unit_token(c) for c in cells)
 
 
 def _guess_columns(names: list[str], units: list[str] | None, rows: list[list[str]]
