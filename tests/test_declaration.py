@@ -36,7 +36,8 @@ TRUTH = _truth()
 # The time checks shared with detection (bendpam.lab.assemble) still refuse these files on this branch;
 # issue 22 item 3 (leniency) makes gaps and repeated time stamps warnings instead.
 GAPS = {"hilhorst_ZwickTXII_EN_Invar_LT_05_01.TRA", "pymechtest_Bluehill3_Tens_No_Yield_Specimen_RawData_1.csv",
-        "pymechtest_Bluehill3_Tens_No_Yield_Specimen_RawData_6.csv", "pymechtest_Bluehill3_Tens_Yield_Specimen_RawData_6.csv"}
+        "pymechtest_Bluehill3_Tens_No_Yield_Specimen_RawData_6.csv",
+        "pymechtest_Bluehill3_Tens_Yield_Specimen_RawData_6.csv"}
 REPEATED_TIME = {"whiterabbit_WaveMatrix_latexglove_Test6.Stop.csv",
                  "pyphasic_CellScaleMicroSquisher_20200204-t5-PC500-TestData.csv"}
 
@@ -264,7 +265,8 @@ def test_units_row_units_in_names_and_thousands(tmp_path):
 def test_fixed_width_and_whitespace(tmp_path):
     text = "  time  stroke   force\n   0.0    0.10    5.00\n   0.1    0.20    6.00\n   0.2    0.30    7.00\n"
     data = write(tmp_path, "f.dat", text)
-    cols = "time = {column = 1, unit = \"s\"}\nstroke = {column = 2, unit = \"mm\"}\nforce = {column = 3, unit = \"N\"}\n"
+    cols = ('time = {column = 1, unit = "s"}\nstroke = {column = 2, unit = "mm"}\n'
+            'force = {column = 3, unit = "N"}\n')
     for layout in ('delimiter = "fixed"\nwidths = [6, 8, 8]\n', 'delimiter = "whitespace"\n'):
         (raw,) = read_declared(data, declare(tmp_path, "header_line = 1\nfirst_data_line = 2\n" + layout + cols))
         assert raw.data.to_numpy().tolist() == [[0.0, 0.1, 5.0], [0.1, 0.2, 6.0], [0.2, 0.3, 7.0]]
@@ -325,7 +327,7 @@ def test_specimens_side_by_side_of_unequal_length(tmp_path):
     a, b = read_declared(data, decl)
     assert (a.metadata["specimen"], b.metadata["specimen"]) == ("A", "B")
     assert a.data["force_n"].tolist() == [1.0, 2.0, 3.0] and b.data["force_n"].tolist() == [5.0, 6.0]
-    with pytest.raises(ReadError, match="holds 2 tests .specimens."):
+    with pytest.raises(ReadError, match=r"holds 2 tests \(specimens\)"):
         read_test(data, format_file=decl)
 
 

@@ -14,10 +14,10 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from bendpam.lab.pressure import PRESSURE_RANGE_KPA, parse_pressure, pressure_from_filename
-    from bendpam.lab.rawtest import COLUMNS, DIALECTS, FORMATS, RawTest, check_cycle_count
     from bendpam.lab.declaration import load_declaration
     from bendpam.lab.declared import read_declared
+    from bendpam.lab.pressure import PRESSURE_RANGE_KPA, parse_pressure, pressure_from_filename
+    from bendpam.lab.rawtest import COLUMNS, DIALECTS, FORMATS, RawTest, check_cycle_count
     from bendpam.lab.read_error import ReadError
     from bendpam.lab.readers import detect_dialect, format_inspection, inspect_file, parse_columns, read_test
     from bendpam.lab.suggest import suggest_declaration

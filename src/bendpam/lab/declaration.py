@@ -258,8 +258,9 @@ def _lines(c: _Checker, data: dict[str, Any]) -> dict[str, Any]:
     if first is None:
         raise c.fail("first_data_line", "missing; expected the 1-based line of the first row of numbers")
     for key in ("header_line", "units_line", "specimen_names_line"):
-        if out[key] is not None and out[key] >= first:
-            raise c.fail(key, f"line {out[key]} is not above first_data_line = {first}; expected a line before "
+        v = out[key]
+        if v is not None and v >= first:
+            raise c.fail(key, f"line {v} is not above first_data_line = {first}; expected a line before "
                               "the numbers")
     if out["units_line"] is not None and out["units_line"] == out["header_line"]:
         raise c.fail("units_line", "is the header_line; expected the line of the units row, or leave it out")

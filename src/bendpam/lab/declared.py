@@ -21,6 +21,7 @@ import re
 from collections import deque
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
+from itertools import pairwise
 from pathlib import Path
 from typing import Any
 
@@ -102,7 +103,7 @@ def _splitter(delimiter: str, widths: tuple[int, ...] | None) -> Callable[[str],
     if delimiter == "fixed":
         assert widths is not None
         edges = np.concatenate([[0], np.cumsum(widths)]).tolist()
-        spans = list(zip(edges[:-1], edges[1:], strict=True))
+        spans = list(pairwise(edges))
         return lambda line: [line[a:b].strip().strip('"').strip() for a, b in spans]
     return lambda line: split_cells(line, delimiter)
 
@@ -143,8 +144,8 @@ def _open(path: Path, decl: Declaration) -> _Input:
     if problem is not None:
         raise ReadError(problem, path)
     try:
-        with open(path, "rb") as fh:
-            head = fh.read(8)
+        with open(path, "rb") as raw:
+            head = raw.read(8)
     except OSError as exc:
         raise ReadError(f"cannot read the file ({exc.strerror or exc})", path) from None
     kind = container_kind(head)
@@ -159,7 +160,7 @@ def _open(path: Path, decl: Declaration) -> _Input:
         raise decl.error("delimiter", 'missing; expected "tab", ";", ",", "whitespace" or "fixed"')
     encoding = decl.encoding or "utf-8"
     try:
-        fh = open(path, encoding=encoding, errors="replace", newline=None)  # noqa: SIM115 - closed by the reader
+        fh = open(path, encoding=encoding, errors="replace", newline=None)
     except OSError as exc:
         raise ReadError(f"cannot read the file ({exc.strerror or exc})", path) from None
     return _Input(path, fh, encoding, None, _splitter(decl.delimiter, decl.widths), decl.delimiter,
@@ -266,7 +267,7 @@ def _to_numbers(cells: list[str], decimal: str, thousands: str) -> tuple[np.ndar
 
 
 def _data_lines(decl: Declaration, lines: Iterator[tuple[int, str]]) -> Iterator[tuple[int, str]]:
-    """The lines from ``first_data_line`` to ``last_data_line`` (negative: counted from the end, blank lines not counted)."""
+    """The lines from ``first_data_line`` to ``last_data_line`` (negative: from the end, blank lines not counted)."""
     last = decl.last_data_line
     if last is None or last > 0:
         for ln, line in lines:

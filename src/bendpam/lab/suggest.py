@@ -14,10 +14,19 @@ from __future__ import annotations
 import json
 import os
 import re
+from itertools import pairwise
 from pathlib import Path
 from typing import Any
 
-from bendpam.lab.channels import DEFAULT_UNIT, ROLES, ColumnInfo, choose_channels, split_name_unit, unit_cell, unit_factor
+from bendpam.lab.channels import (
+    DEFAULT_UNIT,
+    ROLES,
+    ColumnInfo,
+    choose_channels,
+    split_name_unit,
+    unit_cell,
+    unit_factor,
+)
 from bendpam.lab.declaration import parse_declaration
 from bendpam.lab.layout import DELIMITERS, infer_decimal, is_blank, is_unit_token, numeric_cells, split_cells
 from bendpam.lab.read_error import ReadError
@@ -164,7 +173,7 @@ def _guess_columns(names: list[str], units: list[str] | None, rows: list[list[st
                 v = [float(r[j].replace(",", ".")) for r in rows[:50]]
             except ValueError:
                 continue
-            if j not in used and len(v) > 2 and all(b > a for a, b in zip(v, v[1:], strict=False)):
+            if j not in used and len(v) > 2 and all(b > a for a, b in pairwise(v)):
                 chosen["time"] = cols[j] if j < len(cols) else ColumnInfo(j, "", "", None)
                 used.add(j)
                 break
@@ -235,7 +244,7 @@ def _last_text_line(path: Path, source: Any) -> int:
         sheet = next(s for s in open_source(path)[0] if s.sheet == source.sheet)
         lines: Any = sheet.lines
     else:
-        lines = open(path, encoding=source.encoding, errors="replace", newline=None)  # noqa: SIM115
+        lines = open(path, encoding=source.encoding, errors="replace", newline=None)
     try:
         for i, line in enumerate(lines, start=1):
             if not is_blank(line.rstrip("\r\n")):
