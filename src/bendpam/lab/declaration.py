@@ -55,6 +55,7 @@ __all__ = [
     "DECLARATION_HINT",
     "DECLARATION_KEYS",
     "DELIMITER_NAMES",
+    "TEXT_KEYS",
     "ColumnSpec",
     "Declaration",
     "load_declaration",

@@ -625,6 +625,12 @@ def read_declared(
             inp.close()
     if any("\ufffd" in n for n in layout.names):
         state.warnings.append(f"undecodable bytes in the names row (decoded as {inp.encoding}); check encoding")
+    return _tests(inp, decl, layout, state, pressure_kpa, rate_hz, repair)
+
+
+def _tests(inp: _Input, decl: Declaration, layout: _Layout, state: _State, pressure_kpa: float | None,
+           rate_hz: float | None, repair: bool) -> list[RawTest]:
+    """One test per block read (``split``) or for all of them, and per specimen."""
     metadata, pressure, psource = _metadata(layout, decl, inp.label, pressure_kpa)
     if len(state.blocks) > 1:
         state.warnings.append(f"{len(state.blocks)} blocks of numbers (at lines "

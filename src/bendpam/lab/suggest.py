@@ -23,12 +23,13 @@ from bendpam.lab.channels import (
     ROLES,
     ColumnInfo,
     choose_channels,
+    is_unit_token,
     split_name_unit,
     unit_cell,
     unit_factor,
 )
 from bendpam.lab.declaration import parse_declaration
-from bendpam.lab.layout import DELIMITERS, infer_decimal, is_blank, is_unit_token, numeric_cells, split_cells
+from bendpam.lab.layout import DELIMITERS, infer_decimal, is_blank, numeric_cells, split_cells
 from bendpam.lab.read_error import ReadError
 
 __all__ = ["suggest_declaration"]
