@@ -403,3 +403,32 @@ def test_cli_process_takes_a_format_file(tmp_path, capsys, be):
                  "--json"]) == 0
     got = json.loads(capsys.readouterr().out)
     assert got["pressures"][0]["blocked_moment_nmm"] == want["pressures"][0]["blocked_moment_nmm"]
+
+
+@pytest.mark.parametrize("name", ["postmech_BoseWinTest_ramp_to_failure_tdf_2blocks.TXT",
+                                  "lebedigital_MTS793_DEU_cyclic_Emodul_BALosert_MI_Probe6.dat",
+                                  "forcelib_MecmesinEmperor_10samples_example_forces_big.csv",
+                                  "pyziagn_MTSTestSuite_IT_5D.txt"])
+def test_chunk_boundaries_do_not_change_the_numbers(name, monkeypatch):
+    """Blocks, specimens and the fast and exact conversions give the same numbers whatever the chunk size."""
+    import bendpam.lab.declared as declared
+
+    path = TRUTH[name][0]
+    want = read_declared(path, DECLS / f"{name}.toml")
+    monkeypatch.setattr(declared, "_CHUNK", 7)
+    got = read_declared(path, DECLS / f"{name}.toml")
+    assert len(got) == len(want)
+    for a, b in zip(got, want, strict=True):
+        np.testing.assert_array_equal(a.data.to_numpy(), b.data.to_numpy())
+        assert a.blocks == b.blocks
+
+
+def test_whitespace_names_with_single_spaces(tmp_path):
+    text = "Ch 1 Displacement  Ch 1 Force  Time\nmm  kN  s\n0.5 1.5 0\n0.75  2.25  0.1\n"
+    data = write(tmp_path, "mts.txt", text)
+    decl = declare(tmp_path, 'header_line = 1\nunits_line = 2\nfirst_data_line = 3\ndelimiter = "whitespace"\n'
+                             'time = {column = "Time"}\nstroke = {column = "Ch 1 Displacement"}\n'
+                             'force = {column = "Ch 1 Force"}\n')
+    (raw,) = read_declared(data, decl)
+    assert raw.data.to_numpy().tolist() == [[0.0, 0.5, 1500.0], [0.1, 0.75, 2250.0]]
+    assert raw.source_units == {"time_s": "s", "stroke_mm": "mm", "force_n": "kN"}

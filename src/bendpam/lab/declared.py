@@ -208,6 +208,13 @@ def _unit(role: str, decl: Declaration, index: int, names: list[str], units_row:
                                      "e.g. unit = \"s\" (time), \"mm\" (stroke), \"N\" (force)")
 
 
+def _split_names(line: str) -> list[str]:
+    """A names or units row with ``delimiter = "whitespace"``: at runs of two or more blanks (or tabs)
+    when there are several, so that names holding single spaces (``Ch 1 Force  Time``) stay whole."""
+    cells = [c.strip('"') for c in re.split(r"\t|\s{2,}", line.strip()) if c.strip()]
+    return cells if len(cells) >= 2 else [c.strip('"') for c in line.split()]
+
+
 def _read_head(inp: _Input, decl: Declaration, lines: Iterator[tuple[int, str]]) -> _Layout:
     """Read the lines before ``first_data_line``: names, units, specimen names, metadata."""
     head: list[tuple[int, str]] = []
@@ -219,8 +226,9 @@ def _read_head(inp: _Input, decl: Declaration, lines: Iterator[tuple[int, str]])
         raise decl.error("first_data_line", f"line {decl.first_data_line} is past the end of {inp.label.name} "
                                             f"({len(head)} line(s){' in its sheet' if inp.sheet else ''})")
     text = dict(head)
-    names = inp.split(text[decl.header_line]) if decl.header_line else []
-    units_row = inp.split(text[decl.units_line]) if decl.units_line else None
+    split = _split_names if inp.delimiter == "whitespace" else inp.split
+    names = split(text[decl.header_line]) if decl.header_line else []
+    units_row = split(text[decl.units_line]) if decl.units_line else None
     pos: dict[str, int] = {}
     units: dict[str, str] = {}
     sources: dict[str, str | None] = {}
@@ -372,39 +380,35 @@ def _blocks_of(ok_rows: np.ndarray, sep: np.ndarray, state: _State, lines: np.nd
     return block
 
 
-def _convert_chunk(rows: list[tuple[int, str, list[str]]], inp: _Input, layout: _Layout, decl: Declaration,
-                   state: _State, repair: bool) -> None:
-    """Convert one chunk of lines and add its samples to the parts."""
-    n_k = len(layout.roles) * layout.groups
-    lines = np.fromiter((r[0] for r in rows), dtype=np.int64, count=len(rows))
-    vals = np.empty((n_k, len(rows)))
-    status = np.empty((n_k, len(rows)), dtype=np.int8)
-    for k in range(n_k):
-        vals[k], status[k] = _to_numbers([r[2][k] for r in rows], inp.decimal, inp.thousands)
+def _convert_chunk(lines: np.ndarray, vals: np.ndarray, status: np.ndarray, cells: list[list[str]] | None,
+                   texts: list[str], inp: _Input, layout: _Layout, decl: Declaration, state: _State,
+                   repair: bool) -> None:  # fmt: skip
+    """Add the samples of one chunk of lines (numbers already converted) to the parts."""
     any_num = (status == _OK).any(axis=0)
     text_row = ~any_num & (status == _BAD).any(axis=0)
     if decl.blocks == "one" and text_row.any():
+        assert cells is not None  # the fast path converts numbers only
         i = int(np.flatnonzero(text_row)[0])
         k = int(np.flatnonzero(status[:, i] == _BAD)[0])
-        raise _refuse_cell(inp, layout, k, int(lines[i]), rows[i][2][k], "a line that is not numbers (set "
+        raise _refuse_cell(inp, layout, k, int(lines[i]), cells[i][k], "a line that is not numbers (set "
                            "last_data_line to stop before it, or blocks to read several blocks)")
     if decl.blocks == "one":
         block = np.where(any_num, 0, -1)
         if not state.blocks and any_num.any():
             state.blocks.append({"line": int(lines[any_num][0]), "read": True, "rows": 0})
     else:
-        block = _blocks_of(any_num, ~any_num, state, lines, [r[1] for r in rows], inp, layout, decl)
+        block = _blocks_of(any_num, ~any_num, state, lines, texts, inp, layout, decl)
     nr = len(layout.roles)
     for g in range(layout.groups):
         st = status[g * nr:(g + 1) * nr]
         good = (st == _OK).all(axis=0) & (block >= 0)
         damaged = any_num & (block >= 0) & ~good & ~(st == _EMPTY).all(axis=0)
-        if damaged.any():
+        if damaged.any() and not repair:
+            assert cells is not None
             i = int(np.flatnonzero(damaged)[0])
             k = g * nr + int(np.flatnonzero(st[:, i] != _OK)[0])
-            if not repair:
-                what = "an empty cell" if status[k, i] == _EMPTY else "not a number"
-                raise _refuse_cell(inp, layout, k, int(lines[i]), rows[i][2][k], what)
+            what = "an empty cell" if status[k, i] == _EMPTY else "not a number"
+            raise _refuse_cell(inp, layout, k, int(lines[i]), cells[i][k], what)
         for b in np.unique(block[good]).tolist():
             sel = good & (block == b)
             part = state.parts.setdefault((b, g), _Part())
@@ -416,38 +420,84 @@ def _convert_chunk(rows: list[tuple[int, str, list[str]]], inp: _Input, layout: 
                 state.blocks[b]["rows"] += int(sel.sum())
 
 
+def _fast_numbers(texts: list[str], needed: list[int], inp: _Input) -> np.ndarray | None:
+    """The chunk's numbers by pandas' C parser when every line is a regular row of finite numbers, else None.
+
+    Only for a one-character delimiter without a thousands separator (whose digit groups the C
+    parser would not check); anything irregular (a blank or text line, an empty cell, a line with
+    another number of cells) is left to the exact line-by-line path.
+    """
+    if inp.delimiter not in ("\t", ";", ",") or inp.thousands or not texts:
+        return None
+    import io
+    import warnings
+
+    unique = sorted(set(needed))
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            frame = pd.read_csv(io.StringIO("\n".join(texts)), sep=inp.delimiter, header=None, usecols=unique,
+                                dtype=np.float64, decimal=inp.decimal, quotechar='"', skipinitialspace=True,
+                                skip_blank_lines=False, engine="c", na_filter=True)
+    except (ValueError, IndexError, pd.errors.ParserError, pd.errors.EmptyDataError):
+        return None
+    if len(frame) != len(texts):
+        return None
+    vals = np.ascontiguousarray(frame[needed].to_numpy(dtype=np.float64).T)
+    return vals if np.isfinite(vals).all() else None
+
+
+def _groups(cells: list[str], layout: _Layout) -> int:
+    """Specimens side by side in the first line of numbers: the column groups with a number in a declared column."""
+    w = layout.width
+    if not w:
+        return 1
+    return max(1, sum(1 for g in range(len(cells) // w + 1)
+                      if any(layout.pos[r] + g * w < len(cells) and cells[layout.pos[r] + g * w]
+                             for r in layout.roles)))
+
+
 def _read_data(inp: _Input, decl: Declaration, layout: _Layout, lines: Iterator[tuple[int, str]],
                repair: bool) -> _State:
     state = _State()
     needed: list[int] = []
-    rows: list[tuple[int, str, list[str]]] = []
+    first_ln = 0
+    texts: list[str] = []
     for ln, line in _data_lines(decl, lines):
-        cells = inp.split(line) if line.strip() else []
-        if not needed and cells:
-            w = layout.width or 0
-            groups = 1
-            if w:
-                groups = max(1, sum(1 for g in range(len(cells) // w + 1)
-                                    if any(layout.pos[r] + g * w < len(cells) and cells[layout.pos[r] + g * w]
-                                           for r in layout.roles)))
-            layout.groups = groups
-            needed = [layout.pos[r] + g * w for g in range(groups) for r in layout.roles]
-        rows.append((ln, line, [cells[i] if i < len(cells) else "" for i in needed] if needed else []))
-        if len(rows) >= _CHUNK:
-            _flush(rows, needed, inp, layout, decl, state, repair)
-            rows = []
-    if rows:
-        _flush(rows, needed, inp, layout, decl, state, repair)
+        if not needed:
+            if not line.strip():
+                state.after_sep = True
+                continue
+            layout.groups = _groups(inp.split(line), layout)
+            needed = [layout.pos[r] + g * (layout.width or 0) for g in range(layout.groups) for r in layout.roles]
+            first_ln = ln
+        texts.append(line)
+        if len(texts) >= _CHUNK:
+            _flush(first_ln, texts, needed, inp, layout, decl, state, repair)
+            first_ln, texts = ln + 1, []
+    if texts:
+        _flush(first_ln, texts, needed, inp, layout, decl, state, repair)
     return state
 
 
-def _flush(rows: list[tuple[int, str, list[str]]], needed: list[int], inp: _Input, layout: _Layout,
+def _flush(first_ln: int, texts: list[str], needed: list[int], inp: _Input, layout: _Layout,
            decl: Declaration, state: _State, repair: bool) -> None:
-    if not needed:  # only blank lines so far
-        state.after_sep = True
+    """Convert a chunk of consecutive lines (the first is line ``first_ln``)."""
+    lines = np.arange(first_ln, first_ln + len(texts), dtype=np.int64)
+    vals = _fast_numbers(texts, needed, inp)
+    if vals is not None:
+        _convert_chunk(lines, vals, np.zeros(vals.shape, dtype=np.int8), None, texts, inp, layout, decl, state,
+                       repair)
         return
-    rows = [(ln, line, cells or [""] * len(needed)) for ln, line, cells in rows]
-    _convert_chunk(rows, inp, layout, decl, state, repair)
+    cells = []
+    for line in texts:
+        row = inp.split(line) if line.strip() else []
+        cells.append([row[i] if i < len(row) else "" for i in needed])
+    vals = np.empty((len(needed), len(texts)))
+    status = np.empty((len(needed), len(texts)), dtype=np.int8)
+    for k in range(len(needed)):
+        vals[k], status[k] = _to_numbers([c[k] for c in cells], inp.decimal, inp.thousands)
+    _convert_chunk(lines, vals, status, cells, texts, inp, layout, decl, state, repair)
 
 
 # ------------------------------------------------------------------------------------------------
