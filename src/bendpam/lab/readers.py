@@ -337,7 +337,10 @@ def read_test(
     except ReadError as exc:
         raise with_declaration_hint(exc) from None
     fmt = dialect or _classify_format(parsed)
-    return assemble(parsed, fmt=fmt, pressure_kpa=pressure_kpa, rate_hz=rate_hz, repair=repair)
+    try:
+        return assemble(parsed, fmt=fmt, pressure_kpa=pressure_kpa, rate_hz=rate_hz, repair=repair)
+    except ReadError as exc:  # a unit detection did not know: a declaration names it
+        raise (with_declaration_hint(exc) if exc.message.startswith("unknown ") else exc) from None
 
 
 
