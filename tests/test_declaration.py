@@ -13,6 +13,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from bendpam.cli import main
 from bendpam.errors import FileFormatError, InputError
@@ -432,3 +434,37 @@ def test_whitespace_names_with_single_spaces(tmp_path):
     (raw,) = read_declared(data, decl)
     assert raw.data.to_numpy().tolist() == [[0.0, 0.5, 1500.0], [0.1, 0.75, 2250.0]]
     assert raw.source_units == {"time_s": "s", "stroke_mm": "mm", "force_n": "kN"}
+
+
+LAYOUTS = [("tab", "\t", "."), ("tab", "\t", ","), (";", ";", ","), (";", ";", "."), (",", ",", "."),
+           ("whitespace", "   ", "."), ("whitespace", " ", ","), ("fixed", None, "."), ("fixed", None, ",")]
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(values=st.lists(st.tuples(*[st.integers(1, 500)] * 3), min_size=2, max_size=30),
+       layout=st.sampled_from(LAYOUTS), meta=st.integers(0, 3), order=st.permutations([0, 1, 2]))
+def test_any_declared_layout_reads_back_the_numbers_written(tmp_path, values, layout, meta, order):
+    """Property: numbers written in any declared layout (delimiter, decimal, metadata lines, column order) read back."""
+    word, sep, decimal = layout
+    rows = (np.cumsum(np.array(values, dtype=np.float64), axis=0) - 2000.0) / 1000.0  # ramps (no spike), 3 decimals
+    rows[:, 0] = np.arange(len(rows)) * 0.5 + 1.0                         # time increases
+
+    def cell(v):
+        return f"{v:.3f}".replace(".", decimal)
+
+    def line(cells):
+        return "".join(c.rjust(14) for c in cells) if sep is None else sep.join(cells)
+
+    names = ["Time", "Stroke", "Force"]
+    text = [f"Comment {i}: {i}" for i in range(meta)]
+    text.append(line([names[j] for j in order]))
+    text += [line([cell(r[j]) for j in order]) for r in rows]
+    path = tmp_path / "prop.txt"
+    path.write_text("\n".join(text) + "\n", encoding="utf-8")
+    widths = "widths = [14, 14, 14]\n" if word == "fixed" else ""
+    decl = (f'header_line = {meta + 1}\nfirst_data_line = {meta + 2}\ndelimiter = "{word}"\n{widths}'
+            f'decimal = "{decimal}"\n[time]\ncolumn = "Time"\nunit = "s"\n[stroke]\ncolumn = {order.index(1) + 1}\n'
+            'unit = "mm"\n[force]\ncolumn = "Force"\nunit = "kN"\n')
+    (raw,) = read_declared(path, parse_declaration(decl, "prop.toml"))
+    np.testing.assert_allclose(raw.data.to_numpy(), rows * [1.0, 1.0, 1000.0], rtol=1e-12, atol=1e-9)
+    assert raw.data_lines == (meta + 2, meta + 1 + len(rows))
