@@ -29,7 +29,7 @@ import numpy as np
 import pandas as pd
 
 from bendpam.lab.assemble import check_values
-from bendpam.lab.channels import ROLES, canonical_unit, split_name_unit, unit_cell, unit_factor
+from bendpam.lab.channels import ROLES, canonical_unit, is_unit_token, split_name_unit, unit_cell, unit_factor
 from bendpam.lab.declaration import TEXT_KEYS, Declaration, load_declaration
 from bendpam.lab.layout import is_number, parse_metadata_line, split_cells
 from bendpam.lab.pressure import (
@@ -337,6 +337,22 @@ def _same_layout(texts: list[tuple[int, str]], inp: _Input, names: list[str]) ->
     return not other
 
 
+def _block_names(texts: list[tuple[int, str]], inp: _Input, names: list[str]) -> list[str]:
+    """The names row above a block: the declared one when it is repeated (or there is none), else the other one."""
+    declared = [n.strip() for n in names if n.strip()]
+    found: list[str] | None = None
+    for _ln, text in texts:
+        cells = [c.strip() for c in inp.split(text) if c.strip()]
+        if cells == declared:
+            return declared
+        if found is None and len([c for c in cells if not is_number(c)]) >= 2 and not all(
+                is_unit_token(c) for c in cells):
+            found = cells
+    if found is None and texts:  # only a units row (or other short cells) above the block
+        found = [c.strip() for c in inp.split(texts[0][1]) if c.strip()]
+    return found if found is not None else declared
+
+
 def _refuse_cell(inp: _Input, layout: _Layout, k: int, line: int, cell: str, what: str) -> ReadError:
     role = layout.roles[k % len(layout.pos)]
     g = k // len(layout.pos)
@@ -366,7 +382,8 @@ def _blocks_of(ok_rows: np.ndarray, sep: np.ndarray, state: _State, lines: np.nd
         cur += 1
         same = cur == 0 or _same_layout(state.sep_texts, inp, layout.names)
         skip = not same
-        state.blocks.append({"line": int(lines[i]), "read": same, "rows": 0})
+        state.blocks.append({"line": int(lines[i]), "columns": _block_names(state.sep_texts, inp, layout.names),
+                             "rows": 0, "read": same})
         if not same:
             shown = next((t for _ln, t in state.sep_texts if len([c for c in inp.split(t) if c.strip()]) >= 2), "")
             state.warnings.append(f"block at line {int(lines[i])} has other columns ({show(shown.strip(), 60)}); "
@@ -395,7 +412,8 @@ def _convert_chunk(lines: np.ndarray, vals: np.ndarray, status: np.ndarray, cell
     if decl.blocks == "one":
         block = np.where(any_num, 0, -1)
         if not state.blocks and any_num.any():
-            state.blocks.append({"line": int(lines[any_num][0]), "read": True, "rows": 0})
+            state.blocks.append({"line": int(lines[any_num][0]), "columns": [n.strip() for n in layout.names
+                                                                              if n.strip()], "rows": 0, "read": True})
     else:
         block = _blocks_of(any_num, ~any_num, state, lines, texts, inp, layout, decl)
     nr = len(layout.roles)
@@ -427,8 +445,9 @@ def _fast_numbers(texts: list[str], needed: list[int], inp: _Input) -> np.ndarra
     parser would not check); anything irregular (a blank or text line, an empty cell, a line with
     another number of cells) is left to the exact line-by-line path.
     """
-    if inp.delimiter not in ("\t", ";", ",") or inp.thousands or not texts:
+    if inp.delimiter not in ("\t", ";", ",", "whitespace") or inp.thousands or not texts:
         return None
+    sep = r"\s+" if inp.delimiter == "whitespace" else inp.delimiter
     import io
     import warnings
 
@@ -436,7 +455,7 @@ def _fast_numbers(texts: list[str], needed: list[int], inp: _Input) -> np.ndarra
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            frame = pd.read_csv(io.StringIO("\n".join(texts)), sep=inp.delimiter, header=None, usecols=unique,
+            frame = pd.read_csv(io.StringIO("\n".join(texts)), sep=sep, header=None, usecols=unique,
                                 dtype=np.float64, decimal=inp.decimal, quotechar='"', skipinitialspace=True,
                                 skip_blank_lines=False, engine="c", na_filter=True)
     except (ValueError, IndexError, pd.errors.ParserError, pd.errors.EmptyDataError):
