@@ -60,6 +60,7 @@ def check_against_truth(tests, entry, names=None):
                 assert close(float(raw.data[col].iat[i]), spec[which][col]), (spec["name"], which, col)
         if spec["name"] is not None:
             assert raw.metadata["specimen"] == spec["name"]
+    assert 1 <= len(tests[0].blocks) <= entry["blocks"]  # the blocks from first_data_line on, read or not
     for role in ("time", "stroke", "force"):
         want = entry[role]
         source = tests[0].channels[role]["source"]
@@ -97,6 +98,18 @@ def test_declaration_reads_the_file_as_its_truth_entry(name):
         tests = read_declared(path, decl, repair=True)  # repair accepts gaps and keeps every sample
     assert all(t.dialect == "declared" for t in tests)
     check_against_truth(tests, entry)
+
+
+def test_mts793_blocks_are_concatenated_and_the_min_max_block_is_left_out():
+    name = "lebedigital_MTS793_DEU_cyclic_Emodul_BALosert_MI_Probe6.dat"
+    path, entry = TRUTH[name]
+    (raw,) = read_declared(path, DECLS / f"{name}.toml")
+    assert len(raw.blocks) == entry["blocks"] == 6
+    assert [b["read"] for b in raw.blocks] == [True] * 5 + [False]
+    assert sum(b["rows"] for b in raw.blocks) == len(raw) == entry["rows"]
+    assert raw.blocks[-1]["columns"][:2] == ["Ch 1 Kraft", "Ch 1 W2TK Mittel"]
+    assert [w for w in raw.warnings if "not read" in w] == [
+        "block at line 5119 has other columns (Ch 1 Kraft, Ch 1 W2TK Mittel, 1944 A, 1944 B, 1281068); not read"]
 
 
 def test_refused_file_is_refused_by_its_declaration_in_one_line():

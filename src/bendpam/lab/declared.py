@@ -345,9 +345,8 @@ def _block_names(texts: list[tuple[int, str]], inp: _Input, names: list[str]) ->
         cells = [c.strip() for c in inp.split(text) if c.strip()]
         if cells == declared:
             return declared
-        if found is None and len([c for c in cells if not is_number(c)]) >= 2 and not all(
-                is_unit_token(c) for c in cells):
-            found = cells
+        if len([c for c in cells if not is_number(c)]) >= 2 and not all(is_unit_token(c) for c in cells):
+            found = cells  # the last such line: the names row is the nearest above the numbers
     if found is None and texts:  # only a units row (or other short cells) above the block
         found = [c.strip() for c in inp.split(texts[0][1]) if c.strip()]
     return found if found is not None else declared
@@ -382,12 +381,11 @@ def _blocks_of(ok_rows: np.ndarray, sep: np.ndarray, state: _State, lines: np.nd
         cur += 1
         same = cur == 0 or _same_layout(state.sep_texts, inp, layout.names)
         skip = not same
-        state.blocks.append({"line": int(lines[i]), "columns": _block_names(state.sep_texts, inp, layout.names),
-                             "rows": 0, "read": same})
+        names = _block_names(state.sep_texts, inp, layout.names)
+        state.blocks.append({"line": int(lines[i]), "columns": names, "rows": 0, "read": same})
         if not same:
-            shown = next((t for _ln, t in state.sep_texts if len([c for c in inp.split(t) if c.strip()]) >= 2), "")
-            state.warnings.append(f"block at line {int(lines[i])} has other columns ({show(shown.strip(), 60)}); "
-                                  "not read")
+            shown = ", ".join(names[:6]) + (", ..." if len(names) > 6 else "")
+            state.warnings.append(f"block at line {int(lines[i])} has other columns ({shown}); not read")
         state.sep_texts = []
         last = i
     block[last:] = -1 if skip else cur
@@ -409,6 +407,8 @@ def _convert_chunk(lines: np.ndarray, vals: np.ndarray, status: np.ndarray, cell
         k = int(np.flatnonzero(status[:, i] == _BAD)[0])
         raise _refuse_cell(inp, layout, k, int(lines[i]), cells[i][k], "a line that is not numbers (set "
                            "last_data_line to stop before it, or blocks to read several blocks)")
+    if decl.blocks != "one":
+        any_num = _names_rows_as_separators(any_num, status, len(layout.roles), state.after_sep)
     if decl.blocks == "one":
         block = np.where(any_num, 0, -1)
         if not state.blocks and any_num.any():
@@ -436,6 +436,19 @@ def _convert_chunk(lines: np.ndarray, vals: np.ndarray, status: np.ndarray, cell
             part.dropped.extend(lines[damaged & (block == b)].tolist())
             if g == 0:
                 state.blocks[b]["rows"] += int(sel.sum())
+
+
+def _names_rows_as_separators(any_num: np.ndarray, status: np.ndarray, n_roles: int, after_sep: bool
+                              ) -> np.ndarray:  # fmt: skip
+    """Rows of numbers, leaving out a row with some numbers but no complete sample between two rows of
+    text (a names row holding a number, such as a sensor's serial number ``1281068``, above a block)."""
+    complete = np.zeros(any_num.size, dtype=bool)
+    for g in range(status.shape[0] // n_roles):
+        complete |= (status[g * n_roles:(g + 1) * n_roles] == _OK).all(axis=0)
+    sep = ~any_num
+    before = np.concatenate([[after_sep], sep[:-1]])
+    after = np.concatenate([sep[1:], [False]])
+    return any_num & ~(~complete & before & after)
 
 
 def _fast_numbers(texts: list[str], needed: list[int], inp: _Input) -> np.ndarray | None:
