@@ -28,7 +28,7 @@ import typer
 
 from bendpam.cli.options import FORCE_HELP, RUN_ARGS, RUN_COMMAND, RUN_FORCE, WROTE_LINES
 
-__all__ = ["ISSUES_URL", "app", "main"]
+__all__ = ["DECLARATION_HINT_CLI", "ISSUES_URL", "app", "cli_words", "main"]
 
 ISSUES_URL = "the bendpam issue tracker (include the command line and bendpam --version)"
 
@@ -153,6 +153,25 @@ def _run(args: list[str]) -> Any:
     return rv
 
 
+#: What the command line says where the library says how to get a format declaration.
+DECLARATION_HINT_CLI = (
+    "describe the file's layout in a format declaration and give it with --format-file "
+    "('bendpam inspect FILE --suggest' drafts one)"
+)
+
+
+def cli_words(text: str) -> str:
+    """A library message in the command line's words (its options instead of the library's functions).
+
+    >>> from bendpam.lab.declaration import DECLARATION_HINT
+    >>> cli_words(f"x.csv:3: no header row; or {DECLARATION_HINT}")
+    "x.csv:3: no header row; or describe the file's layout in a format declaration and give it with --format-file ..."
+    """
+    from bendpam.lab.declaration import DECLARATION_HINT
+
+    return text.replace(DECLARATION_HINT, DECLARATION_HINT_CLI)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point: run the app; user errors are one line and exit code 2, bugs exit code 1.
 
@@ -191,7 +210,7 @@ def main(argv: list[str] | None = None) -> int:
         typer.echo(f"bendpam: error: {exc.format_message()}", err=True)
         return 2
     except BendpamError as exc:
-        text = _one_line(exc)
+        text = cli_words(_one_line(exc))
         typer.echo(f"bendpam: error: {text}{_MAX_PRESSURE_HINT if 'max_pressure_kpa to go higher' in text else ''}",
                    err=True)
         return 2

@@ -33,7 +33,7 @@ RangeOpt = Optional[tuple[float, float]]
 
 
 def tension_fit(path: Path, gauge_length_mm, area_mm2, width_mm, thickness_mm, stretch_range=None,
-                admissible_range=(0.6, 1.6)):
+                admissible_range=(0.6, 1.6), format_file: Optional[Path] = None):
     """Read and fit a tension test from the command-line options: ``(TensionFit, TensionData)``."""
     from bendpam.identify.tension import fit_tension, tension_data
     from bendpam.lab import read_test
@@ -48,7 +48,7 @@ def tension_fit(path: Path, gauge_length_mm, area_mm2, width_mm, thickness_mm, s
         if width_mm is None or thickness_mm is None:
             raise UserError("the tension test needs --area-mm2, or --width-mm and --thickness-mm")
         area_mm2 = width_mm * thickness_mm
-    td = tension_data(read_test(path), gauge_length_mm=gauge_length_mm, area_mm2=area_mm2,
+    td = tension_data(read_test(path, format_file=format_file), gauge_length_mm=gauge_length_mm, area_mm2=area_mm2,
                       stretch_range=stretch_range)
     tf = fit_tension(td.stretch, td.nominal_stress_kpa, admissible_range=admissible_range, source=td.source)
     return tf, td
@@ -135,13 +135,17 @@ def fit_material(
         "--admissible-range", help="Stretches LO HI the constants must be physical over besides the data's.")]
     = (0.6, 1.6),
     out: Annotated[Optional[Path], typer.Option("--out", help="Write tension_fit.json here (a folder).")] = None,
+    format_file: Annotated[Optional[Path], typer.Option(
+        "--format-file", metavar="PATH",
+        help="Read the tension export by this format declaration (TOML; docs/formats.md), with no detection.")]
+    = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print the result as JSON.")] = False,
 ):
     """Fit Mooney-Rivlin C10, C01 to a uniaxial tension test of the bladder material."""
     if not tension_file.exists():
         raise UserError(f"{tension_file}: no such file")
     tf, _ = tension_fit(tension_file, gauge_length_mm, area_mm2, width_mm, thickness_mm, stretch_range,
-                        admissible_range)
+                        admissible_range, format_file)
     text = json.dumps(tf.to_dict(), indent=2, allow_nan=False)
     if out is not None:
         with output_set(out, [tension_file]) as o:

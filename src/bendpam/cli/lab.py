@@ -8,7 +8,7 @@ from typing import Annotated, Optional
 
 import typer
 
-from bendpam.cli.app import app
+from bendpam.cli.app import app, cli_words
 from bendpam.cli.options import (
     ActuatorOpt,
     FigureFormatOpt,
@@ -39,6 +39,10 @@ ColumnsOpt = Annotated[Optional[str], typer.Option(
          "default: chosen and reported by the reader.")]
 RateOpt = Annotated[Optional[float], typer.Option(
     "--rate-hz", help="Sampling rate (Hz) for a file without a time column (default: from its metadata).")]
+FormatFileOpt = Annotated[Optional[Path], typer.Option(
+    "--format-file", metavar="PATH",
+    help="Read the files by this format declaration (TOML; docs/formats.md), with no detection; "
+         "'bendpam inspect FILE --suggest' drafts one.")]
 RepairOpt = Annotated[bool, typer.Option(
     "--repair", help="Remove isolated spikes and non-increasing samples (reported) instead of refusing the file.")]
 
@@ -66,14 +70,28 @@ def inspect(
     columns: ColumnsOpt = None,
     rate_hz: RateOpt = None,
     repair: RepairOpt = False,
+    format_file: FormatFileOpt = None,
+    suggest: Annotated[bool, typer.Option(
+        "--suggest", help="Print a format declaration that reads each file (what detection found, or the best "
+                          "guesses from its head), to save, edit and give with --format-file.")] = False,
     as_json: Annotated[bool, typer.Option("--json", help="Print a JSON list, one object per file.")] = False,
 ):
     """What the reader understood of each file (format, encoding, channels, units, values), before processing."""
     from bendpam.lab import format_inspection, inspect_file
 
     paths = collect_raw_files(files)
-    infos = [inspect_file(p, pressure_kpa=pressure_kpa, columns=columns, rate_hz=rate_hz, repair=repair)
-             for p in paths]
+    if suggest:
+        _print_suggestions(paths, as_json)
+        return
+    if format_file is not None:
+        from bendpam.lab import load_declaration
+
+        load_declaration(format_file)  # a bad declaration is one error, not one per file
+    infos = [inspect_file(p, pressure_kpa=pressure_kpa, columns=columns, rate_hz=rate_hz, repair=repair,
+                          format_file=format_file) for p in paths]
+    for info in infos:
+        if "error" in info:
+            info["error"] = cli_words(info["error"])
     if as_json:
         print_json(infos)
     else:
@@ -85,6 +103,20 @@ def inspect(
         for i in bad:
             typer.echo(f"bendpam: error: {i['error']}", err=True)
         raise typer.Exit(2)
+
+
+def _print_suggestions(paths: list[Path], as_json: bool) -> None:
+    """``inspect --suggest``: a declaration per file (TOML text, or a JSON list of {file, declaration})."""
+    import json
+
+    from bendpam.lab import suggest_declaration
+
+    drafts = [(p, suggest_declaration(p)) for p in paths]
+    if as_json:
+        typer.echo(json.dumps([{"file": str(p), "declaration": d} for p, d in drafts], indent=2, ensure_ascii=False))
+        return
+    for i, (_p, d) in enumerate(drafts):
+        typer.echo(("\n" if i else "") + d, nl=False)
 
 
 @app.command()
@@ -109,6 +141,7 @@ def process(
     columns: ColumnsOpt = None,
     rate_hz: RateOpt = None,
     repair: RepairOpt = False,
+    format_file: FormatFileOpt = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print summary.json to stdout.")] = False,
     keep_going: Annotated[bool, typer.Option(
         "--keep-going", help="Skip the files that cannot be read or processed (each reported) instead of refusing.")]
@@ -126,6 +159,10 @@ def process(
     if out is None:
         raise UserError("give an output folder with --out OUTDIR")
     _check_l0(l0_mm)
+    if format_file is not None:
+        from bendpam.lab import load_declaration
+
+        load_declaration(format_file)  # refused before any file is read
     files = collect_raw_files(inputs)
     pressures = _file_pressures(pressure_kpa, files)
     fx = Fixture.from_string(fixture, L0_mm=l0_mm, name="--fixture")
@@ -137,7 +174,7 @@ def process(
 
     from bendpam.infra.progress import Progress
 
-    read_kw = {"columns": columns, "rate_hz": rate_hz, "repair": repair}
+    read_kw = {"columns": columns, "rate_hz": rate_hz, "repair": repair, "format_file": format_file}
     per_file = (pressures * len(files) if len(pressures) == 1 else pressures) if pressures else None
     try:
         # the output target is checked (and locked) before any work; a refusal inside leaves it unchanged
@@ -170,8 +207,8 @@ def process(
 
 
 def _flags(message: str) -> str:
-    """A library message in this command's words: the pressure is given with --pressure-kpa."""
-    return message.replace("give pressure_kpa when reading it", "give --pressure-kpa")
+    """A library message in this command's words: --pressure-kpa, --format-file (:func:`cli_words`)."""
+    return cli_words(message.replace("give pressure_kpa when reading it", "give --pressure-kpa"))
 
 
 def _file_pressures(pressure_kpa: Optional[list[str]], files: list[Path]) -> list[float]:

@@ -45,6 +45,7 @@ FILE_SIZE_LIMITS: dict[str, int] = {
     "fit file": 64 * MIB,               # fit.json of `bendpam fit`: tens of KiB
     "scheduler file": 1 * MIB,          # the JSON file of `dask scheduler --scheduler-file`
     "manifest": 64 * MIB,               # manifest.json of an output set
+    "format declaration": 1 * MIB,      # the TOML --format-file of a raw test file: under 2 KiB in practice
 }
 
 #: The deepest nesting of tables and arrays a bendpam TOML file may have: ``[actuator]`` and

@@ -14,6 +14,8 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
+    from bendpam.lab.declaration import load_declaration
+    from bendpam.lab.declared import read_declared
     from bendpam.lab.pressure import PRESSURE_RANGE_KPA, parse_pressure, pressure_from_filename
     from bendpam.lab.rawtest import COLUMNS, DIALECTS, FORMATS, RawTest, check_cycle_count
     from bendpam.lab.read_error import ReadError
@@ -25,6 +27,7 @@ if TYPE_CHECKING:
         read_test,
         read_tests,
     )
+    from bendpam.lab.suggest import suggest_declaration
     from bendpam.lab.writers import write_test
 
 __all__ = [
@@ -38,11 +41,14 @@ __all__ = [
     "detect_dialect",
     "format_inspection",
     "inspect_file",
+    "load_declaration",
     "parse_columns",
     "parse_pressure",
     "pressure_from_filename",
+    "read_declared",
     "read_test",
     "read_tests",
+    "suggest_declaration",
     "write_test",
 ]
 
@@ -54,6 +60,8 @@ _FROM = {
     "format_inspection": "readers", "inspect_file": "readers", "parse_columns": "readers", "read_test": "readers",
     "read_tests": "readers",
     "write_test": "writers",
+    "write_test": "writers", "load_declaration": "declaration", "read_declared": "declared",
+    "suggest_declaration": "suggest",
 }  # fmt: skip
 
 

@@ -38,7 +38,7 @@ from bendpam.lab.pressure import (
 from bendpam.lab.rawtest import COLUMNS, RawTest
 from bendpam.lab.read_error import ReadError, show
 
-__all__ = ["assemble"]
+__all__ = ["assemble", "check_values"]
 
 _ROLE_COLUMN = dict(zip(ROLES, COLUMNS, strict=True))
 _MAX_WARN_LINES = 5  # line numbers quoted in a message
@@ -448,3 +448,42 @@ def assemble(parsed: Parsed, *, fmt: str, pressure_kpa: float | None, rate_hz: f
         sample_rate_hz=sample_rate,
         data_lines=data_lines,
     )
+
+
+def check_values(values: dict[str, np.ndarray], lines: np.ndarray, channels: Channels, label: Path | str,
+                 repair: bool, warnings: list[str]) -> tuple[dict[str, np.ndarray], np.ndarray]:  # fmt: skip
+    """Step 3 for columns read some other way (a format declaration): spikes, time order and gaps.
+
+    Parameters
+    ----------
+    values : dict of str to numpy.ndarray
+        role -> column in s, mm or N (the time made from a rate when its channel has no ``source``).
+    lines : numpy.ndarray
+        1-based line of each sample.
+    channels : dict
+        role -> ``{"source": column name or None, ...}``.
+    label : pathlib.Path or str
+        The file, as named in messages.
+    repair : bool
+        Drop spikes and samples where time does not increase, accept gaps, instead of refusing.
+    warnings : list of str
+        Warnings so far (appended to).
+
+    Returns
+    -------
+    (dict, numpy.ndarray)
+        The values and lines kept.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> values = {"time": np.array([0.0, 0.1, 0.2]), "stroke": np.zeros(3), "force": np.ones(3)}
+    >>> channels = {r: {"source": r} for r in values}
+    >>> kept, lines = check_values(values, np.array([2, 3, 4]), channels, "be.csv", False, [])
+    >>> lines.tolist()
+    [2, 3, 4]
+    """
+    samples = _Samples(values, lines, None)
+    _drop_spikes(samples, channels, label, repair, warnings)
+    _check_time(samples, channels, label, repair, warnings)
+    return samples.values, samples.lines

@@ -49,7 +49,7 @@ ROLES: tuple[str, str, str] = ("time", "stroke", "force")
 TIME_UNITS: dict[str, float] = {
     "s": 1.0, "sec": 1.0, "secs": 1.0, "second": 1.0, "seconds": 1.0, "sek": 1.0, "seg": 1.0,
     "秒": 1.0, "\u0441": 1.0,  # Cyrillic es
-    "ms": 1e-3, "msec": 1e-3,
+    "ms": 1e-3, "msec": 1e-3, "us": 1e-6, "µs": 1e-6, "μs": 1e-6,
     "min": 60.0, "mins": 60.0, "minute": 60.0, "minutes": 60.0, "分": 60.0,
     "h": 3600.0, "hr": 3600.0, "hrs": 3600.0, "hour": 3600.0, "hours": 3600.0,
 }  # fmt: skip
@@ -60,15 +60,15 @@ LENGTH_UNITS: dict[str, float] = {
 }  # fmt: skip
 FORCE_UNITS: dict[str, float] = {
     "n": 1.0, "newton": 1.0, "newtons": 1.0, "牛": 1.0, "н": 1.0,
-    "kn": 1000.0, "千牛": 1000.0, "кн": 1000.0, "mn": 1e-3, "dan": 10.0,
+    "kn": 1000.0, "千牛": 1000.0, "кн": 1000.0, "mn": 1e-3, "un": 1e-6, "µn": 1e-6, "μn": 1e-6, "dan": 10.0,
     "lbf": 4.4482216152605, "lb": 4.4482216152605, "lbs": 4.4482216152605,
     "kgf": 9.80665, "kp": 9.80665,
 }  # fmt: skip
 _UNIT_TABLES = {"time": TIME_UNITS, "stroke": LENGTH_UNITS, "force": FORCE_UNITS}
 UNIT_HINT = {
-    "time": "s, sec, ms, min or h",
+    "time": "s, sec, ms, us, min or h",
     "stroke": "m, cm, mm, µm/um or in",
-    "force": "N, kN, mN, daN, kgf or lbf",
+    "force": "N, kN, mN, uN, daN, kgf or lbf",
 }
 DEFAULT_UNIT = {"time": "s", "stroke": "mm", "force": "N"}
 # Units of other quantities seen in exports (so that a units row is recognised as one).

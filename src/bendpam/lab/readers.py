@@ -90,6 +90,7 @@ __all__ = [
     "pressure_from_filename",
     "read_test",
     "read_tests",  # SHIM until h-reader lands
+    "with_declaration_hint",
 ]
 
 
@@ -221,6 +222,46 @@ def _check_options(pressure_kpa: float | None, dialect: str | None, rate_hz: flo
     return pressure_kpa, rate_hz
 
 
+#: Refusals about the file itself, where a format declaration does not help.
+_NOT_LAYOUT = re.compile(r"^(file not found|is a directory|permission denied|cannot read|file is empty|"
+                         r"binary|native Zwick|.*not found$|is a folder|larger than)")
+
+
+def with_declaration_hint(exc: ReadError) -> ReadError:
+    """A detection refusal that also says how to read the file anyway: with a format declaration.
+
+    Refusals about the file itself (missing, empty, binary, too large) are returned unchanged.
+
+    >>> print(with_declaration_hint(ReadError("no header row naming time, stroke and force columns", "x.csv", 3)))
+    x.csv:3: no header row naming time, stroke and force columns; or describe the file's layout in a format ...
+    >>> print(with_declaration_hint(ReadError("file is empty; expected a header row and data rows", "x.csv")))
+    x.csv: file is empty; expected a header row and data rows
+    """
+    from bendpam.lab.declaration import DECLARATION_HINT
+
+    message = exc.message
+    if _NOT_LAYOUT.match(message) or DECLARATION_HINT in message:
+        return exc
+    return ReadError(f"{message}; or {DECLARATION_HINT}", exc.path, exc.line, exc.column)
+
+
+def _read_declared_one(p: Path, format_file: str | os.PathLike, dialect: str | None, overrides: dict[str, str],
+                       pressure_kpa: float | None, rate_hz: float | None, repair: bool) -> RawTest:  # fmt: skip
+    """read_test with a format declaration: exactly one test."""
+    from bendpam.errors import InputError
+    from bendpam.lab.declared import read_declared
+
+    if dialect is not None or overrides:
+        raise InputError("format_file: the declaration names the columns and the layout; expected no dialect "
+                         "or columns with it")
+    tests = read_declared(p, format_file, pressure_kpa=pressure_kpa, rate_hz=rate_hz, repair=repair)
+    if len(tests) != 1:
+        what = "specimens" if tests[0].metadata.get("specimen") else "blocks"
+        raise ReadError(f"holds {len(tests)} tests ({what}) as declared; read them with read_tests or "
+                        "bendpam.lab.declared.read_declared", p)
+    return tests[0]
+
+
 def read_test(
     path: str | os.PathLike,
     *,
@@ -229,6 +270,7 @@ def read_test(
     columns: Mapping[str, str] | str | None = None,
     rate_hz: float | None = None,
     repair: bool = False,
+    format_file: str | os.PathLike | None = None,
 ) -> RawTest:
     """Read one raw four-point-bending test export.
 
@@ -252,6 +294,11 @@ def read_test(
     repair : bool
         Drop spikes, samples where time does not increase and rows with non-finite values,
         and accept gaps, reporting each in :attr:`RawTest.warnings` (default: refuse them).
+    format_file : str or os.PathLike, optional
+        A format declaration (TOML, see ``docs/formats.md``): read the file as it says, with no
+        detection (:func:`bendpam.lab.declared.read_declared`); ``dialect`` and ``columns`` are
+        not allowed with it.  When detection fails, its error says so; a declaration reads
+        the file, and :func:`bendpam.lab.suggest.suggest_declaration` drafts one.
 
     Returns
     -------
@@ -284,9 +331,17 @@ def read_test(
     overrides = parse_columns(columns)
     p = Path(path)
     verify_input(p)  # raw files of a bendpam set (simulate-test) are read only as bendpam wrote them
-    parsed = parse_path(p, dialect=dialect, overrides=overrides, rate_hz=rate_hz, repair=repair)
+    if format_file is not None:
+        return _read_declared_one(p, format_file, dialect, overrides, pressure_kpa, rate_hz, repair)
+    try:
+        parsed = parse_path(p, dialect=dialect, overrides=overrides, rate_hz=rate_hz, repair=repair)
+    except ReadError as exc:
+        raise with_declaration_hint(exc) from None
     fmt = dialect or _classify_format(parsed)
-    return assemble(parsed, fmt=fmt, pressure_kpa=pressure_kpa, rate_hz=rate_hz, repair=repair)
+    try:
+        return assemble(parsed, fmt=fmt, pressure_kpa=pressure_kpa, rate_hz=rate_hz, repair=repair)
+    except ReadError as exc:  # a unit detection did not know: a declaration names it
+        raise (with_declaration_hint(exc) if exc.message.startswith("unknown ") else exc) from None
 
 
 
@@ -344,6 +399,7 @@ def inspect_file(
     columns: Mapping[str, str] | str | None = None,
     rate_hz: float | None = None,
     repair: bool = False,
+    format_file: str | os.PathLike | None = None,
 ) -> dict[str, Any]:
     """How a raw test export reads, as a JSON-ready dict (never raises for a bad file).
 
@@ -351,7 +407,7 @@ def inspect_file(
     ----------
     path : str or os.PathLike
         The export.
-    pressure_kpa, columns, rate_hz, repair
+    pressure_kpa, columns, rate_hz, repair, format_file
         As for :func:`read_test`.
 
     Returns
@@ -383,7 +439,7 @@ def inspect_file(
     name = os.fspath(path)
     try:
         raw = read_test(path, pressure_kpa=pressure_kpa, columns=columns, rate_hz=rate_hz,
-                        repair=repair)  # fmt: skip
+                        repair=repair, format_file=format_file)  # fmt: skip
     except (BendpamError, ValueError, OSError) as exc:
         return {"file": name, "error": str(exc)}
     d = raw.data
