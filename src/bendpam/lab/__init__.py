@@ -59,7 +59,6 @@ _FROM = {
     "pressure_from_filename": "pressure", "ReadError": "read_error", "detect_dialect": "readers",
     "format_inspection": "readers", "inspect_file": "readers", "parse_columns": "readers", "read_test": "readers",
     "read_tests": "readers",
-    "write_test": "writers",
     "write_test": "writers", "load_declaration": "declaration", "read_declared": "declared",
     "suggest_declaration": "suggest",
 }  # fmt: skip
