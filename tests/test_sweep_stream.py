@@ -1,6 +1,5 @@
 """Streamed sweeps (issue 24): a Zarr store written block by block, resumable, bounded in memory, on Dask."""
 
-import os
 import signal
 import subprocess
 import sys
@@ -161,7 +160,7 @@ def test_killed_process_resumes_to_the_same_store(tmp_path, reference):
     assert store_files(target) == store_files(reference)
 
 
-def test_cli_writes_a_zarr_store_and_resumes(tmp_path, monkeypatch, reference):
+def test_cli_writes_a_zarr_store_from_the_suffix_or_format(tmp_path, monkeypatch, reference):
     monkeypatch.chdir(tmp_path)
     args = ["sweep", "--preset", "be-pam", "--param", "alpha0_deg=64,67,70,73,76", "--param", "t0_mm=2,2.5,3",
             "--pressure-kpa", "60,120,180,240", "--chunk-cases", "2", "--out", "s.zarr", "--plot", "s.png",
@@ -177,7 +176,7 @@ def test_default_blocks_and_memory_refusal():
     assert default_chunk_cases(16) == 2048
     plan = plan_sweep(base(), P, chunk_cases=default_chunk_cases(len(P)), **GRID)
     assert plan.n_blocks == 1
-    with pytest.raises(InputError, match="streamed sweep in blocks of 15 cases x 4 pressures .* max_memory_gib"):
+    with pytest.raises(InputError, match=r"streamed sweep in blocks of 15 cases x 4 pressures .* max_memory_gib"):
         sweep_zarr(base(), "never.zarr", P, max_memory_gib=0.01, **GRID)
     assert not Path("never.zarr").exists()
 

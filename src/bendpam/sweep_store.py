@@ -48,6 +48,7 @@ import numpy as np
 
 from bendpam.errors import InputError
 from bendpam.infra.budgets import MEMORY_BUDGET_GIB, SCHEDULER_TIMEOUT_S, memory_problem
+from bendpam.infra.fsops import fsync_dir, fsync_file
 from bendpam.infra.outputs import OutputSet
 from bendpam.physics.actuator import Actuator
 from bendpam.physics.braid import DEFAULT_ORDER
@@ -223,6 +224,10 @@ def _write_template(plan: SweepPlan, store: Path, state: Path) -> None:
     with _quiet_zarr():
         ds.to_zarr(store, mode="a", compute=False, zarr_format=2, consolidated=True)
     (state / "blocks").mkdir(exist_ok=True)
+    for dirpath, _, files in os.walk(store):
+        for f in files:
+            fsync_file(Path(dirpath) / f)
+        fsync_dir(Path(dirpath))
     (state / "template").touch()
 
 
@@ -242,10 +247,20 @@ class _Writer:
     def __init__(self, plan: SweepPlan, store: Path, marks: Path, progress: Callable[[int], Any] | None) -> None:
         import zarr
 
-        self.plan, self.marks, self.progress = plan, marks, progress
+        self.plan, self.marks, self.progress, self.store = plan, marks, progress, store
         with _quiet_zarr():
             group = zarr.open_group(str(store), mode="r+", zarr_format=2)
-        self.arrays = {name: group[name] for name in plan.outputs}
+        self.arrays: dict[str, Any] = {name: group[name] for name in plan.outputs}
+
+    def _flush(self, region: tuple[slice, ...]) -> None:
+        """Flush the block's chunks to disk before its marker is made (a marker never outlives its data)."""
+        at = [str(s.start // n) for s, n in zip(region, self.plan.block_shape, strict=True)]
+        for name in self.plan.outputs:
+            key = ".".join(at if name in _PER_CASE else [*at, "0"]) or "0"
+            chunk = self.store / name / key
+            if chunk.exists():  # (a chunk all NaN is not written: it reads back as NaN)
+                fsync_file(chunk)
+            fsync_dir(chunk.parent)
 
     def cases(self, block: int) -> int:
         return int(np.prod([s.stop - s.start for s in self.plan.region(block)]))
@@ -259,7 +274,9 @@ class _Writer:
                 v = v[0]
             if name == "branch_end":
                 v = v.astype(np.int8)
-            self.arrays[name][(*region, ...) if region else ...] = v
+            where: Any = (*region, Ellipsis) if region else Ellipsis
+            self.arrays[name][where] = v
+        self._flush(region)
         fd = os.open(self.marks / str(block), os.O_CREAT | os.O_WRONLY, 0o644)
         os.close(fd)
         if self.progress is not None:
@@ -287,6 +304,13 @@ def _run_local(plan: SweepPlan, todo: list[int], write: _Writer) -> None:
         pool.shutdown(wait=True, cancel_futures=True)
 
 
+def _worker_version() -> str:
+    """The bendpam version a Dask worker imports."""
+    from bendpam.version import __version__ as version
+
+    return version
+
+
 def _compute_block(plan: SweepPlan, block: int) -> np.ndarray:
     """One block, on a Dask worker."""
     return plan.compute(block)
@@ -309,6 +333,10 @@ def _run_cluster(plan: SweepPlan, todo: list[int], write: _Writer, scheduler: st
             cluster = stack.enter_context(LocalCluster(n_workers=int(workers or 1), threads_per_worker=1,
                                                        processes=True, host="127.0.0.1", dashboard_address=None))
             client = stack.enter_context(Client(cluster))
+        other = sorted({str(v) for v in client.run(_worker_version).values()} - {__version__})
+        if other:  # the store records this version; blocks of another would not be the same numbers
+            raise InputError(f"the Dask workers run bendpam {', '.join(other)}, this process {__version__}; "
+                             "install the same version on every worker")
         window = 2 * max(1, sum(client.nthreads().values()))
         shared = client.scatter(plan, broadcast=True)
         queue = iter(todo)

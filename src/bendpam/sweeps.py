@@ -580,7 +580,7 @@ class SweepPlan:
                       self.eq19_factor, idx)
 
     def dataset(self, data) -> Any:
-        """The sweep's :class:`xarray.Dataset` over ``data`` (all blocks: cases + (pressures, outputs)), as :func:`sweep`."""
+        """The sweep's :class:`xarray.Dataset` over ``data`` (cases + (pressures, outputs)), as :func:`sweep` gives."""
         return _dataset(data, self.names, self.grids, self.shape, self.pressure_kpa, self.base, self.model, self.order)
 
 

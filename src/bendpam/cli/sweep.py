@@ -123,8 +123,8 @@ def sweep_cmd(
     plot: Annotated[Optional[Path], typer.Option("--plot", help="Quick figure of one output (.png, .pdf, .svg).")]
     = None,
     fmt: Annotated[Optional[SweepFormat], typer.Option(
-        "--format", help="Format of --out (nc, csv, parquet, zarr) or of --plot (png, pdf, svg); default: from the file "
-        "names.")] = None,
+        "--format", help="Format of --out (nc, csv, parquet, zarr) or of --plot (png, pdf, svg); default: from the "
+        "file names.")] = None,
     plot_var: Annotated[str, typer.Option("--plot-var", help="Output to plot.")] = "free_angle_deg",
     plot_x: Annotated[Optional[str], typer.Option("--plot-x", help="Parameter on the x axis (default: first).")]
     = None,
@@ -141,8 +141,6 @@ def sweep_cmd(
                                            help="Same as --quiet (--no-progress).")] = True,
 ):
     """Design sweep: actuator parameters crossed with pressures (in-process or on Dask)."""
-    from bendpam.sweeps import sweep
-
     if out is None and plot is None:
         raise UserError("give --out FILE.nc|.csv|.parquet|.zarr and/or --plot FILE.png|.pdf|.svg")
     fixed_at = parse_at(at)
@@ -154,31 +152,39 @@ def sweep_cmd(
                   max_minutes)
     scheduler = check_run(out, data_fmt, scheduler, workers)
     act = load_actuator(preset, actuator, model)
-    quiet = quiet or not progress
+    run: dict[str, Any] = dict(chunk_cases=chunk_cases, scheduler=scheduler, workers=workers,
+                               quiet=quiet or not progress, max_memory_gib=max_memory_gib, actuator=actuator)
     if data_fmt == "zarr":
         assert out is not None
-        ds = write_store(out, act, P, model_name(model), grids, chunk_cases=chunk_cases, scheduler=scheduler,
-                         workers=workers, quiet=quiet, max_memory_gib=max_memory_gib, actuator=actuator)
+        ds = write_store(out, act, P, model_name(model), grids, **run)
     else:
-        from bendpam.infra.progress import Progress
-
-        with Progress(n_cases, "sweep", quiet=quiet) as bar:
-            ds = sweep(act, P, model_name(model), chunk_cases=chunk_cases, scheduler=scheduler, workers=workers,
-                       progress=bar.advance, max_memory_gib=max_memory_gib, **grids)
-    if out is not None and data_fmt != "zarr":
-        from bendpam.sweeps import write_sweep
-
-        with output_file(out, [actuator]) as f:
-            write_sweep(ds, f.path, data_fmt)
-        shape = " x ".join(f"{d}={n}" for d, n in ds.sizes.items())
-        rows = f", {int(np.prod(list(ds.sizes.values())))} rows" if data_fmt != "nc" else ""
-        echo_wrote(f"wrote {out} ({shape}{rows})")
+        ds = sweep_in_memory(out, data_fmt, act, P, model_name(model), grids, **run)
     if plot is not None:
         from bendpam.present.figures import save_figure, sweep_figure
 
         with output_file(plot, [actuator]) as f:
             save_figure(sweep_figure(ds, plot_var, plot_x, plot_y, at=fixed_at), f.path, format=fig_fmt)
         echo_wrote(f"wrote {plot}")
+
+
+def sweep_in_memory(out: Path | None, data_fmt: str | None, act: Any, P: list[float], model: str,
+                    grids: dict[str, Any], *, chunk_cases: int, scheduler: str | None, workers: int | None, quiet: bool,
+                    max_memory_gib: float, actuator: Path | None) -> Any:
+    """The sweep computed whole, then written to ``out`` (NetCDF, CSV, Parquet) if given; its dataset."""
+    from bendpam.infra.progress import Progress
+    from bendpam.sweeps import sweep, write_sweep
+
+    n_cases = int(np.prod([len(v) for v in grids.values()] or [1]))
+    with Progress(n_cases, "sweep", quiet=quiet) as bar:
+        ds = sweep(act, P, model, chunk_cases=chunk_cases, scheduler=scheduler, workers=workers,
+                   progress=bar.advance, max_memory_gib=max_memory_gib, **grids)
+    if out is not None:
+        with output_file(out, [actuator]) as f:
+            write_sweep(ds, f.path, data_fmt)
+        shape = " x ".join(f"{d}={n}" for d, n in ds.sizes.items())
+        rows = f", {int(np.prod(list(ds.sizes.values())))} rows" if data_fmt != "nc" else ""
+        echo_wrote(f"wrote {out} ({shape}{rows})")
+    return ds
 
 
 def default_zarr_chunk(n_pressures: int) -> int:
