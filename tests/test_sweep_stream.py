@@ -220,3 +220,26 @@ def test_ten_million_points_peak_under_1_gb(tmp_path):
     direct = bendpam.sweep(presets.be_pam(), np.linspace(60.0, 250.0, pressures), alpha0_deg=[80.0],
                            chunk_cases=default_chunk_cases(pressures))
     np.testing.assert_allclose(last, direct["free_angle_deg"].values[0], rtol=1e-12)  # (other blocks)
+
+
+def test_cli_run_again_after_an_interruption_resumes(tmp_path, monkeypatch, capsys, reference):
+    from bendpam.sweeps import SweepPlan
+
+    monkeypatch.chdir(tmp_path)
+    compute = SweepPlan.compute
+
+    def stop_at_block_4(self, block):
+        if block == 4:
+            raise KeyboardInterrupt
+        return compute(self, block)
+
+    args = ["sweep", "--preset", "be-pam", "--param", "alpha0_deg=64,67,70,73,76", "--param", "t0_mm=2,2.5,3",
+            "--pressure-kpa", "60,120,180,240", "--chunk-cases", "2", "--out", "s.zarr", "--quiet"]
+    monkeypatch.setattr(SweepPlan, "compute", stop_at_block_4)
+    assert main(args) != 0
+    err = capsys.readouterr().err
+    assert "the finished blocks are kept in" in err and "run the same command again" in err
+    assert not (tmp_path / "s.zarr").exists()
+    monkeypatch.setattr(SweepPlan, "compute", compute)
+    assert main(args) == 0
+    assert store_files(tmp_path / "s.zarr") == store_files(reference)

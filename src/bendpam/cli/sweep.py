@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from enum import Enum
 from pathlib import Path
 from typing import Annotated, Any, Optional
@@ -73,8 +74,6 @@ def sweep_formats(out: Path | None, plot: Path | None, fmt: SweepFormat | None) 
 
 def max_local_workers() -> int:
     """The most processes ``--workers`` may start: four per CPU."""
-    import os
-
     return 4 * (os.cpu_count() or 1)
 
 
@@ -209,10 +208,20 @@ def write_store(out: Path, act: Any, P: list[float], model: str, grids: dict[str
 
     n_cases = int(np.prod([len(v) for v in grids.values()] or [1]))
     inputs = [actuator] if actuator is not None else []
-    with Progress(n_cases, "sweep", quiet=quiet) as bar:
-        path = sweep_zarr(act, as_given(out), P, model, chunk_cases=chunk_cases, scheduler=scheduler, workers=workers,
-                          progress=bar.advance, max_memory_gib=max_memory_gib, force=RUN_FORCE.get(),
-                          command=command_line(), inputs=inputs, producer=RUN_COMMAND.get() or "sweep", **grids)
+    try:
+        with Progress(n_cases, "sweep", quiet=quiet) as bar:
+            path = sweep_zarr(act, as_given(out), P, model, chunk_cases=chunk_cases, scheduler=scheduler,
+                              workers=workers, progress=bar.advance, max_memory_gib=max_memory_gib,
+                              force=RUN_FORCE.get(), command=command_line(), inputs=inputs,
+                              producer=RUN_COMMAND.get() or "sweep", **grids)
+    except BaseException:
+        from bendpam.infra.fsops import part_name
+
+        kept = Path(os.path.expanduser(str(out))).parent / part_name(out.name)
+        if kept.is_dir() and any((kept / ".bendpam-resume" / "blocks").glob("*")):
+            typer.echo(f"bendpam: the finished blocks are kept in {str(kept)!r}; run the same command again to "
+                       "resume the sweep", err=True)
+        raise
     ds = xr.open_zarr(path)
     shape = " x ".join(f"{d}={n}" for d, n in ds.sizes.items())
     echo_wrote(f"wrote {out} ({shape}, {ds.attrs.get('blocks')} blocks of {chunk_cases} cases)")
