@@ -156,7 +156,7 @@ def sweep_zarr(base_actuator: Actuator, target: str | os.PathLike[str], pressure
     with OutputSet(target, inputs=inputs, command=command, force=force, producer=producer,
                    resume_key=sweep_fingerprint(plan)) as out:
         marks = out.resume_dir / "blocks"
-        done = _done_blocks(marks) if out.resumed and (out.resume_dir / "template").is_file() else set()
+        done = _done_blocks(marks, plan.n_blocks) if out.resumed and (out.resume_dir / "template").is_file() else set()
         if not done and not (out.resume_dir / "template").is_file():
             _write_template(plan, out.staging, out.resume_dir)
         writer = _Writer(plan, out.staging, marks, progress)
@@ -191,10 +191,10 @@ def _need_zarr() -> None:
         raise InputError('streamed sweeps need zarr and dask: pip install "bendpam[zarr]"') from None
 
 
-def _done_blocks(marks: Path) -> set[int]:
+def _done_blocks(marks: Path, n_blocks: int) -> set[int]:
     """The blocks whose marker file an interrupted run left (each written whole before it was marked)."""
     try:
-        return {int(p.name) for p in marks.iterdir() if p.name.isdigit()}
+        return {int(p.name) for p in marks.iterdir() if p.name.isdigit() and int(p.name) < n_blocks}
     except FileNotFoundError:
         return set()
 
