@@ -748,3 +748,45 @@ def test_output_file_refusals_and_stale_temporaries(tmp_path):
         assert not stale.exists()
         f.write_text("ok\n")
     only(tmp_path, "data.csv", "link.csv", "out.csv")
+
+
+# --------------------------------------------------------------------------------------
+# resumable sets (issue 24): a kept, locked staging folder with a key
+# --------------------------------------------------------------------------------------
+def _interrupted_resumable(target, key, name="a.txt"):
+    with pytest.raises(KeyboardInterrupt):
+        with OutputSet(target, command=["t"], resume_key=key) as out:
+            out.write_text(name, name)
+            raise KeyboardInterrupt
+
+
+def test_resumable_set_keeps_its_staging_for_the_same_key_only(tmp_path):
+    target = tmp_path / "out"
+    part = tmp_path / fsops.part_name("out")
+    _interrupted_resumable(target, "k1")
+    assert not target.exists() and (part / "a.txt").read_text() == "a.txt"
+    assert (part / ".bendpam-resume" / "key").read_text() == "k1"
+    with OutputSet(target, command=["t"], resume_key="k2") as out:  # another key: afresh
+        assert not out.resumed and not (out.staging / "a.txt").exists()
+        out.write_text("b.txt", "b")
+    assert sorted(p.name for p in target.iterdir()) == ["b.txt", "manifest.json"]
+    assert not part.exists()
+    _interrupted_resumable(target, "k3")
+    with OutputSet(target, command=["t"], resume_key="k3") as out:
+        assert out.resumed and (out.staging / "a.txt").is_file()
+    manifest = json.loads((target / "manifest.json").read_text())
+    assert [f["path"] for f in manifest["files"]] == ["a.txt"]  # the key and markers are not in the set
+
+
+def test_a_plain_set_on_the_target_removes_a_kept_staging_folder(tmp_path):
+    target = tmp_path / "out"
+    _interrupted_resumable(target, "k1")
+    with OutputSet(target, command=["t"]) as out:
+        out.write_text("c.txt", "c")
+    assert not (tmp_path / fsops.part_name("out")).exists()
+    assert fsops.ANY_TEMP.fullmatch(fsops.part_name("out"))  # skipped when a folder is hashed as an input
+
+
+def test_resume_key_must_be_a_printable_string(tmp_path):
+    with pytest.raises(InputError, match="resume_key"):
+        OutputSet(tmp_path / "out", resume_key="")

@@ -78,8 +78,8 @@ from bendpam.physics.models import resolve_model
 from bendpam.validate import instance, plausible
 from bendpam.validate import pressure_kpa as check_pressure
 
-__all__ = ["SWEEP_FORMATS", "SWEEP_PARAMETERS", "SweepEstimate", "build_cases", "evaluate_cases", "sweep",
-           "sweep_estimate", "sweep_format", "to_table", "write_sweep"]
+__all__ = ["SWEEP_FORMATS", "SWEEP_PARAMETERS", "SweepEstimate", "SweepPlan", "build_cases", "evaluate_cases",
+           "plan_sweep", "sweep", "sweep_estimate", "sweep_format", "to_table", "write_sweep"]
 
 #: Parameters that can be swept (Actuator field names; units in the names).
 SWEEP_PARAMETERS = (
@@ -529,6 +529,93 @@ def _compute(arr, scheduler, workers, report, case_chunks, timeout_s=SCHEDULER_T
             if cluster is not None:
                 cluster.close()
     return dask.compute(arr, scheduler="threads")[0]
+
+
+class SweepPlan:
+    """A validated sweep cut into blocks of cases, each computed on its own (made by :func:`plan_sweep`).
+
+    The blocks are those of :func:`sweep` (the same ``chunk_cases`` gives the same blocks and
+    bit-for-bit the same numbers); they are numbered in C order over the grid of blocks.
+    :meth:`compute` is picklable with the plan, so a block can run on a Dask worker.
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> plan = plan_sweep(bendpam.physics.presets.be_pam(), [150.0, 200.0], alpha0_deg=[65, 70, 75], chunk_cases=2)
+    >>> plan.shape, plan.n_blocks, plan.region(1), plan.compute(1).shape     # (cases, pressures, outputs)
+    ((3,), 2, (slice(2, 3, None),), (1, 2, 13))
+    """
+
+    #: The outputs in the order of the last axis of :meth:`compute`.
+    outputs = _OUTPUTS
+
+    def __init__(self, base: Actuator, model: str, names: list[str], grids: list[np.ndarray], P: np.ndarray,
+                 chunks: tuple[tuple[int, ...], ...], order: int, eq19_factor: bool) -> None:
+        self.base, self.model, self.names, self.grids = base, model, list(names), list(grids)
+        self.pressure_kpa, self.chunks, self.order, self.eq19_factor = P, chunks, int(order), bool(eq19_factor)
+        self.shape: tuple[int, ...] = tuple(g.size for g in self.grids)
+        self._bounds = [np.cumsum((0, *c)) for c in chunks]
+        self._grid = tuple(len(c) for c in chunks)
+
+    @property
+    def n_blocks(self) -> int:
+        """The number of blocks."""
+        return int(np.prod(self._grid)) if self._grid else 1
+
+    @property
+    def block_shape(self) -> tuple[int, ...]:
+        """The cases of the first (largest) block along each swept parameter."""
+        return tuple(c[0] for c in self.chunks)
+
+    def region(self, block: int) -> tuple[slice, ...]:
+        """The slices of the case grid that block ``block`` covers (empty without a swept parameter)."""
+        if not self._grid:
+            return ()
+        at = np.unravel_index(int(block), self._grid)
+        return tuple(slice(int(bd[i]), int(bd[i + 1])) for bd, i in zip(self._bounds, at, strict=True))
+
+    def compute(self, block: int) -> np.ndarray:
+        """All outputs of block ``block``: an array of its cases' shape + (pressures, outputs)."""
+        flat = np.arange(int(np.prod(self.shape)) if self.shape else 1).reshape(self.shape or (1,))
+        idx = flat[self.region(block)] if self.shape else flat
+        return _block(self.base, self.model, self.names, self.grids, self.pressure_kpa, self.order,
+                      self.eq19_factor, idx)
+
+    def dataset(self, data) -> Any:
+        """The sweep's :class:`xarray.Dataset` over ``data`` (cases + (pressures, outputs)), as :func:`sweep` gives."""
+        return _dataset(data, self.names, self.grids, self.shape, self.pressure_kpa, self.base, self.model, self.order)
+
+
+def plan_sweep(base_actuator: Actuator, pressure_kpa, model: str | None = None, *, chunk_cases: int = 256,
+               order: int = DEFAULT_ORDER, eq19_factor: bool = True, **params) -> SweepPlan:
+    """Validate a sweep as :func:`sweep` does and cut it into blocks, without computing anything.
+
+    The arguments are those of :func:`sweep`; every refusal is the same one line.  A streamed
+    sweep (:func:`bendpam.sweep_store.sweep_zarr`) computes and writes the blocks one by one.
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> plan = plan_sweep(bendpam.physics.presets.be_pam(), [150.0], alpha0_deg=[65, 70], t0_mm=[2.0, 2.5, 3.0],
+    ...                   chunk_cases=4)
+    >>> plan.names, plan.shape, plan.chunks, plan.n_blocks
+    (['alpha0_deg', 't0_mm'], (2, 3), ((1, 1), (3,)), 2)
+    """
+    instance("base_actuator", base_actuator, Actuator, "a bendpam.Actuator")
+    model = str(resolve_model(base_actuator, model))  # a plain name, as in sweep()
+    P = np.atleast_1d(check_pressure(pressure_kpa, limit_kpa=base_actuator.max_pressure_kpa))
+    if P.ndim != 1 or P.size == 0:
+        raise InputError("pressure_kpa must be a non-empty 1-D list of pressures >= 0 kPa")
+    base_actuator.outside_tested(P)
+    grids_d = _grid_values(params)
+    names = list(grids_d)
+    grids = [grids_d[n] for n in names]
+    chunk_cases = int(chunk_cases)
+    if chunk_cases < 1:
+        raise InputError(f"chunk_cases = {chunk_cases} must be >= 1")
+    _prevalidate(base_actuator, names, grids)
+    chunks = _natural_chunks(tuple(g.size for g in grids), chunk_cases)
+    return SweepPlan(base_actuator, model, names, grids, P, chunks, order, eq19_factor)
 
 
 _UNIT_OF_SUFFIX = {"kpa": "kPa", "mpa": "MPa", "mm": "mm", "deg": "deg"}

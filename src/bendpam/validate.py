@@ -236,7 +236,8 @@ def pressure_kpa(value: Any, name: str = "pressure_kpa", *, warn: bool = True,
 #: File name suffixes that name a format (a suffix outside this list is just part of the name).
 KNOWN_SUFFIXES = {".png": "png", ".pdf": "pdf", ".svg": "svg", ".nc": "nc", ".csv": "csv", ".parquet": "parquet",
                   ".pq": "parquet", ".jpg": "jpg", ".jpeg": "jpg", ".eps": "eps", ".ps": "ps", ".tif": "tif",
-                  ".tiff": "tif", ".json": "json", ".toml": "toml", ".txt": "txt", ".html": "html"}
+                  ".tiff": "tif", ".json": "json", ".toml": "toml", ".txt": "txt", ".html": "html",
+                  ".zarr": "zarr"}
 
 
 def file_format(path: Any, fmt: Any, formats: tuple[str, ...], *, option: str = "path",

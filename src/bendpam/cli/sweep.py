@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from enum import Enum
 from pathlib import Path
 from typing import Annotated, Any, Optional
@@ -48,6 +49,7 @@ class TableFormat(str, Enum):
     nc = "nc"
     csv = "csv"
     parquet = "parquet"
+    zarr = "zarr"
 
 
 class SweepFormat(str, Enum):
@@ -56,12 +58,13 @@ class SweepFormat(str, Enum):
     nc = "nc"
     csv = "csv"
     parquet = "parquet"
+    zarr = "zarr"
     png = "png"
     pdf = "pdf"
     svg = "svg"
 
 
-DATA_FORMATS = ("nc", "csv", "parquet")
+DATA_FORMATS = ("nc", "csv", "parquet", "zarr")
 FIGURE_FORMATS = ("png", "pdf", "svg")
 
 
@@ -84,8 +87,6 @@ def sweep_formats(out: Path | None, plot: Path | None, fmt: SweepFormat | None,
 
 def max_local_workers() -> int:
     """The most processes ``--workers`` may start: four per CPU."""
-    import os
-
     return 4 * (os.cpu_count() or 1)
 
 
@@ -116,8 +117,10 @@ def sweep_cmd(
     scheduler: Annotated[Optional[str], typer.Option("--scheduler", help="Dask scheduler address.")] = None,
     workers: Annotated[Optional[int], typer.Option("--workers", help="Start a local Dask cluster of N processes.")]
     = None,
-    chunk_cases: Annotated[int, typer.Option("--chunk-cases", min=1, max=1_000_000,
-                                             help="Actuator cases per block (memory bound).")] = 256,
+    chunk_cases: Annotated[Optional[int], typer.Option(
+        "--chunk-cases", min=1, max=1_000_000, show_default=False,
+        help="Actuator cases per block (memory bound; default 256, or 32768 (case, pressure) points a block for a "
+        ".zarr store).")] = None,
     max_points: Annotated[Optional[int], typer.Option(
         "--max-points", min=1, max=MAX_POINTS_LIMIT, show_default=False,
         help="Refuse sweeps larger than this many (case, pressure) points (default: as many as fit "
@@ -125,7 +128,9 @@ def sweep_cmd(
     max_memory_gib: MaxMemoryOpt = MEMORY_BUDGET_GIB,
     max_minutes: MaxMinutesOpt = TIME_BUDGET_MIN,
     out: Annotated[Optional[Path], typer.Option(
-        "--out", help="Output file: NetCDF (.nc), or a tidy table of one row per case and pressure (.csv, .parquet)."
+        "--out", help="Output file: NetCDF (.nc), a tidy table of one row per case and pressure (.csv, .parquet), or "
+        "a Zarr store (.zarr, a folder) written block by block in bounded memory and resumed when the same command "
+        "is run again after an interruption."
     )] = None,
     plot: Annotated[Optional[Path], typer.Option("--plot", help="Quick figure of one output (.png, .pdf, .svg).")]
     = None,
@@ -133,7 +138,7 @@ def sweep_cmd(
         "--format", metavar="[png|pdf|svg]", help="Figure format of --plot: png, pdf or svg (default: from the "
         "file name).")] = None,
     table_fmt: Annotated[Optional[TableFormat], typer.Option(
-        "--table-format", help="Format of --out: nc, csv or parquet (default: from the file name).")] = None,
+        "--table-format", help="Format of --out: nc, csv, parquet or zarr (default: from the file name).")] = None,
     plot_var: Annotated[str, typer.Option("--plot-var", help="Output to plot.")] = "free_angle_deg",
     plot_x: Annotated[Optional[str], typer.Option("--plot-x", help="Parameter on the x axis (default: first).")]
     = None,
@@ -150,36 +155,92 @@ def sweep_cmd(
                                            help="Same as --quiet (--no-progress).")] = True,
 ):
     """Design sweep: actuator parameters crossed with pressures (in-process or on Dask)."""
-    from bendpam.sweeps import sweep
-
     if out is None and plot is None:
-        raise UserError("give --out FILE.nc|.csv|.parquet and/or --plot FILE.png|.pdf|.svg")
+        raise UserError("give --out FILE.nc|.csv|.parquet|.zarr and/or --plot FILE.png|.pdf|.svg")
     fixed_at = parse_at(at)
     data_fmt, fig_fmt = sweep_formats(out, plot, fmt, table_fmt)
-    grids, P, n_cases = sweep_grid(param, pressure_kpa, max_points, chunk_cases)
+    grids, P, n_cases = sweep_grid(param, pressure_kpa, max_points, chunk_cases or 1)
+    chunk_cases = chunk_cases or (default_zarr_chunk(len(P)) if data_fmt == "zarr" else 256)
+    sweep_grid(param, pressure_kpa, max_points, chunk_cases)  # the block size checked
     check_budgets(len(grids), len(P), n_cases, chunk_cases, data_fmt, bool(scheduler or workers), max_memory_gib,
                   max_minutes)
     scheduler = check_run(out, data_fmt, scheduler, workers)
     act = load_actuator(preset, actuator, model)
-    from bendpam.infra.progress import Progress
-
-    with Progress(n_cases, "sweep", quiet=quiet or not progress) as bar:
-        ds = sweep(act, P, model_for(act, model), chunk_cases=chunk_cases, scheduler=scheduler, workers=workers,
-                   progress=bar.advance, max_memory_gib=max_memory_gib, **grids)
-    if out is not None:
-        from bendpam.sweeps import write_sweep
-
-        with output_file(out, [actuator]) as f:
-            write_sweep(ds, f.path, data_fmt)
-        shape = " x ".join(f"{d}={n}" for d, n in ds.sizes.items())
-        rows = f", {int(np.prod(list(ds.sizes.values())))} rows" if data_fmt != "nc" else ""
-        echo_wrote(f"wrote {out} ({shape}{rows})")
+    run: dict[str, Any] = dict(chunk_cases=chunk_cases, scheduler=scheduler, workers=workers,
+                               quiet=quiet or not progress, max_memory_gib=max_memory_gib, actuator=actuator)
+    if data_fmt == "zarr":
+        assert out is not None
+        ds = write_store(out, act, P, model_for(act, model), grids, **run)
+    else:
+        ds = sweep_in_memory(out, data_fmt, act, P, model_for(act, model), grids, **run)
     if plot is not None:
         from bendpam.present.figures import save_figure, sweep_figure
 
         with output_file(plot, [actuator]) as f:
             save_figure(sweep_figure(ds, plot_var, plot_x, plot_y, at=fixed_at), f.path, format=fig_fmt)
         echo_wrote(f"wrote {plot}")
+
+
+def sweep_in_memory(out: Path | None, data_fmt: str | None, act: Any, P: list[float], model: str,
+                    grids: dict[str, Any], *, chunk_cases: int, scheduler: str | None, workers: int | None, quiet: bool,
+                    max_memory_gib: float, actuator: Path | None) -> Any:
+    """The sweep computed whole, then written to ``out`` (NetCDF, CSV, Parquet) if given; its dataset."""
+    from bendpam.infra.progress import Progress
+    from bendpam.sweeps import sweep, write_sweep
+
+    n_cases = int(np.prod([len(v) for v in grids.values()] or [1]))
+    with Progress(n_cases, "sweep", quiet=quiet) as bar:
+        ds = sweep(act, P, model, chunk_cases=chunk_cases, scheduler=scheduler, workers=workers,
+                   progress=bar.advance, max_memory_gib=max_memory_gib, **grids)
+    if out is not None:
+        with output_file(out, [actuator]) as f:
+            write_sweep(ds, f.path, data_fmt)
+        shape = " x ".join(f"{d}={n}" for d, n in ds.sizes.items())
+        rows = f", {int(np.prod(list(ds.sizes.values())))} rows" if data_fmt != "nc" else ""
+        echo_wrote(f"wrote {out} ({shape}{rows})")
+    return ds
+
+
+def default_zarr_chunk(n_pressures: int) -> int:
+    """Cases a block of a .zarr store holds by default (:func:`bendpam.sweep_store.default_chunk_cases`)."""
+    from bendpam.sweep_store import default_chunk_cases
+
+    return default_chunk_cases(n_pressures)
+
+
+def write_store(out: Path, act: Any, P: list[float], model: str, grids: dict[str, Any], *, chunk_cases: int,
+                scheduler: str | None, workers: int | None, quiet: bool, max_memory_gib: float,
+                actuator: Path | None) -> Any:
+    """Stream the sweep into the Zarr store ``out`` (resuming an interrupted run of the same command); its dataset.
+
+    The dataset is opened lazily from the store written (for --plot).
+    """
+    import xarray as xr
+
+    from bendpam.cli.options import RUN_COMMAND, RUN_FORCE, as_given, command_line
+    from bendpam.infra.progress import Progress
+    from bendpam.sweep_store import sweep_zarr
+
+    n_cases = int(np.prod([len(v) for v in grids.values()] or [1]))
+    inputs = [actuator] if actuator is not None else []
+    try:
+        with Progress(n_cases, "sweep", quiet=quiet) as bar:
+            path = sweep_zarr(act, as_given(out), P, model, chunk_cases=chunk_cases, scheduler=scheduler,
+                              workers=workers, progress=bar.advance, max_memory_gib=max_memory_gib,
+                              force=RUN_FORCE.get(), command=command_line(), inputs=inputs,
+                              producer=RUN_COMMAND.get() or "sweep", **grids)
+    except BaseException:
+        from bendpam.infra.fsops import part_name
+
+        kept = Path(os.path.expanduser(str(out))).parent / part_name(out.name)
+        if kept.is_dir() and any((kept / ".bendpam-resume" / "blocks").glob("*")):
+            typer.echo(f"bendpam: the finished blocks are kept in {str(kept)!r}; run the same command again to "
+                       "resume the sweep", err=True)
+        raise
+    ds = xr.open_zarr(path)
+    shape = " x ".join(f"{d}={n}" for d, n in ds.sizes.items())
+    echo_wrote(f"wrote {out} ({shape}, {ds.attrs.get('blocks')} blocks of {chunk_cases} cases)")
+    return ds
 
 
 def parse_at(at: list[str] | None) -> dict[str, float]:
@@ -232,14 +293,20 @@ def check_budgets(n_params: int, n_pressures: int, n_cases: int, chunk_cases: in
     from bendpam.sweeps import sweep_estimate
 
     table = data_fmt if data_fmt in ("csv", "parquet") else None
-    est = sweep_estimate(n_cases, n_pressures, n_params, chunk_cases=chunk_cases, table=table, remote=remote)
+    stream = data_fmt == "zarr"  # written block by block: only the blocks in flight are held
+    est = sweep_estimate(n_cases, n_pressures, n_params, chunk_cases=chunk_cases, table=table, remote=remote,
+                         compute=not stream)
     size = (f"{est.points} (case, pressure) points ({n_cases} case{'s' * (n_cases != 1)} x {n_pressures} "
             f"pressure{'s' * (n_pressures != 1)})")
     problem = memory_problem(est.memory_bytes, max_memory_gib)
+    raise_it = (", or raise --max-memory-gib if this machine has the memory"
+                if est.memory_bytes > max_memory_gib * GIB else "")
+    if problem is not None and stream:
+        raise UserError(f"the sweep of {size} in blocks of {chunk_cases} cases holds {problem}; give a smaller "
+                        f"--chunk-cases{raise_it}")
     if problem is not None:
         raise UserError(f"the sweep of {size} holds its whole result in memory before writing it: {problem}; give "
-                        "fewer values" + (", or raise --max-memory-gib if this machine has the memory"
-                                          if est.memory_bytes > max_memory_gib * GIB else ""))
+                        f"fewer values, or write a Zarr store (--out NAME.zarr: block by block){raise_it}")
     if est.seconds > 60.0 * max_minutes:
         raise UserError(f"the sweep of {size} would take about {est.time_text} on one core (a conservative estimate), "
                         f"more than --max-minutes {max_minutes:g}; give fewer values, or raise --max-minutes (the "

@@ -4,7 +4,9 @@ Temporaries beside a target ``NAME`` are named ``.NAME.bendpam-<kind>-<pid>-<ran
 with ``kind`` one of ``tmp`` (a staging folder or temporary file), ``old`` (an old version kept
 until the run ends) and ``del`` (an old set being removed).  A writer that itself writes through a
 temporary beside the path it was given (:func:`bendpam.infra.atomic.atomic_path`) adds one more
-leading dot, so :func:`stale_temporaries` finds those too.
+leading dot, so :func:`stale_temporaries` finds those too.  A resumable set keeps its staging
+folder under the fixed name ``.NAME.bendpam-part`` (:func:`part_name`): it is not stale, the next run
+on the target either resumes it or removes it.
 
 The swap of a folder into place (:func:`swap_in`):
 
@@ -40,6 +42,7 @@ __all__ = [
     "fsync_dir",
     "fsync_file",
     "hash_file",
+    "part_name",
     "remove_path",
     "restore_or_remove_stale",
     "stale_temporaries",
@@ -51,7 +54,7 @@ __all__ = [
 #: The kinds of temporaries (see the module docstring).
 TEMP_KINDS = ("tmp", "old", "del")
 #: Any bendpam temporary or lock file, of any target (skipped when hashing inputs).
-ANY_TEMP = re.compile(r"\..+\.bendpam-(lock|(" + "|".join(TEMP_KINDS) + r")-\d+-.*)")
+ANY_TEMP = re.compile(r"\..+\.bendpam-(lock|part|(" + "|".join(TEMP_KINDS) + r")-\d+-.*)")
 
 _AT_FDCWD = -100
 _RENAME_EXCHANGE = 2
@@ -180,6 +183,20 @@ def temp_name(name: str, kind: str, suffix: str = "") -> str:
     True
     """
     return f".{name}.bendpam-{kind}-{os.getpid()}-{secrets.token_hex(4)}{suffix}"
+
+
+def part_name(name: str) -> str:
+    """The name of the kept staging folder of a resumable set of target ``name`` (no pid: any later run may resume it).
+
+    Unlike the other temporaries it is not stale when its run died: the next run with the same
+    resume key continues it, any other run on the target removes it (both under the target's lock).
+
+    Examples
+    --------
+    >>> part_name("sweep.zarr")
+    '.sweep.zarr.bendpam-part'
+    """
+    return f".{name}.bendpam-part"
 
 
 def _temp_pattern(name: str) -> re.Pattern[str]:

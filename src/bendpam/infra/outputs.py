@@ -372,6 +372,15 @@ class OutputSet(_Output):
     producer : str, optional
         The name of what writes the set (a command name: ``"process"``); a set of one
         producer is not replaced by another without ``force``.
+    resume_key : str, optional
+        Make the set *resumable*: a fingerprint of the run's inputs and options.  The staging
+        folder is then ``.<name>.bendpam-part`` beside the target and is *kept* when the block
+        ends with an exception (an error, a signal); the next set entered on the same target
+        with the same key reuses it (:attr:`resumed` is True and the files written so far are
+        still there), while a set with another key, or without one, removes it under the lock.
+        The key is kept in :attr:`resume_dir` (``.bendpam-resume/`` in the staging folder,
+        where the writer may keep its own progress markers), which is removed before the
+        manifest is written: the committed set is the same as one written in a single run.
 
     Raises
     ------
@@ -390,6 +399,8 @@ class OutputSet(_Output):
         The names given to :meth:`path` and the ``write_*`` methods, in order.
     manifest : dict or None
         The manifest written, once the set is complete.
+    resumed : bool
+        The staging folder was kept by an interrupted run with the same ``resume_key``.
 
     Examples
     --------
@@ -399,15 +410,36 @@ class OutputSet(_Output):
     ...         _ = out.write_text("a.txt", "a")
     ...     print(sorted(p.name for p in (Path(d) / "out").iterdir()), out.manifest["producer"])
     ['a.txt', 'manifest.json'] demo
+
+    A resumable set keeps what an interrupted run wrote, for the next run with the same key:
+
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     try:
+    ...         with OutputSet(Path(d) / "out", command=["demo"], resume_key="k1") as out:
+    ...             _ = out.write_text("part-1.txt", "1")
+    ...             raise KeyboardInterrupt
+    ...     except KeyboardInterrupt:
+    ...         pass
+    ...     with OutputSet(Path(d) / "out", command=["demo"], resume_key="k1") as out:
+    ...         print(out.resumed, sorted(p.name for p in out.staging.iterdir() if p.is_file()))
+    ...         _ = out.write_text("part-2.txt", "2")
+    ...     print(sorted(p.name for p in (Path(d) / "out").iterdir()))
+    True ['part-1.txt']
+    ['manifest.json', 'part-1.txt', 'part-2.txt']
     """
 
     _kind = "folder"
 
     def __init__(self, target_dir: str | os.PathLike[str], *, inputs: Iterable[str | os.PathLike[str]] = (),
                  command: str | Sequence[str] | None = None, lock_timeout_s: float = 0.0, force: bool = False,
-                 producer: str | None = None) -> None:
+                 producer: str | None = None, resume_key: str | None = None) -> None:
         super().__init__(target_dir, inputs=inputs, command=command, lock_timeout_s=lock_timeout_s, force=force)
         self.producer = producer
+        if resume_key is not None and (not isinstance(resume_key, str) or not resume_key
+                                       or not resume_key.isprintable()):
+            raise InputError(f"resume_key = {resume_key!r} must be a non-empty printable string")
+        self.resume_key = resume_key
+        self.resumed = False
         self.files: list[str] = []
         self.manifest: dict[str, Any] | None = None
         self._staging: Path | None = None
@@ -451,9 +483,28 @@ class OutputSet(_Output):
         fsops.restore_or_remove_stale(self.target)
         self._check_target()  # again, under the lock
         self._check_replaceable()
+        part = self.target.parent / fsops.part_name(self.target.name)
         with HeldSignals():
-            self._staging = Path(tempfile.mkdtemp(prefix=f".{self.target.name}.bendpam-tmp-{os.getpid()}-",
-                                                  dir=self.target.parent))
+            if self.resume_key is None:
+                if os.path.lexists(part):  # an interrupted resumable run of another command
+                    fsops.remove_path(part)
+                self._staging = Path(tempfile.mkdtemp(prefix=f".{self.target.name}.bendpam-tmp-{os.getpid()}-",
+                                                      dir=self.target.parent))
+                return
+            self.resumed = _resume_key_of(part) == self.resume_key
+            if not self.resumed:
+                fsops.remove_path(part)
+                (part / RESUME_DIR).mkdir(parents=True)
+                key_file = part / RESUME_DIR / "key"
+                key_file.write_text(self.resume_key, encoding="utf-8")
+            self._staging = part
+
+    @property
+    def resume_dir(self) -> Path:
+        """The folder of a resumable set's own state (its key, the writer's markers); removed before the commit."""
+        if self.resume_key is None:
+            raise RuntimeError("resume_dir is kept only by a set with a resume_key")
+        return self.staging / RESUME_DIR
 
     def __enter__(self) -> OutputSet:
         return self._enter()
@@ -527,6 +578,8 @@ class OutputSet(_Output):
 
     def _stage(self) -> None:
         staging = self.staging
+        if self.resume_key is not None:
+            fsops.remove_path(staging / RESUME_DIR)  # the committed set is as one written in one run
         manifest = build_manifest(staging, producer=self.producer, command=self.command, target=self.target,
                                   inputs=self._inputs_resolved, started_utc=self._started)
         (staging / MANIFEST_NAME).write_text(to_json(manifest), encoding="utf-8")
@@ -563,12 +616,26 @@ class OutputSet(_Output):
 
     def _discard(self) -> None:
         staging, self._staging = self._staging, None
-        if staging is not None:
-            fsops.remove_path(staging)
+        if staging is not None and not (self.resume_key is not None and (staging / RESUME_DIR).is_dir()):
+            fsops.remove_path(staging)  # (a resumable set keeps its staging folder for the next run)
 
     def _finish(self) -> None:
         self._staging = None
         super()._finish()
+
+
+#: The folder of a resumable set's own state inside its staging folder (see ``OutputSet(resume_key=...)``).
+RESUME_DIR = ".bendpam-resume"
+
+
+def _resume_key_of(part: Path) -> str | None:
+    """The key of a kept staging folder, or None (none there, or unreadable: it is then started afresh)."""
+    try:
+        if part.is_symlink() or not part.is_dir():
+            return None
+        return (part / RESUME_DIR / "key").read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError):
+        return None
 
 
 # --------------------------------------------------------------------------------------
