@@ -1,7 +1,8 @@
 """Raw four-point-bending tests: read and write testing-machine exports.
 
 A raw test at one pressure is a time series of time (s), crosshead stroke (mm) and force (N).
-:func:`read_test` reads the exports of real testing machines (Zwick testXpert, Instron
+:func:`read_test` (one test) and :func:`read_tests` (every test of a file) read the exports
+of real testing machines (Zwick testXpert, Instron
 Bluehill/WaveMatrix/console, MTS 793 and TestSuite, Shimadzu Trapezium, plain CSV, ``.xlsx``/
 ``.xls`` workbooks; the layout, encoding and channels are found from the content) into a
 :class:`RawTest`; :func:`inspect_file` reports how a file reads; :func:`write_test` writes
@@ -17,7 +18,14 @@ if TYPE_CHECKING:
     from bendpam.lab.pressure import PRESSURE_RANGE_KPA, parse_pressure, pressure_from_filename
     from bendpam.lab.rawtest import COLUMNS, DIALECTS, FORMATS, RawTest, check_cycle_count
     from bendpam.lab.read_error import ReadError
-    from bendpam.lab.readers import detect_dialect, format_inspection, inspect_file, parse_columns, read_test
+    from bendpam.lab.readers import (
+        detect_dialect,
+        format_inspection,
+        inspect_file,
+        parse_columns,
+        read_test,
+        read_tests,
+    )
     from bendpam.lab.writers import write_test
 
 __all__ = [
@@ -35,6 +43,7 @@ __all__ = [
     "parse_pressure",
     "pressure_from_filename",
     "read_test",
+    "read_tests",
     "write_test",
 ]
 
@@ -44,6 +53,7 @@ _FROM = {
     "check_cycle_count": "rawtest", "PRESSURE_RANGE_KPA": "pressure", "parse_pressure": "pressure",
     "pressure_from_filename": "pressure", "ReadError": "read_error", "detect_dialect": "readers",
     "format_inspection": "readers", "inspect_file": "readers", "parse_columns": "readers", "read_test": "readers",
+    "read_tests": "readers",
     "write_test": "writers",
 }  # fmt: skip
 

@@ -89,6 +89,7 @@ __all__ = [
     "parse_pressure",
     "pressure_from_filename",
     "read_test",
+    "read_tests",
 ]
 
 
@@ -287,6 +288,48 @@ def read_test(
     fmt = dialect or _classify_format(parsed)
     return assemble(parsed, fmt=fmt, pressure_kpa=pressure_kpa, rate_hz=rate_hz, repair=repair)
 
+
+def read_tests(
+    path: str | os.PathLike,
+    *,
+    pressure_kpa: float | None = None,
+    dialect: str | None = None,
+    columns: Mapping[str, str] | str | None = None,
+    rate_hz: float | None = None,
+    repair: bool = False,
+) -> list[RawTest]:
+    """Read every test of a raw export: one per specimen side by side, one per separate block.
+
+    Parameters
+    ----------
+    path, pressure_kpa, dialect, columns, rate_hz, repair
+        As for :func:`read_test`.
+
+    Returns
+    -------
+    list of RawTest
+        One test for a file of one test (the same as :func:`read_test`); for several specimens
+        side by side one per specimen (:attr:`RawTest.specimen` names it); for several blocks
+        that do not continue one test, one per block (:attr:`RawTest.block` numbers it).
+
+    Raises
+    ------
+    ReadError, bendpam.errors.InputError
+        As for :func:`read_test`.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = Path(folder) / "be_150kPa.csv"
+    ...     _ = path.write_text("time_s,stroke_mm,force_n\\n0,0.000,11.80\\n0.05,0.027,11.71\\n")
+    ...     tests = read_tests(path)
+    >>> len(tests), len(tests[0]), tests[0].specimen, tests[0].block
+    (1, 2, None, None)
+    """
+    return [read_test(path, pressure_kpa=pressure_kpa, dialect=dialect, columns=columns,
+                      rate_hz=rate_hz, repair=repair)]  # fmt: skip
 
 
 def detect_dialect(path_or_text_lines: str | os.PathLike | Iterable[str]) -> str:
