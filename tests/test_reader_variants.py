@@ -306,15 +306,15 @@ def test_time_backwards_refused_and_repaired(tmp_path):
     assert len(raw) == len(arr) - 1 and np.all(np.diff(raw.data["time_s"]) > 0)
 
 
-def test_gap_refused_and_kept_with_repair(tmp_path):
+def test_gap_read_and_reported(tmp_path):
+    # issue 22: a pause in the sampling is what labs write; it is read, reported and splits the series
     arr = _series()
     arr[25:, 0] += 300.0
     p = _zwick_like(tmp_path, arr)
-    with pytest.raises(ReadError, match="gap") as info:
-        read_test(p)
-    assert info.value.line == 29
-    raw = read_test(p, repair=True)
-    assert len(raw) == len(arr) and any("gap" in w for w in raw.warnings)
+    for repair in (False, True):
+        raw = read_test(p, repair=repair)
+        assert len(raw) == len(arr) and raw.segments == [(0, 25), (25, len(arr))]
+        assert any("gap" in w and "line 29" in w for w in raw.warnings)
 
 
 def test_nonfinite_rows_dropped_with_repair(tmp_path):

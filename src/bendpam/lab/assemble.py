@@ -18,6 +18,7 @@ steps, each a function here:
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
@@ -26,7 +27,7 @@ import numpy as np
 import pandas as pd
 
 from bendpam.lab.channels import DEFAULT_UNIT, ROLES, UNIT_HINT, ChannelChoice, canonical_unit, unit_factor
-from bendpam.lab.checks import find_spikes, time_problems
+from bendpam.lab.checks import find_spikes, padding_rows, time_structure
 from bendpam.lab.parser import Block, ColumnData, Parsed, Parser
 from bendpam.lab.pressure import (
     PRESSURE_RANGE_TEXT,
@@ -190,53 +191,73 @@ def _drop_spikes(samples: _Samples, channels: Channels, label: Path | str, repai
         samples.keep(keep)
 
 
+def _drop_padding(samples: _Samples, channels: Channels, warnings: list[str]) -> None:
+    """Drop padding rows at the end (rows of zeros, an end record whose time goes back to the start)."""
+    v = samples.values
+    if channels["time"]["source"] is None and channels["stroke"]["source"] is None:
+        return
+    k = padding_rows(v["time"], v["stroke"], v["force"]) if channels["time"]["source"] is not None else \
+        padding_rows(np.zeros_like(v["force"]), v["stroke"], v["force"])
+    if k:
+        lines = samples.lines[-k:].tolist()
+        warnings.append(f"dropped {k} padding row(s) at the end (zeros, or time back to the start) "
+                        f"at line(s) {_lines_text(lines)}")  # fmt: skip
+        keep = np.ones(samples.lines.size, dtype=bool)
+        keep[-k:] = False
+        samples.keep(keep)
+
+
 def _check_time(samples: _Samples, channels: Channels, label: Path | str, repair: bool,
-                warnings: list[str]) -> None:  # fmt: skip
-    """Refuse (or drop, with ``repair``) time that does not increase; refuse (or accept) gaps."""
+                warnings: list[str]) -> list[tuple[int, int]]:  # fmt: skip
+    """Refuse (or drop, with ``repair``) samples out of order; report resets, repeats and gaps; the segments."""
     t = samples.values["time"]
     if channels["time"]["source"] is None:
-        return
-    tp = time_problems(t)
+        return [(0, t.size)]
+    ts = time_structure(t)
     tname = channels["time"]["source"]
-    if tp.backwards.size:
+    if math.isnan(ts.median_step_s):
+        raise ReadError(
+            f"time does not advance in column {tname!r}: all {t.size} samples at {_fmt(t[0])} s or going back "
+            f"(lines {int(samples.lines[0])}-{int(samples.lines[-1])}); expected a time series",
+            label, int(samples.lines[0]), tname)  # fmt: skip
+    if ts.glitches.size:
         lines = samples.lines
-        i = int(tp.backwards[0])
+        i = int(ts.glitches[0])
+        where = f"({ts.glitches.size} sample(s), at line(s) {_lines_text(lines[ts.glitches].tolist())})"
         if not repair:
             raise ReadError(
-                f"time does not increase in column {tname!r}: {_fmt(t[i - 1])} s then "
-                f"{_fmt(t[i])} s ({tp.backwards.size} sample(s), at line(s) "
-                f"{_lines_text(lines[tp.backwards].tolist())}); expected increasing time "
-                "(read with repair=True to drop such samples)",
+                f"time does not increase in column {tname!r}: {_fmt(t[i - 1])} s then {_fmt(t[i])} s, "
+                f"then {_fmt(t[min(i + 1, t.size - 1)])} s: a sample out of order {where}; expected "
+                "increasing time (read with repair=True to drop such samples)",
                 label,
                 int(lines[i]),
                 tname,
             )
-        warnings.append(
-            f"dropped {tp.backwards.size} sample(s) where time does not increase, at line(s) "
-            f"{_lines_text(lines[tp.backwards].tolist())}"
-        )
+        warnings.append(f"dropped the sample(s) out of order in time {where}")
         k2 = np.ones(t.size, dtype=bool)
-        k2[tp.backwards] = False
+        k2[ts.glitches] = False
         samples.keep(k2)
         t = samples.values["time"]
-        tp = time_problems(t)
-    if tp.gaps.size:
-        lines = samples.lines
-        i = int(tp.gaps[0])
-        gap = t[i] - t[i - 1]
-        msg = (
-            f"gap in the sampling: {_fmt(gap)} s between line {int(lines[i - 1])} and line "
-            f"{int(lines[i])} against a median step of {_fmt(tp.median_step_s)} s "
-            f"({tp.gaps.size} gap(s), at line(s) {_lines_text(lines[tp.gaps].tolist())})"
+        ts = time_structure(t)
+    lines = samples.lines
+    if ts.repeats.size:
+        warnings.append(f"time {tname!r} repeats the previous sample's value at {ts.repeats.size} sample(s), "
+                        f"line(s) {_lines_text(lines[ts.repeats].tolist())}; kept")  # fmt: skip
+    if ts.resets.size:
+        i = int(ts.resets[0])
+        warnings.append(
+            f"time {tname!r} restarts {ts.resets.size} time(s), at line(s) "
+            f"{_lines_text(lines[ts.resets].tolist())} (first: {_fmt(t[i - 1])} s then {_fmt(t[i])} s); "
+            "each run is a segment of the series"
         )
-        if not repair:
-            raise ReadError(
-                msg + "; expected regular sampling (read with repair=True to accept the gaps)",
-                label,
-                int(lines[i]),
-                tname,
-            )
-        warnings.append(msg + "; kept (no samples to restore)")
+    if ts.gaps.size:
+        i = int(ts.gaps[0])
+        warnings.append(
+            f"gap in the sampling: {_fmt(t[i] - t[i - 1])} s between line {int(lines[i - 1])} and line "
+            f"{int(lines[i])} against a median step of {_fmt(ts.median_step_s)} s ({ts.gaps.size} gap(s), "
+            f"at line(s) {_lines_text(lines[ts.gaps].tolist())}); the series is split there"
+        )
+    return ts.segments(t.size)
 
 
 def _check_counter(samples: _Samples, ch: ChannelChoice, data: ColumnData, warnings: list[str]) -> str | None:
@@ -333,7 +354,8 @@ def _other_columns(blk: Block, ch: ChannelChoice) -> list[str]:
 
 
 def _samples(parsed: Parsed, rate_hz: float | None, repair: bool, warnings: list[str]) -> tuple[
-        pd.DataFrame, Channels, dict[str, str], str | None, np.ndarray | None, float | None, tuple[int, int]]:
+        pd.DataFrame, Channels, dict[str, str], str | None, np.ndarray | None, float | None, tuple[int, int],
+        list[tuple[int, int]]]:
     """Steps 1-3: the checked samples as a frame, with their channels, units, counter, rate and lines."""
     p, blk = parsed.parser, parsed.block
     label = p.label
@@ -351,8 +373,9 @@ def _samples(parsed: Parsed, rate_hz: float | None, repair: bool, warnings: list
     counter = _column(data, "counter") if ch.counter is not None else None
     sample_rate = _time_from_rate(values, source_units, channels, p, blk, rate_hz, warnings)
     samples = _Samples(values, lines, counter)
+    _drop_padding(samples, channels, warnings)
     _drop_spikes(samples, channels, label, repair, warnings)
-    _check_time(samples, channels, label, repair, warnings)
+    segments = _check_time(samples, channels, label, repair, warnings)
     if values["time"].size < 2:
         raise ReadError(
             f"only {values['time'].size} sample(s) left after the checks; expected at least 2",
@@ -366,7 +389,7 @@ def _samples(parsed: Parsed, rate_hz: float | None, repair: bool, warnings: list
         copy=False,
     )  # fmt: skip
     data_lines = (int(samples.lines[0]), int(samples.lines[-1]))
-    return frame, channels, source_units, counter_source, samples.counter, sample_rate, data_lines
+    return frame, channels, source_units, counter_source, samples.counter, sample_rate, data_lines, segments
 
 
 def assemble(parsed: Parsed, *, fmt: str, pressure_kpa: float | None, rate_hz: float | None,
@@ -415,7 +438,7 @@ def assemble(parsed: Parsed, *, fmt: str, pressure_kpa: float | None, rate_hz: f
     path = Path(label) if isinstance(label, (str, Path)) else Path(str(label))
     assert blk.choice is not None
     warnings = list(p.warnings)
-    frame, channels, source_units, counter_source, counter, sample_rate, data_lines = _samples(
+    frame, channels, source_units, counter_source, counter, sample_rate, data_lines, segments = _samples(
         parsed, rate_hz, repair, warnings)
     metadata, meta_pressure = _metadata(p, blk, label, pressure_kpa)
     pressure, psource = _choose_pressure(pressure_kpa, meta_pressure, path, label)
@@ -447,4 +470,5 @@ def assemble(parsed: Parsed, *, fmt: str, pressure_kpa: float | None, rate_hz: f
         blocks=blocks,
         sample_rate_hz=sample_rate,
         data_lines=data_lines,
+        segments=segments,
     )
