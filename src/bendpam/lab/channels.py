@@ -50,6 +50,7 @@ TIME_UNITS: dict[str, float] = {
     "s": 1.0, "sec": 1.0, "secs": 1.0, "second": 1.0, "seconds": 1.0, "sek": 1.0, "seg": 1.0,
     "秒": 1.0, "\u0441": 1.0,  # Cyrillic es
     "ms": 1e-3, "msec": 1e-3,
+    "us": 1e-6, "µs": 1e-6, "μs": 1e-6,
     "min": 60.0, "mins": 60.0, "minute": 60.0, "minutes": 60.0, "分": 60.0,
     "h": 3600.0, "hr": 3600.0, "hrs": 3600.0, "hour": 3600.0, "hours": 3600.0,
 }  # fmt: skip
@@ -62,13 +63,13 @@ FORCE_UNITS: dict[str, float] = {
     "n": 1.0, "newton": 1.0, "newtons": 1.0, "牛": 1.0, "н": 1.0,
     "kn": 1000.0, "千牛": 1000.0, "кн": 1000.0, "mn": 1e-3, "dan": 10.0,
     "lbf": 4.4482216152605, "lb": 4.4482216152605, "lbs": 4.4482216152605,
-    "kgf": 9.80665, "kp": 9.80665,
+    "kgf": 9.80665, "kp": 9.80665, "µn": 1e-6, "μn": 1e-6, "un": 1e-6,
 }  # fmt: skip
 _UNIT_TABLES = {"time": TIME_UNITS, "stroke": LENGTH_UNITS, "force": FORCE_UNITS}
 UNIT_HINT = {
     "time": "s, sec, ms, min or h",
     "stroke": "m, cm, mm, µm/um or in",
-    "force": "N, kN, mN, daN, kgf or lbf",
+    "force": "N, kN, mN, µN/uN, daN, kgf or lbf",
 }
 DEFAULT_UNIT = {"time": "s", "stroke": "mm", "force": "N"}
 # Units of other quantities seen in exports (so that a units row is recognised as one).
@@ -132,7 +133,7 @@ _TIME_VOCAB: list[_Entry] = [
            ["time", "zeit", "temps", "tempo", "tiempo", "czas", "tijd", "tid", "t",
             "elapsed time", "durée", "duree"],
            ["时间", "時間", "時刻", "时刻"], extra=r"\w+zeit" + _E),
-    _entry(1, "time", ["godzina"]),
+    _entry(1, "time", ["godzina", "point", "punkt", "points"]),
 ]  # fmt: skip
 _TIME_EXCLUDE = re.compile(
     _words("cycle", "cycles", "step", "segment", "start", "end", "uhrzeit", "clock", "date",
@@ -148,17 +149,22 @@ _STROKE_VOCAB: list[_Entry] = [
             "crosshead", "cross head", "stroke", "actuator", "traverse", "traversenweg",
             "traversenposition", "querhaupt", "querhauptweg", "kolbenweg", "zylinderweg",
             "maschinenweg", "course", "corsa", "traversa", "carrera", "travesaño", "trawersa",
-            "skok", "ram", "piston", "axial displacement", "travel"],
+            "skok", "ram", "piston", "axial displacement", "travel", "weg maschine", "maschine",
+            "machine", "course traverse", "course standard", "traversenweg", "crosshead position",
+            "position machine", "déplacement traverse"],
            ["ストローク", "クロスヘッド", "行程", "横梁位移", "横梁", "活塞位移"]),
     _entry(2, "digital position", ["digital position", "digitale position", "encoder"]),
     _entry(1, "extensometer",
            ["extensometer", "extensometers", "ave", "video", "clip on", "clip", "feindehnung",
             "dehnungsaufnehmer", "makroxtens", "extensomètre", "estensimetro", "extensómetro",
-            "ekstensometr", "lvdt", "dic", "strain gauge", "laser"],
+            "ekstensometr", "lvdt", "dic", "strain gauge", "laser", "extenso", "iwa", "clip gauge",
+            "wegaufnehmer", "capteur", "déform"],
            ["引伸计", "引伸計", "伸び計"]),
+    _entry(4, "position (actuator)", ["position", "posizione", "posición", "posicion", "pozycja"],
+           ["位置"]),
     _entry(3, "displacement",
            ["displacement", "extension", "deflection", "position", "weg", "verschiebung",
-            "durchbiegung", "verformung", "verlängerung", "déplacement", "deplacement", "flèche",
+            "durchbiegung", "verformung", "verlängerung", "déplacement", "deplacement", "flèche", "distance",
             "fleche", "allongement", "spostamento", "estensione", "posizione", "freccia",
             "allungamento", "abbassamento", "desplazamiento", "extensión", "posición",
             "posicion", "deflexión", "flecha", "alargamiento", "przemieszczenie", "wydłużenie",
@@ -172,7 +178,8 @@ _STROKE_EXCLUDE = re.compile(
            "sollwert", "soll", "setpoint", "set point", "command", "target", "demand", "limit",
            "consigne", "riferimento", "consigna", "zadana", "at", "bei", "à", "rate", "speed",
            "velocity", "geschwindigkeit", "vitesse", "velocità", "velocidad", "prędkość",
-           "after", "nach", "break", "bruch", "strain", "dehnung", "rotation", "angle")
+           "after", "nach", "break", "bruch", "strain", "dehnung", "rotation", "angle", "kraft", "force",
+           "load", "charge")
     + r"|速度|最大|最小|平均|目標|目标|指令|设定"
 )  # fmt: skip
 _ABSOLUTE = re.compile(_words("abs", "absolute", "absolut", "absolue", "assoluta", "absoluta",
@@ -424,6 +431,9 @@ def classify_column(col: ColumnInfo) -> list[Candidate]:
     [('counter', 'cycle counter')]
     """
     name = normalize_name(col.name)
+    head, dash, tail = col.name.partition(" - ")
+    if dash and re.search(r"rate|messrate|abtast", tail, re.IGNORECASE):
+        name = normalize_name(head)  # HBM catman: 'Time  1 - default sample rate' is the time of rate group 1
     unit = (col.unit or "").strip()
     if name and re.fullmatch(r"[\d\s.,+-]+", name) and unit and unit_factor("stroke", unit):
         return [Candidate(col, "stroke", 0, "length channel of unknown kind", True)]

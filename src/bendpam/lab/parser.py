@@ -38,6 +38,7 @@ from bendpam.lab.channels import (
     unit_cell,
     unit_factor,
 )
+from bendpam.lab.header import find_header
 from bendpam.lab.layout import (
     DELIMITERS,
     LineReader,
@@ -103,6 +104,10 @@ class Block:
         The block whose numbers were read.
     decimal : str or None
         Decimal mark of the block's numbers.
+    specimen_line, specimens : int or None, list of str or None
+        A row naming specimens side by side (column groups), if any.
+    header_candidates : list of dict
+        The rows scored as the names row (:func:`bendpam.lab.header.find_header`), best first.
 
     Examples
     --------
@@ -129,6 +134,9 @@ class Block:
     last_line: int = 0
     read: bool = False
     decimal: str | None = None
+    specimen_line: int | None = None
+    specimens: list[str] | None = None
+    header_candidates: list[dict] = field(default_factory=list)
 
     def describe(self) -> str:
         """Where the block is and what it holds, for a message."""
@@ -374,10 +382,17 @@ class Parser:
         if self.mts is not None and self.mts.delimiter in order:
             order.remove(self.mts.delimiter)
             order.insert(0, self.mts.delimiter)
+        guess = find_header(pre, line, order, role_hits=_role_hits, is_units_row=_is_units_row)
         best: tuple[tuple[int, int, int, int], Block] | None = None
+        if guess is not None:
+            cols = _make_columns(guess.names, guess.units, guess.names_line, guess.units_line)
+            blk = Block(len(self.blocks) + 1, guess.names_line, guess.names, guess.units_line, guess.units,
+                        guess.sep, ln, line, cols, specimen_line=guess.specimen_line, specimens=guess.specimens,
+                        header_candidates=guess.candidates)  # fmt: skip
+            best = ((0, 0, 0, 0), blk)
         p1 = pre[-1]
         p2 = pre[-2] if len(pre) >= 2 else None
-        for k, sep in enumerate(order):
+        for k, sep in enumerate(order if best is None else []):
             data_cells = split_cells(line, sep)
             c1 = split_cells(p1[1], sep)
             names_ln, names, units_ln, units = p1[0], c1, None, None
