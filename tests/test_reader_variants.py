@@ -14,7 +14,7 @@ import pytest
 from numpy.testing import assert_allclose
 
 from bendpam.errors import FileFormatError, InputError
-from bendpam.lab import ReadError, inspect_file, read_test
+from bendpam.lab import ReadError, inspect_file, read_test, read_tests
 
 LBF = 4.4482216152605
 
@@ -107,13 +107,20 @@ def _trapezium(arr1, arr2) -> list[str]:
 
 
 def test_japanese_trapezium_shift_jis_two_specimens(tmp_path):
+    # issue 22: two blocks with one header each whose time restarts are two tests (read_tests), not
+    # "the first block read and the second listed"
     a1, a2 = _series(30), _series(25) * [1, 2, 1]
-    raw = read_test(_write(tmp_path / "jp.csv", _trapezium(a1, a2), "shift_jis"))
+    path = _write(tmp_path / "jp.csv", _trapezium(a1, a2), "shift_jis")
+    with pytest.raises(ReadError, match="holds 2 tests in separate blocks"):
+        read_test(path)
+    raw, raw2 = read_tests(path)
     assert raw.encoding == "shift_jis"
     assert raw.dialect == "trapezium"
     _check(raw, a1, ("時間", "ストローク", "試験力"))
+    _check(raw2, a2, ("時間", "ストローク", "試験力"))
+    assert (raw.block, raw2.block) == (1, 2)
     assert raw.metadata["試験名"] == "曲げ試験"
-    assert len(raw.blocks) == 2 and raw.blocks[0]["read"] and not raw.blocks[1]["read"]
+    assert len(raw.blocks) == 2 and raw.blocks[0]["read"] and raw.blocks[1]["read"]
     assert any("2 data blocks" in w for w in raw.warnings)
 
 

@@ -22,6 +22,7 @@ import math
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -326,10 +327,16 @@ def _choose_pressure(pressure_kpa: float | None, meta_pressure: float | None, pa
 def _file_warnings(parsed: Parsed, warnings: list[str]) -> None:
     """What else the file holds: other data blocks, text after the data, undecodable bytes."""
     p, blk = parsed.parser, parsed.block
-    if len(p.blocks) > 1:
-        others = [b for b in p.blocks if b is not blk]
+    others = [b for b in p.blocks if b is not blk and b not in p.joined]
+    if p.joined:
         warnings.append(
-            f"the file holds {len(p.blocks)} data blocks; read the one at {blk.describe()}; "
+            f"the file holds {len(p.joined) + 1} data blocks with the same columns, read one after the other: "
+            f"{'; '.join(b.describe() for b in [blk, *p.joined])}"
+        )
+    if others:
+        warnings.append(
+            f"the file holds {len(p.blocks)} data blocks; read {blk.describe()}"
+            f"{' and the blocks that repeat its header' if p.joined else ''}; "
             f"not read: {'; '.join(b.describe() for b in others)}"
         )
     if p.trailing:
@@ -345,6 +352,25 @@ def _file_warnings(parsed: Parsed, warnings: list[str]) -> None:
         )
 
 
+def _blocks(parsed: Parsed, t: np.ndarray, lines: np.ndarray) -> list[dict[str, Any]]:
+    """Every data block: line, columns, rows, read; for the blocks read, the first sample and whether time continues."""
+    p, blk = parsed.parser, parsed.block
+    out: list[dict[str, Any]] = []
+    for b in p.blocks:
+        d: dict[str, Any] = {"line": b.header_line, "columns": [n for n in b.names if n], "rows": b.n_rows,
+                             "read": b is blk or b in p.joined}  # fmt: skip
+        if d["read"]:
+            i = int(np.searchsorted(lines, b.first_line))
+            d["start"] = i
+            d["lines"] = (b.first_line, b.last_line)
+            d["continues"] = bool(b is blk or (0 < i < t.size and t[i] > t[i - 1]))
+        if b.groups > 1:
+            d["specimens"] = list(b.group_labels)
+            d["specimen"] = b.group
+        out.append(d)
+    return out
+
+
 def _other_columns(blk: Block, ch: ChannelChoice) -> list[str]:
     """The block's columns not used, as written."""
     used = {id(c) for c in ch.chosen.values()}
@@ -354,7 +380,7 @@ def _other_columns(blk: Block, ch: ChannelChoice) -> list[str]:
 
 
 def _samples(parsed: Parsed, rate_hz: float | None, repair: bool, warnings: list[str]) -> tuple[
-        pd.DataFrame, Channels, dict[str, str], str | None, np.ndarray | None, float | None, tuple[int, int],
+        pd.DataFrame, Channels, dict[str, str], str | None, np.ndarray | None, float | None, np.ndarray,
         list[tuple[int, int]]]:
     """Steps 1-3: the checked samples as a frame, with their channels, units, counter, rate and lines."""
     p, blk = parsed.parser, parsed.block
@@ -388,8 +414,7 @@ def _samples(parsed: Parsed, rate_hz: float | None, repair: bool, warnings: list
          "force_n": values.pop("force")},
         copy=False,
     )  # fmt: skip
-    data_lines = (int(samples.lines[0]), int(samples.lines[-1]))
-    return frame, channels, source_units, counter_source, samples.counter, sample_rate, data_lines, segments
+    return frame, channels, source_units, counter_source, samples.counter, sample_rate, samples.lines, segments
 
 
 def assemble(parsed: Parsed, *, fmt: str, pressure_kpa: float | None, rate_hz: float | None,
@@ -438,16 +463,13 @@ def assemble(parsed: Parsed, *, fmt: str, pressure_kpa: float | None, rate_hz: f
     path = Path(label) if isinstance(label, (str, Path)) else Path(str(label))
     assert blk.choice is not None
     warnings = list(p.warnings)
-    frame, channels, source_units, counter_source, counter, sample_rate, data_lines, segments = _samples(
+    frame, channels, source_units, counter_source, counter, sample_rate, lines, segments = _samples(
         parsed, rate_hz, repair, warnings)
+    data_lines = (int(lines[0]), int(lines[-1]))
     metadata, meta_pressure = _metadata(p, blk, label, pressure_kpa)
     pressure, psource = _choose_pressure(pressure_kpa, meta_pressure, path, label)
     _file_warnings(parsed, warnings)
-    blocks = [
-        {"line": b.header_line, "columns": [n for n in b.names if n], "rows": b.n_rows,
-         "read": b is blk}
-        for b in p.blocks
-    ]  # fmt: skip
+    blocks = _blocks(parsed, frame["time_s"].to_numpy(), lines)
     if parsed.source.is_excel:
         metadata.setdefault("sheet", parsed.source.sheet or "")
     return RawTest(

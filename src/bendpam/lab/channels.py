@@ -164,7 +164,7 @@ _STROKE_VOCAB: list[_Entry] = [
            ["位置"]),
     _entry(3, "displacement",
            ["displacement", "extension", "deflection", "position", "weg", "verschiebung",
-            "durchbiegung", "verformung", "verlängerung", "déplacement", "deplacement", "flèche", "distance",
+            "durchbiegung", "verformung", "verlängerung", "déplacement", "deplacement", "flèche", "distance", "disp",
             "fleche", "allongement", "spostamento", "estensione", "posizione", "freccia",
             "allungamento", "abbassamento", "desplazamiento", "extensión", "posición",
             "posicion", "deflexión", "flecha", "alargamiento", "przemieszczenie", "wydłużenie",

@@ -13,6 +13,7 @@ block could be read.
 
 from __future__ import annotations
 
+import dataclasses
 import io
 import math
 import re
@@ -38,7 +39,7 @@ from bendpam.lab.channels import (
     unit_cell,
     unit_factor,
 )
-from bendpam.lab.header import find_header
+from bendpam.lab.header import find_header, group_period
 from bendpam.lab.layout import (
     DELIMITERS,
     LineReader,
@@ -108,6 +109,9 @@ class Block:
         A row naming specimens side by side (column groups), if any.
     header_candidates : list of dict
         The rows scored as the names row (:func:`bendpam.lab.header.find_header`), best first.
+    groups, group_labels, group : int, list of str, int
+        Specimens side by side: the number of column groups, their names, and the 0-based group
+        whose columns :attr:`columns` are (1, [], 0 for one specimen).
 
     Examples
     --------
@@ -137,6 +141,9 @@ class Block:
     specimen_line: int | None = None
     specimens: list[str] | None = None
     header_candidates: list[dict] = field(default_factory=list)
+    groups: int = 1
+    group_labels: list[str] = field(default_factory=list)
+    group: int = 0
 
     def describe(self) -> str:
         """Where the block is and what it holds, for a message."""
@@ -254,6 +261,9 @@ class Parser:
     want_data : bool
         Read the chosen block's numbers (False: only find the blocks, as
         :func:`~bendpam.lab.readers.detect_dialect` does).
+    specimen : int or None
+        For several specimens side by side (column groups), the 0-based group to read (default
+        the first).
 
     Examples
     --------
@@ -279,6 +289,7 @@ class Parser:
         rate_hz: float | None,
         repair: bool,
         want_data: bool = True,
+        specimen: int | None = None,
     ) -> None:
         self.reader = reader
         self.label = label
@@ -296,6 +307,8 @@ class Parser:
         self.first_orphan: int | None = None
         self.dollar = False
         self.warnings: list[str] = []
+        self.joined: list[Block] = []  # blocks after the chosen one that repeat its header, read with it
+        self.specimen = specimen
         self.trailing: list[tuple[int, str]] = []
 
     # -- metadata ----------------------------------------------------------------------------
@@ -348,6 +361,9 @@ class Parser:
             ln = reader.lineno
             if is_blank(line):
                 continue
+            if line.endswith("\x00") and not self.blocks and "\x00" not in line.rstrip("\x00"):
+                line = line.rstrip("\x00")  # a stray NUL at the end of a text line before the data
+                self.warnings.append(f"line {ln}: a NUL byte at the end of the line was ignored")
             if has_control_chars(line):
                 self._binary_line(ln)
             if line.lstrip().startswith("$"):
@@ -389,6 +405,7 @@ class Parser:
             blk = Block(len(self.blocks) + 1, guess.names_line, guess.names, guess.units_line, guess.units,
                         guess.sep, ln, line, cols, specimen_line=guess.specimen_line, specimens=guess.specimens,
                         header_candidates=guess.candidates)  # fmt: skip
+            self._split_groups(blk, pre)
             best = ((0, 0, 0, 0), blk)
         p1 = pre[-1]
         p2 = pre[-2] if len(pre) >= 2 else None
@@ -420,6 +437,27 @@ class Parser:
         blk.summary = looks_like_summary(blk.columns)
         return blk
 
+    def _split_groups(self, blk: Block, pre: list[tuple[int, str]]) -> None:
+        """Several specimens side by side: keep the columns of the asked group, name the groups."""
+        width = len(_trim(split_cells(blk.first_row, blk.sep)))
+        g = group_period(blk.names, width)
+        if g is None:
+            return
+        n = max(len(_trim(blk.names)), width) // g
+        k = min(self.specimen or 0, n - 1)
+        repeated = len(_trim(blk.names)) >= 2 * g
+        lo = k * g if repeated else 0
+        names = blk.names[lo:lo + g]
+        units = blk.units[lo:lo + g] if blk.units is not None else None
+        cols = _make_columns(names, units, blk.header_line, blk.units_line)
+        blk.columns = [dataclasses.replace(c, index=c.index + k * g) for c in cols]
+        label_rows = [split_cells(line, blk.sep) for ln, line in pre if ln in (blk.header_line - 1, blk.specimen_line)]
+        labels = []
+        for j in range(n):
+            found = [c for row in label_rows for c in row[j * g:(j + 1) * g] if c]
+            labels.append(found[0] if found else f"specimen {j + 1}")
+        blk.groups, blk.group_labels, blk.group = n, labels, k
+
     def _usable(self, blk: Block) -> int:
         """2 = time, stroke and force; 1 = stroke and force with a rate; 0 = not usable."""
         ch = blk.choice
@@ -433,13 +471,30 @@ class Parser:
             return 1
         return 0
 
+    def _continues(self, blk: Block, level: int) -> bool:
+        """Does ``blk`` repeat the chosen block's header (same delimiter and names): one more block of its test?"""
+        ch = self.chosen
+        if ch is None or level == 0 or self._usable(ch) != level or blk.sep != ch.sep or not self.want_data:
+            return False
+        return [normalize_name(n) for n in _trim(blk.names)] == [normalize_name(n) for n in _trim(ch.names)]
+
     def _consume_block(self, blk: Block) -> None:
         self.trailing = []
         level = self._usable(blk)
         current = 0 if self.chosen is None else self._usable(self.chosen)
+        if self._continues(blk, level):
+            assert self.chosen is not None and self.data is not None
+            blk.read = True
+            blk.decimal = self.chosen.decimal
+            blk.choice = self.chosen.choice
+            blk.columns = self.chosen.columns
+            self.joined.append(blk)
+            self._read_rows(blk, self.data)
+            return
         if level > current:
             self.chosen = blk
             blk.read = True
+            self.joined = []
             self.trailing = []
             if self.want_data:
                 self.data = ColumnData()
@@ -490,7 +545,7 @@ class Parser:
             return
         needed = self._needed(blk)
         for role, _col in needed:
-            data.cols[role] = []
+            data.cols.setdefault(role, [])
         while True:
             lines = reader.take(_CHUNK_LINES)
             if not lines:
@@ -607,6 +662,10 @@ class Parser:
                 rows.append(vals)
                 lnos.append(ln)
                 blank_run = None
+                continue
+            if blk.groups > 1 and all(col.index >= len(cells) or not cells[col.index] for _r, col in needed):
+                if blank_run is None:  # this specimen's columns have ended (a shorter one side by side)
+                    blank_run = k
                 continue
             num, nonempty = numeric_cells(cells)
             datalike = num >= 2 and 2 * num >= nonempty
@@ -766,7 +825,8 @@ class Parsed:
 
 
 def parse_source(source: Source, *, dialect: str | None, overrides: dict[str, str],
-                 rate_hz: float | None, repair: bool, want_data: bool = True) -> Parsed:  # fmt: skip
+                 rate_hz: float | None, repair: bool, want_data: bool = True,
+                 specimen: int | None = None) -> Parsed:  # fmt: skip
     """Parse one source: its blocks and metadata, and the numbers of the block to read.
 
     Parameters
@@ -775,7 +835,7 @@ def parse_source(source: Source, *, dialect: str | None, overrides: dict[str, st
         The lines (closed when read).
     dialect : str or None
         The format asked for; ``"testxpert"`` makes the decimal comma the default.
-    overrides, rate_hz, repair, want_data
+    overrides, rate_hz, repair, want_data, specimen
         As for :class:`Parser`.
 
     Returns
@@ -802,7 +862,8 @@ def parse_source(source: Source, *, dialect: str | None, overrides: dict[str, st
     default_decimal = "," if dialect == "testxpert" else None
     reader = LineReader(source.lines)
     p = Parser(reader, source.label, mts=mts, default_decimal=default_decimal,
-               overrides=overrides, rate_hz=rate_hz, repair=repair, want_data=want_data)  # fmt: skip
+               overrides=overrides, rate_hz=rate_hz, repair=repair, want_data=want_data,
+               specimen=specimen)  # fmt: skip
     try:
         p.run()
     finally:

@@ -41,6 +41,7 @@ module holds the entry points and the naming of the format.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import re
@@ -280,13 +281,65 @@ def read_test(
     >>> raw.data["force_n"].tolist()                     # N
     [11.8, 11.71, 11.54]
     """
+    raw = _read_one(path, pressure_kpa=pressure_kpa, dialect=dialect, columns=columns, rate_hz=rate_hz,
+                    repair=repair)  # fmt: skip
+    labels = _specimen_labels(raw)
+    if len(labels) > 1:
+        raise ReadError(f"holds {len(labels)} specimens side by side ({', '.join(labels[:4])}"
+                        f"{', ...' if len(labels) > 4 else ''}); read them with read_tests",
+                        raw.path, raw.header_line)  # fmt: skip
+    parts = _split_blocks(raw)
+    if len(parts) > 1:
+        lines = ", ".join(str(t.header_line) for t in parts[1:4])
+        raise ReadError(f"holds {len(parts)} tests in separate blocks (time restarts in the blocks at line(s) "
+                        f"{lines}); read them with read_tests", raw.path, parts[1].header_line)  # fmt: skip
+    return raw
+
+
+def _read_one(path: str | os.PathLike, *, pressure_kpa: float | None, dialect: str | None,
+              columns: Mapping[str, str] | str | None, rate_hz: float | None, repair: bool,
+              specimen: int | None = None) -> RawTest:  # fmt: skip
+    """One pass of the reader: the chosen block (and the blocks that repeat its header) of one specimen."""
     pressure_kpa, rate_hz = _check_options(pressure_kpa, dialect, rate_hz)
     overrides = parse_columns(columns)
     p = Path(path)
     verify_input(p)  # raw files of a bendpam set (simulate-test) are read only as bendpam wrote them
-    parsed = parse_path(p, dialect=dialect, overrides=overrides, rate_hz=rate_hz, repair=repair)
+    parsed = parse_path(p, dialect=dialect, overrides=overrides, rate_hz=rate_hz, repair=repair,
+                        specimen=specimen)  # fmt: skip
     fmt = dialect or _classify_format(parsed)
     return assemble(parsed, fmt=fmt, pressure_kpa=pressure_kpa, rate_hz=rate_hz, repair=repair)
+
+
+def _specimen_labels(raw: RawTest) -> list[str]:
+    for b in raw.blocks:
+        if b.get("read") and b.get("specimens"):
+            return list(b["specimens"])
+    return []
+
+
+def _split_blocks(raw: RawTest) -> list[RawTest]:
+    """The tests of a file whose blocks restart time: one per run of blocks that continue each other."""
+    read = [b for b in raw.blocks if b.get("read")]
+    cuts = [b for b in read[1:] if not b.get("continues", True)]
+    if not cuts:
+        return [raw]
+    groups: list[list[dict[str, Any]]] = [[]]
+    for b in read:
+        if b in cuts:
+            groups.append([])
+        groups[-1].append(b)
+    out = []
+    n = len(raw)
+    for k, group in enumerate(groups):
+        a = int(group[0]["start"])
+        z = int(groups[k + 1][0]["start"]) if k + 1 < len(groups) else n
+        segs = [(max(s, a) - a, min(e, z) - a) for s, e in raw.segments if s < z and e > a]
+        counter = raw.cycle_counter[a:z] if raw.cycle_counter is not None else None
+        out.append(dataclasses.replace(
+            raw, data=raw.data.iloc[a:z].reset_index(drop=True), block=k + 1, segments=segs,
+            cycle_counter=counter, header_line=int(group[0]["line"]),
+            data_lines=(int(group[0]["lines"][0]), int(group[-1]["lines"][1])), warnings=list(raw.warnings)))
+    return out
 
 
 def read_tests(
@@ -328,8 +381,17 @@ def read_tests(
     >>> len(tests), len(tests[0]), tests[0].specimen, tests[0].block
     (1, 2, None, None)
     """
-    return [read_test(path, pressure_kpa=pressure_kpa, dialect=dialect, columns=columns,
-                      rate_hz=rate_hz, repair=repair)]  # fmt: skip
+    kw: dict[str, Any] = {"pressure_kpa": pressure_kpa, "dialect": dialect, "columns": columns,
+                          "rate_hz": rate_hz, "repair": repair}  # fmt: skip
+    raw = _read_one(path, **kw)
+    labels = _specimen_labels(raw)
+    if len(labels) <= 1:
+        return _split_blocks(raw)
+    out = [dataclasses.replace(raw, specimen=labels[0])]
+    for k in range(1, len(labels)):
+        other = _read_one(path, specimen=k, **kw)
+        out.append(dataclasses.replace(other, specimen=labels[k]))
+    return out
 
 
 def detect_dialect(path_or_text_lines: str | os.PathLike | Iterable[str]) -> str:
