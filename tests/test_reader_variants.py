@@ -241,7 +241,7 @@ def test_no_time_column_with_rate_in_metadata(tmp_path):
     assert raw.channels["time"]["source"] is None and "2 Hz" in raw.channels["time"]["why"]
     _check(raw, arr, (None, "Extension (mm)", "Load (N)"))
     info = inspect_file(tmp_path / "rate.csv")
-    assert info["columns"]["time"] == {"source": None, "unit": "s"}
+    assert info["columns"]["time"] == {"source": None, "unit": "s", "candidates": []}
 
 
 def test_no_time_column_with_rate_option_or_error(tmp_path):

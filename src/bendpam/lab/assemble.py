@@ -27,7 +27,15 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from bendpam.lab.channels import DEFAULT_UNIT, ROLES, UNIT_HINT, ChannelChoice, canonical_unit, unit_factor
+from bendpam.lab.channels import (
+    DEFAULT_UNIT,
+    ROLES,
+    UNIT_HINT,
+    ChannelChoice,
+    canonical_unit,
+    classify_column,
+    unit_factor,
+)
 from bendpam.lab.checks import find_spikes, padding_rows, time_structure
 from bendpam.lab.parser import Block, ColumnData, Parsed, Parser
 from bendpam.lab.pressure import (
@@ -352,6 +360,27 @@ def _file_warnings(parsed: Parsed, warnings: list[str]) -> None:
         )
 
 
+def _channel_candidates(blk: Block) -> dict[str, list[dict[str, Any]]]:
+    """Every column that could play each role, with its score (name rank, unit) and reasons."""
+    out: dict[str, list[dict[str, Any]]] = {r: [] for r in ROLES}
+    chosen = blk.choice.chosen if blk.choice is not None else {}
+    for col in blk.columns:
+        for c in classify_column(col):
+            if c.role not in out:
+                continue
+            is_chosen = c.role in chosen and chosen[c.role].index == col.index
+            reasons = [f"named as {c.kind} (rank {c.rank})",
+                       f"unit {col.unit!r} fits" if col.unit and c.unit_ok else
+                       ("no unit" if not col.unit else f"unit {col.unit!r} does not fit")]  # fmt: skip
+            if is_chosen and blk.choice is not None:
+                reasons.append("chosen: " + blk.choice.why.get(c.role, ""))
+            score = c.rank + (10 if is_chosen else 0) - (0 if c.unit_ok else 5)
+            out[c.role].append({"column": col.source, "score": score, "reasons": "; ".join(reasons)})
+    for role in out:
+        out[role].sort(key=lambda d: -d["score"])
+    return out
+
+
 def _blocks(parsed: Parsed, t: np.ndarray, lines: np.ndarray) -> list[dict[str, Any]]:
     """Every data block: line, columns, rows, read; for the blocks read, the first sample and whether time continues."""
     p, blk = parsed.parser, parsed.block
@@ -364,6 +393,9 @@ def _blocks(parsed: Parsed, t: np.ndarray, lines: np.ndarray) -> list[dict[str, 
             d["start"] = i
             d["lines"] = (b.first_line, b.last_line)
             d["continues"] = bool(b is blk or (0 < i < t.size and t[i] > t[i - 1]))
+        if b is blk:
+            d["header_candidates"] = list(b.header_candidates)
+            d["channel_candidates"] = _channel_candidates(b)
         if b.groups > 1:
             d["specimens"] = list(b.group_labels)
             d["specimen"] = b.group

@@ -119,10 +119,10 @@ def _between_ok(cells: list[str], names: list[str], width: int) -> str | None:
     n_names = _trimmed_len(names)
     n = _trimmed_len(cells)
     num, _ne = numeric_cells(cells)
+    if 2 <= len(nonempty) <= max(2, width // 2) and len(nonempty) < n and num == 0 and not cells[1]:
+        return "specimen names"
     if n >= 2 and abs(n - n_names) <= 1 and len(nonempty) >= max(2, n_names - 1):
         return "one cell per column (channel metadata)"
-    if 2 <= len(nonempty) <= max(2, width // 2) and num == 0:
-        return "specimen names"
     return None
 
 

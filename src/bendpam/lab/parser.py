@@ -670,7 +670,8 @@ class Parser:
             num, nonempty = numeric_cells(cells)
             datalike = num >= 2 and 2 * num >= nonempty
             if not datalike:
-                repeated = [normalize_name(c) for c in cells] == names_norm
+                repeated = [normalize_name(c) for c in cells] == names_norm or any(
+                    [normalize_name(c) for c in split_cells(nxt, sep)] == names_norm for nxt in lines[k + 1:k + 3])
                 if blank_run is not None or repeated or _role_hits(cells) >= 2:
                     end = blank_run if blank_run is not None else k
                     break

@@ -86,6 +86,7 @@ __all__ = [
     "format_inspection",
     "inspect_file",
     "is_pressure_key",
+    "looks_dead",
     "parse_columns",
     "parse_pressure",
     "pressure_from_filename",
@@ -307,7 +308,89 @@ def _read_one(path: str | os.PathLike, *, pressure_kpa: float | None, dialect: s
     parsed = parse_path(p, dialect=dialect, overrides=overrides, rate_hz=rate_hz, repair=repair,
                         specimen=specimen)  # fmt: skip
     fmt = dialect or _classify_format(parsed)
-    return assemble(parsed, fmt=fmt, pressure_kpa=pressure_kpa, rate_hz=rate_hz, repair=repair)
+    alternates = _alternates(parsed, overrides)
+    raw = assemble(parsed, fmt=fmt, pressure_kpa=pressure_kpa, rate_hz=rate_hz, repair=repair)
+    for role, names in alternates.items():
+        raw = _replace_dead(raw, role, names, path=path, pressure_kpa=pressure_kpa, dialect=dialect,
+                            overrides=overrides, rate_hz=rate_hz, repair=repair, specimen=specimen)  # fmt: skip
+    return raw
+
+
+_ROLE_COL = {"stroke": "stroke_mm", "force": "force_n"}
+
+
+def _alternates(parsed: Parsed, overrides: Mapping[str, str]) -> dict[str, list[str]]:
+    """Other columns named for stroke and force (best rank first), for roles not given by the caller."""
+    from bendpam.lab.channels import classify_column
+
+    blk = parsed.block
+    chosen = blk.choice.chosen if blk.choice is not None else {}
+    out: dict[str, list[str]] = {}
+    for role in ("stroke", "force"):
+        if role in overrides or role not in chosen:
+            continue
+        cands = [c for col in blk.columns for c in classify_column(col)
+                 if c.role == role and c.unit_ok and c.rank > 0 and col.index != chosen[role].index]  # fmt: skip
+        names = [c.column.source for c in sorted(cands, key=lambda c: -c.rank)]
+        if names:
+            out[role] = names[:3]
+    return out
+
+
+def looks_dead(x: np.ndarray) -> bool:
+    """A channel whose whole range is within its sample-to-sample noise (a dead or unplugged sensor).
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        The channel's samples.
+
+    Returns
+    -------
+    bool
+        True when the range (max - min) is below 20 median steps, or zero.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> rng = np.random.default_rng(0)
+    >>> looks_dead(0.2 * rng.standard_normal(500)), looks_dead(np.linspace(0.0, 373.0, 500))   # N
+    (True, False)
+    """
+    v = np.asarray(x, dtype=np.float64)
+    v = v[np.isfinite(v)]
+    if v.size < 10:
+        return False
+    span = float(v.max() - v.min())
+    step = float(np.median(np.abs(np.diff(v))))
+    return span == 0.0 or span < 20.0 * step
+
+
+def _replace_dead(raw: RawTest, role: str, names: list[str], *, path: str | os.PathLike, **kw: Any) -> RawTest:
+    """Read an alternate column when the chosen one looks dead and the alternate moves (10x its range or more)."""
+    col = _ROLE_COL[role]
+    x = raw.data[col].to_numpy()
+    if not looks_dead(x):
+        return raw
+    span = float(np.ptp(x)) if x.size else 0.0
+    overrides = dict(kw.pop("overrides"))
+    for name in names:
+        try:
+            parsed = parse_path(Path(path), overrides={**overrides, role: name}, **{
+                k: kw[k] for k in ("dialect", "rate_hz", "repair", "specimen")})
+            alt = assemble(parsed, fmt=raw.dialect, pressure_kpa=kw["pressure_kpa"], rate_hz=kw["rate_hz"],
+                           repair=kw["repair"])  # fmt: skip
+        except ReadError:
+            continue
+        y = alt.data[col].to_numpy()
+        if len(alt) == len(raw) and not looks_dead(y) and float(np.ptp(y)) >= 10.0 * span:
+            dead = raw.channels[role]["source"]
+            alt.channels[role]["why"] = (f"{dead!r} looks dead (range {span:.3g} within its noise); "
+                                         f"{name!r} moves over {float(np.ptp(y)):.3g}")  # fmt: skip
+            alt.warnings.append(f"the {role} column {dead!r} looks dead (range {span:.3g} within its noise); "
+                                f"read {name!r} instead")  # fmt: skip
+            return alt
+    return raw
 
 
 def _specimen_labels(raw: RawTest) -> list[str]:
@@ -462,10 +545,14 @@ def inspect_file(
     -------
     dict
         ``{"file", "format", "encoding", "delimiter", "decimal", "header_line", "n_samples",
-        "columns": {"time": {"source", "unit"}, "stroke": {...}, "force": {...}},
+        "columns": {"time": {"source", "unit", "candidates"}, "stroke": {...}, "force": {...}},
         "other_columns", "first": {"time_s", "stroke_mm", "force_n"}, "last": {...},
-        "metadata", "pressure_kpa", "cycle_counter": {"source", "max"} or None, "warnings"}``;
-        for a file that cannot be read ``{"file", "error"}``.  No NaN or infinity anywhere
+        "metadata", "pressure_kpa", "cycle_counter": {"source", "max"} or None, "warnings",
+        "header": {"line", "candidates"}, "specimen", "block", "segments"}``
+        (and ``"tests"``, one summary per test, for a file of several specimens or blocks; the
+        other keys describe the first); ``candidates`` list every column or row scored, each
+        ``{"column" or "line", "score", "reasons"}``, best first.  For a file that cannot be read
+        ``{"file", "error"}``.  No NaN or infinity anywhere
         (None instead).  Values are in s, mm, N and kPa.
 
     Examples
@@ -477,8 +564,10 @@ def inspect_file(
     ...     _ = path.write_text("time_s,stroke_mm,force_n\\n0,0.000,11.80\\n0.05,0.027,11.71\\n")
     ...     info = inspect_file(path)
     ...     bad = inspect_file(Path(folder) / "missing.csv")
-    >>> info["format"], info["n_samples"], info["columns"]["force"], info["pressure_kpa"]
-    ('csv', 2, {'source': 'force_n', 'unit': 'N'}, 150.0)
+    >>> info["format"], info["n_samples"], info["columns"]["force"]["source"], info["pressure_kpa"]
+    ('csv', 2, 'force_n', 150.0)
+    >>> [c["column"] for c in info["columns"]["force"]["candidates"]], info["header"]["line"]
+    (['force_n'], 1)
     >>> sorted(bad)
     ['error', 'file']
     """
@@ -486,11 +575,26 @@ def inspect_file(
 
     name = os.fspath(path)
     try:
-        raw = read_test(path, pressure_kpa=pressure_kpa, columns=columns, rate_hz=rate_hz,
-                        repair=repair)  # fmt: skip
+        tests = read_tests(path, pressure_kpa=pressure_kpa, columns=columns, rate_hz=rate_hz,
+                           repair=repair)  # fmt: skip
     except (BendpamError, ValueError, OSError) as exc:
         return {"file": name, "error": str(exc)}
+    info = _inspect_one(name, tests[0])
+    if len(tests) > 1:
+        info["tests"] = [{"specimen": t.specimen, "block": t.block, "n_samples": len(t),
+                          "first": _row(t, 0), "last": _row(t, len(t) - 1)} for t in tests]  # fmt: skip
+    return info
+
+
+def _row(raw: RawTest, i: int) -> dict[str, float | None]:
+    return {c: _finite_or_none(raw.data[c].iat[i]) for c in COLUMNS}
+
+
+def _inspect_one(name: str, raw: RawTest) -> dict[str, Any]:
+    """The inspection dict of one test."""
     d = raw.data
+    chosen = next((b for b in raw.blocks if b.get("header_candidates") is not None), {})
+    cands = chosen.get("channel_candidates", {})
 
     def row(i: int) -> dict[str, float | None]:
         return {c: _finite_or_none(d[c].iat[i]) for c in COLUMNS}
@@ -509,7 +613,8 @@ def inspect_file(
         "header_line": raw.header_line,
         "n_samples": len(d),
         "columns": {
-            r: {"source": raw.channels[r]["source"], "unit": raw.channels[r]["unit"]} for r in ROLES
+            r: {"source": raw.channels[r]["source"], "unit": raw.channels[r]["unit"],
+                "candidates": list(cands.get(r, []))} for r in ROLES
         },
         "other_columns": list(raw.other_columns),
         "first": row(0),
@@ -518,6 +623,10 @@ def inspect_file(
         "pressure_kpa": _finite_or_none(raw.pressure_kpa) if raw.pressure_kpa is not None else None,
         "cycle_counter": counter,
         "warnings": list(raw.warnings),
+        "header": {"line": raw.header_line, "candidates": list(chosen.get("header_candidates", []))},
+        "specimen": raw.specimen,
+        "block": raw.block,
+        "segments": [list(s) for s in raw.segments],
     }
 
 
