@@ -129,3 +129,15 @@ def test_inspect_reports_header_candidates(tmp_path):
     info = inspect_file(_write(tmp_path / "c.csv", lines))
     cands = info["header"]["candidates"]
     assert cands[0]["line"] == 2 and "units row at line 3" in cands[0]["reasons"]
+
+
+def test_space_aligned_names_with_single_spaces(tmp_path):
+    # MTS BasicTestWare: names hold single spaces and are separated by two or more; numbers right-aligned
+    lines = ["Test: BE-1", "", "Ch 1 Displacement  Ch 1 Force  Time", "mm                 kN          sec"]
+    lines += [f"{0.01 * k:>17.3f}  {0.002 * k:>10.4f}  {0.5 * k:>5.1f}" for k in range(6)]
+    raw = read_test(_write(tmp_path / "btw.dat", lines))
+    assert [raw.channels[r]["source"] for r in ("time", "stroke", "force")] == ["Time", "Ch 1 Displacement",
+                                                                               "Ch 1 Force"]
+    assert raw.delimiter == " " and len(raw) == 6
+    assert raw.data["force_n"].iat[-1] == pytest.approx(10.0)  # 0.01 kN
+    assert raw.data["time_s"].iat[-1] == 2.5

@@ -74,11 +74,17 @@ _BLANK_CHARS = ' \t"\x1a\x0c\x0b\ufeff'
 def split_cells(line: str, sep: str | None) -> list[str]:
     """Split one line at ``sep`` honouring double quotes; cells are stripped and unquoted.
 
+    ``sep=" "`` is a space-aligned table: numbers split at any blanks, names at two or more.
+
     >>> split_cells('"Time";"Load";0,5', ";")
     ['Time', 'Load', '0,5']
+    >>> split_cells("Ch 1 Displacement  Ch 1 Force  Time", " "), split_cells("  0.5 -1.25   3", " ")
+    (['Ch 1 Displacement', 'Ch 1 Force', 'Time'], ['0.5', '-1.25', '3'])
     """
     if sep is None:
         return [line.strip().strip('"').strip()]
+    if sep == " ":
+        return _split_spaces(line)
     if '"' not in line:
         return [c.strip() for c in line.split(sep)]
     try:
@@ -86,6 +92,16 @@ def split_cells(line: str, sep: str | None) -> list[str]:
     except csv.Error:
         return [c.strip().strip('"').strip() for c in line.split(sep)]
     return [c.strip() for c in cells]
+
+
+def _split_spaces(line: str) -> list[str]:
+    """Cells of a space-aligned line: a row of numbers splits at any run of blanks, a names row
+    (names may hold single spaces, ``Ch 1 Force``) at two blanks or more or a tab."""
+    tokens = line.split()
+    num = sum(_NUM_ANY.fullmatch(t) is not None for t in tokens)
+    if tokens and 2 * num >= len(tokens):
+        return tokens
+    return [c.strip('"').strip() for c in re.split(r"\s{2,}|\t", line.strip())]
 
 
 def is_blank(line: str, sep: str | None = None) -> bool:

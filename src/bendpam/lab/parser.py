@@ -236,6 +236,10 @@ def _data_seps(line: str) -> list[str]:
             num, nonempty = numeric_cells(split_cells(line, sep))
             if num >= 2 and 2 * num >= nonempty:
                 out.append(sep)
+    if not out and " " in line.strip():  # a space-aligned table (MTS BasicTestWare, fixed-width exports)
+        num, nonempty = numeric_cells(split_cells(line, " "))
+        if num >= 2 and num == nonempty:
+            out.append(" ")
     return out
 
 
@@ -578,7 +582,7 @@ class Parser:
         try:
             df = pd.read_csv(
                 io.BytesIO("\n".join(lines).encode("utf-8", "surrogatepass")),
-                sep=blk.sep,
+                sep=r"\s+" if blk.sep == " " else blk.sep,
                 decimal=dec,
                 header=None,
                 usecols=sorted(set(idx)),
