@@ -7,9 +7,11 @@ steps, each a function here:
 2. convert the units to s, mm and N (:func:`_convert_units`), or make the time from a sampling
    rate when the block has no time column (:func:`_time_from_rate`);
 3. check the values (:mod:`bendpam.lab.checks`): isolated spikes and absurd magnitudes
-   (:func:`_drop_spikes`), time that does not increase and gaps (:func:`_check_time`), the
-   machine's cycle counter (:func:`_check_counter`); each problem is refused or, with
-   ``repair=True``, removed and reported;
+   (:func:`_drop_spikes`), padding rows at the end (:func:`_drop_padding`), samples out of
+   order in time, restarts, repeated stamps and gaps (:func:`_check_time`: the segments), the
+   machine's cycle counter (:func:`_check_counter`); a wrong number is refused or, with
+   ``repair=True``, removed and reported; what labs write (gaps, restarts, padding) is read and
+   reported;
 4. the metadata and the pressure: option, metadata line or file name (:func:`_metadata`,
    :func:`_choose_pressure`);
 5. what else the file holds (:func:`_file_warnings`): other blocks, text after the data,
@@ -464,8 +466,8 @@ def assemble(parsed: Parsed, *, fmt: str, pressure_kpa: float | None, rate_hz: f
     rate_hz : float or None
         Sampling rate (Hz) for a block without a time column.
     repair : bool
-        Drop spikes and samples where time does not increase, accept gaps (reported in
-        :attr:`RawTest.warnings`), instead of refusing them.
+        Drop spikes and samples out of order in time (reported in :attr:`RawTest.warnings`)
+        instead of refusing them.  Gaps, restarts and padding are read and reported either way.
 
     Returns
     -------
@@ -474,8 +476,8 @@ def assemble(parsed: Parsed, *, fmt: str, pressure_kpa: float | None, rate_hz: f
     Raises
     ------
     ReadError
-        For an unknown unit, a spike, time that does not increase or a gap (without ``repair``),
-        fewer than 2 samples, or a pressure that cannot be read or is out of range.
+        For an unknown unit, a spike or a sample out of order in time (without ``repair``),
+        time that never advances, fewer than 2 samples, or a pressure that cannot be read or is out of range.
 
     Examples
     --------

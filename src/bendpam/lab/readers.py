@@ -15,17 +15,21 @@ The reader is layered, not a list of dialects:
    (``MTS793|MPT|DEU|1|2|,|.|...``) is honoured; quoted or unquoted cells, empty first fields,
    specimen-index columns, trailing empty columns, exponents like ``e-005``.
 3. **Structure**: metadata lines in several grammars, a names row, an optional units row
-   (``(s)``, ``[s]``, ``s``, ``in s``), several data blocks in one file (the one with time,
-   stroke and force is read, the others are listed).
+   (``(s)``, ``[s]``, ``s``, ``in s``), found by scoring the rows above the data
+   (:mod:`bendpam.lab.header`); several data blocks in one file (those that repeat the header
+   of the one read are read with it: one test when time continues, one test per block when it
+   restarts; the others are listed); several specimens side by side (:func:`read_tests`).
 4. **Channels** (:mod:`bendpam.lab.channels`): names in English, German, French, Italian,
    Spanish, Polish, Chinese and Japanese; units s/ms/min, N/kN/lbf, mm/m/in converted.  Where
    several displacement channels exist, the relative crosshead travel is chosen (eq 6 wants the
    stroke from the blocked state); the choice and its reason are recorded, ``columns=``
    overrides it.  A file without time but with a sampling rate (metadata or ``rate_hz=``)
    reads.  A per-cycle summary or a results table is refused with the reason.
-5. **Values** (:mod:`bendpam.lab.checks`): non-finite cells, isolated spikes, time that does
-   not increase and gaps are found and refused (default) or, with ``repair=True``, removed
-   and reported in :attr:`RawTest.warnings`.
+5. **Values** (:mod:`bendpam.lab.checks`): gaps, clock restarts, repeated stamps and padding
+   rows are read and reported (:attr:`RawTest.segments`); non-finite cells, isolated spikes and
+   samples out of order in time are refused (default) or, with ``repair=True``, removed and
+   reported in :attr:`RawTest.warnings`; a dead stroke or force channel is replaced by a named
+   one that moves.
 
 The numeric block is read in chunks of lines by the C parser of :func:`pandas.read_csv`, so
 a 500 MB export is read in bounded memory and linear time; a chunk the C parser cannot read is
@@ -252,8 +256,9 @@ def read_test(
     rate_hz : float, optional
         Sampling rate (Hz) for a file without a time column.
     repair : bool
-        Drop spikes, samples where time does not increase and rows with non-finite values,
-        and accept gaps, reporting each in :attr:`RawTest.warnings` (default: refuse them).
+        Drop spikes, samples out of order in time and rows with non-finite values, reporting
+        each in :attr:`RawTest.warnings` (default: refuse them).  Gaps, clock restarts and
+        padding rows are read and reported either way.
 
     Returns
     -------
