@@ -141,3 +141,12 @@ def test_space_aligned_names_with_single_spaces(tmp_path):
     assert raw.delimiter == " " and len(raw) == 6
     assert raw.data["force_n"].iat[-1] == pytest.approx(10.0)  # 0.01 kN
     assert raw.data["time_s"].iat[-1] == 2.5
+
+
+def test_a_numeric_metadata_row_between_names_and_data(tmp_path):
+    # catman ASCII: a row of zeros among the channel-metadata rows is not a data block
+    lines = ["Zeit  2 - Standardmessrate\tKraft Maschine\tWeg Maschine", "s\tN\tmm",
+             "Sensor: -\tSensor: 1 kN\tSensor: 100 mm", "0\t0\t0", "Tarawert: 0 s\tTarawert: 0 N\tTarawert: 0 mm"]
+    lines += [f"{0.01 * k:.2f}\t{1.5 * k:.1f}\t{0.02 * k:.2f}" for k in range(5)]
+    raw = read_test(_write(tmp_path / "catman.asc", lines))
+    assert raw.header_line == 1 and len(raw) == 5 and raw.data["force_n"].iat[-1] == 6.0

@@ -98,3 +98,9 @@ def test_time_that_never_advances_is_refused(tmp_path):
 def test_read_tests_of_a_single_test_file(tmp_path):
     (raw,) = read_tests(_write(tmp_path, _ramp(0.0, 6)))
     assert raw.specimen is None and raw.block is None and len(raw) == 6 and raw.segments == [(0, 6)]
+
+
+def test_two_end_records_back_at_time_zero_are_dropped(tmp_path):
+    raw = read_test(_write(tmp_path, _ramp(0.0, 30) + "0.0,0.5,0.1\n0.0,0.6,0.2\n"))
+    assert len(raw) == 30 and raw.data["time_s"].iat[-1] == pytest.approx(2.9)
+    assert any("padding" in w and "32, 33" in w for w in raw.warnings)

@@ -244,6 +244,9 @@ def padding_rows(t: np.ndarray, stroke: np.ndarray, force: np.ndarray) -> int:
     n = t.size
     zero = (t == 0) & (stroke == 0) & (force == 0)
     k = int(np.argmin(zero[::-1])) if not zero.all() else 0
-    if n - k >= 3 and t[n - k - 1] < t[n - k - 2] and t[n - k - 1] <= t[0]:
-        k += 1  # an end record whose time goes back to the start (or to 0)
+    m = n - k
+    back = t[:m] <= t[0]  # end records whose time goes back to the start (or to 0)
+    r = int(np.argmin(back[::-1])) if m and not back.all() else 0
+    if r and m - r >= 2 and t[m - r - 1] > t[0] and r <= max(1, min(5, m // 10)):
+        k += r
     return k if k <= n // 2 and n - k >= 2 else 0

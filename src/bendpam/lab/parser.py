@@ -376,7 +376,14 @@ class Parser:
             if seps and pre:
                 blk = self._start_block(pre, line, ln, seps)
                 reader.push_back([line])
+                before = (self.chosen, self.data, list(self.joined), [b.read for b in self.blocks])
                 self._consume_block(blk)
+                if blk.n_rows < 2 and blk not in self.joined and self._more_lines():
+                    # one numeric row among text rows (a channel-metadata row of zeros): not a block;
+                    # the rows above stay candidates for the names row of the next block
+                    self._dissolve(blk, before)
+                    pre.append((ln, line))
+                    continue
                 pre = []
                 if self.chosen is not None and self.chosen.choice is not None and (
                     "time" in self.chosen.choice.chosen and not self.want_data
@@ -391,6 +398,24 @@ class Parser:
             self.text.append((ln, line))
             if self.chosen is not None and self.chosen.read:
                 self.trailing.append((ln, line))
+
+    def _more_lines(self) -> bool:
+        """Are there lines left to read?"""
+        nxt = self.reader.next()
+        if nxt is None:
+            return False
+        self.reader.push_back([nxt])
+        return True
+
+    def _dissolve(self, blk: Block, before: tuple[Any, ...]) -> None:
+        """Undo a block of fewer than 2 rows: the parser's state as it was before it."""
+        self.chosen, self.data, self.joined, reads = before
+        self.blocks.remove(blk)
+        for b, r in zip(self.blocks, reads, strict=False):
+            b.read = r
+        self.block_lines.discard(blk.header_line)
+        if blk.units_line is not None:
+            self.block_lines.discard(blk.units_line)
 
     def _binary_line(self, ln: int) -> None:
         raise ReadError(
@@ -676,7 +701,7 @@ class Parser:
             if not datalike:
                 repeated = [normalize_name(c) for c in cells] == names_norm or any(
                     [normalize_name(c) for c in split_cells(nxt, sep)] == names_norm for nxt in lines[k + 1:k + 3])
-                if blank_run is not None or repeated or _role_hits(cells) >= 2:
+                if blank_run is not None or repeated or _role_hits(cells) >= 2 or blk.n_rows + len(rows) < 2:
                     end = blank_run if blank_run is not None else k
                     break
             role, col, cell = problem
