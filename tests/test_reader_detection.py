@@ -150,3 +150,35 @@ def test_a_numeric_metadata_row_between_names_and_data(tmp_path):
     lines += [f"{0.01 * k:.2f}\t{1.5 * k:.1f}\t{0.02 * k:.2f}" for k in range(5)]
     raw = read_test(_write(tmp_path / "catman.asc", lines))
     assert raw.header_line == 1 and len(raw) == 5 and raw.data["force_n"].iat[-1] == 6.0
+
+
+def test_specimen_groups_separated_by_an_empty_column(tmp_path):
+    lines = ['"C1",,,,"C2",,', '"Temps","Force","Course","","Temps","Force","Course"',
+             '"sec","N","mm","","sec","N","mm"']
+    lines += [f'"{0.1 * k:.1f}","{k}","{0.01 * k:.2f}","","{0.1 * k:.1f}","{3 * k}","{0.02 * k:.2f}"' for k in range(5)]
+    c1, c2 = read_tests(_write(tmp_path / "ms.csv", lines))
+    assert (c1.specimen, c2.specimen) == ("C1", "C2")
+    assert c2.data["force_n"].tolist() == [0.0, 3.0, 6.0, 9.0, 12.0] and c2.data["stroke_mm"].iat[-1] == 0.08
+
+
+def test_space_separated_names_without_inner_spaces(tmp_path):
+    lines = ["Time Stroke Force", "0.0 0.00 1.0", "0.1 0.05 1.5", "0.2 0.10 2.0"]
+    raw = read_test(_write(tmp_path / "ws.txt", lines))
+    assert raw.data["force_n"].tolist() == [1.0, 1.5, 2.0]
+
+
+def test_time_that_restarts_each_cycle_gives_way_to_one_that_runs_through(tmp_path):
+    # 'Prüfzeit' (the better time name) restarts every 4 samples; 'Zeit' runs through
+    lines = ["Prüfzeit (s)\tZeit (s)\tWeg (mm)\tKraft (N)"]
+    lines += [f"{0.1 * (k % 4):.1f}\t{0.1 * k:.1f}\t{0.01 * k:.2f}\t{k}" for k in range(12)]
+    raw = read_test(_write(tmp_path / "cyc.txt", lines))
+    assert raw.channels["time"]["source"] == "Zeit (s)" and raw.segments == [(0, 12)]
+    assert any("restarts or pauses" in w for w in raw.warnings)
+
+
+def test_time_with_a_sample_out_of_order_gives_way_to_another_time(tmp_path):
+    times = [0.0, 0.1, 0.2, 0.05, 0.4, 0.5, 0.6, 0.7]
+    lines = ["Time (s)\tTest time (s)\tStroke (mm)\tForce (N)"]
+    lines += [f"{t}\t{0.1 * k:.1f}\t{0.01 * k:.2f}\t{k}" for k, t in enumerate(times)]
+    raw = read_test(_write(tmp_path / "ooo.txt", lines))
+    assert raw.channels["time"]["source"] == "Test time (s)" and len(raw) == 8

@@ -125,7 +125,8 @@ def _entry(rank: int, kind: str, latin: Sequence[str] = (), cjk: Sequence[str] =
 _TIME_VOCAB: list[_Entry] = [
     _entry(3, "test time",
            ["total time", "test time", "running time", "run time", "prüfzeit", "pruefzeit",
-            "laufzeit", "versuchszeit", "messzeit", "gesamtzeit", "temps total", "temps d essai",
+            "laufzeit", "versuchszeit", "messzeit", "gesamtzeit", "versuchsdauer", "test duration",
+            "temps total", "temps d essai",
             "tempo totale", "tempo di prova", "tiempo total", "tiempo de ensayo", "czas testu",
             "czas badania"],
            ["试验时间", "测试时间", "经过时间", "経過時間", "試験時間"]),

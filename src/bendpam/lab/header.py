@@ -98,16 +98,23 @@ def group_period(names: Sequence[str], width: int) -> int | None:
     3
     >>> group_period(["Force", "Distance", "Time", "Event", "", "", "", ""], 8)
     4
-    >>> group_period(["Time", "Force", "Stroke"], 3) is None
-    True
+    >>> group_period(["Temps", "Force", "Course", "", "Temps", "Force", "Course"], 7)
+    4
+    >>> group_period(["Time", "Force", "Stroke"], 3) is None, group_period(["Time", "Load", "Time"], 3) is None
+    (True, True)
     """
     low = [" ".join(n.split()).casefold() for n in names]
     n = _trimmed_len(low)
-    for g in range(2, max(2, max(n, width) // 2) + 1):
-        if n >= 2 * g and n % g == 0 and all(low[i] == low[i % g] for i in range(n)) and all(low[:g]):
-            return g
-        if n == g and width >= 2 * g and width % g == 0 and all(low[:g]) and len(set(low[:g])) == g:
-            return g
+    for g in range(2, (max(n, width) + 1) // 2 + 1):
+        first = [x for x in low[:g] if x]
+        if len(first) < 2 or len(set(first)) < len(first):
+            continue
+        groups = -(-n // g)
+        if (groups >= 2 and all(low[i] == low[i % g] for i in range(n))
+                and all(not low[i % g] for i in range(n, groups * g))):  # fmt: skip
+            return g  # names repeated per group (an empty separator column may end each group)
+        if n <= g and len(first) == n and width >= 2 * g and width % g == 0:
+            return g  # names above the first group only
     return None
 
 

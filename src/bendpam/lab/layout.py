@@ -101,7 +101,8 @@ def _split_spaces(line: str) -> list[str]:
     num = sum(_NUM_ANY.fullmatch(t) is not None for t in tokens)
     if tokens and 2 * num >= len(tokens):
         return tokens
-    return [c.strip('"').strip() for c in re.split(r"\s{2,}|\t", line.strip())]
+    cells = [c.strip('"').strip() for c in re.split(r"\s{2,}|\t", line.strip())]
+    return cells if len(cells) > 1 else [c.strip('"') for c in tokens]
 
 
 def is_blank(line: str, sep: str | None = None) -> bool:

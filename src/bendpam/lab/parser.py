@@ -472,7 +472,7 @@ class Parser:
         g = group_period(blk.names, width)
         if g is None:
             return
-        n = max(len(_trim(blk.names)), width) // g
+        n = -(-max(len(_trim(blk.names)), width) // g)
         k = min(self.specimen or 0, n - 1)
         repeated = len(_trim(blk.names)) >= 2 * g
         lo = k * g if repeated else 0

@@ -314,24 +314,69 @@ def _read_one(path: str | os.PathLike, *, pressure_kpa: float | None, dialect: s
                         specimen=specimen)  # fmt: skip
     fmt = dialect or _classify_format(parsed)
     alternates = _alternates(parsed, overrides)
-    raw = assemble(parsed, fmt=fmt, pressure_kpa=pressure_kpa, rate_hz=rate_hz, repair=repair)
+    kw: dict[str, Any] = {"pressure_kpa": pressure_kpa, "dialect": dialect, "overrides": overrides,
+                          "rate_hz": rate_hz, "repair": repair, "specimen": specimen}  # fmt: skip
+    try:
+        raw = assemble(parsed, fmt=fmt, pressure_kpa=pressure_kpa, rate_hz=rate_hz, repair=repair)
+    except ReadError as exc:
+        time_col = parsed.block.choice.chosen.get("time") if parsed.block.choice is not None else None
+        if time_col is None or exc.column != time_col.source or not alternates.get("time"):
+            raise
+        raw = _other_time(exc, alternates["time"], p, fmt, **kw)
     for role, names in alternates.items():
-        raw = _replace_dead(raw, role, names, path=path, pressure_kpa=pressure_kpa, dialect=dialect,
-                            overrides=overrides, rate_hz=rate_hz, repair=repair, specimen=specimen)  # fmt: skip
+        if role != "time":
+            raw = _replace_dead(raw, role, names, path=path, **kw)
+        elif len(raw.segments) > 1:
+            raw = _steadier_time(raw, names, p, fmt, **kw)
     return raw
+
+
+def _steadier_time(raw: RawTest, names: list[str], path: Path, fmt: str, **kw: Any) -> RawTest:
+    """A time column that restarts or pauses: another time column that runs through, if one does."""
+    for name in names:
+        try:
+            parsed = parse_path(path, overrides={**kw["overrides"], "time": name},
+                                **{k: kw[k] for k in ("dialect", "rate_hz", "repair", "specimen")})  # fmt: skip
+            alt = assemble(parsed, fmt=fmt, pressure_kpa=kw["pressure_kpa"], rate_hz=kw["rate_hz"],
+                           repair=kw["repair"])  # fmt: skip
+        except ReadError:
+            continue
+        if len(alt) == len(raw) and len(alt.segments) < len(raw.segments):
+            old = raw.channels["time"]["source"]
+            alt.channels["time"]["why"] = (f"{old!r} restarts or pauses ({len(raw.segments)} segments); "
+                                           f"{name!r} runs through ({len(alt.segments)})")  # fmt: skip
+            alt.warnings.append(f"time column {old!r} restarts or pauses; read {name!r}, which runs through")
+            return alt
+    return raw
+
+
+def _other_time(exc: ReadError, names: list[str], path: Path, fmt: str, **kw: Any) -> RawTest:
+    """The chosen time column cannot be a test time (it goes back, it never advances): try the other time columns."""
+    for name in names:
+        try:
+            parsed = parse_path(path, overrides={**kw["overrides"], "time": name},
+                                **{k: kw[k] for k in ("dialect", "rate_hz", "repair", "specimen")})  # fmt: skip
+            raw = assemble(parsed, fmt=fmt, pressure_kpa=kw["pressure_kpa"], rate_hz=kw["rate_hz"],
+                           repair=kw["repair"])  # fmt: skip
+        except ReadError:
+            continue
+        raw.channels["time"]["why"] = f"{exc.column!r} cannot be the test time ({exc.message}); {name!r} can"
+        raw.warnings.append(f"time column {exc.column!r} not used (line {exc.line}: {exc.message}); read {name!r}")
+        return raw
+    raise exc
 
 
 _ROLE_COL = {"stroke": "stroke_mm", "force": "force_n"}
 
 
 def _alternates(parsed: Parsed, overrides: Mapping[str, str]) -> dict[str, list[str]]:
-    """Other columns named for stroke and force (best rank first), for roles not given by the caller."""
+    """Other columns named for time, stroke and force (best rank first), for roles not given by the caller."""
     from bendpam.lab.channels import classify_column
 
     blk = parsed.block
     chosen = blk.choice.chosen if blk.choice is not None else {}
     out: dict[str, list[str]] = {}
-    for role in ("stroke", "force"):
+    for role in ("time", "stroke", "force"):
         if role in overrides or role not in chosen:
             continue
         cands = [c for col in blk.columns for c in classify_column(col)
