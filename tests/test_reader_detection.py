@@ -182,3 +182,15 @@ def test_time_with_a_sample_out_of_order_gives_way_to_another_time(tmp_path):
     lines += [f"{t}\t{0.1 * k:.1f}\t{0.01 * k:.2f}\t{k}" for k, t in enumerate(times)]
     raw = read_test(_write(tmp_path / "ooo.txt", lines))
     assert raw.channels["time"]["source"] == "Test time (s)" and len(raw) == 8
+
+
+def test_quiet_force_channel_gives_way_to_one_that_moves_100_times_more(tmp_path):
+    # a smooth +-0.2 N drift on the load cell (not noise-like) while the machine force reaches 373 N
+    n = 200
+    quiet = np.round(0.2 * np.sin(np.linspace(0, 3, n)), 4)
+    force = np.round(np.linspace(0, 373, n), 3)
+    lines = ["Zeit [s]\tWeg Maschine [mm]\tWägezelle-200 N [N]\tKraft Maschine [N]"]
+    lines += [f"{0.1 * k:.1f}\t{0.01 * k:.2f}\t{quiet[k]}\t{force[k]}" for k in range(n)]
+    raw = read_test(_write(tmp_path / "catman.txt", lines))
+    assert raw.channels["force"]["source"] == "Kraft Maschine [N]"
+    assert any("looks dead" in w and "Wägezelle" in w for w in raw.warnings)

@@ -193,7 +193,9 @@ _FORCE_VOCAB: list[_Entry] = [
            ["試験力", "试验力"]),
     _entry(3, "force",
            ["force", "load", "kraft", "charge", "effort", "forza", "carico", "fuerza", "carga",
-            "obciążenie", "obciazenie", "siła", "sila", "kracht", "belasting"],
+            "obciążenie", "obciazenie", "siła", "sila", "kracht", "belasting", "wägezelle", "waegezelle",
+            "load cell", "loadcell", "kraftaufnehmer", "kraftsensor", "cellule de charge", "cella di carico",
+            "célula de carga", "kraft maschine", "maschinenkraft"],
            ["载荷", "荷载", "负荷", "负载", "荷重", "力值", "拉力"],
            extra=r"\w+kraft" + _E + r"|^力$"),
 ]  # fmt: skip

@@ -133,6 +133,20 @@ def _between_ok(cells: list[str], names: list[str], width: int) -> str | None:
     return None
 
 
+def _runs(rows: list[tuple[int, str]]) -> list[str]:
+    """``line 5: x`` for each row, runs of one kind shown as ``lines 5-31: x (27 rows)``."""
+    out: list[str] = []
+    k = 0
+    while k < len(rows):
+        j = k
+        while j + 1 < len(rows) and rows[j + 1][1] == rows[k][1]:
+            j += 1
+        a, b = rows[k][0], rows[j][0]
+        out.append(f"line {a}: {rows[k][1]}" if j == k else f"lines {a}-{b}: {rows[k][1]} ({j - k + 1} rows)")
+        k = j + 1
+    return out
+
+
 def _score_candidate(pre: Sequence[tuple[int, str]], j: int, sep: str, width: int,
                      role_hits: Callable[[list[str]], int],
                      is_units_row: Callable[[list[str], list[str]], bool]) -> tuple[tuple, HeaderGuess, str] | None:
@@ -144,6 +158,7 @@ def _score_candidate(pre: Sequence[tuple[int, str]], j: int, sep: str, width: in
         return None
     guess = HeaderGuess(sep, ln, names)
     reasons = [f"names {hits} channel(s)"]
+    between: list[tuple[int, str]] = []
     for k in range(j + 1, len(pre)):
         bl, bline = pre[k]
         cells = split_cells(bline, sep)
@@ -156,7 +171,8 @@ def _score_candidate(pre: Sequence[tuple[int, str]], j: int, sep: str, width: in
             return None
         if why == "specimen names" and guess.specimens is None:
             guess.specimen_line, guess.specimens = bl, cells
-        reasons.append(f"line {bl}: {why}")
+        between.append((bl, why))
+    reasons += _runs(between)
     fit = 2 if abs(n_names - width) <= 1 else (1 if group_period(names, width) else 0)
     reasons.append({2: "as many names as data cells", 1: "column groups side by side",
                     0: f"{n_names} names for {width} data cells"}[fit])  # fmt: skip

@@ -367,6 +367,8 @@ def _other_time(exc: ReadError, names: list[str], path: Path, fmt: str, **kw: An
 
 
 _ROLE_COL = {"stroke": "stroke_mm", "force": "force_n"}
+# below these ranges (mm, N) a channel is compared with the other channels named for its role
+_SMALL_SPAN = {"stroke": 0.1, "force": 10.0}
 
 
 def _alternates(parsed: Parsed, overrides: Mapping[str, str]) -> dict[str, list[str]]:
@@ -408,11 +410,12 @@ def looks_dead(x: np.ndarray) -> bool:
     (True, False)
     """
     v = np.asarray(x, dtype=np.float64)
-    v = v[np.isfinite(v)]
+    if not np.isfinite(v).all():
+        v = v[np.isfinite(v)]
     if v.size < 10:
         return False
     span = float(v.max() - v.min())
-    step = float(np.median(np.abs(np.diff(v))))
+    step = float(np.median(np.abs(np.diff(v[:200_001]))))  # the noise, from the first 200 000 samples
     return span == 0.0 or span < 20.0 * step
 
 
@@ -420,9 +423,11 @@ def _replace_dead(raw: RawTest, role: str, names: list[str], *, path: str | os.P
     """Read an alternate column when the chosen one looks dead and the alternate moves (10x its range or more)."""
     col = _ROLE_COL[role]
     x = raw.data[col].to_numpy()
-    if not looks_dead(x):
-        return raw
     span = float(np.ptp(x)) if x.size else 0.0
+    dead = looks_dead(x)
+    if not dead and span >= _SMALL_SPAN[role]:
+        return raw
+    factor = 10.0 if dead else 100.0  # a quiet channel gives way only to one that moves 100 times more
     overrides = dict(kw.pop("overrides"))
     for name in names:
         try:
@@ -433,11 +438,12 @@ def _replace_dead(raw: RawTest, role: str, names: list[str], *, path: str | os.P
         except ReadError:
             continue
         y = alt.data[col].to_numpy()
-        if len(alt) == len(raw) and not looks_dead(y) and float(np.ptp(y)) >= 10.0 * span:
-            dead = raw.channels[role]["source"]
-            alt.channels[role]["why"] = (f"{dead!r} looks dead (range {span:.3g} within its noise); "
+        if len(alt) == len(raw) and not looks_dead(y) and float(np.ptp(y)) >= factor * span:
+            old = raw.channels[role]["source"]
+            what = "within its noise" if dead else f"against {float(np.ptp(y)):.3g} for {name!r}"
+            alt.channels[role]["why"] = (f"{old!r} looks dead (range {span:.3g} {what}); "
                                          f"{name!r} moves over {float(np.ptp(y)):.3g}")  # fmt: skip
-            alt.warnings.append(f"the {role} column {dead!r} looks dead (range {span:.3g} within its noise); "
+            alt.warnings.append(f"the {role} column {old!r} looks dead (range {span:.3g} {what}); "
                                 f"read {name!r} instead")  # fmt: skip
             return alt
     return raw
@@ -713,6 +719,11 @@ def format_inspection(info: Mapping[str, Any]) -> str:
         f"decimal {info.get('decimal')!r}, header at line {info.get('header_line')}"
     )
     out.append(f"  {info.get('n_samples')} samples")
+    tests = info.get("tests") or []
+    if tests:
+        names = [str(t.get("specimen") or f"block {t.get('block')}") for t in tests]
+        shown = ", ".join(names[:6]) + (", ..." if len(names) > 6 else "")
+        out.append(f"  {len(tests)} tests in the file ({shown}); the first is shown")
     cols = info.get("columns") or {}
     for role in ROLES:
         c = cols.get(role) or {}
