@@ -194,3 +194,12 @@ def test_quiet_force_channel_gives_way_to_one_that_moves_100_times_more(tmp_path
     raw = read_test(_write(tmp_path / "catman.txt", lines))
     assert raw.channels["force"]["source"] == "Kraft Maschine [N]"
     assert any("looks dead" in w and "Wägezelle" in w for w in raw.warnings)
+
+
+def test_names_written_over_two_rows(tmp_path):
+    lines = ["Ch 1\t\tTime", "Displacement\tForce\t", "mm\tkN\ts"]
+    lines += [f"{0.01 * k:.2f}\t{0.002 * k:.3f}\t{0.5 * k:.1f}" for k in range(6)]
+    raw = read_test(_write(tmp_path / "two.txt", lines))
+    assert [raw.channels[r]["source"] for r in ("time", "stroke", "force")] == ["Time", "Ch 1 Displacement",
+                                                                               "Ch 1 Force"]
+    assert raw.data["force_n"].iat[-1] == pytest.approx(10.0) and raw.data["time_s"].iat[-1] == 2.5

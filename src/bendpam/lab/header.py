@@ -147,17 +147,34 @@ def _runs(rows: list[tuple[int, str]]) -> list[str]:
     return out
 
 
+def _merged(upper: list[str], lower: list[str]) -> list[str]:
+    """Names written over two rows (``Ch 1`` above ``Force``): the cells joined, the upper carried right."""
+    out, carry = [], ""
+    for k, low in enumerate(lower):
+        up = upper[k] if k < len(upper) else ""
+        carry = up or carry
+        out.append(" ".join(x for x in (carry if up or low else "", low) if x))
+    return out
+
+
 def _score_candidate(pre: Sequence[tuple[int, str]], j: int, sep: str, width: int,
                      role_hits: Callable[[list[str]], int],
                      is_units_row: Callable[[list[str], list[str]], bool]) -> tuple[tuple, HeaderGuess, str] | None:
     ln, line = pre[j]
     names = split_cells(line, sep)
     hits = role_hits(names)
+    two_rows = False
+    if 0 < hits < 3 and j > 0:  # a names row over two rows?
+        upper = split_cells(pre[j - 1][1], sep)
+        if _trimmed_len(upper) >= 2 and abs(_trimmed_len(upper) - _trimmed_len(names)) <= 1:
+            merged = _merged(upper, names)
+            if role_hits(merged) > hits and role_hits(upper) < role_hits(merged):
+                names, hits, two_rows = merged, role_hits(merged), True
     n_names = _trimmed_len(names)
     if n_names < 2 and not (n_names == 1 and width == 1):
         return None
     guess = HeaderGuess(sep, ln, names)
-    reasons = [f"names {hits} channel(s)"]
+    reasons = [f"names {hits} channel(s)" + (" (over two rows)" if two_rows else "")]
     between: list[tuple[int, str]] = []
     for k in range(j + 1, len(pre)):
         bl, bline = pre[k]
