@@ -203,3 +203,24 @@ def test_names_written_over_two_rows(tmp_path):
     assert [raw.channels[r]["source"] for r in ("time", "stroke", "force")] == ["Time", "Ch 1 Displacement",
                                                                                "Ch 1 Force"]
     assert raw.data["force_n"].iat[-1] == pytest.approx(10.0) and raw.data["time_s"].iat[-1] == 2.5
+
+
+def test_one_test_per_values_sheet_of_a_workbook(tmp_path, monkeypatch):
+    # testXpert workbooks hold a 'Values <specimen>' sheet per specimen; the sheets are given here
+    # through the workbook reader (no workbook writer in the dependencies)
+    import bendpam.lab.excel as excel
+
+    def values(k: int) -> list[str]:
+        return ["Test time\tStandard travel\tStandard force", "s\tmm\tN"] + [
+            f"{0.1 * i:.1f}\t{0.01 * i:.2f}\t{k * i}" for i in range(5)]
+
+    sheets = [excel.Sheet("Results", ["Specimen\tFmax", "\tN", "A\t12"]),
+              excel.Sheet("Values A", values(1)), excel.Sheet("Values B", values(3))]
+    monkeypatch.setattr(excel, "workbook_sheets", lambda path: sheets)
+    path = tmp_path / "tx.xlsx"
+    path.write_bytes(b"PK\x03\x04" + bytes(60))
+    with pytest.raises(ReadError, match="holds 2 tests on the sheets 'Values A', 'Values B'"):
+        read_test(path)
+    a, b = read_tests(path)
+    assert (a.specimen, b.specimen) == ("Values A", "Values B")
+    assert b.data["force_n"].tolist() == [0.0, 3.0, 6.0, 9.0, 12.0]

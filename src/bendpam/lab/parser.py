@@ -904,8 +904,8 @@ def parse_source(source: Source, *, dialect: str | None, overrides: dict[str, st
     return Parsed(p, source, p.chosen)
 
 
-def parse_path(path: Path, **kw: Any) -> Parsed:
-    """Parse a file (the first readable sheet of a workbook); ``kw`` as for :func:`parse_source`.
+def parse_path(path: Path, *, sheet: str | None = None, **kw: Any) -> Parsed:
+    """Parse a file (the first readable sheet of a workbook, or the sheet named); ``kw`` as for :func:`parse_source`.
 
     Examples
     --------
@@ -919,6 +919,10 @@ def parse_path(path: Path, **kw: Any) -> Parsed:
     (1, 2, 'utf-8')
     """
     sources, _size = open_source(path)
+    if sheet is not None:
+        sources = [s for s in sources if s.sheet == sheet]
+        if not sources:
+            raise ReadError(f"no sheet {sheet!r} in the workbook", path)
     first_error: ReadError | None = None
     for src in sources:
         try:

@@ -294,6 +294,12 @@ def read_test(
         raise ReadError(f"holds {len(labels)} specimens side by side ({', '.join(labels[:4])}"
                         f"{', ...' if len(labels) > 4 else ''}); read them with read_tests",
                         raw.path, raw.header_line)  # fmt: skip
+    sheets = _other_sheets(raw, pressure_kpa=pressure_kpa, dialect=dialect, columns=columns, rate_hz=rate_hz,
+                           repair=repair)  # fmt: skip
+    if sheets:
+        names = ", ".join(repr(s) for s in [raw.metadata.get("sheet"), *[t.metadata.get("sheet") for t in sheets]])
+        raise ReadError(f"holds {len(sheets) + 1} tests on the sheets {names}; read them with read_tests",
+                        raw.path)  # fmt: skip
     parts = _split_blocks(raw)
     if len(parts) > 1:
         lines = ", ".join(str(t.header_line) for t in parts[1:4])
@@ -304,18 +310,19 @@ def read_test(
 
 def _read_one(path: str | os.PathLike, *, pressure_kpa: float | None, dialect: str | None,
               columns: Mapping[str, str] | str | None, rate_hz: float | None, repair: bool,
-              specimen: int | None = None) -> RawTest:  # fmt: skip
+              specimen: int | None = None, sheet: str | None = None) -> RawTest:  # fmt: skip
     """One pass of the reader: the chosen block (and the blocks that repeat its header) of one specimen."""
     pressure_kpa, rate_hz = _check_options(pressure_kpa, dialect, rate_hz)
     overrides = parse_columns(columns)
     p = Path(path)
     verify_input(p)  # raw files of a bendpam set (simulate-test) are read only as bendpam wrote them
     parsed = parse_path(p, dialect=dialect, overrides=overrides, rate_hz=rate_hz, repair=repair,
-                        specimen=specimen)  # fmt: skip
+                        specimen=specimen, sheet=sheet)  # fmt: skip
     fmt = dialect or _classify_format(parsed)
     alternates = _alternates(parsed, overrides)
     kw: dict[str, Any] = {"pressure_kpa": pressure_kpa, "dialect": dialect, "overrides": overrides,
-                          "rate_hz": rate_hz, "repair": repair, "specimen": specimen}  # fmt: skip
+                          "rate_hz": rate_hz, "repair": repair, "specimen": specimen,
+                          "sheet": sheet}  # fmt: skip
     try:
         raw = assemble(parsed, fmt=fmt, pressure_kpa=pressure_kpa, rate_hz=rate_hz, repair=repair)
     except ReadError as exc:
@@ -336,7 +343,7 @@ def _steadier_time(raw: RawTest, names: list[str], path: Path, fmt: str, **kw: A
     for name in names:
         try:
             parsed = parse_path(path, overrides={**kw["overrides"], "time": name},
-                                **{k: kw[k] for k in ("dialect", "rate_hz", "repair", "specimen")})  # fmt: skip
+                                **{k: kw[k] for k in _PARSE_KEYS})  # fmt: skip
             alt = assemble(parsed, fmt=fmt, pressure_kpa=kw["pressure_kpa"], rate_hz=kw["rate_hz"],
                            repair=kw["repair"])  # fmt: skip
         except ReadError:
@@ -355,7 +362,7 @@ def _other_time(exc: ReadError, names: list[str], path: Path, fmt: str, **kw: An
     for name in names:
         try:
             parsed = parse_path(path, overrides={**kw["overrides"], "time": name},
-                                **{k: kw[k] for k in ("dialect", "rate_hz", "repair", "specimen")})  # fmt: skip
+                                **{k: kw[k] for k in _PARSE_KEYS})  # fmt: skip
             raw = assemble(parsed, fmt=fmt, pressure_kpa=kw["pressure_kpa"], rate_hz=kw["rate_hz"],
                            repair=kw["repair"])  # fmt: skip
         except ReadError:
@@ -367,6 +374,7 @@ def _other_time(exc: ReadError, names: list[str], path: Path, fmt: str, **kw: An
 
 
 _ROLE_COL = {"stroke": "stroke_mm", "force": "force_n"}
+_PARSE_KEYS = ("dialect", "rate_hz", "repair", "specimen", "sheet")  # what parse_path takes of _read_one's keywords
 # below these ranges (mm, N) a channel is compared with the other channels named for its role
 _SMALL_SPAN = {"stroke": 0.1, "force": 10.0}
 
@@ -432,7 +440,7 @@ def _replace_dead(raw: RawTest, role: str, names: list[str], *, path: str | os.P
     for name in names:
         try:
             parsed = parse_path(Path(path), overrides={**overrides, role: name}, **{
-                k: kw[k] for k in ("dialect", "rate_hz", "repair", "specimen")})
+                k: kw[k] for k in ("dialect", "rate_hz", "repair", "specimen", "sheet")})
             alt = assemble(parsed, fmt=raw.dialect, pressure_kpa=kw["pressure_kpa"], rate_hz=kw["rate_hz"],
                            repair=kw["repair"])  # fmt: skip
         except ReadError:
@@ -447,6 +455,27 @@ def _replace_dead(raw: RawTest, role: str, names: list[str], *, path: str | os.P
                                 f"read {name!r} instead")  # fmt: skip
             return alt
     return raw
+
+
+def _other_sheets(raw: RawTest, **kw: Any) -> list[RawTest]:
+    """The tests on the sheets of a workbook after the one read (testXpert writes a 'Values' sheet per specimen)."""
+    sheet = raw.metadata.get("sheet")
+    if not sheet:
+        return []
+    from bendpam.lab.excel import workbook_sheets
+
+    try:
+        names = [s.name for s in workbook_sheets(raw.path)]
+    except Exception:  # the workbook was read a moment ago; a failure now leaves the first test alone
+        return []
+    later = names[names.index(sheet) + 1:] if sheet in names else []
+    out = []
+    for name in later:
+        try:
+            out.append(_read_one(raw.path, sheet=name, **kw))
+        except (ReadError, ValueError):
+            continue
+    return out
 
 
 def _specimen_labels(raw: RawTest) -> list[str]:
@@ -525,6 +554,9 @@ def read_tests(
     raw = _read_one(path, **kw)
     labels = _specimen_labels(raw)
     if len(labels) <= 1:
+        sheets = _other_sheets(raw, **kw)
+        if sheets:
+            return [dataclasses.replace(t, specimen=t.metadata.get("sheet")) for t in [raw, *sheets]]
         return _split_blocks(raw)
     out = [dataclasses.replace(raw, specimen=labels[0])]
     for k in range(1, len(labels)):
