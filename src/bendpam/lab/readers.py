@@ -333,8 +333,8 @@ def _read_one(path: str | os.PathLike, *, pressure_kpa: float | None, dialect: s
     for role, names in alternates.items():
         if role != "time":
             raw = _replace_dead(raw, role, names, path=path, **kw)
-        elif len(raw.segments) > 1:
-            raw = _steadier_time(raw, names, p, fmt, **kw)
+        elif len(raw.segments) > 1 and bool(np.any(np.diff(raw.data["time_s"].to_numpy()) < 0)):
+            raw = _steadier_time(raw, names, p, fmt, **kw)  # the clock restarts: is another one steadier?
     return raw
 
 
