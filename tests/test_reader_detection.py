@@ -224,3 +224,12 @@ def test_one_test_per_values_sheet_of_a_workbook(tmp_path, monkeypatch):
     a, b = read_tests(path)
     assert (a.specimen, b.specimen) == ("Values A", "Values B")
     assert b.data["force_n"].tolist() == [0.0, 3.0, 6.0, 9.0, 12.0]
+
+
+def test_channels_found_by_their_units_when_no_name_is_known(tmp_path):
+    lines = ["Kanal A (s);Kanal B (mm);Kanal C (kN)"]
+    lines += [f"{k};{0.5 * k};{0.25 * k}".replace(".", ",") for k in range(5)]
+    raw = read_test(_write(tmp_path / "units.csv", lines))
+    assert [raw.channels[r]["source"] for r in ("time", "stroke", "force")] == ["Kanal A (s)", "Kanal B (mm)",
+                                                                               "Kanal C (kN)"]
+    assert raw.data["force_n"].iat[-1] == 1000.0 and "only column in kN" in raw.channels["force"]["why"]

@@ -464,8 +464,12 @@ def classify_column(col: ColumnInfo) -> list[Candidate]:
         out.append(Candidate(col, role, rank, kind, unit_ok))
     if not out and ulow and unit_factor("stroke", unit) is not None and not _STROKE_EXCLUDE.search(name):
         # a length channel with an unknown name (a sensor's serial number, '1944 B'): listed
-        # among the alternatives, never chosen without the columns option
+        # among the alternatives, chosen only when it is the one length column of the block
         out.append(Candidate(col, "stroke", 0, "length channel of unknown kind", True))
+    for role, exclude in (("time", _TIME_EXCLUDE), ("force", _FORCE_EXCLUDE)):
+        if not out and ulow and ulow not in ("m", "-", "1") and unit_factor(role, unit) is not None \
+                and not exclude.search(name):
+            out.append(Candidate(col, role, 0, f"{role} channel of unknown kind (by its unit)", True))
     if not _COUNTER_EXCLUDE.search(name) and ulow in _COUNTER_UNITS:
         hit = _best(_COUNTER_VOCAB, name)
         if hit is not None:
@@ -593,6 +597,12 @@ def choose_channels(
         pool = [c for c in cands[role] if c.column.index not in used]
         good = [c for c in pool if c.unit_ok and c.rank > 0]
         unknown = [c for c in pool if c.rank == 0]
+        if not good and len(unknown) == 1 and not [c for c in pool if c.rank > 0]:
+            # no column named for the role: the one column whose unit is the role's
+            choice.chosen[role] = unknown[0].column
+            used.add(unknown[0].column.index)
+            choice.why[role] = f"no column named as {role}: the only column in {unknown[0].column.unit}"
+            continue
         if not good:
             named = [c for c in pool if c.rank > 0]
             if named:
