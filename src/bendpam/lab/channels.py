@@ -543,6 +543,18 @@ def _find_override(columns: Sequence[ColumnInfo], wanted: str) -> ColumnInfo | N
     return None
 
 
+def _by_unit(choice: ChannelChoice, role: str, pool: list[Candidate], used: set[int]) -> bool:
+    """No column named for the role: choose the one column in the role's unit, if there is exactly one."""
+    unknown = [c for c in pool if c.rank == 0]
+    if len(unknown) != 1 or any(c.rank > 0 for c in pool):
+        return False
+    col = unknown[0].column
+    choice.chosen[role] = col
+    used.add(col.index)
+    choice.why[role] = f"no column named as {role}: the only column in {col.unit}"
+    return True
+
+
 def _kind_word(c: Candidate) -> str:
     return f"{c.kind} {c.column.source!r}"
 
@@ -597,11 +609,7 @@ def choose_channels(
         pool = [c for c in cands[role] if c.column.index not in used]
         good = [c for c in pool if c.unit_ok and c.rank > 0]
         unknown = [c for c in pool if c.rank == 0]
-        if not good and len(unknown) == 1 and not [c for c in pool if c.rank > 0]:
-            # no column named for the role: the one column whose unit is the role's
-            choice.chosen[role] = unknown[0].column
-            used.add(unknown[0].column.index)
-            choice.why[role] = f"no column named as {role}: the only column in {unknown[0].column.unit}"
+        if not good and _by_unit(choice, role, pool, used):
             continue
         if not good:
             named = [c for c in pool if c.rank > 0]
