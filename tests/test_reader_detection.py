@@ -233,3 +233,15 @@ def test_channels_found_by_their_units_when_no_name_is_known(tmp_path):
     assert [raw.channels[r]["source"] for r in ("time", "stroke", "force")] == ["Kanal A (s)", "Kanal B (mm)",
                                                                                "Kanal C (kN)"]
     assert raw.data["force_n"].iat[-1] == 1000.0 and "only column in kN" in raw.channels["force"]["why"]
+
+
+def test_german_bluehill_extension_named_dehnung_in_mm(tmp_path):
+    lines = ["Zeit;Dehnung;Standardkraft", "(s);(mm);(N)"] + [f"{k};{k},5;{3 * k}" for k in range(5)]
+    raw = read_test(_write(tmp_path / "dehnung.csv", lines))
+    assert raw.channels["stroke"]["source"] == "Dehnung" and raw.data["stroke_mm"].iat[-1] == 4.5
+
+
+def test_strain_in_percent_is_not_a_stroke(tmp_path):
+    lines = ["Zeit;Dehnung;Standardkraft", "(s);(%);(N)"] + [f"{k};{k},5;{3 * k}" for k in range(5)]
+    with pytest.raises(ReadError, match="no stroke column"):
+        read_test(_write(tmp_path / "pct.csv", lines))

@@ -183,6 +183,7 @@ _STROKE_EXCLUDE = re.compile(
            "load", "charge")
     + r"|速度|最大|最小|平均|目標|目标|指令|设定"
 )  # fmt: skip
+_STRAIN_WORD = re.compile(_words("strain", "dehnung", "nominal strain", "nominale dehnung"))
 _ABSOLUTE = re.compile(_words("abs", "absolute", "absolut", "absolue", "assoluta", "absoluta",
                               "bezwzględna") + r"|绝对|絶対")  # fmt: skip
 
@@ -462,6 +463,10 @@ def classify_column(col: ColumnInfo) -> list[Candidate]:
         elif role == "stroke" and kind == "crosshead travel":
             kind = "crosshead travel (relative)"
         out.append(Candidate(col, role, rank, kind, unit_ok))
+    if not out and ulow and unit_factor("stroke", unit) is not None and _STRAIN_WORD.search(name) \
+            and not _STROKE_EXCLUDE.search(_STRAIN_WORD.sub(" ", name)):
+        # 'Dehnung (mm)', 'Strain (mm)': Bluehill and testXpert name an extension in mm so
+        out.append(Candidate(col, "stroke", 1, "extension (a strain channel in a length unit)", True))
     if not out and ulow and unit_factor("stroke", unit) is not None and not _STROKE_EXCLUDE.search(name):
         # a length channel with an unknown name (a sensor's serial number, '1944 B'): listed
         # among the alternatives, chosen only when it is the one length column of the block
