@@ -132,7 +132,7 @@ _TIME_VOCAB: list[_Entry] = [
            ["试验时间", "测试时间", "经过时间", "経過時間", "試験時間"]),
     _entry(2, "time",
            ["time", "zeit", "temps", "tempo", "tiempo", "czas", "tijd", "tid", "t",
-            "elapsed time", "durée", "duree"],
+            "elapsed time", "durée", "duree", "čas", "cas", "время", "zaman", "aika", "idő"],
            ["时间", "時間", "時刻", "时刻"], extra=r"\w+zeit" + _E),
     _entry(1, "time", ["godzina", "point", "punkt", "points"]),
 ]  # fmt: skip
@@ -170,8 +170,10 @@ _STROKE_VOCAB: list[_Entry] = [
             "allungamento", "abbassamento", "desplazamiento", "extensión", "posición",
             "posicion", "deflexión", "flecha", "alargamiento", "przemieszczenie", "wydłużenie",
             "wydluzenie", "pozycja", "ugięcie", "ugiecie", "elongation", "verplaatsing",
-            "deformation", "deformación", "deformazione"],
-           ["位移", "变形", "伸长", "変位", "伸び", "たわみ", "位置", "挠度", "撓み"],
+            "deformation", "deformación", "deformazione", "deslocamento", "posição", "posicao",
+            "förskjutning", "forskjutning", "posunutí", "posunuti", "dráha", "перемещение",
+            "удлинение", "деформация", "uzama", "deplasman", "siirtymä"],
+           ["位移", "变形", "伸长", "変位", "伸び", "たわみ", "位置", "挠度", "撓み", "拉伸", "压缩", "延伸"],
            extra=r"\w+weg" + _E),
 ]  # fmt: skip
 _STROKE_EXCLUDE = re.compile(
@@ -181,7 +183,7 @@ _STROKE_EXCLUDE = re.compile(
            "velocity", "geschwindigkeit", "vitesse", "velocità", "velocidad", "prędkość",
            "after", "nach", "break", "bruch", "strain", "dehnung", "rotation", "angle", "kraft", "force",
            "load", "charge")
-    + r"|速度|最大|最小|平均|目標|目标|指令|设定"
+    + r"|速度|最大|最小|平均|目標|目标|指令|设定|应变|應變|ひずみ|歪み"
 )  # fmt: skip
 _STRAIN_WORD = re.compile(_words("strain", "dehnung", "nominal strain", "nominale dehnung"))
 _ABSOLUTE = re.compile(_words("abs", "absolute", "absolut", "absolue", "assoluta", "absoluta",
@@ -196,7 +198,8 @@ _FORCE_VOCAB: list[_Entry] = [
            ["force", "load", "kraft", "charge", "effort", "forza", "carico", "fuerza", "carga",
             "obciążenie", "obciazenie", "siła", "sila", "kracht", "belasting", "wägezelle", "waegezelle",
             "load cell", "loadcell", "kraftaufnehmer", "kraftsensor", "cellule de charge", "cella di carico",
-            "célula de carga", "kraft maschine", "maschinenkraft"],
+            "célula de carga", "kraft maschine", "maschinenkraft", "força", "forca", "síla", "sila",
+            "сила", "нагрузка", "kuvvet", "yük", "yuk", "voima", "erő"],
            ["载荷", "荷载", "负荷", "负载", "荷重", "力值", "拉力"],
            extra=r"\w+kraft" + _E + r"|^力$"),
 ]  # fmt: skip
@@ -207,7 +210,7 @@ _FORCE_EXCLUDE = re.compile(
            "geschwindigkeit", "vitesse", "velocidad", "bruch", "break", "after", "nach",
            "moment", "torque", "drehmoment", "stress", "spannung", "contrainte", "sforzo",
            "tensión", "naprężenie", "strain", "dehnung", "preload", "vorkraft")
-    + r"|速度|最大|最小|平均|目標|目标|指令|设定|应力|応力|压力|圧力"
+    + r"|速度|最大|最小|平均|目標|目标|指令|设定|应力|応力|压力|圧力|应变|應變|ひずみ"
 )  # fmt: skip
 
 _COUNTER_VOCAB: list[_Entry] = [
