@@ -245,3 +245,13 @@ def test_strain_in_percent_is_not_a_stroke(tmp_path):
     lines = ["Zeit;Dehnung;Standardkraft", "(s);(%);(N)"] + [f"{k};{k},5;{3 * k}" for k in range(5)]
     with pytest.raises(ReadError, match="no stroke column"):
         read_test(_write(tmp_path / "pct.csv", lines))
+
+
+def test_digits_grouped_by_spaces(tmp_path):
+    # a French-locale spreadsheet export: '1 234,5' with a no-break space
+    lines = ["Temps (s);Déplacement (mm);Force (N)"]
+    lines += [f"{k},0;{k},25;{1000 + 250 * k:,.1f}".replace(",", "\u00a0").replace(".", ",").replace(
+        "\u00a00;", ",0;").replace("\u00a025;", ",25;") for k in range(5)]
+    raw = read_test(_write(tmp_path / "fr.csv", lines))
+    assert raw.data["force_n"].tolist() == [1000.0, 1250.0, 1500.0, 1750.0, 2000.0]
+    assert raw.data["stroke_mm"].iat[-1] == 4.25

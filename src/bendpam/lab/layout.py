@@ -67,6 +67,7 @@ _GROUP_COMMAS = re.compile(r"[+-]?\d{1,3}(?:,\d{3}){2,}")
 _GROUP_DOTS = re.compile(r"[+-]?\d{1,3}(?:\.\d{3}){2,}")
 _COLLIDE_COMMA = re.compile(r"[+-]?\d{1,3}(?:,\d{3})+,\d+(?:[eE][+-]?\d+)?")
 _COLLIDE_DOT = re.compile(r"[+-]?\d{1,3}(?:\.\d{3})+\.\d+(?:[eE][+-]?\d+)?")
+_GROUP_SPACES = re.compile(r"[+-]?\d{1,3}(?:[ \u00a0\u202f\u2009]\d{3})+(?:[.,]\d*)?(?:[eE][+-]?\d+)?")
 _CONTROL = re.compile(r"[\x00-\x08\x0e-\x19\x1b-\x1f\x7f]")
 _BLANK_CHARS = ' \t"\x1a\x0c\x0b\ufeff'
 
@@ -143,7 +144,7 @@ def numeric_cells(cells: list[str]) -> tuple[int, int]:
     for c in cells:
         if c:
             nonempty += 1
-            if _NUM_ANY.fullmatch(c) is not None:
+            if _NUM_ANY.fullmatch(c) is not None or _GROUP_SPACES.fullmatch(c) is not None:
                 num += 1
     return num, nonempty
 
@@ -183,10 +184,14 @@ def parse_number(cell: str, decimal: str) -> NumberParse:
     (6.8902e-05, 1000.5)
     >>> parse_number("1,000,5", ",").problem, parse_number("n/a", ".").problem
     ('thousands', 'nonfinite')
+    >>> parse_number("-1\u00a0234,5", ",").value            # digits grouped by a no-break space
+    -1234.5
     """
     c = cell.strip().replace("\u2212", "-")
     if not c:
         return NumberParse(None, "empty")
+    if _GROUP_SPACES.fullmatch(c):  # digits grouped by (narrow, no-break) spaces: '1 234,5'
+        c = re.sub(r"[ \u00a0\u202f\u2009]", "", c)
     if decimal == ",":
         if _NUM_COMMA.fullmatch(c):
             v = float(c.replace(",", "."))
