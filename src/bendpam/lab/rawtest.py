@@ -91,7 +91,7 @@ class RawTest:
     segments : list of tuple of int
         ``(start, stop)`` sample indices (``stop`` exclusive) of the stretches of continuous
         sampling; a gap in the sampling or a reset of time starts a new one.  One segment
-        ``(0, n)`` for a test without either.
+        ``(0, n)`` for a test read without either; empty (one segment) for a test a script made.
 
     Examples
     --------
