@@ -255,3 +255,13 @@ def test_digits_grouped_by_spaces(tmp_path):
     raw = read_test(_write(tmp_path / "fr.csv", lines))
     assert raw.data["force_n"].tolist() == [1000.0, 1250.0, 1500.0, 1750.0, 2000.0]
     assert raw.data["stroke_mm"].iat[-1] == 4.25
+
+
+def test_extensometer_removed_mid_test_gives_way_to_the_crosshead(tmp_path):
+    # the chosen stroke ('Extension', first of two generic displacements) has empty cells once the
+    # extensometer is removed (line 8 on); the other displacement channel runs through and is read
+    lines = ["Time (s),Extension (mm),Deflection (mm),Load (N)"]
+    lines += [f"{0.1 * k:.1f},{'' if k > 5 else f'{0.001 * k:.3f}'},{0.01 * k:.2f},{k}" for k in range(10)]
+    raw = read_test(_write(tmp_path / "ext.csv", lines))
+    assert raw.channels["stroke"]["source"] == "Deflection (mm)" and len(raw) == 10
+    assert any("stroke column 'Extension (mm)' not used (line 8" in w for w in raw.warnings)

@@ -316,20 +316,23 @@ def _read_one(path: str | os.PathLike, *, pressure_kpa: float | None, dialect: s
     overrides = parse_columns(columns)
     p = Path(path)
     verify_input(p)  # raw files of a bendpam set (simulate-test) are read only as bendpam wrote them
-    parsed = parse_path(p, dialect=dialect, overrides=overrides, rate_hz=rate_hz, repair=repair,
-                        specimen=specimen, sheet=sheet)  # fmt: skip
-    fmt = dialect or _classify_format(parsed)
-    alternates = _alternates(parsed, overrides)
     kw: dict[str, Any] = {"pressure_kpa": pressure_kpa, "dialect": dialect, "overrides": overrides,
                           "rate_hz": rate_hz, "repair": repair, "specimen": specimen,
                           "sheet": sheet}  # fmt: skip
     try:
+        parsed = parse_path(p, overrides=overrides, **{k: kw[k] for k in _PARSE_KEYS})
+    except ReadError as exc:
+        if exc.column is None:
+            raise
+        # a chosen column with cells that are not numbers (an extensometer removed mid-test): another one?
+        found = parse_path(p, overrides=overrides, want_data=False, **{k: kw[k] for k in _PARSE_KEYS})
+        return _other_column(exc, found, _alternates(found, overrides), p, dialect or _classify_format(found), **kw)
+    fmt = dialect or _classify_format(parsed)
+    alternates = _alternates(parsed, overrides)
+    try:
         raw = assemble(parsed, fmt=fmt, pressure_kpa=pressure_kpa, rate_hz=rate_hz, repair=repair)
     except ReadError as exc:
-        time_col = parsed.block.choice.chosen.get("time") if parsed.block.choice is not None else None
-        if time_col is None or exc.column != time_col.source or not alternates.get("time"):
-            raise
-        raw = _other_time(exc, alternates["time"], p, fmt, **kw)
+        raw = _other_column(exc, parsed, alternates, p, fmt, **kw)
     for role, names in alternates.items():
         if role != "time":
             raw = _replace_dead(raw, role, names, path=path, **kw)
@@ -357,18 +360,23 @@ def _steadier_time(raw: RawTest, names: list[str], path: Path, fmt: str, **kw: A
     return raw
 
 
-def _other_time(exc: ReadError, names: list[str], path: Path, fmt: str, **kw: Any) -> RawTest:
-    """The chosen time column cannot be a test time (it goes back, it never advances): try the other time columns."""
-    for name in names:
+def _other_column(exc: ReadError, parsed: Parsed, alternates: dict[str, list[str]], path: Path, fmt: str,
+                  **kw: Any) -> RawTest:  # fmt: skip
+    """The refusal names a chosen column (time that goes back, a cell that is not a number): try the others
+    named for its role; the first that reads is used, with a warning; else the refusal stands."""
+    chosen = parsed.block.choice.chosen if parsed.block.choice is not None else {}
+    role = next((r for r, col in chosen.items() if col.source == exc.column), None)
+    if role is None or not alternates.get(role):
+        raise exc
+    for name in alternates[role]:
         try:
-            parsed = parse_path(path, overrides={**kw["overrides"], "time": name},
-                                **{k: kw[k] for k in _PARSE_KEYS})  # fmt: skip
-            raw = assemble(parsed, fmt=fmt, pressure_kpa=kw["pressure_kpa"], rate_hz=kw["rate_hz"],
+            alt = parse_path(path, overrides={**kw["overrides"], role: name}, **{k: kw[k] for k in _PARSE_KEYS})
+            raw = assemble(alt, fmt=fmt, pressure_kpa=kw["pressure_kpa"], rate_hz=kw["rate_hz"],
                            repair=kw["repair"])  # fmt: skip
         except ReadError:
             continue
-        raw.channels["time"]["why"] = f"{exc.column!r} cannot be the test time ({exc.message}); {name!r} can"
-        raw.warnings.append(f"time column {exc.column!r} not used (line {exc.line}: {exc.message}); read {name!r}")
+        raw.channels[role]["why"] = f"{exc.column!r} cannot be read ({exc.message}); {name!r} can"
+        raw.warnings.append(f"{role} column {exc.column!r} not used (line {exc.line}: {exc.message}); read {name!r}")
         return raw
     raise exc
 
