@@ -20,7 +20,8 @@ A file scores 1 when:
     sampling rate or the sample index is fine);
   - first/last values match to 1e-6 relative + 1e-9 absolute, for each role whose chosen
     column is the truth's own column (an alternative column has other values); nan in the
-    truth is not compared.  With ``per_specimen`` every specimen's first/last are compared.
+    truth is not compared.  With ``per_specimen`` every specimen's first/last are compared;
+    with ``specimens > 1`` and no ``per_specimen``, first/last are those of the first test.
 """
 
 from __future__ import annotations
@@ -127,9 +128,11 @@ def score_entry(path: Path, entry: dict) -> tuple[bool, str]:
         return False, f"{rows} rows in {len(tests)} test(s), truth {entry['rows']}"
     _why, use_first = _check_columns(tests[0], entry)
     why = _check_values(tests[0], entry["first"], {}, use_first, "first test")
+    # several specimens without per_specimen: first/last are those of the first specimen (README)
+    last = tests[0] if int(entry.get("specimens", 1)) > 1 else tests[-1]
     if why is None:
-        _why, use_last = _check_columns(tests[-1], entry)
-        why = _check_values(tests[-1], {}, entry["last"], use_last, "last test")
+        _why, use_last = _check_columns(last, entry)
+        why = _check_values(last, {}, entry["last"], use_last, "last test")
     if why:
         return False, why
     return True, f"{rows} rows in {len(tests)} test(s)"
