@@ -265,3 +265,12 @@ def test_extensometer_removed_mid_test_gives_way_to_the_crosshead(tmp_path):
     raw = read_test(_write(tmp_path / "ext.csv", lines))
     assert raw.channels["stroke"]["source"] == "Deflection (mm)" and len(raw) == 10
     assert any("stroke column 'Extension (mm)' not used (line 8" in w for w in raw.warnings)
+
+
+def test_a_stroke_stuck_at_saturation_gives_way_to_one_that_moves(tmp_path):
+    # the clip gauge (chosen first of two generic displacements) saturates at 2.0 mm from sample 20 of 40
+    lines = ["Time (s)\tExtension (mm)\tDisplacement (mm)\tForce (N)"]
+    lines += [f"{0.1 * k:.1f}\t{min(0.1 * k, 2.0):.2f}\t{0.2 * k:.2f}\t{k}" for k in range(40)]
+    raw = read_test(_write(tmp_path / "sat.txt", lines))
+    assert raw.channels["stroke"]["source"] == "Displacement (mm)" and raw.data["stroke_mm"].iat[-1] == 7.8
+    assert any("stuck" in w for w in raw.warnings)

@@ -435,20 +435,47 @@ def looks_dead(x: np.ndarray) -> bool:
     return span == 0.0 or span < 20.0 * step
 
 
+def _stuck_tail(x: np.ndarray) -> bool:
+    """The last quarter of a moving channel holds one value (an extensometer saturated or taken off)."""
+    n = x.size
+    return n >= 40 and float(np.ptp(x)) > 0 and float(np.ptp(x[(3 * n) // 4:])) == 0.0
+
+
+def _unstuck(raw: RawTest, names: list[str], *, path: str | os.PathLike, **kw: Any) -> RawTest:
+    """A stroke stuck over the last quarter (an extensometer): a named displacement that still moves there."""
+    overrides = dict(kw.pop("overrides"))
+    for name in names:
+        try:
+            parsed = parse_path(Path(path), overrides={**overrides, "stroke": name}, **{k: kw[k] for k in _PARSE_KEYS})
+            alt = assemble(parsed, fmt=raw.dialect, pressure_kpa=kw["pressure_kpa"], rate_hz=kw["rate_hz"],
+                           repair=kw["repair"])  # fmt: skip
+        except ReadError:
+            continue
+        y = alt.data["stroke_mm"].to_numpy()
+        if len(alt) == len(raw) and not _stuck_tail(y) and not looks_dead(y):
+            old = raw.channels["stroke"]["source"]
+            alt.channels["stroke"]["why"] = f"{old!r} is stuck over the last quarter of the test; {name!r} moves"
+            alt.warnings.append(f"the stroke column {old!r} is stuck over the last quarter of the test "
+                                f"(saturated or taken off); read {name!r}, which moves")  # fmt: skip
+            return alt
+    return raw
+
+
 def _replace_dead(raw: RawTest, role: str, names: list[str], *, path: str | os.PathLike, **kw: Any) -> RawTest:
     """Read an alternate column when the chosen one looks dead and the alternate moves (10x its range or more)."""
     col = _ROLE_COL[role]
     x = raw.data[col].to_numpy()
     span = float(np.ptp(x)) if x.size else 0.0
     dead = looks_dead(x)
+    if role == "stroke" and not dead and _stuck_tail(x):
+        return _unstuck(raw, names, path=path, **kw)
     if not dead and span >= _SMALL_SPAN[role]:
         return raw
     factor = 10.0 if dead else 100.0  # a quiet channel gives way only to one that moves 100 times more
     overrides = dict(kw.pop("overrides"))
     for name in names:
         try:
-            parsed = parse_path(Path(path), overrides={**overrides, role: name}, **{
-                k: kw[k] for k in ("dialect", "rate_hz", "repair", "specimen", "sheet")})
+            parsed = parse_path(Path(path), overrides={**overrides, role: name}, **{k: kw[k] for k in _PARSE_KEYS})
             alt = assemble(parsed, fmt=raw.dialect, pressure_kpa=kw["pressure_kpa"], rate_hz=kw["rate_hz"],
                            repair=kw["repair"])  # fmt: skip
         except ReadError:
