@@ -14,7 +14,7 @@ import pytest
 from numpy.testing import assert_allclose
 
 from bendpam.errors import FileFormatError, InputError
-from bendpam.lab import ReadError, inspect_file, read_test
+from bendpam.lab import ReadError, inspect_file, read_test, read_tests
 
 LBF = 4.4482216152605
 
@@ -107,13 +107,20 @@ def _trapezium(arr1, arr2) -> list[str]:
 
 
 def test_japanese_trapezium_shift_jis_two_specimens(tmp_path):
+    # issue 22: two blocks with one header each whose time restarts are two tests (read_tests), not
+    # "the first block read and the second listed"
     a1, a2 = _series(30), _series(25) * [1, 2, 1]
-    raw = read_test(_write(tmp_path / "jp.csv", _trapezium(a1, a2), "shift_jis"))
+    path = _write(tmp_path / "jp.csv", _trapezium(a1, a2), "shift_jis")
+    with pytest.raises(ReadError, match="holds 2 tests in separate blocks"):
+        read_test(path)
+    raw, raw2 = read_tests(path)
     assert raw.encoding == "shift_jis"
     assert raw.dialect == "trapezium"
     _check(raw, a1, ("時間", "ストローク", "試験力"))
+    _check(raw2, a2, ("時間", "ストローク", "試験力"))
+    assert (raw.block, raw2.block) == (1, 2)
     assert raw.metadata["試験名"] == "曲げ試験"
-    assert len(raw.blocks) == 2 and raw.blocks[0]["read"] and not raw.blocks[1]["read"]
+    assert len(raw.blocks) == 2 and raw.blocks[0]["read"] and raw.blocks[1]["read"]
     assert any("2 data blocks" in w for w in raw.warnings)
 
 
@@ -234,7 +241,7 @@ def test_no_time_column_with_rate_in_metadata(tmp_path):
     assert raw.channels["time"]["source"] is None and "2 Hz" in raw.channels["time"]["why"]
     _check(raw, arr, (None, "Extension (mm)", "Load (N)"))
     info = inspect_file(tmp_path / "rate.csv")
-    assert info["columns"]["time"] == {"source": None, "unit": "s"}
+    assert info["columns"]["time"] == {"source": None, "unit": "s", "candidates": []}
 
 
 def test_no_time_column_with_rate_option_or_error(tmp_path):
@@ -306,15 +313,15 @@ def test_time_backwards_refused_and_repaired(tmp_path):
     assert len(raw) == len(arr) - 1 and np.all(np.diff(raw.data["time_s"]) > 0)
 
 
-def test_gap_refused_and_kept_with_repair(tmp_path):
+def test_gap_read_and_reported(tmp_path):
+    # issue 22: a pause in the sampling is what labs write; it is read, reported and splits the series
     arr = _series()
     arr[25:, 0] += 300.0
     p = _zwick_like(tmp_path, arr)
-    with pytest.raises(ReadError, match="gap") as info:
-        read_test(p)
-    assert info.value.line == 29
-    raw = read_test(p, repair=True)
-    assert len(raw) == len(arr) and any("gap" in w for w in raw.warnings)
+    for repair in (False, True):
+        raw = read_test(p, repair=repair)
+        assert len(raw) == len(arr) and raw.segments == [(0, 25), (25, len(arr))]
+        assert any("gap" in w and "line 29" in w for w in raw.warnings)
 
 
 def test_nonfinite_rows_dropped_with_repair(tmp_path):

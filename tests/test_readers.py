@@ -322,16 +322,19 @@ def test_round_trip_fuzz(tmp_path_factory, rows, dialect, language, force_unit):
     try:
         raw = read_test(p)
     except ReadError as exc:
-        assert any(w in str(exc) for w in ("spike", "time does not increase", "gap"))
+        assert any(w in str(exc) for w in ("spike", "time does not increase", "time does not advance"))
         try:
             written = read_test(p, repair=True)  # the checked samples dropped
         except ReadError as again:
-            assert "expected at least 2" in str(again)
+            assert "expected at least 2" in str(again) or "time does not advance" in str(again)
         else:
             assert len(written.data) < len(df)
         return
     assert raw.dialect == dialect
-    assert_allclose(raw.data.to_numpy(), df.to_numpy(), rtol=1e-8, atol=1e-300)
+    # gaps and resets are read (issue 22: reported, not refused); padding rows at the end are dropped
+    n = len(raw.data)
+    assert n == len(df) or any("padding" in w for w in raw.warnings)
+    assert_allclose(raw.data.to_numpy(), df.to_numpy()[:n], rtol=1e-8, atol=1e-300)
 
 
 def test_overwrite_is_atomic_and_replaces(tmp_path):

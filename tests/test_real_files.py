@@ -227,10 +227,13 @@ def test_inspect_file_shape(name):
     assert list(info) == [
         "file", "format", "encoding", "delimiter", "decimal", "header_line", "n_samples",
         "columns", "other_columns", "first", "last", "metadata", "pressure_kpa", "cycle_counter",
-        "warnings",
+        "warnings", "header", "specimen", "block", "segments",
     ]  # fmt: skip
     assert set(info["columns"]) == {"time", "stroke", "force"}
-    assert all(set(c) == {"source", "unit"} for c in info["columns"].values())
+    # issue 22: every candidate column with its score (a time made from a rate has none)
+    assert all(set(c) == {"source", "unit", "candidates"} for c in info["columns"].values())
+    for c in info["columns"].values():
+        assert c["source"] is None or c["candidates"][0]["column"] == c["source"]
     assert set(info["first"]) == set(info["last"]) == {"time_s", "stroke_mm", "force_n"}
     assert info["format"] in FORMATS
     assert _no_nan(info)

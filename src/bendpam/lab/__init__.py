@@ -1,7 +1,8 @@
 """Raw four-point-bending tests: read and write testing-machine exports.
 
 A raw test at one pressure is a time series of time (s), crosshead stroke (mm) and force (N).
-:func:`read_test` reads the exports of real testing machines (Zwick testXpert, Instron
+:func:`read_test` (one test) and :func:`read_tests` (every test of a file) read the exports
+of real testing machines (Zwick testXpert, Instron
 Bluehill/WaveMatrix/console, MTS 793 and TestSuite, Shimadzu Trapezium, plain CSV, ``.xlsx``/
 ``.xls`` workbooks; the layout, encoding and channels are found from the content) into a
 :class:`RawTest`; :func:`inspect_file` reports how a file reads; :func:`write_test` writes

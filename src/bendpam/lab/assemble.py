@@ -7,9 +7,11 @@ steps, each a function here:
 2. convert the units to s, mm and N (:func:`_convert_units`), or make the time from a sampling
    rate when the block has no time column (:func:`_time_from_rate`);
 3. check the values (:mod:`bendpam.lab.checks`): isolated spikes and absurd magnitudes
-   (:func:`_drop_spikes`), time that does not increase and gaps (:func:`_check_time`), the
-   machine's cycle counter (:func:`_check_counter`); each problem is refused or, with
-   ``repair=True``, removed and reported;
+   (:func:`_drop_spikes`), padding rows at the end (:func:`_drop_padding`), samples out of
+   order in time, restarts, repeated stamps and gaps (:func:`_check_time`: the segments), the
+   machine's cycle counter (:func:`_check_counter`); a wrong number is refused or, with
+   ``repair=True``, removed and reported; what labs write (gaps, restarts, padding) is read and
+   reported;
 4. the metadata and the pressure: option, metadata line or file name (:func:`_metadata`,
    :func:`_choose_pressure`);
 5. what else the file holds (:func:`_file_warnings`): other blocks, text after the data,
@@ -18,15 +20,25 @@ steps, each a function here:
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pandas as pd
 
-from bendpam.lab.channels import DEFAULT_UNIT, ROLES, UNIT_HINT, ChannelChoice, canonical_unit, unit_factor
-from bendpam.lab.checks import find_spikes, time_problems
+from bendpam.lab.channels import (
+    DEFAULT_UNIT,
+    ROLES,
+    UNIT_HINT,
+    ChannelChoice,
+    canonical_unit,
+    classify_column,
+    unit_factor,
+)
+from bendpam.lab.checks import find_spikes, padding_rows, time_structure
 from bendpam.lab.parser import Block, ColumnData, Parsed, Parser
 from bendpam.lab.pressure import (
     PRESSURE_RANGE_TEXT,
@@ -190,53 +202,73 @@ def _drop_spikes(samples: _Samples, channels: Channels, label: Path | str, repai
         samples.keep(keep)
 
 
+def _drop_padding(samples: _Samples, channels: Channels, warnings: list[str]) -> None:
+    """Drop padding rows at the end (rows of zeros, an end record whose time goes back to the start)."""
+    v = samples.values
+    if channels["time"]["source"] is None and channels["stroke"]["source"] is None:
+        return
+    k = padding_rows(v["time"], v["stroke"], v["force"]) if channels["time"]["source"] is not None else \
+        padding_rows(np.zeros_like(v["force"]), v["stroke"], v["force"])
+    if k:
+        lines = samples.lines[-k:].tolist()
+        warnings.append(f"dropped {k} padding row(s) at the end (zeros, or time back to the start) "
+                        f"at line(s) {_lines_text(lines)}")  # fmt: skip
+        keep = np.ones(samples.lines.size, dtype=bool)
+        keep[-k:] = False
+        samples.keep(keep)
+
+
 def _check_time(samples: _Samples, channels: Channels, label: Path | str, repair: bool,
-                warnings: list[str]) -> None:  # fmt: skip
-    """Refuse (or drop, with ``repair``) time that does not increase; refuse (or accept) gaps."""
+                warnings: list[str]) -> list[tuple[int, int]]:  # fmt: skip
+    """Refuse (or drop, with ``repair``) samples out of order; report resets, repeats and gaps; the segments."""
     t = samples.values["time"]
     if channels["time"]["source"] is None:
-        return
-    tp = time_problems(t)
+        return [(0, t.size)]
+    ts = time_structure(t)
     tname = channels["time"]["source"]
-    if tp.backwards.size:
+    if math.isnan(ts.median_step_s):
+        raise ReadError(
+            f"time does not advance in column {tname!r}: all {t.size} samples at {_fmt(t[0])} s or going back "
+            f"(lines {int(samples.lines[0])}-{int(samples.lines[-1])}); expected a time series",
+            label, int(samples.lines[0]), tname)  # fmt: skip
+    if ts.glitches.size:
         lines = samples.lines
-        i = int(tp.backwards[0])
+        i = int(ts.glitches[0])
+        where = f"({ts.glitches.size} sample(s), at line(s) {_lines_text(lines[ts.glitches].tolist())})"
         if not repair:
             raise ReadError(
-                f"time does not increase in column {tname!r}: {_fmt(t[i - 1])} s then "
-                f"{_fmt(t[i])} s ({tp.backwards.size} sample(s), at line(s) "
-                f"{_lines_text(lines[tp.backwards].tolist())}); expected increasing time "
-                "(read with repair=True to drop such samples)",
+                f"time does not increase in column {tname!r}: {_fmt(t[i - 1])} s then {_fmt(t[i])} s, "
+                f"then {_fmt(t[min(i + 1, t.size - 1)])} s: a sample out of order {where}; expected "
+                "increasing time (read with repair=True to drop such samples)",
                 label,
                 int(lines[i]),
                 tname,
             )
-        warnings.append(
-            f"dropped {tp.backwards.size} sample(s) where time does not increase, at line(s) "
-            f"{_lines_text(lines[tp.backwards].tolist())}"
-        )
+        warnings.append(f"dropped the sample(s) out of order in time {where}")
         k2 = np.ones(t.size, dtype=bool)
-        k2[tp.backwards] = False
+        k2[ts.glitches] = False
         samples.keep(k2)
         t = samples.values["time"]
-        tp = time_problems(t)
-    if tp.gaps.size:
-        lines = samples.lines
-        i = int(tp.gaps[0])
-        gap = t[i] - t[i - 1]
-        msg = (
-            f"gap in the sampling: {_fmt(gap)} s between line {int(lines[i - 1])} and line "
-            f"{int(lines[i])} against a median step of {_fmt(tp.median_step_s)} s "
-            f"({tp.gaps.size} gap(s), at line(s) {_lines_text(lines[tp.gaps].tolist())})"
+        ts = time_structure(t)
+    lines = samples.lines
+    if ts.repeats.size:
+        warnings.append(f"time {tname!r} repeats the previous sample's value at {ts.repeats.size} sample(s), "
+                        f"line(s) {_lines_text(lines[ts.repeats].tolist())}; kept")  # fmt: skip
+    if ts.resets.size:
+        i = int(ts.resets[0])
+        warnings.append(
+            f"time {tname!r} restarts {ts.resets.size} time(s), at line(s) "
+            f"{_lines_text(lines[ts.resets].tolist())} (first: {_fmt(t[i - 1])} s then {_fmt(t[i])} s); "
+            "each run is a segment of the series"
         )
-        if not repair:
-            raise ReadError(
-                msg + "; expected regular sampling (read with repair=True to accept the gaps)",
-                label,
-                int(lines[i]),
-                tname,
-            )
-        warnings.append(msg + "; kept (no samples to restore)")
+    if ts.gaps.size:
+        i = int(ts.gaps[0])
+        warnings.append(
+            f"gap in the sampling: {_fmt(t[i] - t[i - 1])} s between line {int(lines[i - 1])} and line "
+            f"{int(lines[i])} against a median step of {_fmt(ts.median_step_s)} s ({ts.gaps.size} gap(s), "
+            f"at line(s) {_lines_text(lines[ts.gaps].tolist())}); the series is split there"
+        )
+    return ts.segments(t.size)
 
 
 def _check_counter(samples: _Samples, ch: ChannelChoice, data: ColumnData, warnings: list[str]) -> str | None:
@@ -305,10 +337,16 @@ def _choose_pressure(pressure_kpa: float | None, meta_pressure: float | None, pa
 def _file_warnings(parsed: Parsed, warnings: list[str]) -> None:
     """What else the file holds: other data blocks, text after the data, undecodable bytes."""
     p, blk = parsed.parser, parsed.block
-    if len(p.blocks) > 1:
-        others = [b for b in p.blocks if b is not blk]
+    others = [b for b in p.blocks if b is not blk and b not in p.joined]
+    if p.joined:
         warnings.append(
-            f"the file holds {len(p.blocks)} data blocks; read the one at {blk.describe()}; "
+            f"the file holds {len(p.joined) + 1} data blocks with the same columns, read one after the other: "
+            f"{'; '.join(b.describe() for b in [blk, *p.joined])}"
+        )
+    if others:
+        warnings.append(
+            f"the file holds {len(p.blocks)} data blocks; read {blk.describe()}"
+            f"{' and the blocks that repeat its header' if p.joined else ''}; "
             f"not read: {'; '.join(b.describe() for b in others)}"
         )
     if p.trailing:
@@ -324,6 +362,49 @@ def _file_warnings(parsed: Parsed, warnings: list[str]) -> None:
         )
 
 
+def _channel_candidates(blk: Block) -> dict[str, list[dict[str, Any]]]:
+    """Every column that could play each role, with its score (name rank, unit) and reasons."""
+    out: dict[str, list[dict[str, Any]]] = {r: [] for r in ROLES}
+    chosen = blk.choice.chosen if blk.choice is not None else {}
+    for col in blk.columns:
+        for c in classify_column(col):
+            if c.role not in out:
+                continue
+            is_chosen = c.role in chosen and chosen[c.role].index == col.index
+            reasons = [f"named as {c.kind} (rank {c.rank})",
+                       f"unit {col.unit!r} fits" if col.unit and c.unit_ok else
+                       ("no unit" if not col.unit else f"unit {col.unit!r} does not fit")]  # fmt: skip
+            if is_chosen and blk.choice is not None:
+                reasons.append("chosen: " + blk.choice.why.get(c.role, ""))
+            score = c.rank + (10 if is_chosen else 0) - (0 if c.unit_ok else 5)
+            out[c.role].append({"column": col.source, "score": score, "reasons": "; ".join(reasons)})
+    for role in out:
+        out[role].sort(key=lambda d: -d["score"])
+    return out
+
+
+def _blocks(parsed: Parsed, t: np.ndarray, lines: np.ndarray) -> list[dict[str, Any]]:
+    """Every data block: line, columns, rows, read; for the blocks read, the first sample and whether time continues."""
+    p, blk = parsed.parser, parsed.block
+    out: list[dict[str, Any]] = []
+    for b in p.blocks:
+        d: dict[str, Any] = {"line": b.header_line, "columns": [n for n in b.names if n], "rows": b.n_rows,
+                             "read": b is blk or b in p.joined}  # fmt: skip
+        if d["read"]:
+            i = int(np.searchsorted(lines, b.first_line))
+            d["start"] = i
+            d["lines"] = (b.first_line, b.last_line)
+            d["continues"] = bool(b is blk or (0 < i < t.size and t[i] > t[i - 1]))
+        if b is blk:
+            d["header_candidates"] = list(b.header_candidates)
+            d["channel_candidates"] = _channel_candidates(b)
+        if b.groups > 1:
+            d["specimens"] = list(b.group_labels)
+            d["specimen"] = b.group
+        out.append(d)
+    return out
+
+
 def _other_columns(blk: Block, ch: ChannelChoice) -> list[str]:
     """The block's columns not used, as written."""
     used = {id(c) for c in ch.chosen.values()}
@@ -333,7 +414,8 @@ def _other_columns(blk: Block, ch: ChannelChoice) -> list[str]:
 
 
 def _samples(parsed: Parsed, rate_hz: float | None, repair: bool, warnings: list[str]) -> tuple[
-        pd.DataFrame, Channels, dict[str, str], str | None, np.ndarray | None, float | None, tuple[int, int]]:
+        pd.DataFrame, Channels, dict[str, str], str | None, np.ndarray | None, float | None, np.ndarray,
+        list[tuple[int, int]]]:
     """Steps 1-3: the checked samples as a frame, with their channels, units, counter, rate and lines."""
     p, blk = parsed.parser, parsed.block
     label = p.label
@@ -351,8 +433,9 @@ def _samples(parsed: Parsed, rate_hz: float | None, repair: bool, warnings: list
     counter = _column(data, "counter") if ch.counter is not None else None
     sample_rate = _time_from_rate(values, source_units, channels, p, blk, rate_hz, warnings)
     samples = _Samples(values, lines, counter)
+    _drop_padding(samples, channels, warnings)
     _drop_spikes(samples, channels, label, repair, warnings)
-    _check_time(samples, channels, label, repair, warnings)
+    segments = _check_time(samples, channels, label, repair, warnings)
     if values["time"].size < 2:
         raise ReadError(
             f"only {values['time'].size} sample(s) left after the checks; expected at least 2",
@@ -365,8 +448,7 @@ def _samples(parsed: Parsed, rate_hz: float | None, repair: bool, warnings: list
          "force_n": values.pop("force")},
         copy=False,
     )  # fmt: skip
-    data_lines = (int(samples.lines[0]), int(samples.lines[-1]))
-    return frame, channels, source_units, counter_source, samples.counter, sample_rate, data_lines
+    return frame, channels, source_units, counter_source, samples.counter, sample_rate, samples.lines, segments
 
 
 def assemble(parsed: Parsed, *, fmt: str, pressure_kpa: float | None, rate_hz: float | None,
@@ -384,8 +466,8 @@ def assemble(parsed: Parsed, *, fmt: str, pressure_kpa: float | None, rate_hz: f
     rate_hz : float or None
         Sampling rate (Hz) for a block without a time column.
     repair : bool
-        Drop spikes and samples where time does not increase, accept gaps (reported in
-        :attr:`RawTest.warnings`), instead of refusing them.
+        Drop spikes and samples out of order in time (reported in :attr:`RawTest.warnings`)
+        instead of refusing them.  Gaps, restarts and padding are read and reported either way.
 
     Returns
     -------
@@ -394,8 +476,8 @@ def assemble(parsed: Parsed, *, fmt: str, pressure_kpa: float | None, rate_hz: f
     Raises
     ------
     ReadError
-        For an unknown unit, a spike, time that does not increase or a gap (without ``repair``),
-        fewer than 2 samples, or a pressure that cannot be read or is out of range.
+        For an unknown unit, a spike or a sample out of order in time (without ``repair``),
+        time that never advances, fewer than 2 samples, or a pressure that cannot be read or is out of range.
 
     Examples
     --------
@@ -415,16 +497,13 @@ def assemble(parsed: Parsed, *, fmt: str, pressure_kpa: float | None, rate_hz: f
     path = Path(label) if isinstance(label, (str, Path)) else Path(str(label))
     assert blk.choice is not None
     warnings = list(p.warnings)
-    frame, channels, source_units, counter_source, counter, sample_rate, data_lines = _samples(
+    frame, channels, source_units, counter_source, counter, sample_rate, lines, segments = _samples(
         parsed, rate_hz, repair, warnings)
+    data_lines = (int(lines[0]), int(lines[-1]))
     metadata, meta_pressure = _metadata(p, blk, label, pressure_kpa)
     pressure, psource = _choose_pressure(pressure_kpa, meta_pressure, path, label)
     _file_warnings(parsed, warnings)
-    blocks = [
-        {"line": b.header_line, "columns": [n for n in b.names if n], "rows": b.n_rows,
-         "read": b is blk}
-        for b in p.blocks
-    ]  # fmt: skip
+    blocks = _blocks(parsed, frame["time_s"].to_numpy(), lines)
     if parsed.source.is_excel:
         metadata.setdefault("sheet", parsed.source.sheet or "")
     return RawTest(
@@ -447,6 +526,7 @@ def assemble(parsed: Parsed, *, fmt: str, pressure_kpa: float | None, rate_hz: f
         blocks=blocks,
         sample_rate_hz=sample_rate,
         data_lines=data_lines,
+        segments=segments,
     )
 
 

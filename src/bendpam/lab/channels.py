@@ -49,7 +49,8 @@ ROLES: tuple[str, str, str] = ("time", "stroke", "force")
 TIME_UNITS: dict[str, float] = {
     "s": 1.0, "sec": 1.0, "secs": 1.0, "second": 1.0, "seconds": 1.0, "sek": 1.0, "seg": 1.0,
     "秒": 1.0, "\u0441": 1.0,  # Cyrillic es
-    "ms": 1e-3, "msec": 1e-3, "us": 1e-6, "µs": 1e-6, "μs": 1e-6,
+    "ms": 1e-3, "msec": 1e-3,
+    "us": 1e-6, "µs": 1e-6, "μs": 1e-6,
     "min": 60.0, "mins": 60.0, "minute": 60.0, "minutes": 60.0, "分": 60.0,
     "h": 3600.0, "hr": 3600.0, "hrs": 3600.0, "hour": 3600.0, "hours": 3600.0,
 }  # fmt: skip
@@ -62,13 +63,13 @@ FORCE_UNITS: dict[str, float] = {
     "n": 1.0, "newton": 1.0, "newtons": 1.0, "牛": 1.0, "н": 1.0,
     "kn": 1000.0, "千牛": 1000.0, "кн": 1000.0, "mn": 1e-3, "un": 1e-6, "µn": 1e-6, "μn": 1e-6, "dan": 10.0,
     "lbf": 4.4482216152605, "lb": 4.4482216152605, "lbs": 4.4482216152605,
-    "kgf": 9.80665, "kp": 9.80665,
+    "kgf": 9.80665, "kp": 9.80665, "gf": 9.80665e-3, "µn": 1e-6, "μn": 1e-6, "un": 1e-6,
 }  # fmt: skip
 _UNIT_TABLES = {"time": TIME_UNITS, "stroke": LENGTH_UNITS, "force": FORCE_UNITS}
 UNIT_HINT = {
     "time": "s, sec, ms, us, min or h",
     "stroke": "m, cm, mm, µm/um or in",
-    "force": "N, kN, mN, uN, daN, kgf or lbf",
+    "force": "N, kN, mN, µN/uN, daN, kgf, gf or lbf",
 }
 DEFAULT_UNIT = {"time": "s", "stroke": "mm", "force": "N"}
 # Units of other quantities seen in exports (so that a units row is recognised as one).
@@ -124,15 +125,16 @@ def _entry(rank: int, kind: str, latin: Sequence[str] = (), cjk: Sequence[str] =
 _TIME_VOCAB: list[_Entry] = [
     _entry(3, "test time",
            ["total time", "test time", "running time", "run time", "prüfzeit", "pruefzeit",
-            "laufzeit", "versuchszeit", "messzeit", "gesamtzeit", "temps total", "temps d essai",
+            "laufzeit", "versuchszeit", "messzeit", "gesamtzeit", "versuchsdauer", "test duration",
+            "temps total", "temps d essai",
             "tempo totale", "tempo di prova", "tiempo total", "tiempo de ensayo", "czas testu",
             "czas badania"],
            ["试验时间", "测试时间", "经过时间", "経過時間", "試験時間"]),
     _entry(2, "time",
            ["time", "zeit", "temps", "tempo", "tiempo", "czas", "tijd", "tid", "t",
-            "elapsed time", "durée", "duree"],
+            "elapsed time", "durée", "duree", "čas", "cas", "время", "zaman", "aika", "idő"],
            ["时间", "時間", "時刻", "时刻"], extra=r"\w+zeit" + _E),
-    _entry(1, "time", ["godzina"]),
+    _entry(1, "time", ["godzina", "point", "punkt", "points"]),
 ]  # fmt: skip
 _TIME_EXCLUDE = re.compile(
     _words("cycle", "cycles", "step", "segment", "start", "end", "uhrzeit", "clock", "date",
@@ -148,23 +150,30 @@ _STROKE_VOCAB: list[_Entry] = [
             "crosshead", "cross head", "stroke", "actuator", "traverse", "traversenweg",
             "traversenposition", "querhaupt", "querhauptweg", "kolbenweg", "zylinderweg",
             "maschinenweg", "course", "corsa", "traversa", "carrera", "travesaño", "trawersa",
-            "skok", "ram", "piston", "axial displacement", "travel"],
+            "skok", "ram", "piston", "axial displacement", "travel", "weg maschine", "maschine",
+            "machine", "course traverse", "course standard", "traversenweg", "crosshead position",
+            "position machine", "déplacement traverse"],
            ["ストローク", "クロスヘッド", "行程", "横梁位移", "横梁", "活塞位移"]),
     _entry(2, "digital position", ["digital position", "digitale position", "encoder"]),
     _entry(1, "extensometer",
            ["extensometer", "extensometers", "ave", "video", "clip on", "clip", "feindehnung",
             "dehnungsaufnehmer", "makroxtens", "extensomètre", "estensimetro", "extensómetro",
-            "ekstensometr", "lvdt", "dic", "strain gauge", "laser"],
+            "ekstensometr", "lvdt", "dic", "strain gauge", "laser", "extenso", "iwa", "clip gauge",
+            "wegaufnehmer", "capteur", "déform"],
            ["引伸计", "引伸計", "伸び計"]),
+    _entry(4, "position (actuator)", ["position", "posizione", "posición", "posicion", "pozycja"],
+           ["位置"]),
     _entry(3, "displacement",
            ["displacement", "extension", "deflection", "position", "weg", "verschiebung",
-            "durchbiegung", "verformung", "verlängerung", "déplacement", "deplacement", "flèche",
+            "durchbiegung", "verformung", "verlängerung", "déplacement", "deplacement", "flèche", "distance", "disp",
             "fleche", "allongement", "spostamento", "estensione", "posizione", "freccia",
             "allungamento", "abbassamento", "desplazamiento", "extensión", "posición",
             "posicion", "deflexión", "flecha", "alargamiento", "przemieszczenie", "wydłużenie",
             "wydluzenie", "pozycja", "ugięcie", "ugiecie", "elongation", "verplaatsing",
-            "deformation", "deformación", "deformazione"],
-           ["位移", "变形", "伸长", "変位", "伸び", "たわみ", "位置", "挠度", "撓み"],
+            "deformation", "deformación", "deformazione", "deslocamento", "posição", "posicao",
+            "förskjutning", "forskjutning", "posunutí", "posunuti", "dráha", "перемещение",
+            "удлинение", "деформация", "uzama", "deplasman", "siirtymä"],
+           ["位移", "变形", "伸长", "変位", "伸び", "たわみ", "位置", "挠度", "撓み", "拉伸", "压缩", "延伸"],
            extra=r"\w+weg" + _E),
 ]  # fmt: skip
 _STROKE_EXCLUDE = re.compile(
@@ -172,9 +181,11 @@ _STROKE_EXCLUDE = re.compile(
            "sollwert", "soll", "setpoint", "set point", "command", "target", "demand", "limit",
            "consigne", "riferimento", "consigna", "zadana", "at", "bei", "à", "rate", "speed",
            "velocity", "geschwindigkeit", "vitesse", "velocità", "velocidad", "prędkość",
-           "after", "nach", "break", "bruch", "strain", "dehnung", "rotation", "angle")
-    + r"|速度|最大|最小|平均|目標|目标|指令|设定"
+           "after", "nach", "break", "bruch", "strain", "dehnung", "rotation", "angle", "kraft", "force",
+           "load", "charge")
+    + r"|速度|最大|最小|平均|目標|目标|指令|设定|应变|應變|ひずみ|歪み"
 )  # fmt: skip
+_STRAIN_WORD = re.compile(_words("strain", "dehnung", "nominal strain", "nominale dehnung"))
 _ABSOLUTE = re.compile(_words("abs", "absolute", "absolut", "absolue", "assoluta", "absoluta",
                               "bezwzględna") + r"|绝对|絶対")  # fmt: skip
 
@@ -185,7 +196,10 @@ _FORCE_VOCAB: list[_Entry] = [
            ["試験力", "试验力"]),
     _entry(3, "force",
            ["force", "load", "kraft", "charge", "effort", "forza", "carico", "fuerza", "carga",
-            "obciążenie", "obciazenie", "siła", "sila", "kracht", "belasting"],
+            "obciążenie", "obciazenie", "siła", "sila", "kracht", "belasting", "wägezelle", "waegezelle",
+            "load cell", "loadcell", "kraftaufnehmer", "kraftsensor", "cellule de charge", "cella di carico",
+            "célula de carga", "kraft maschine", "maschinenkraft", "força", "forca", "síla", "sila",
+            "сила", "нагрузка", "kuvvet", "yük", "yuk", "voima", "erő"],
            ["载荷", "荷载", "负荷", "负载", "荷重", "力值", "拉力"],
            extra=r"\w+kraft" + _E + r"|^力$"),
 ]  # fmt: skip
@@ -196,7 +210,7 @@ _FORCE_EXCLUDE = re.compile(
            "geschwindigkeit", "vitesse", "velocidad", "bruch", "break", "after", "nach",
            "moment", "torque", "drehmoment", "stress", "spannung", "contrainte", "sforzo",
            "tensión", "naprężenie", "strain", "dehnung", "preload", "vorkraft")
-    + r"|速度|最大|最小|平均|目標|目标|指令|设定|应力|応力|压力|圧力"
+    + r"|速度|最大|最小|平均|目標|目标|指令|设定|应力|応力|压力|圧力|应变|應變|ひずみ"
 )  # fmt: skip
 
 _COUNTER_VOCAB: list[_Entry] = [
@@ -424,6 +438,9 @@ def classify_column(col: ColumnInfo) -> list[Candidate]:
     [('counter', 'cycle counter')]
     """
     name = normalize_name(col.name)
+    head, dash, tail = col.name.partition(" - ")
+    if dash and re.search(r"rate|messrate|abtast", tail, re.IGNORECASE):
+        name = normalize_name(head)  # HBM catman: 'Time  1 - default sample rate' is the time of rate group 1
     unit = (col.unit or "").strip()
     if name and re.fullmatch(r"[\d\s.,+-]+", name) and unit and unit_factor("stroke", unit):
         return [Candidate(col, "stroke", 0, "length channel of unknown kind", True)]
@@ -449,10 +466,18 @@ def classify_column(col: ColumnInfo) -> list[Candidate]:
         elif role == "stroke" and kind == "crosshead travel":
             kind = "crosshead travel (relative)"
         out.append(Candidate(col, role, rank, kind, unit_ok))
+    if not out and ulow and unit_factor("stroke", unit) is not None and _STRAIN_WORD.search(name) \
+            and not _STROKE_EXCLUDE.search(_STRAIN_WORD.sub(" ", name)):
+        # 'Dehnung (mm)', 'Strain (mm)': Bluehill and testXpert name an extension in mm so
+        out.append(Candidate(col, "stroke", 1, "extension (a strain channel in a length unit)", True))
     if not out and ulow and unit_factor("stroke", unit) is not None and not _STROKE_EXCLUDE.search(name):
         # a length channel with an unknown name (a sensor's serial number, '1944 B'): listed
-        # among the alternatives, never chosen without the columns option
+        # among the alternatives, chosen only when it is the one length column of the block
         out.append(Candidate(col, "stroke", 0, "length channel of unknown kind", True))
+    for role, exclude in (("time", _TIME_EXCLUDE), ("force", _FORCE_EXCLUDE)):
+        if not out and ulow and ulow not in ("m", "-", "1") and unit_factor(role, unit) is not None \
+                and not exclude.search(name):
+            out.append(Candidate(col, role, 0, f"{role} channel of unknown kind (by its unit)", True))
     if not _COUNTER_EXCLUDE.search(name) and ulow in _COUNTER_UNITS:
         hit = _best(_COUNTER_VOCAB, name)
         if hit is not None:
@@ -526,6 +551,18 @@ def _find_override(columns: Sequence[ColumnInfo], wanted: str) -> ColumnInfo | N
     return None
 
 
+def _by_unit(choice: ChannelChoice, role: str, pool: list[Candidate], used: set[int]) -> bool:
+    """No column named for the role: choose the one column in the role's unit, if there is exactly one."""
+    unknown = [c for c in pool if c.rank == 0]
+    if len(unknown) != 1 or any(c.rank > 0 for c in pool):
+        return False
+    col = unknown[0].column
+    choice.chosen[role] = col
+    used.add(col.index)
+    choice.why[role] = f"no column named as {role}: the only column in {col.unit}"
+    return True
+
+
 def _kind_word(c: Candidate) -> str:
     return f"{c.kind} {c.column.source!r}"
 
@@ -580,6 +617,8 @@ def choose_channels(
         pool = [c for c in cands[role] if c.column.index not in used]
         good = [c for c in pool if c.unit_ok and c.rank > 0]
         unknown = [c for c in pool if c.rank == 0]
+        if not good and _by_unit(choice, role, pool, used):
+            continue
         if not good:
             named = [c for c in pool if c.rank > 0]
             if named:

@@ -8,11 +8,22 @@ sampling.  Both work on whole columns with NumPy (linear time, a few temporary a
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["GAP_FACTOR", "GAP_MIN_S", "SPIKE_FACTOR", "TimeProblems", "find_spikes", "time_problems"]
+__all__ = [
+    "GAP_FACTOR",
+    "GAP_MIN_S",
+    "SPIKE_FACTOR",
+    "TimeProblems",
+    "TimeStructure",
+    "find_spikes",
+    "padding_rows",
+    "time_problems",
+    "time_structure",
+]
 
 #: A sample is a spike when it lies this many robust column ranges off the median of its
 #: neighbourhood (5 samples).
@@ -130,3 +141,112 @@ def time_problems(t: np.ndarray) -> TimeProblems:
     else:
         gaps = np.empty(0, dtype=np.int64)
     return TimeProblems(backwards.astype(np.int64), gaps.astype(np.int64), med)
+
+
+@dataclass(frozen=True)
+class TimeStructure:
+    """How a time column runs: out-of-order samples, resets, repeats and gaps.
+
+    Attributes
+    ----------
+    glitches : numpy.ndarray
+        Indices of isolated samples out of order (time goes back at ``i`` and the next sample
+        is past ``t[i-1]`` again): a wrong number, not a lab habit.
+    resets : numpy.ndarray
+        Indices where time goes back and runs on from there (a restart of the clock).
+    repeats : numpy.ndarray
+        Indices ``i`` with ``t[i] == t[i-1]`` (a repeated time stamp).
+    gaps : numpy.ndarray
+        Indices ``i`` where ``t[i] - t[i-1]`` is a gap (a pause: see :data:`GAP_FACTOR`).
+    median_step_s : float
+        Median positive time step (s), NaN if none.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> ts = time_structure(np.array([0.0, 0.1, 0.2, 0.2, 30.0, 30.1, 0.0, 0.1, 0.2]))   # s
+    >>> ts.repeats.tolist(), ts.gaps.tolist(), ts.resets.tolist(), ts.glitches.tolist()
+    ([3], [4], [6], [])
+    >>> ts.segments(9)
+    [(0, 4), (4, 6), (6, 9)]
+    """
+
+    glitches: np.ndarray
+    resets: np.ndarray
+    repeats: np.ndarray
+    gaps: np.ndarray
+    median_step_s: float
+
+    def segments(self, n: int) -> list[tuple[int, int]]:
+        """``(start, stop)`` sample ranges of continuous sampling (split at resets and gaps)."""
+        cuts = np.union1d(self.resets, self.gaps).astype(np.int64).tolist()
+        edges = [0, *[c for c in cuts if 0 < c < n], n]
+        return [(int(a), int(b)) for a, b in itertools.pairwise(edges) if b > a]
+
+
+def time_structure(t: np.ndarray) -> TimeStructure:
+    """Find out-of-order samples, resets, repeated stamps and gaps in a time column (s).
+
+    Parameters
+    ----------
+    t : numpy.ndarray
+        Time in s, finite.
+
+    Returns
+    -------
+    TimeStructure
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> ts = time_structure(np.array([0.0, 0.05, 0.1, 0.08, 0.15]))     # s: one sample out of order
+    >>> ts.glitches.tolist(), ts.resets.tolist()
+    ([3], [])
+    """
+    e = np.empty(0, dtype=np.int64)
+    if t.size < 2:
+        return TimeStructure(e, e, e, e, float("nan"))
+    dt = np.diff(t)
+    back = np.flatnonzero(dt < 0) + 1
+    nxt = np.minimum(back + 1, t.size - 1)
+    # out of order: the next sample is past the one before the step back again (or it is the last sample)
+    glitch = (t[nxt] > t[back - 1]) | (back == t.size - 1)
+    pos = dt[dt > 0]
+    med = float(np.median(pos)) if pos.size else float("nan")
+    gaps = np.flatnonzero(dt > max(GAP_FACTOR * med, GAP_MIN_S)) + 1 if pos.size else e
+    repeats = np.flatnonzero(dt == 0) + 1
+    return TimeStructure(back[glitch].astype(np.int64), back[~glitch].astype(np.int64),
+                         repeats.astype(np.int64), gaps.astype(np.int64), med)  # fmt: skip
+
+
+def padding_rows(t: np.ndarray, stroke: np.ndarray, force: np.ndarray) -> int:
+    """Number of padding rows at the end: rows of zeros, or a last row whose time goes back to the start.
+
+    Parameters
+    ----------
+    t, stroke, force : numpy.ndarray
+        Time (s), stroke (mm) and force (N), one length.
+
+    Returns
+    -------
+    int
+        How many rows at the end are padding (never all of them).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.array([0.1, 0.2, 0.3, 0.0, 0.0])       # s
+    >>> s = np.array([0.0, 0.1, 0.2, 0.0, 0.0])       # mm
+    >>> f = np.array([1.0, 2.0, 3.0, 0.0, 0.0])       # N
+    >>> padding_rows(t, s, f), padding_rows(t[:4], s[:4], np.r_[f[:3], 0.5])
+    (2, 1)
+    """
+    n = t.size
+    zero = (t == 0) & (stroke == 0) & (force == 0)
+    k = int(np.argmin(zero[::-1])) if not zero.all() else 0
+    m = n - k
+    back = t[:m] <= t[0]  # end records whose time goes back to the start (or to 0)
+    r = int(np.argmin(back[::-1])) if m and not back.all() else 0
+    if r and m - r >= 2 and t[m - r - 1] > t[0] and r <= max(1, min(5, m // 10)):
+        k += r
+    return k if k <= n // 2 and n - k >= 2 else 0

@@ -67,6 +67,7 @@ _GROUP_COMMAS = re.compile(r"[+-]?\d{1,3}(?:,\d{3}){2,}")
 _GROUP_DOTS = re.compile(r"[+-]?\d{1,3}(?:\.\d{3}){2,}")
 _COLLIDE_COMMA = re.compile(r"[+-]?\d{1,3}(?:,\d{3})+,\d+(?:[eE][+-]?\d+)?")
 _COLLIDE_DOT = re.compile(r"[+-]?\d{1,3}(?:\.\d{3})+\.\d+(?:[eE][+-]?\d+)?")
+_GROUP_SPACES = re.compile(r"[+-]?\d{1,3}(?:[ \u00a0\u202f\u2009]\d{3})+(?:[.,]\d*)?(?:[eE][+-]?\d+)?")
 _CONTROL = re.compile(r"[\x00-\x08\x0e-\x19\x1b-\x1f\x7f]")
 _BLANK_CHARS = ' \t"\x1a\x0c\x0b\ufeff'
 
@@ -74,11 +75,17 @@ _BLANK_CHARS = ' \t"\x1a\x0c\x0b\ufeff'
 def split_cells(line: str, sep: str | None) -> list[str]:
     """Split one line at ``sep`` honouring double quotes; cells are stripped and unquoted.
 
+    ``sep=" "`` is a space-aligned table: numbers split at any blanks, names at two or more.
+
     >>> split_cells('"Time";"Load";0,5', ";")
     ['Time', 'Load', '0,5']
+    >>> split_cells("Ch 1 Displacement  Ch 1 Force  Time", " "), split_cells("  0.5 -1.25   3", " ")
+    (['Ch 1 Displacement', 'Ch 1 Force', 'Time'], ['0.5', '-1.25', '3'])
     """
     if sep is None:
         return [line.strip().strip('"').strip()]
+    if sep == " ":
+        return _split_spaces(line)
     if '"' not in line:
         return [c.strip() for c in line.split(sep)]
     try:
@@ -86,6 +93,17 @@ def split_cells(line: str, sep: str | None) -> list[str]:
     except csv.Error:
         return [c.strip().strip('"').strip() for c in line.split(sep)]
     return [c.strip() for c in cells]
+
+
+def _split_spaces(line: str) -> list[str]:
+    """Cells of a space-aligned line: a row of numbers splits at any run of blanks, a names row
+    (names may hold single spaces, ``Ch 1 Force``) at two blanks or more or a tab."""
+    tokens = line.split()
+    num = sum(_NUM_ANY.fullmatch(t) is not None for t in tokens)
+    if tokens and 2 * num >= len(tokens):
+        return tokens
+    cells = [c.strip('"').strip() for c in re.split(r"\s{2,}|\t", line.strip())]
+    return cells if len(cells) > 1 else [c.strip('"') for c in tokens]
 
 
 def is_blank(line: str, sep: str | None = None) -> bool:
@@ -126,7 +144,7 @@ def numeric_cells(cells: list[str]) -> tuple[int, int]:
     for c in cells:
         if c:
             nonempty += 1
-            if _NUM_ANY.fullmatch(c) is not None:
+            if _NUM_ANY.fullmatch(c) is not None or _GROUP_SPACES.fullmatch(c) is not None:
                 num += 1
     return num, nonempty
 
@@ -166,10 +184,14 @@ def parse_number(cell: str, decimal: str) -> NumberParse:
     (6.8902e-05, 1000.5)
     >>> parse_number("1,000,5", ",").problem, parse_number("n/a", ".").problem
     ('thousands', 'nonfinite')
+    >>> parse_number("-1\u00a0234,5", ",").value            # digits grouped by a no-break space
+    -1234.5
     """
     c = cell.strip().replace("\u2212", "-")
     if not c:
         return NumberParse(None, "empty")
+    if _GROUP_SPACES.fullmatch(c):  # digits grouped by (narrow, no-break) spaces: '1 234,5'
+        c = re.sub(r"[ \u00a0\u202f\u2009]", "", c)
     if decimal == ",":
         if _NUM_COMMA.fullmatch(c):
             v = float(c.replace(",", "."))

@@ -13,6 +13,7 @@ block could be read.
 
 from __future__ import annotations
 
+import dataclasses
 import io
 import math
 import re
@@ -38,6 +39,7 @@ from bendpam.lab.channels import (
     unit_cell,
     unit_factor,
 )
+from bendpam.lab.header import find_header, group_period
 from bendpam.lab.layout import (
     DELIMITERS,
     LineReader,
@@ -103,6 +105,13 @@ class Block:
         The block whose numbers were read.
     decimal : str or None
         Decimal mark of the block's numbers.
+    specimen_line, specimens : int or None, list of str or None
+        A row naming specimens side by side (column groups), if any.
+    header_candidates : list of dict
+        The rows scored as the names row (:func:`bendpam.lab.header.find_header`), best first.
+    groups, group_labels, group : int, list of str, int
+        Specimens side by side: the number of column groups, their names, and the 0-based group
+        whose columns :attr:`columns` are (1, [], 0 for one specimen).
 
     Examples
     --------
@@ -129,6 +138,12 @@ class Block:
     last_line: int = 0
     read: bool = False
     decimal: str | None = None
+    specimen_line: int | None = None
+    specimens: list[str] | None = None
+    header_candidates: list[dict] = field(default_factory=list)
+    groups: int = 1
+    group_labels: list[str] = field(default_factory=list)
+    group: int = 0
 
     def describe(self) -> str:
         """Where the block is and what it holds, for a message."""
@@ -221,6 +236,10 @@ def _data_seps(line: str) -> list[str]:
             num, nonempty = numeric_cells(split_cells(line, sep))
             if num >= 2 and 2 * num >= nonempty:
                 out.append(sep)
+    if not out and " " in line.strip():  # a space-aligned table (MTS BasicTestWare, fixed-width exports)
+        num, nonempty = numeric_cells(split_cells(line, " "))
+        if num >= 2 and num == nonempty:
+            out.append(" ")
     return out
 
 
@@ -246,6 +265,9 @@ class Parser:
     want_data : bool
         Read the chosen block's numbers (False: only find the blocks, as
         :func:`~bendpam.lab.readers.detect_dialect` does).
+    specimen : int or None
+        For several specimens side by side (column groups), the 0-based group to read (default
+        the first).
 
     Examples
     --------
@@ -271,6 +293,7 @@ class Parser:
         rate_hz: float | None,
         repair: bool,
         want_data: bool = True,
+        specimen: int | None = None,
     ) -> None:
         self.reader = reader
         self.label = label
@@ -288,6 +311,8 @@ class Parser:
         self.first_orphan: int | None = None
         self.dollar = False
         self.warnings: list[str] = []
+        self.joined: list[Block] = []  # blocks after the chosen one that repeat its header, read with it
+        self.specimen = specimen
         self.trailing: list[tuple[int, str]] = []
 
     # -- metadata ----------------------------------------------------------------------------
@@ -340,6 +365,9 @@ class Parser:
             ln = reader.lineno
             if is_blank(line):
                 continue
+            if line.endswith("\x00") and not self.blocks and "\x00" not in line.rstrip("\x00"):
+                line = line.rstrip("\x00")  # a stray NUL at the end of a text line before the data
+                self.warnings.append(f"line {ln}: a NUL byte at the end of the line was ignored")
             if has_control_chars(line):
                 self._binary_line(ln)
             if line.lstrip().startswith("$"):
@@ -348,7 +376,14 @@ class Parser:
             if seps and pre:
                 blk = self._start_block(pre, line, ln, seps)
                 reader.push_back([line])
+                before = (self.chosen, self.data, list(self.joined), [b.read for b in self.blocks])
                 self._consume_block(blk)
+                if blk.n_rows < 2 and blk not in self.joined and self._more_lines():
+                    # one numeric row among text rows (a channel-metadata row of zeros): not a block;
+                    # the rows above stay candidates for the names row of the next block
+                    self._dissolve(blk, before)
+                    pre.append((ln, line))
+                    continue
                 pre = []
                 if self.chosen is not None and self.chosen.choice is not None and (
                     "time" in self.chosen.choice.chosen and not self.want_data
@@ -364,6 +399,24 @@ class Parser:
             if self.chosen is not None and self.chosen.read:
                 self.trailing.append((ln, line))
 
+    def _more_lines(self) -> bool:
+        """Are there lines left to read?"""
+        nxt = self.reader.next()
+        if nxt is None:
+            return False
+        self.reader.push_back([nxt])
+        return True
+
+    def _dissolve(self, blk: Block, before: tuple[Any, ...]) -> None:
+        """Undo a block of fewer than 2 rows: the parser's state as it was before it."""
+        self.chosen, self.data, self.joined, reads = before
+        self.blocks.remove(blk)
+        for b, r in zip(self.blocks, reads, strict=False):
+            b.read = r
+        self.block_lines.discard(blk.header_line)
+        if blk.units_line is not None:
+            self.block_lines.discard(blk.units_line)
+
     def _binary_line(self, ln: int) -> None:
         raise ReadError(
             "binary data (control characters); expected a text export (CSV/TXT)", self.label, ln
@@ -374,10 +427,18 @@ class Parser:
         if self.mts is not None and self.mts.delimiter in order:
             order.remove(self.mts.delimiter)
             order.insert(0, self.mts.delimiter)
+        guess = find_header(pre, line, order, role_hits=_role_hits, is_units_row=_is_units_row)
         best: tuple[tuple[int, int, int, int], Block] | None = None
+        if guess is not None:
+            cols = _make_columns(guess.names, guess.units, guess.names_line, guess.units_line)
+            blk = Block(len(self.blocks) + 1, guess.names_line, guess.names, guess.units_line, guess.units,
+                        guess.sep, ln, line, cols, specimen_line=guess.specimen_line, specimens=guess.specimens,
+                        header_candidates=guess.candidates)  # fmt: skip
+            self._split_groups(blk, pre)
+            best = ((0, 0, 0, 0), blk)
         p1 = pre[-1]
         p2 = pre[-2] if len(pre) >= 2 else None
-        for k, sep in enumerate(order):
+        for k, sep in enumerate(order if best is None else []):
             data_cells = split_cells(line, sep)
             c1 = split_cells(p1[1], sep)
             names_ln, names, units_ln, units = p1[0], c1, None, None
@@ -405,6 +466,27 @@ class Parser:
         blk.summary = looks_like_summary(blk.columns)
         return blk
 
+    def _split_groups(self, blk: Block, pre: list[tuple[int, str]]) -> None:
+        """Several specimens side by side: keep the columns of the asked group, name the groups."""
+        width = len(_trim(split_cells(blk.first_row, blk.sep)))
+        g = group_period(blk.names, width)
+        if g is None:
+            return
+        n = -(-max(len(_trim(blk.names)), width) // g)
+        k = min(self.specimen or 0, n - 1)
+        repeated = len(_trim(blk.names)) >= 2 * g
+        lo = k * g if repeated else 0
+        names = blk.names[lo:lo + g]
+        units = blk.units[lo:lo + g] if blk.units is not None else None
+        cols = _make_columns(names, units, blk.header_line, blk.units_line)
+        blk.columns = [dataclasses.replace(c, index=c.index + k * g) for c in cols]
+        label_rows = [split_cells(line, blk.sep) for ln, line in pre if ln in (blk.header_line - 1, blk.specimen_line)]
+        labels = []
+        for j in range(n):
+            found = [c for row in label_rows for c in row[j * g:(j + 1) * g] if c]
+            labels.append(found[0] if found else f"specimen {j + 1}")
+        blk.groups, blk.group_labels, blk.group = n, labels, k
+
     def _usable(self, blk: Block) -> int:
         """2 = time, stroke and force; 1 = stroke and force with a rate; 0 = not usable."""
         ch = blk.choice
@@ -418,13 +500,30 @@ class Parser:
             return 1
         return 0
 
+    def _continues(self, blk: Block, level: int) -> bool:
+        """Does ``blk`` repeat the chosen block's header (same delimiter and names): one more block of its test?"""
+        ch = self.chosen
+        if ch is None or level == 0 or self._usable(ch) != level or blk.sep != ch.sep or not self.want_data:
+            return False
+        return [normalize_name(n) for n in _trim(blk.names)] == [normalize_name(n) for n in _trim(ch.names)]
+
     def _consume_block(self, blk: Block) -> None:
         self.trailing = []
         level = self._usable(blk)
         current = 0 if self.chosen is None else self._usable(self.chosen)
+        if self._continues(blk, level):
+            assert self.chosen is not None and self.data is not None
+            blk.read = True
+            blk.decimal = self.chosen.decimal
+            blk.choice = self.chosen.choice
+            blk.columns = self.chosen.columns
+            self.joined.append(blk)
+            self._read_rows(blk, self.data)
+            return
         if level > current:
             self.chosen = blk
             blk.read = True
+            self.joined = []
             self.trailing = []
             if self.want_data:
                 self.data = ColumnData()
@@ -475,7 +574,7 @@ class Parser:
             return
         needed = self._needed(blk)
         for role, _col in needed:
-            data.cols[role] = []
+            data.cols.setdefault(role, [])
         while True:
             lines = reader.take(_CHUNK_LINES)
             if not lines:
@@ -508,7 +607,7 @@ class Parser:
         try:
             df = pd.read_csv(
                 io.BytesIO("\n".join(lines).encode("utf-8", "surrogatepass")),
-                sep=blk.sep,
+                sep=r"\s+" if blk.sep == " " else blk.sep,
                 decimal=dec,
                 header=None,
                 usecols=sorted(set(idx)),
@@ -593,11 +692,16 @@ class Parser:
                 lnos.append(ln)
                 blank_run = None
                 continue
+            if blk.groups > 1 and all(col.index >= len(cells) or not cells[col.index] for _r, col in needed):
+                if blank_run is None:  # this specimen's columns have ended (a shorter one side by side)
+                    blank_run = k
+                continue
             num, nonempty = numeric_cells(cells)
             datalike = num >= 2 and 2 * num >= nonempty
             if not datalike:
-                repeated = [normalize_name(c) for c in cells] == names_norm
-                if blank_run is not None or repeated or _role_hits(cells) >= 2:
+                repeated = [normalize_name(c) for c in cells] == names_norm or any(
+                    [normalize_name(c) for c in split_cells(nxt, sep)] == names_norm for nxt in lines[k + 1:k + 3])
+                if blank_run is not None or repeated or _role_hits(cells) >= 2 or blk.n_rows + len(rows) < 2:
                     end = blank_run if blank_run is not None else k
                     break
             role, col, cell = problem
@@ -751,7 +855,8 @@ class Parsed:
 
 
 def parse_source(source: Source, *, dialect: str | None, overrides: dict[str, str],
-                 rate_hz: float | None, repair: bool, want_data: bool = True) -> Parsed:  # fmt: skip
+                 rate_hz: float | None, repair: bool, want_data: bool = True,
+                 specimen: int | None = None) -> Parsed:  # fmt: skip
     """Parse one source: its blocks and metadata, and the numbers of the block to read.
 
     Parameters
@@ -760,7 +865,7 @@ def parse_source(source: Source, *, dialect: str | None, overrides: dict[str, st
         The lines (closed when read).
     dialect : str or None
         The format asked for; ``"testxpert"`` makes the decimal comma the default.
-    overrides, rate_hz, repair, want_data
+    overrides, rate_hz, repair, want_data, specimen
         As for :class:`Parser`.
 
     Returns
@@ -787,7 +892,8 @@ def parse_source(source: Source, *, dialect: str | None, overrides: dict[str, st
     default_decimal = "," if dialect == "testxpert" else None
     reader = LineReader(source.lines)
     p = Parser(reader, source.label, mts=mts, default_decimal=default_decimal,
-               overrides=overrides, rate_hz=rate_hz, repair=repair, want_data=want_data)  # fmt: skip
+               overrides=overrides, rate_hz=rate_hz, repair=repair, want_data=want_data,
+               specimen=specimen)  # fmt: skip
     try:
         p.run()
     finally:
@@ -798,8 +904,8 @@ def parse_source(source: Source, *, dialect: str | None, overrides: dict[str, st
     return Parsed(p, source, p.chosen)
 
 
-def parse_path(path: Path, **kw: Any) -> Parsed:
-    """Parse a file (the first readable sheet of a workbook); ``kw`` as for :func:`parse_source`.
+def parse_path(path: Path, *, sheet: str | None = None, **kw: Any) -> Parsed:
+    """Parse a file (the first readable sheet of a workbook, or the sheet named); ``kw`` as for :func:`parse_source`.
 
     Examples
     --------
@@ -813,6 +919,10 @@ def parse_path(path: Path, **kw: Any) -> Parsed:
     (1, 2, 'utf-8')
     """
     sources, _size = open_source(path)
+    if sheet is not None:
+        sources = [s for s in sources if s.sheet == sheet]
+        if not sources:
+            raise ReadError(f"no sheet {sheet!r} in the workbook", path)
     first_error: ReadError | None = None
     for src in sources:
         try:

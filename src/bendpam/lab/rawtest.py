@@ -81,6 +81,17 @@ class RawTest:
     data_lines : tuple of int or None
         First and last line (1-based; rows of a worksheet) of the samples read, for messages
         about the data as a whole; None for a test not read from a file.
+    specimen : str or None
+        Name of the specimen when the file holds several side by side (column groups), e.g.
+        ``"Sample 2"``; None for a file of one specimen.
+    block : int or None
+        1-based number of the data block when the file holds several tests one after the other
+        (each with its own header); None when the test is the whole file (blocks that continue
+        one test are concatenated and listed in :attr:`blocks`).
+    segments : list of tuple of int
+        ``(start, stop)`` sample indices (``stop`` exclusive) of the stretches of continuous
+        sampling; a gap in the sampling or a reset of time starts a new one.  One segment
+        ``(0, n)`` for a test read without either; empty (one segment) for a test a script made.
 
     Examples
     --------
@@ -113,6 +124,9 @@ class RawTest:
     blocks: list[dict[str, Any]] = field(default_factory=list)
     sample_rate_hz: float | None = None
     data_lines: tuple[int, int] | None = None
+    specimen: str | None = None
+    block: int | None = None
+    segments: list[tuple[int, int]] = field(default_factory=list)
 
     @property
     def format(self) -> str:

@@ -15,17 +15,21 @@ The reader is layered, not a list of dialects:
    (``MTS793|MPT|DEU|1|2|,|.|...``) is honoured; quoted or unquoted cells, empty first fields,
    specimen-index columns, trailing empty columns, exponents like ``e-005``.
 3. **Structure**: metadata lines in several grammars, a names row, an optional units row
-   (``(s)``, ``[s]``, ``s``, ``in s``), several data blocks in one file (the one with time,
-   stroke and force is read, the others are listed).
+   (``(s)``, ``[s]``, ``s``, ``in s``), found by scoring the rows above the data
+   (:mod:`bendpam.lab.header`); several data blocks in one file (those that repeat the header
+   of the one read are read with it: one test when time continues, one test per block when it
+   restarts; the others are listed); several specimens side by side (:func:`read_tests`).
 4. **Channels** (:mod:`bendpam.lab.channels`): names in English, German, French, Italian,
    Spanish, Polish, Chinese and Japanese; units s/ms/min, N/kN/lbf, mm/m/in converted.  Where
    several displacement channels exist, the relative crosshead travel is chosen (eq 6 wants the
    stroke from the blocked state); the choice and its reason are recorded, ``columns=``
    overrides it.  A file without time but with a sampling rate (metadata or ``rate_hz=``)
    reads.  A per-cycle summary or a results table is refused with the reason.
-5. **Values** (:mod:`bendpam.lab.checks`): non-finite cells, isolated spikes, time that does
-   not increase and gaps are found and refused (default) or, with ``repair=True``, removed
-   and reported in :attr:`RawTest.warnings`.
+5. **Values** (:mod:`bendpam.lab.checks`): gaps, clock restarts, repeated stamps and padding
+   rows are read and reported (:attr:`RawTest.segments`); non-finite cells, isolated spikes and
+   samples out of order in time are refused (default) or, with ``repair=True``, removed and
+   reported in :attr:`RawTest.warnings`; a dead stroke or force channel is replaced by a named
+   one that moves.
 
 The numeric block is read in chunks of lines by the C parser of :func:`pandas.read_csv`, so
 a 500 MB export is read in bounded memory and linear time; a chunk the C parser cannot read is
@@ -41,6 +45,7 @@ module holds the entry points and the naming of the format.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import re
@@ -85,11 +90,12 @@ __all__ = [
     "format_inspection",
     "inspect_file",
     "is_pressure_key",
+    "looks_dead",
     "parse_columns",
     "parse_pressure",
     "pressure_from_filename",
     "read_test",
-    "read_tests",  # SHIM until h-reader lands
+    "read_tests",
     "with_declaration_hint",
 ]
 
@@ -224,7 +230,7 @@ def _check_options(pressure_kpa: float | None, dialect: str | None, rate_hz: flo
 
 #: Refusals about the file itself, where a format declaration does not help.
 _NOT_LAYOUT = re.compile(r"^(file not found|is a directory|permission denied|cannot read|file is empty|"
-                         r"binary|native Zwick|.*not found$|is a folder|larger than)")
+                         r"binary|native Zwick|.*not found$|is a folder|larger than|byte 0|lines? [\d-]+: only)")
 
 
 def with_declaration_hint(exc: ReadError) -> ReadError:
@@ -234,8 +240,8 @@ def with_declaration_hint(exc: ReadError) -> ReadError:
 
     >>> print(with_declaration_hint(ReadError("no header row naming time, stroke and force columns", "x.csv", 3)))
     x.csv:3: no header row naming time, stroke and force columns; or describe the file's layout in a format ...
-    >>> print(with_declaration_hint(ReadError("file is empty; expected a header row and data rows", "x.csv")))
-    x.csv: file is empty; expected a header row and data rows
+    >>> print(with_declaration_hint(ReadError("byte 0: the file is empty (0 bytes); expected data rows", "x.csv")))
+    x.csv: byte 0: the file is empty (0 bytes); expected data rows
     """
     from bendpam.lab.declaration import DECLARATION_HINT
 
@@ -245,21 +251,19 @@ def with_declaration_hint(exc: ReadError) -> ReadError:
     return ReadError(f"{message}; or {DECLARATION_HINT}", exc.path, exc.line, exc.column)
 
 
-def _read_declared_one(p: Path, format_file: str | os.PathLike, dialect: str | None, overrides: dict[str, str],
-                       pressure_kpa: float | None, rate_hz: float | None, repair: bool) -> RawTest:  # fmt: skip
-    """read_test with a format declaration: exactly one test."""
+def _read_declared(path: str | os.PathLike, format_file: str | os.PathLike, dialect: str | None,
+                   columns: Mapping[str, str] | str | None, pressure_kpa: float | None, rate_hz: float | None,
+                   repair: bool) -> list[RawTest]:  # fmt: skip
+    """Every test of a file read by its format declaration (no detection)."""
     from bendpam.errors import InputError
     from bendpam.lab.declared import read_declared
 
-    if dialect is not None or overrides:
+    if dialect is not None or parse_columns(columns):
         raise InputError("format_file: the declaration names the columns and the layout; expected no dialect "
                          "or columns with it")
-    tests = read_declared(p, format_file, pressure_kpa=pressure_kpa, rate_hz=rate_hz, repair=repair)
-    if len(tests) != 1:
-        what = "specimens" if tests[0].metadata.get("specimen") else "blocks"
-        raise ReadError(f"holds {len(tests)} tests ({what}) as declared; read them with read_tests or "
-                        "bendpam.lab.declared.read_declared", p)
-    return tests[0]
+    p = Path(path)
+    verify_input(p)
+    return read_declared(p, format_file, pressure_kpa=pressure_kpa, rate_hz=rate_hz, repair=repair)
 
 
 def read_test(
@@ -292,8 +296,9 @@ def read_test(
     rate_hz : float, optional
         Sampling rate (Hz) for a file without a time column.
     repair : bool
-        Drop spikes, samples where time does not increase and rows with non-finite values,
-        and accept gaps, reporting each in :attr:`RawTest.warnings` (default: refuse them).
+        Drop spikes, samples out of order in time and rows with non-finite values, reporting
+        each in :attr:`RawTest.warnings` (default: refuse them).  Gaps, clock restarts and
+        padding rows are read and reported either way.
     format_file : str or os.PathLike, optional
         A format declaration (TOML, see ``docs/formats.md``): read the file as it says, with no
         detection (:func:`bendpam.lab.declared.read_declared`); ``dialect`` and ``columns`` are
@@ -327,22 +332,329 @@ def read_test(
     >>> raw.data["force_n"].tolist()                     # N
     [11.8, 11.71, 11.54]
     """
+    if format_file is not None:
+        tests = _read_declared(path, format_file, dialect, columns, pressure_kpa, rate_hz, repair)
+        if len(tests) != 1:
+            what = "specimens" if tests[0].metadata.get("specimen") else "blocks"
+            raise ReadError(f"holds {len(tests)} tests ({what}) as declared; read them with read_tests", path)
+        return tests[0]
+    raw = _read_one(path, pressure_kpa=pressure_kpa, dialect=dialect, columns=columns, rate_hz=rate_hz,
+                    repair=repair)  # fmt: skip
+    labels = _specimen_labels(raw)
+    if len(labels) > 1:
+        raise ReadError(f"holds {len(labels)} specimens side by side ({', '.join(labels[:4])}"
+                        f"{', ...' if len(labels) > 4 else ''}); read them with read_tests",
+                        raw.path, raw.header_line)  # fmt: skip
+    sheets = _other_sheets(raw, pressure_kpa=pressure_kpa, dialect=dialect, columns=columns, rate_hz=rate_hz,
+                           repair=repair)  # fmt: skip
+    if sheets:
+        names = ", ".join(repr(s) for s in [raw.metadata.get("sheet"), *[t.metadata.get("sheet") for t in sheets]])
+        raise ReadError(f"holds {len(sheets) + 1} tests on the sheets {names}; read them with read_tests",
+                        raw.path)  # fmt: skip
+    parts = _split_blocks(raw)
+    if len(parts) > 1:
+        lines = ", ".join(str(t.header_line) for t in parts[1:4])
+        raise ReadError(f"holds {len(parts)} tests in separate blocks (time restarts in the blocks at line(s) "
+                        f"{lines}); read them with read_tests", raw.path, parts[1].header_line)  # fmt: skip
+    return raw
+
+
+def _read_one(path: str | os.PathLike, *, pressure_kpa: float | None, dialect: str | None,
+              columns: Mapping[str, str] | str | None, rate_hz: float | None, repair: bool,
+              specimen: int | None = None, sheet: str | None = None) -> RawTest:  # fmt: skip
+    """One pass of the reader: the chosen block (and the blocks that repeat its header) of one specimen."""
     pressure_kpa, rate_hz = _check_options(pressure_kpa, dialect, rate_hz)
     overrides = parse_columns(columns)
     p = Path(path)
     verify_input(p)  # raw files of a bendpam set (simulate-test) are read only as bendpam wrote them
-    if format_file is not None:
-        return _read_declared_one(p, format_file, dialect, overrides, pressure_kpa, rate_hz, repair)
+    kw: dict[str, Any] = {"pressure_kpa": pressure_kpa, "dialect": dialect, "overrides": overrides,
+                          "rate_hz": rate_hz, "repair": repair, "specimen": specimen,
+                          "sheet": sheet}  # fmt: skip
     try:
-        parsed = parse_path(p, dialect=dialect, overrides=overrides, rate_hz=rate_hz, repair=repair)
+        parsed = parse_path(p, overrides=overrides, **{k: kw[k] for k in _PARSE_KEYS})
     except ReadError as exc:
-        raise with_declaration_hint(exc) from None
+        if exc.column is None:
+            raise with_declaration_hint(exc) from None
+        # a chosen column with cells that are not numbers (an extensometer removed mid-test): another one?
+        found = parse_path(p, overrides=overrides, want_data=False, **{k: kw[k] for k in _PARSE_KEYS})
+        return _other_column(exc, found, _alternates(found, overrides), p, dialect or _classify_format(found), **kw)
     fmt = dialect or _classify_format(parsed)
+    alternates = _alternates(parsed, overrides)
     try:
-        return assemble(parsed, fmt=fmt, pressure_kpa=pressure_kpa, rate_hz=rate_hz, repair=repair)
-    except ReadError as exc:  # a unit detection did not know: a declaration names it
-        raise (with_declaration_hint(exc) if exc.message.startswith("unknown ") else exc) from None
+        raw = assemble(parsed, fmt=fmt, pressure_kpa=pressure_kpa, rate_hz=rate_hz, repair=repair)
+    except ReadError as exc:
+        try:
+            raw = _other_column(exc, parsed, alternates, p, fmt, **kw)
+        except ReadError as final:  # a unit detection did not know: a declaration names it
+            raise (with_declaration_hint(final) if final.message.startswith("unknown ") else final) from None
+    for role, names in alternates.items():
+        if role != "time":
+            raw = _replace_dead(raw, role, names, path=path, **kw)
+        elif len(raw.segments) > 1 and bool(np.any(np.diff(raw.data["time_s"].to_numpy()) < 0)):
+            raw = _steadier_time(raw, names, p, fmt, **kw)  # the clock restarts: is another one steadier?
+    return raw
 
+
+def _steadier_time(raw: RawTest, names: list[str], path: Path, fmt: str, **kw: Any) -> RawTest:
+    """A time column that restarts or pauses: another time column that runs through, if one does."""
+    for name in names:
+        try:
+            parsed = parse_path(path, overrides={**kw["overrides"], "time": name},
+                                **{k: kw[k] for k in _PARSE_KEYS})  # fmt: skip
+            alt = assemble(parsed, fmt=fmt, pressure_kpa=kw["pressure_kpa"], rate_hz=kw["rate_hz"],
+                           repair=kw["repair"])  # fmt: skip
+        except ReadError:
+            continue
+        if len(alt) == len(raw) and len(alt.segments) < len(raw.segments):
+            old = raw.channels["time"]["source"]
+            alt.channels["time"]["why"] = (f"{old!r} restarts or pauses ({len(raw.segments)} segments); "
+                                           f"{name!r} runs through ({len(alt.segments)})")  # fmt: skip
+            alt.warnings.append(f"time column {old!r} restarts or pauses; read {name!r}, which runs through")
+            return alt
+    return raw
+
+
+def _other_column(exc: ReadError, parsed: Parsed, alternates: dict[str, list[str]], path: Path, fmt: str,
+                  **kw: Any) -> RawTest:  # fmt: skip
+    """The refusal names a chosen column (time that goes back, a cell that is not a number): try the others
+    named for its role; the first that reads is used, with a warning; else the refusal stands."""
+    chosen = parsed.block.choice.chosen if parsed.block.choice is not None else {}
+    role = next((r for r, col in chosen.items() if col.source == exc.column), None)
+    if role is None or not alternates.get(role):
+        raise exc
+    for name in alternates[role]:
+        try:
+            alt = parse_path(path, overrides={**kw["overrides"], role: name}, **{k: kw[k] for k in _PARSE_KEYS})
+            raw = assemble(alt, fmt=fmt, pressure_kpa=kw["pressure_kpa"], rate_hz=kw["rate_hz"],
+                           repair=kw["repair"])  # fmt: skip
+        except ReadError:
+            continue
+        raw.channels[role]["why"] = f"{exc.column!r} cannot be read ({exc.message}); {name!r} can"
+        raw.warnings.append(f"{role} column {exc.column!r} not used (line {exc.line}: {exc.message}); read {name!r}")
+        return raw
+    raise exc
+
+
+_ROLE_COL = {"stroke": "stroke_mm", "force": "force_n"}
+_PARSE_KEYS = ("dialect", "rate_hz", "repair", "specimen", "sheet")  # what parse_path takes of _read_one's keywords
+# below these ranges (mm, N) a channel is compared with the other channels named for its role
+_SMALL_SPAN = {"stroke": 0.1, "force": 10.0}
+
+
+def _alternates(parsed: Parsed, overrides: Mapping[str, str]) -> dict[str, list[str]]:
+    """Other columns named for time, stroke and force (best rank first), for roles not given by the caller."""
+    from bendpam.lab.channels import classify_column
+
+    blk = parsed.block
+    chosen = blk.choice.chosen if blk.choice is not None else {}
+    out: dict[str, list[str]] = {}
+    for role in ("time", "stroke", "force"):
+        if role in overrides or role not in chosen:
+            continue
+        cands = [c for col in blk.columns for c in classify_column(col)
+                 if c.role == role and c.unit_ok and c.rank > 0 and col.index != chosen[role].index]  # fmt: skip
+        names = [c.column.source for c in sorted(cands, key=lambda c: -c.rank)]
+        if names:
+            out[role] = names[:3]
+    return out
+
+
+def looks_dead(x: np.ndarray) -> bool:
+    """A channel whose whole range is within its sample-to-sample noise (a dead or unplugged sensor).
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        The channel's samples.
+
+    Returns
+    -------
+    bool
+        True when the range (max - min) is below 20 median steps, or zero.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> rng = np.random.default_rng(0)
+    >>> looks_dead(0.2 * rng.standard_normal(500)), looks_dead(np.linspace(0.0, 373.0, 500))   # N
+    (True, False)
+    """
+    v = np.asarray(x, dtype=np.float64)
+    if not np.isfinite(v).all():
+        v = v[np.isfinite(v)]
+    if v.size < 10:
+        return False
+    span = float(v.max() - v.min())
+    step = float(np.median(np.abs(np.diff(v[:200_001]))))  # the noise, from the first 200 000 samples
+    return span == 0.0 or span < 20.0 * step
+
+
+def _stuck_tail(x: np.ndarray) -> bool:
+    """The last quarter of a moving channel holds one value (an extensometer saturated or taken off)."""
+    n = x.size
+    return n >= 40 and float(np.ptp(x)) > 0 and float(np.ptp(x[(3 * n) // 4:])) == 0.0
+
+
+def _unstuck(raw: RawTest, names: list[str], *, path: str | os.PathLike, **kw: Any) -> RawTest:
+    """A stroke stuck over the last quarter (an extensometer): a named displacement that still moves there."""
+    overrides = dict(kw.pop("overrides"))
+    for name in names:
+        try:
+            parsed = parse_path(Path(path), overrides={**overrides, "stroke": name}, **{k: kw[k] for k in _PARSE_KEYS})
+            alt = assemble(parsed, fmt=raw.dialect, pressure_kpa=kw["pressure_kpa"], rate_hz=kw["rate_hz"],
+                           repair=kw["repair"])  # fmt: skip
+        except ReadError:
+            continue
+        y = alt.data["stroke_mm"].to_numpy()
+        if len(alt) == len(raw) and not _stuck_tail(y) and not looks_dead(y):
+            old = raw.channels["stroke"]["source"]
+            alt.channels["stroke"]["why"] = f"{old!r} is stuck over the last quarter of the test; {name!r} moves"
+            alt.warnings.append(f"the stroke column {old!r} is stuck over the last quarter of the test "
+                                f"(saturated or taken off); read {name!r}, which moves")  # fmt: skip
+            return alt
+    return raw
+
+
+def _replace_dead(raw: RawTest, role: str, names: list[str], *, path: str | os.PathLike, **kw: Any) -> RawTest:
+    """Read an alternate column when the chosen one looks dead and the alternate moves (10x its range or more)."""
+    col = _ROLE_COL[role]
+    x = raw.data[col].to_numpy()
+    span = float(np.ptp(x)) if x.size else 0.0
+    dead = looks_dead(x)
+    if role == "stroke" and not dead and _stuck_tail(x):
+        return _unstuck(raw, names, path=path, **kw)
+    if not dead and span >= _SMALL_SPAN[role]:
+        return raw
+    factor = 10.0 if dead else 100.0  # a quiet channel gives way only to one that moves 100 times more
+    overrides = dict(kw.pop("overrides"))
+    for name in names:
+        try:
+            parsed = parse_path(Path(path), overrides={**overrides, role: name}, **{k: kw[k] for k in _PARSE_KEYS})
+            alt = assemble(parsed, fmt=raw.dialect, pressure_kpa=kw["pressure_kpa"], rate_hz=kw["rate_hz"],
+                           repair=kw["repair"])  # fmt: skip
+        except ReadError:
+            continue
+        y = alt.data[col].to_numpy()
+        if len(alt) == len(raw) and not looks_dead(y) and float(np.ptp(y)) >= factor * span:
+            old = raw.channels[role]["source"]
+            what = "within its noise" if dead else f"against {float(np.ptp(y)):.3g} for {name!r}"
+            alt.channels[role]["why"] = (f"{old!r} looks dead (range {span:.3g} {what}); "
+                                         f"{name!r} moves over {float(np.ptp(y)):.3g}")  # fmt: skip
+            alt.warnings.append(f"the {role} column {old!r} looks dead (range {span:.3g} {what}); "
+                                f"read {name!r} instead")  # fmt: skip
+            return alt
+    return raw
+
+
+def _other_sheets(raw: RawTest, **kw: Any) -> list[RawTest]:
+    """The tests on the sheets of a workbook after the one read (testXpert writes a 'Values' sheet per specimen)."""
+    sheet = raw.metadata.get("sheet")
+    if not sheet:
+        return []
+    from bendpam.lab.excel import workbook_sheets
+
+    try:
+        names = [s.name for s in workbook_sheets(raw.path)]
+    except Exception:  # the workbook was read a moment ago; a failure now leaves the first test alone
+        return []
+    later = names[names.index(sheet) + 1:] if sheet in names else []
+    out = []
+    for name in later:
+        try:
+            out.append(_read_one(raw.path, sheet=name, **kw))
+        except (ReadError, ValueError):
+            continue
+    return out
+
+
+def _specimen_labels(raw: RawTest) -> list[str]:
+    for b in raw.blocks:
+        if b.get("read") and b.get("specimens"):
+            return list(b["specimens"])
+    return []
+
+
+def _split_blocks(raw: RawTest) -> list[RawTest]:
+    """The tests of a file whose blocks restart time: one per run of blocks that continue each other."""
+    read = [b for b in raw.blocks if b.get("read")]
+    cuts = [b for b in read[1:] if not b.get("continues", True)]
+    if not cuts:
+        return [raw]
+    groups: list[list[dict[str, Any]]] = [[]]
+    for b in read:
+        if b in cuts:
+            groups.append([])
+        groups[-1].append(b)
+    out = []
+    n = len(raw)
+    for k, group in enumerate(groups):
+        a = int(group[0]["start"])
+        z = int(groups[k + 1][0]["start"]) if k + 1 < len(groups) else n
+        segs = [(max(s, a) - a, min(e, z) - a) for s, e in raw.segments if s < z and e > a]
+        counter = raw.cycle_counter[a:z] if raw.cycle_counter is not None else None
+        out.append(dataclasses.replace(
+            raw, data=raw.data.iloc[a:z].reset_index(drop=True), block=k + 1, segments=segs,
+            cycle_counter=counter, header_line=int(group[0]["line"]),
+            data_lines=(int(group[0]["lines"][0]), int(group[-1]["lines"][1])), warnings=list(raw.warnings)))
+    return out
+
+
+def read_tests(
+    path: str | os.PathLike,
+    *,
+    pressure_kpa: float | None = None,
+    dialect: str | None = None,
+    columns: Mapping[str, str] | str | None = None,
+    rate_hz: float | None = None,
+    repair: bool = False,
+    format_file: str | os.PathLike | None = None,
+) -> list[RawTest]:
+    """Read every test of a raw export: one per specimen side by side, one per separate block.
+
+    Parameters
+    ----------
+    path, pressure_kpa, dialect, columns, rate_hz, repair, format_file
+        As for :func:`read_test`.
+
+    Returns
+    -------
+    list of RawTest
+        One test for a file of one test (the same as :func:`read_test`); for several specimens
+        side by side one per specimen (:attr:`RawTest.specimen` names it); for several blocks
+        that do not continue one test, one per block (:attr:`RawTest.block` numbers it).
+
+    Raises
+    ------
+    ReadError, bendpam.errors.InputError
+        As for :func:`read_test`.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = Path(folder) / "be_150kPa.csv"
+    ...     _ = path.write_text("time_s,stroke_mm,force_n\\n0,0.000,11.80\\n0.05,0.027,11.71\\n")
+    ...     tests = read_tests(path)
+    >>> len(tests), len(tests[0]), tests[0].specimen, tests[0].block
+    (1, 2, None, None)
+    """
+    if format_file is not None:
+        return _read_declared(path, format_file, dialect, columns, pressure_kpa, rate_hz, repair)
+    kw: dict[str, Any] = {"pressure_kpa": pressure_kpa, "dialect": dialect, "columns": columns,
+                          "rate_hz": rate_hz, "repair": repair}  # fmt: skip
+    raw = _read_one(path, **kw)
+    labels = _specimen_labels(raw)
+    if len(labels) <= 1:
+        sheets = _other_sheets(raw, **kw)
+        if sheets:
+            return [dataclasses.replace(t, specimen=t.metadata.get("sheet")) for t in [raw, *sheets]]
+        return _split_blocks(raw)
+    out = [dataclasses.replace(raw, specimen=labels[0])]
+    for k in range(1, len(labels)):
+        other = _read_one(path, specimen=k, **kw)
+        out.append(dataclasses.replace(other, specimen=labels[k]))
+    return out
 
 
 def detect_dialect(path_or_text_lines: str | os.PathLike | Iterable[str]) -> str:
@@ -414,10 +726,14 @@ def inspect_file(
     -------
     dict
         ``{"file", "format", "encoding", "delimiter", "decimal", "header_line", "n_samples",
-        "columns": {"time": {"source", "unit"}, "stroke": {...}, "force": {...}},
+        "columns": {"time": {"source", "unit", "candidates"}, "stroke": {...}, "force": {...}},
         "other_columns", "first": {"time_s", "stroke_mm", "force_n"}, "last": {...},
-        "metadata", "pressure_kpa", "cycle_counter": {"source", "max"} or None, "warnings"}``;
-        for a file that cannot be read ``{"file", "error"}``.  No NaN or infinity anywhere
+        "metadata", "pressure_kpa", "cycle_counter": {"source", "max"} or None, "warnings",
+        "header": {"line", "candidates"}, "specimen", "block", "segments"}``
+        (and ``"tests"``, one summary per test, for a file of several specimens or blocks; the
+        other keys describe the first); ``candidates`` list every column or row scored, each
+        ``{"column" or "line", "score", "reasons"}``, best first.  For a file that cannot be read
+        ``{"file", "error"}``.  No NaN or infinity anywhere
         (None instead).  Values are in s, mm, N and kPa.
 
     Examples
@@ -429,8 +745,10 @@ def inspect_file(
     ...     _ = path.write_text("time_s,stroke_mm,force_n\\n0,0.000,11.80\\n0.05,0.027,11.71\\n")
     ...     info = inspect_file(path)
     ...     bad = inspect_file(Path(folder) / "missing.csv")
-    >>> info["format"], info["n_samples"], info["columns"]["force"], info["pressure_kpa"]
-    ('csv', 2, {'source': 'force_n', 'unit': 'N'}, 150.0)
+    >>> info["format"], info["n_samples"], info["columns"]["force"]["source"], info["pressure_kpa"]
+    ('csv', 2, 'force_n', 150.0)
+    >>> [c["column"] for c in info["columns"]["force"]["candidates"]], info["header"]["line"]
+    (['force_n'], 1)
     >>> sorted(bad)
     ['error', 'file']
     """
@@ -438,11 +756,26 @@ def inspect_file(
 
     name = os.fspath(path)
     try:
-        raw = read_test(path, pressure_kpa=pressure_kpa, columns=columns, rate_hz=rate_hz,
-                        repair=repair, format_file=format_file)  # fmt: skip
+        tests = read_tests(path, pressure_kpa=pressure_kpa, columns=columns, rate_hz=rate_hz,
+                           repair=repair, format_file=format_file)  # fmt: skip
     except (BendpamError, ValueError, OSError) as exc:
         return {"file": name, "error": str(exc)}
+    info = _inspect_one(name, tests[0])
+    if len(tests) > 1:
+        info["tests"] = [{"specimen": t.specimen, "block": t.block, "n_samples": len(t),
+                          "first": _row(t, 0), "last": _row(t, len(t) - 1)} for t in tests]  # fmt: skip
+    return info
+
+
+def _row(raw: RawTest, i: int) -> dict[str, float | None]:
+    return {c: _finite_or_none(raw.data[c].iat[i]) for c in COLUMNS}
+
+
+def _inspect_one(name: str, raw: RawTest) -> dict[str, Any]:
+    """The inspection dict of one test."""
     d = raw.data
+    chosen = next((b for b in raw.blocks if b.get("header_candidates") is not None), {})
+    cands = chosen.get("channel_candidates", {})
 
     def row(i: int) -> dict[str, float | None]:
         return {c: _finite_or_none(d[c].iat[i]) for c in COLUMNS}
@@ -461,7 +794,8 @@ def inspect_file(
         "header_line": raw.header_line,
         "n_samples": len(d),
         "columns": {
-            r: {"source": raw.channels[r]["source"], "unit": raw.channels[r]["unit"]} for r in ROLES
+            r: {"source": raw.channels[r]["source"], "unit": raw.channels[r]["unit"],
+                "candidates": list(cands.get(r, []))} for r in ROLES
         },
         "other_columns": list(raw.other_columns),
         "first": row(0),
@@ -470,6 +804,10 @@ def inspect_file(
         "pressure_kpa": _finite_or_none(raw.pressure_kpa) if raw.pressure_kpa is not None else None,
         "cycle_counter": counter,
         "warnings": list(raw.warnings),
+        "header": {"line": raw.header_line, "candidates": list(chosen.get("header_candidates", []))},
+        "specimen": raw.specimen,
+        "block": raw.block,
+        "segments": [list(s) for s in raw.segments],
     }
 
 
@@ -506,6 +844,11 @@ def format_inspection(info: Mapping[str, Any]) -> str:
         f"decimal {info.get('decimal')!r}, header at line {info.get('header_line')}"
     )
     out.append(f"  {info.get('n_samples')} samples")
+    tests = info.get("tests") or []
+    if tests:
+        names = [str(t.get("specimen") or f"block {t.get('block')}") for t in tests]
+        shown = ", ".join(names[:6]) + (", ..." if len(names) > 6 else "")
+        out.append(f"  {len(tests)} tests in the file ({shown}); the first is shown")
     cols = info.get("columns") or {}
     for role in ROLES:
         c = cols.get(role) or {}
@@ -536,24 +879,3 @@ def format_inspection(info: Mapping[str, Any]) -> str:
         out.append(f"  warning: {w}")
     return "\n".join(out)
 
-
-
-# ------------------------------------------------------------------------------------------------
-# TEMPORARY SHIM until h-reader lands: h-reader adds the real ``read_tests`` (one RawTest per
-# specimen/block).  Until then a file is one test.  Delete this block when merging h-reader.
-# ------------------------------------------------------------------------------------------------
-def read_tests(path, **kw) -> list[RawTest]:
-    """Every test in one file: one :class:`RawTest` per specimen or block (SHIM: one per file for now).
-
-    Takes the keywords of :func:`read_test`.
-
-    >>> import tempfile
-    >>> from pathlib import Path
-    >>> with tempfile.TemporaryDirectory() as folder:
-    ...     _ = Path(folder, "t.csv").write_text("time_s,stroke_mm,force_n\\n" + "".join(
-    ...         f"{i},{i % 7},{7 - i % 7}\\n" for i in range(30)))
-    ...     tests = read_tests(Path(folder, "t.csv"), pressure_kpa=100.0)
-    >>> len(tests), tests[0].pressure_kpa
-    (1, 100.0)
-    """
-    return [read_test(path, **kw)]  # SHIM until h-reader lands

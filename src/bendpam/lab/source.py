@@ -86,9 +86,25 @@ def _read_head(path: Path) -> tuple[bytes, int]:
     return head, size
 
 
+def _stray_nuls(head: bytes | str) -> bool:
+    """A few NUL bytes, each just before a line end (Bose WinTest ends its first line with one): text, not binary."""
+    nul = "\x00" if isinstance(head, str) else b"\x00"
+    n = head.count(nul)  # type: ignore[arg-type]
+    if n == 0 or n > 4:
+        return False
+    ends = ("\r", "\n") if isinstance(head, str) else (b"\r", b"\n")
+    i = head.find(nul)  # type: ignore[arg-type]
+    while i >= 0:
+        nxt = head[i + 1:i + 2]
+        if nxt not in ends:
+            return False
+        i = head.find(nul, i + 1)  # type: ignore[arg-type]
+    return True
+
+
 def _binary_error(path: Path, head: bytes) -> None:
     nul = head.find(b"\x00")
-    if nul >= 0:
+    if nul >= 0 and not _stray_nuls(head):
         raise ReadError(
             "binary data (NUL byte); expected a text export (CSV/TXT) or an .xlsx/.xls "
             "workbook, not a proprietary test file",
@@ -98,14 +114,14 @@ def _binary_error(path: Path, head: bytes) -> None:
 
 
 def _check_text_head(text: str, label: Path | str, whole: bool = True) -> None:
-    if "\x00" in text:
+    if "\x00" in text and not _stray_nuls(text[:65536]):
         raise ReadError(
             "binary data (NUL character); expected a text export (CSV/TXT)",
             label,
             text.count("\n", 0, text.index("\x00")) + 1,
         )
     head = text[:65536]
-    bad = re.findall(r"[\x00-\x08\x0e-\x19\x1b-\x1f\x7f]", head)
+    bad = re.findall(r"[\x01-\x08\x0e-\x19\x1b-\x1f\x7f]", head)
     if len(bad) > max(2, len(head) // 100):
         first = re.search(r"[\x00-\x08\x0e-\x19\x1b-\x1f\x7f]", head)
         assert first is not None
