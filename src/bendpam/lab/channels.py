@@ -63,7 +63,7 @@ FORCE_UNITS: dict[str, float] = {
     "n": 1.0, "newton": 1.0, "newtons": 1.0, "牛": 1.0, "н": 1.0,
     "kn": 1000.0, "千牛": 1000.0, "кн": 1000.0, "mn": 1e-3, "un": 1e-6, "µn": 1e-6, "μn": 1e-6, "dan": 10.0,
     "lbf": 4.4482216152605, "lb": 4.4482216152605, "lbs": 4.4482216152605,
-    "kgf": 9.80665, "kp": 9.80665, "gf": 9.80665e-3, "µn": 1e-6, "μn": 1e-6, "un": 1e-6,
+    "kgf": 9.80665, "kp": 9.80665, "gf": 9.80665e-3,
 }  # fmt: skip
 _UNIT_TABLES = {"time": TIME_UNITS, "stroke": LENGTH_UNITS, "force": FORCE_UNITS}
 UNIT_HINT = {
