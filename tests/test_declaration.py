@@ -18,7 +18,15 @@ from hypothesis import strategies as st
 
 from bendpam.cli import main
 from bendpam.errors import FileFormatError, InputError
-from bendpam.lab import ReadError, inspect_file, load_declaration, read_declared, read_test, suggest_declaration
+from bendpam.lab import (
+    ReadError,
+    inspect_file,
+    load_declaration,
+    read_declared,
+    read_test,
+    read_tests,
+    suggest_declaration,
+)
 from bendpam.lab.declaration import DECLARATION_HINT, parse_declaration
 
 REAL = Path(__file__).parent / "data" / "real"
@@ -122,7 +130,7 @@ def test_refused_file_is_refused_by_its_declaration_in_one_line():
 def test_aborted_test_is_refused_by_its_declaration():
     path, entry = TRUTH["hilhorst_ZwickTXIII_EN_Target-2.xlsx"]
     assert entry["verdict"] == "refuse"
-    with pytest.raises(ReadError, match="time does not increase"):
+    with pytest.raises(ReadError, match=r"time does not (increase|advance)"):
         read_declared(path, DECLS / "hilhorst_ZwickTXIII_EN_Target-2.xlsx.toml")
 
 
@@ -133,8 +141,9 @@ DEV_FILES = sorted(n for n, (_p, e) in TRUTH.items())
 
 
 def _detected(path):
+    """The first test detection reads in ``path`` (``read_tests``: specimens and blocks too), or None."""
     try:
-        return read_test(path)
+        return read_tests(path)[0]
     except (ReadError, InputError):
         return None
 
@@ -147,7 +156,7 @@ def test_suggest_round_trips_where_detection_reads(name):
         pytest.skip("detection refuses this file (see the next test)")
     text = suggest_declaration(path)
     assert text.startswith(f"# bendpam format declaration for {name}\n# filled in with what detection found")
-    (again,) = read_declared(path, parse_declaration(text, "draft.toml"))
+    again = read_declared(path, parse_declaration(text, "draft.toml"))[0]
     np.testing.assert_array_equal(again.data.to_numpy(), raw.data.to_numpy())
     for role in ("time", "stroke", "force"):
         assert again.channels[role]["source"] == raw.channels[role]["source"]
@@ -172,7 +181,8 @@ EDITS = {
 @pytest.mark.parametrize("name", sorted(EDITS))
 def test_suggest_drafts_a_working_declaration_where_detection_refuses(name):
     path, entry = TRUTH[name]
-    assert _detected(path) is None
+    if _detected(path) is not None:
+        pytest.skip("detection reads this file now (issue 22 items 2-3): the round-trip test covers it")
     text = suggest_declaration(path)
     assert "# drafted from the file's head" in text and "CHECK" in text
     for pattern, replacement in EDITS[name].items():
@@ -181,8 +191,13 @@ def test_suggest_drafts_a_working_declaration_where_detection_refuses(name):
     check_against_truth(read_declared(path, parse_declaration(text, "edited.toml")), entry)
 
 
-def test_detection_refusal_says_a_declaration_reads_the_file():
-    path = TRUTH["uttcsr_DebenMicrotest_FRTEST_007.MTR"][0]
+#: A file detection cannot read (no row names the channels, no units): columns only by position.
+NAMELESS = "logger export\n0.0;0.00;0.1\n0.5;0.10;1.2\n1.0;0.20;2.3\n1.5;0.30;3.1\n"
+
+
+def test_detection_refusal_says_a_declaration_reads_the_file(tmp_path):
+    path = tmp_path / "nameless.csv"
+    path.write_text(NAMELESS, encoding="utf-8")
     with pytest.raises(ReadError) as err:
         read_test(path)
     assert str(err.value).endswith(f"; or {DECLARATION_HINT}") and "--" not in str(err.value)
@@ -214,7 +229,7 @@ COLS = '[time]\ncolumn = "t"\nunit = "s"\n[stroke]\ncolumn = "x"\nunit = "mm"\n[
     (BASE.replace("header_line = 1", "header_line = 3") + COLS, r"header_line: line 3 is not above first_data_line"),
     (BASE.replace("header_line = 1", 'header_line = "none"') + COLS, r"time\.column: a name needs header_line"),
     (BASE + "specimen_width = 2\n" + COLS.replace('"f"', "3"), r"force\.column: position 3 is beyond specimen_width"),
-    (BASE + COLS.replace('unit = "N"', 'unit = "psi"'), r"force\.unit: 'psi' is not allowed; expected N, kN, mN, uN"),
+    (BASE + COLS.replace('unit = "N"', 'unit = "psi"'), r"force\.unit: 'psi' is not allowed; expected N, kN, mN, "),
     (BASE + COLS.replace('unit = "s"', 'unit = "s"\nscale = 2'), r"time\.scale: unknown key; expected column or unit"),
     (BASE + COLS.replace('"x"', '"t"'), r"force: one column given for two roles"),
     (BASE + COLS.replace('[time]\ncolumn = "t"\nunit = "s"\n', ""), r"time: missing, and no rate_hz"),
@@ -383,17 +398,19 @@ def test_read_test_and_inspect_file_take_a_format_file(tmp_path):
 
 
 def test_cli_inspect_suggest_and_format_file(tmp_path, capsys):
-    path = TRUTH["uttcsr_DebenMicrotest_FRTEST_007.MTR"][0]
+    path = tmp_path / "nameless.csv"
+    path.write_text(NAMELESS, encoding="utf-8")
     assert main(["inspect", str(path)]) == 2
     err = capsys.readouterr().err
     assert "--format-file" in err and "inspect FILE --suggest" in err and "suggest_declaration" not in err
     assert main(["inspect", str(path), "--suggest"]) == 0
     draft = capsys.readouterr().out
-    decl = tmp_path / "deben.toml"
-    decl.write_text(draft.replace("[stroke]\ncolumn = 2", "[stroke]\ncolumn = 4"), encoding="utf-8")
+    assert "# drafted from the file's head" in draft
+    decl = tmp_path / "nameless.toml"
+    decl.write_text(draft, encoding="utf-8")
     assert main(["inspect", str(path), "--format-file", str(decl), "--json"]) == 0
     (info,) = json.loads(capsys.readouterr().out)
-    assert info["n_samples"] == 1593 and info["columns"]["stroke"]["source"] == "Position"
+    assert info["n_samples"] == 4 and info["last"]["force_n"] == 3.1
     assert main(["inspect", str(path), "--suggest", "--json"]) == 0
     (item,) = json.loads(capsys.readouterr().out)
     assert item["declaration"] == draft

@@ -272,9 +272,12 @@ def _end_record(path: Path, encoding: str | None, sep: str, column: int) -> bool
     return b < a
 
 
-def _from_detection(path: Path, parsed: Any) -> str:
-    """A draft from what detection found (reads the file to the same numbers)."""
+def _from_detection(path: Path, parsed: Any, raw: Any) -> str:
+    """A draft from what detection found (reads the file to the same numbers as ``raw``, its first test)."""
     p, blk, source = parsed.parser, parsed.block, parsed.source
+    last_line = blk.last_line
+    if raw.data_lines is not None and blk.first_line <= raw.data_lines[1] < blk.last_line:
+        last_line = raw.data_lines[1]  # padding rows or end records after the samples were dropped
     keys: list[tuple[str, Any, str]] = []
     if source.is_excel:
         keys.append(("sheet", source.sheet, ""))
@@ -282,7 +285,11 @@ def _from_detection(path: Path, parsed: Any) -> str:
     if blk.units_line is not None:
         keys.append(("units_line", blk.units_line, ""))
     keys.append(("first_data_line", blk.first_line, ""))
-    if len(p.blocks) > 1 or p.trailing or _last_text_line(path, source) > blk.last_line:
+    if raw.data_lines is not None and raw.data_lines[1] > blk.last_line:
+        keys.append(("blocks", "concatenate", "the blocks continue one test"))
+    elif last_line < blk.last_line:
+        keys.append(("last_data_line", last_line, "padding or end records follow the samples"))
+    elif len(p.blocks) > 1 or p.trailing or _last_text_line(path, source) > blk.last_line:
         keys.append(("last_data_line", blk.last_line, "other lines follow the numbers"))
     if not source.is_excel:
         keys.append(("delimiter", _DELIM_WORDS.get(blk.sep, blk.sep), ""))
@@ -300,7 +307,10 @@ def _from_detection(path: Path, parsed: Any) -> str:
             keys.append(("rate_hz", float(got[0]), f"from {got[1]}"))
     names = [c.source for c in blk.columns]
     columns: dict[str, tuple[Any, str, str]] = {}
+    by_name = {c.source: c for c in blk.columns}
     for role, col in ch.chosen.items():
+        final = raw.channels.get(role, {}).get("source")
+        col = by_name.get(final, col)  # detection may have replaced a dead or unreadable channel
         unit = col.unit or DEFAULT_UNIT[role]
         comment = "" if col.unit else "no unit in the file: assumed"
         column: Any = col.source if col.source and names.count(col.source) == 1 else col.index + 1
@@ -351,13 +361,15 @@ def suggest_declaration(path: str | os.PathLike) -> str:
     ...
     """
     from bendpam.lab.parser import parse_path
+    from bendpam.lab.readers import read_tests
 
     p = Path(path)
     try:
         parsed = parse_path(p, dialect=None, overrides={}, rate_hz=None, repair=False, want_data=False)
+        first = read_tests(p)[0]  # what detection reads in the end (padding dropped, dead channels replaced)
     except ReadError as exc:
         text = _from_head(p, exc.message)
     else:
-        text = _from_detection(p, parsed)
+        text = _from_detection(p, parsed, first)
     parse_declaration(text, f"<draft for {p.name}>")  # a draft is always a valid declaration
     return text
