@@ -69,6 +69,7 @@ __all__ = [
     "ProcessedSet",
     "ProcessingError",
     "ProcessingOptions",
+    "continuous_time",
     "deadband_fit",
     "find_turning_points",
     "load_processed",
@@ -506,10 +507,11 @@ def process_one(rt, *, fixture: Fixture = PAPER_FIXTURE, options: ProcessingOpti
             f"{src}: no pressure: give pressure_kpa when reading it, a 'Pressure' metadata line, "
             "or a filename token like 200kPa"
         )
+    t, restarts = continuous_time(d["time_s"].to_numpy(dtype=float), getattr(rt, "segments", None) or [])
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
         try:
-            res = process_series(d["time_s"].to_numpy(), d["stroke_mm"].to_numpy(), d["force_n"].to_numpy(),
+            res = process_series(t, d["stroke_mm"].to_numpy(), d["force_n"].to_numpy(),
                                  float(rt.pressure_kpa), fixture=fixture, options=options, source=src,
                                  keep_series=keep_series)
         except ProcessingError as exc:
@@ -517,10 +519,38 @@ def process_one(rt, *, fixture: Fixture = PAPER_FIXTURE, options: ProcessingOpti
             raise (type(exc)(str(located)) if isinstance(exc, NotABendingTest) else located) from None
     res.specimen = getattr(rt, "specimen", None)
     res.notes.extend(getattr(rt, "warnings", []) or [])
+    if restarts:
+        res.notes.append(f"the clock restarts {restarts} time(s): each later segment was placed after the one "
+                         "before it, one median sampling interval on")
     mismatch = check_cycle_count(rt, res.n_cycles)
     if mismatch:
         res.notes.append(mismatch)
     return res
+
+
+def continuous_time(time_s: np.ndarray, segments: list[tuple[int, int]]) -> tuple[np.ndarray, int]:
+    """Time made to run on across clock restarts between ``segments`` (sample ranges of a raw test).
+
+    A segment that starts at or before the end of the one before it (a restart of the machine's
+    clock, reported by the reader) is shifted to start one median sampling interval after it;
+    gaps (time jumping forward) are kept.  Returns the time (s) and the number of restarts.
+
+    >>> t = np.array([0.0, 0.1, 0.2, 0.0, 0.1, 0.2])
+    >>> continuous_time(t, [(0, 3), (3, 6)])
+    (array([0. , 0.1, 0.2, 0.3, 0.4, 0.5]), 1)
+    """
+    t = np.asarray(time_s, dtype=float)
+    if len(segments) < 2 or t.size < 2:
+        return t, 0
+    d = np.diff(t)
+    step = float(np.median(d[d > 0])) if np.any(d > 0) else 1.0
+    out = t.copy()
+    restarts = 0
+    for start, _stop in segments[1:]:
+        if 0 < start < out.size and out[start] <= out[start - 1]:
+            out[start:] += out[start - 1] + step - out[start]
+            restarts += 1
+    return out, restarts
 
 
 def number_replicates(results: list[PressureResult]) -> list[PressureResult]:
