@@ -274,3 +274,23 @@ def test_a_stroke_stuck_at_saturation_gives_way_to_one_that_moves(tmp_path):
     raw = read_test(_write(tmp_path / "sat.txt", lines))
     assert raw.channels["stroke"]["source"] == "Displacement (mm)" and raw.data["stroke_mm"].iat[-1] == 7.8
     assert any("stuck" in w for w in raw.warnings)
+
+
+def test_fixed_width_columns_with_blanks_in_names_and_a_column_without_unit(tmp_path):
+    # a dilatometer/testing-machine ASCII export (TA DIL 805 style): right-aligned columns, a names
+    # row whose names hold two blanks ('Phi  (D)'), and a units row with no unit over 'No.'
+    lines = [
+        r" C:\WinTA100\DIL805.PRO\Data\test_1.asc",
+        "     No.          Time        DL     Force    Phi  (D)        Poti",
+        "                     s        um         N                      mm",
+        "      19      0.002099    -93.72      -0.7      0.0316     11.2011",
+        "      20      0.002220    -95.12      -4.2      0.0023     11.2010",
+        "      21      0.002323    -94.84      -2.8     -0.0108     11.2009",
+    ]
+    path = tmp_path / "dil_150kPa.asc"
+    path.write_text("\r\n".join(lines) + "\r\n", encoding="latin-1")
+    raw = read_test(path)
+    assert [raw.channels[r]["source"] for r in ("time", "stroke", "force")] == ["Time", "DL", "Force"]
+    # first row: 0.002099 s, -93.72 um = -0.09372 mm, -0.7 N; last: 0.002323 s, -0.09484 mm, -2.8 N
+    np.testing.assert_allclose(raw.data.iloc[0].to_numpy(), [0.002099, -0.09372, -0.7])
+    np.testing.assert_allclose(raw.data.iloc[-1].to_numpy(), [0.002323, -0.09484, -2.8])

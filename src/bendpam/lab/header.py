@@ -12,12 +12,19 @@ specimen row, a row of empty cells or a row of one cell per column.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 from bendpam.lab.layout import numeric_cells, split_cells
 
-__all__ = ["LOOK_BACK", "HeaderGuess", "find_header", "group_period"]
+__all__ = [
+    "LOOK_BACK",
+    "HeaderGuess",
+    "find_header",
+    "grid_cells",
+    "group_period",
+]
 
 #: Text rows above a data row considered as its names row.
 LOOK_BACK = 60
@@ -157,11 +164,37 @@ def _merged(upper: list[str], lower: list[str]) -> list[str]:
     return out
 
 
+def grid_cells(text: str, data_line: str) -> list[str]:
+    """A space-aligned names or units row cut at the columns of the data row under it.
+
+    Each piece of ``text`` (split at two or more blanks) belongs to the first data column that
+    ends at or after the piece's end (right-aligned columns, as fixed-width exports write them);
+    pieces of one column are joined as written, and a column with none is ``""``.  Used only when
+    the plain split does not give one cell per data column.
+
+    >>> names = "     No.          Time    Phi  (D)    Force"
+    >>> data = "      19      0.002099      0.0316     -0.7"
+    >>> grid_cells(names, data), grid_cells("                     s                   N", data)
+    (['No.', 'Time', 'Phi  (D)', 'Force'], ['', 's', '', 'N'])
+    """
+    ends = [m.end() for m in re.finditer(r"\S+", data_line)]
+    spans: list[list[tuple[int, int]]] = [[] for _ in ends]
+    for m in re.finditer(r"\S+(?: \S+)*", text):
+        k = next((i for i, e in enumerate(ends) if e >= m.end()), len(ends) - 1)
+        if k >= 0:
+            spans[k].append((m.start(), m.end()))
+    return [text[sp[0][0]:sp[-1][1]] if sp else "" for sp in spans]
+
+
 def _score_candidate(pre: Sequence[tuple[int, str]], j: int, sep: str, width: int,
                      role_hits: Callable[[list[str]], int],
-                     is_units_row: Callable[[list[str], list[str]], bool]) -> tuple[tuple, HeaderGuess, str] | None:
+                     is_units_row: Callable[[list[str], list[str]], bool],
+                     data_line: str = "") -> tuple[tuple, HeaderGuess, str] | None:
     ln, line = pre[j]
     names = split_cells(line, sep)
+    gridded = sep == " " and data_line and _trimmed_len(names) != width
+    if gridded:  # fixed-width columns whose names hold blanks, or a column without a name
+        names = grid_cells(line, data_line)
     hits = role_hits(names)
     two_rows = False
     if 0 < hits < 3 and j > 0:  # a names row over two rows?
@@ -178,7 +211,7 @@ def _score_candidate(pre: Sequence[tuple[int, str]], j: int, sep: str, width: in
     between: list[tuple[int, str]] = []
     for k in range(j + 1, len(pre)):
         bl, bline = pre[k]
-        cells = split_cells(bline, sep)
+        cells = grid_cells(bline, data_line) if gridded else split_cells(bline, sep)
         if guess.units is None and k == j + 1 and is_units_row(cells, names):
             guess.units_line, guess.units = bl, cells
             reasons.append(f"units row at line {bl}")
@@ -235,7 +268,7 @@ def find_header(pre: Sequence[tuple[int, str]], data_line: str, seps: Sequence[s
     for k, sep in enumerate(seps):
         width = _trimmed_len(split_cells(data_line, sep))
         for j in range(len(pre) - 1, lo - 1, -1):
-            got = _score_candidate(pre, j, sep, width, role_hits, is_units_row)
+            got = _score_candidate(pre, j, sep, width, role_hits, is_units_row, data_line)
             if got is None:
                 continue
             score, guess, reasons = got
