@@ -247,9 +247,11 @@ def test_no_time_column_with_rate_in_metadata(tmp_path):
 def test_no_time_column_with_rate_option_or_error(tmp_path):
     arr = _series()
     p = _write(tmp_path / "norate.csv", ["Extension (mm);Load (N)", *_rows(arr[:, 1:], ";")])
-    with pytest.raises(ReadError, match="no time column") as info:
-        read_test(p)
-    assert info.value.line == 1 and "rate_hz" in str(info.value)
+    plain = read_test(p)  # read, and said: the sample number stands for the time
+    assert plain.channels["time"]["source"] is None and plain.source_units["time_s"] == "sample"
+    np.testing.assert_array_equal(plain.data["time_s"].to_numpy(), np.arange(len(arr), dtype=float))
+    np.testing.assert_allclose(plain.data[["stroke_mm", "force_n"]].to_numpy(), arr[:, 1:], atol=1e-5)
+    assert any("no time column and no sampling rate" in w for w in plain.warnings)
     raw = read_test(p, rate_hz=2)
     _check(raw, arr, (None, "Extension (mm)", "Load (N)"))
     with pytest.raises(InputError, match="rate_hz"):

@@ -145,13 +145,18 @@ def _time_from_rate(values: dict[str, np.ndarray], source_units: dict[str, str],
     """Make the time from the sampling rate when the block has none; the rate used (Hz) or None."""
     sample_rate: float | None = None
     if "time" not in values:
-        if rate_hz is not None:
-            sample_rate, rate_src = float(rate_hz), "the rate_hz option"
-        else:
-            got = p.rate_from_metadata(blk.header_line)
-            assert got is not None
-            sample_rate, rate_src = got
+        got = p.rate_from_metadata(blk.header_line) if rate_hz is None else (float(rate_hz), "the rate_hz option")
         n = values["stroke"].size
+        if got is None:  # no time and no rate: the sample number stands for the time, and says so
+            values["time"] = np.arange(n, dtype=np.float64)
+            source_units["time_s"] = "sample"
+            channels["time"] = {"source": None, "unit": "sample",
+                                "why": "no time column and no sampling rate: the sample number (0, 1, 2, ...)"}
+            warnings.append("no time column and no sampling rate known: time_s is the sample number (one per "
+                            "second as if sampled at 1 Hz); give the sampling rate for real times. Curvature and "
+                            "moment do not depend on it")
+            return None
+        sample_rate, rate_src = got
         values["time"] = np.arange(n, dtype=np.float64) / sample_rate
         source_units["time_s"] = "s"
         channels["time"] = {

@@ -488,15 +488,13 @@ class Parser:
         blk.groups, blk.group_labels, blk.group = n, labels, k
 
     def _usable(self, blk: Block) -> int:
-        """2 = time, stroke and force; 1 = stroke and force with a rate; 0 = not usable."""
+        """2 = time, stroke and force; 1 = stroke and force (time from a rate, or the sample number); 0 = not usable."""
         ch = blk.choice
         if ch is None or ch.bad_unit:
             return 0
         if {"time", "stroke", "force"} <= set(ch.chosen):
             return 2
-        if {"stroke", "force"} <= set(ch.chosen) and (
-            self.rate_hz is not None or self.rate_from_metadata(blk.header_line) is not None
-        ):
+        if {"stroke", "force"} <= set(ch.chosen):
             return 1
         return 0
 

@@ -305,6 +305,8 @@ def _from_detection(path: Path, parsed: Any, raw: Any) -> str:
         got = p.rate_from_metadata(blk.header_line)
         if got is not None:
             keys.append(("rate_hz", float(got[0]), f"from {got[1]}"))
+        else:
+            keys.append(("rate_hz", 1.0, "CHECK: no time column and no rate known; 1 Hz makes time the sample number"))
     names = [c.source for c in blk.columns]
     columns: dict[str, tuple[Any, str, str]] = {}
     by_name = {c.source: c for c in blk.columns}
