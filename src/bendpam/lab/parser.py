@@ -57,7 +57,9 @@ from bendpam.lab.source import Source, open_source
 
 __all__ = ["Block", "ColumnData", "Parsed", "Parser", "parse_path", "parse_source"]
 
-_CHUNK_LINES = 100_000  # lines handed to the C parser at a time
+_CHUNK_LINES = 100_000  # lines looked at at a time when a block is only skipped
+_CHUNK_CHARS = 1 << 21  # characters of data lines handed to the C parser at a time
+_PIECE_LINES = 2_000  # lines per piece of a chunk that has odd lines (the odd piece is read line by line)
 _PEEK_LINES = 200  # data rows inspected for the decimal mark
 _RATE_KEY = re.compile(
     r"sampl|abtast|mess ?rate|data rate|acquisition rate|recording rate|aufzeichnungsrate|"
@@ -289,6 +291,7 @@ class Parser:
         self.dollar = False
         self.warnings: list[str] = []
         self.trailing: list[tuple[int, str]] = []
+        self._blank_carry = False  # the last chunk of data lines read ended in blank lines
 
     # -- metadata ----------------------------------------------------------------------------
     def meta_items(self, before: int | None = None) -> list[tuple[int, MetaItem]]:
@@ -476,38 +479,58 @@ class Parser:
         needed = self._needed(blk)
         for role, _col in needed:
             data.cols[role] = []
+        self._blank_carry = False
         while True:
-            lines = reader.take(_CHUNK_LINES)
-            if not lines:
+            got = reader.take_text(_CHUNK_CHARS)
+            if got is None:
                 break
-            start = reader.lineno - len(lines) + 1
-            arrs = self._fast(lines, blk, needed, dec)
-            if arrs is None and needed[-1][0] == "counter":
-                # the optional counter alone may be what the C parser cannot read
-                arrs = self._fast(lines, blk, needed[:-1], dec)
-                if arrs is not None:
-                    arrs.append(np.full(len(lines), np.nan))
-                    if data.counter_bad_line is None:
-                        data.counter_bad_line = start
+            text, n = got
+            start = reader.lineno - n + 1
+            arrs = self._fast(text, n, blk, needed, dec, data)
             if arrs is not None:
-                for (role, _col), arr in zip(needed, arrs, strict=True):
-                    data.cols[role].append(arr)
-                data.lines.append(np.arange(start, start + len(lines), dtype=np.int32))
-                blk.n_rows += len(lines)
-                blk.last_line = start + len(lines) - 1
+                self._keep_rows(blk, needed, data, arrs, np.arange(start, start + n, dtype=np.int32))
                 continue
-            end = self._slow(lines, start, blk, needed, dec, data)
-            if end is not None:
-                reader.push_back(lines[end:])
+            lines = text.split("\n")
+            del text
+            if self._rows_of_lines(lines, start, blk, needed, dec, data):
                 break
 
-    def _fast(self, lines: list[str], blk: Block, needed, dec: str) -> list[np.ndarray] | None:
+    def _keep_rows(self, blk: Block, needed, data: ColumnData, arrs: list[np.ndarray], lnos: np.ndarray) -> None:
+        for (role, _col), arr in zip(needed, arrs, strict=True):
+            data.cols[role].append(arr)
+        data.lines.append(lnos)
+        blk.n_rows += len(lnos)
+        blk.last_line = int(lnos[-1])
+        self._blank_carry = False
+
+    def _rows_of_lines(self, lines: list[str], start: int, blk: Block, needed, dec: str, data: ColumnData) -> bool:
+        """Read a chunk that has odd lines in pieces; True if the block ends in it (the rest pushed back)."""
+        for off in range(0, len(lines), _PIECE_LINES):
+            piece = lines[off:off + _PIECE_LINES]
+            first = start + off
+            arrs = self._fast("\n".join(piece), len(piece), blk, needed, dec, data)
+            if arrs is not None:
+                self._keep_rows(blk, needed, data, arrs, np.arange(first, first + len(piece), dtype=np.int32))
+                continue
+            end = self._slow(piece, first, blk, needed, dec, data)
+            if end is not None:
+                self.reader.push_back(lines[off + end:])
+                return True
+        return False
+
+    def _fast(self, text: str, n: int, blk: Block, needed, dec: str, data: ColumnData) -> list[np.ndarray] | None:
+        """The needed columns of ``n`` lines of numbers by the C parser, or None if any line is odd.
+
+        Once the optional cycle counter is known to hold a non-number, it is no longer parsed
+        (NaN: the counter is left out anyway).
+        """
         if blk.sep == dec:
             return None
-        idx = [col.index for _role, col in needed]
+        counter_off = needed[-1][0] == "counter" and data.counter_bad_line is not None
+        idx = [col.index for _role, col in (needed[:-1] if counter_off else needed)]
         try:
             df = pd.read_csv(
-                io.BytesIO("\n".join(lines).encode("utf-8", "surrogatepass")),
+                io.BytesIO(text.encode("utf-8", "surrogatepass")),
                 sep=blk.sep,
                 decimal=dec,
                 header=None,
@@ -523,8 +546,10 @@ class Parser:
         except Exception:  # any parser trouble -> the slow path finds the line
             return None
         del df
-        if any(len(a) != len(lines) or not np.isfinite(a).all() for a in arrs):
+        if any(len(a) != n or not np.isfinite(a).all() for a in arrs):
             return None
+        if counter_off:
+            arrs.append(np.full(n, np.nan))
         return arrs
 
     def _row_problem(self, role: str, col: ColumnInfo, cell: str | None, dec: str, blk: Block,
@@ -556,7 +581,7 @@ class Parser:
         sep = blk.sep
         rows: list[list[float]] = []
         lnos: list[int] = []
-        blank_run: int | None = None
+        blank_run: int | None = 0 if self._blank_carry else None  # blank lines ended the previous chunk
         names_norm = [normalize_name(n) for n in blk.names]
         end: int | None = None
         for k, line in enumerate(lines):
@@ -619,8 +644,7 @@ class Parser:
             data.lines.append(np.asarray(lnos, dtype=np.int32))
             blk.n_rows += len(rows)
             blk.last_line = lnos[-1]
-        if end is None and blank_run is not None:
-            return None  # trailing blank lines: the next chunk decides
+        self._blank_carry = end is None and blank_run is not None  # trailing blank lines: the next chunk decides
         return end
 
     def _skip_rows(self, blk: Block) -> None:
