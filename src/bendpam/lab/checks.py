@@ -75,7 +75,8 @@ def _off_median5(x: np.ndarray, limit: float) -> np.ndarray:
     ``scipy.ndimage.median_filter(x, 5, mode="nearest")``, without filtering the whole column).
 
     >>> import numpy as np
-    >>> _off_median5(np.array([1.0, 1.1, 9.0, 1.2, 1.0, 1.1, 8.0, 8.0, 1.0]), 1.0).tolist()
+    >>> x = np.array([1.0, 1.1, 9.0, 1.2, 1.0, 1.1, 1.0, 8.0, 8.0, 8.0, 1.1, 1.0, 1.2])  # a spike, a plateau
+    >>> _off_median5(x, 1.0).tolist()
     [2]
     """
     n = x.size
@@ -148,13 +149,19 @@ def time_problems(t: np.ndarray) -> TimeProblems:
     if t.size < 2:
         e = np.empty(0, dtype=np.int64)
         return TimeProblems(e, e, float("nan"))
-    running = np.maximum.accumulate(t)
-    backwards = np.flatnonzero(t[1:] <= running[:-1]) + 1
-    del running
     dt = np.diff(t)
-    pos = dt[dt > 0]
-    med = float(np.median(pos)) if pos.size else float("nan")
-    if pos.size:
+    if (dt > 0).all():  # increasing throughout: nothing goes back, every step counts
+        backwards = np.empty(0, dtype=np.int64)
+        pos = dt.copy()
+    else:
+        running = np.maximum.accumulate(t)
+        backwards = np.flatnonzero(t[1:] <= running[:-1]) + 1
+        del running
+        pos = dt[dt > 0]
+    any_step = pos.size > 0
+    med = float(np.median(pos, overwrite_input=True)) if any_step else float("nan")
+    del pos
+    if any_step:
         limit = max(GAP_FACTOR * med, GAP_MIN_S)
         gaps = np.flatnonzero(dt > limit) + 1
     else:

@@ -18,7 +18,9 @@ Metadata grammars (one per line, all seen in real files)::
 from __future__ import annotations
 
 import csv
+import io
 import math
+import os
 import re
 from collections import deque
 from collections.abc import Iterable, Iterator
@@ -422,8 +424,8 @@ class LineReader:
         per line, any other iterable line by line.
 
         >>> import io
-        >>> reader = LineReader(io.StringIO("a\\r\\nb\\rc\\nd"))
-        >>> reader.next(), reader.take_text(2), reader.lineno, reader.take_text(2)
+        >>> reader = LineReader(io.StringIO("a\\r\\nb\\rc\\nd", newline=None))
+        >>> reader.next(), reader.take_text(3), reader.lineno, reader.take_text(2)
         ('a', ('b\\nc', 2), 3, ('d', 1))
         >>> reader.push_back(["d"]); reader.take_text(100), reader.take_text(100)
         (('d', 1), None)
@@ -431,7 +433,7 @@ class LineReader:
         if self._pending:
             lines = list(self._pending)
             self._pending.clear()
-        elif hasattr(self._src, "read"):
+        elif isinstance(self._src, io.TextIOBase):
             text = self._src.read(n_chars)
             if not text:
                 return None
@@ -449,6 +451,18 @@ class LineReader:
             return None
         self.lineno += len(lines)
         return "\n".join(lines), len(lines)
+
+    def bytes_left(self) -> int | None:
+        """Bytes of the file not read yet (about: the stream reads ahead), or None if not a file.
+
+        >>> LineReader(["0,1"]).bytes_left() is None
+        True
+        """
+        try:
+            raw = self._src.buffer  # type: ignore[attr-defined]  # a text file's bytes
+            return max(0, os.fstat(raw.fileno()).st_size - raw.tell())
+        except (AttributeError, OSError, ValueError, io.UnsupportedOperation):
+            return None
 
     def push_back(self, lines: list[str]) -> None:
         """Return ``lines`` (the last ones handed out, in order) to the reader."""

@@ -226,6 +226,50 @@ def _data_seps(line: str) -> list[str]:
     return out
 
 
+class _Sink:
+    """Growing buffers for the numbers of the block read, one per role and one of line numbers.
+
+    The rows of every chunk are copied in place (no list of chunks to join at the end, which would
+    hold the numbers twice); the buffers are sized from an estimate of the rows left (the bytes
+    left in the file at the bytes per line seen so far), which untouched pages of memory do not
+    cost, and grow by half when the estimate was short.
+    """
+
+    def __init__(self, roles: list[str]) -> None:
+        self.roles = roles
+        self.n = 0
+        self.bufs = {role: np.empty(0) for role in roles}
+        self.lines = np.empty(0, dtype=np.int32)
+
+    def reserve(self, rows: int) -> None:
+        """Room for at least ``rows`` rows in all."""
+        if rows <= self.lines.size:
+            return
+        for role in self.roles:
+            buf = np.empty(rows)
+            buf[:self.n] = self.bufs[role][:self.n]
+            self.bufs[role] = buf
+        lines = np.empty(rows, dtype=np.int32)
+        lines[:self.n] = self.lines[:self.n]
+        self.lines = lines
+
+    def add(self, arrs: list[np.ndarray], lnos: np.ndarray) -> None:
+        k = len(lnos)
+        if self.n + k > self.lines.size:
+            self.reserve(max(self.n + k, self.lines.size + self.lines.size // 2 + 4096))
+        for role, arr in zip(self.roles, arrs, strict=True):
+            self.bufs[role][self.n:self.n + k] = arr
+        self.lines[self.n:self.n + k] = lnos
+        self.n += k
+
+    def into(self, data: ColumnData) -> None:
+        """Hand the rows to ``data``: one chunk per role (none when no row was read)."""
+        for role in self.roles:
+            data.cols[role] = [self.bufs[role][:self.n]] if self.n else []
+        if self.n:
+            data.lines.append(self.lines[:self.n])
+
+
 class Parser:
     """One pass over the lines of an export: blocks, metadata and the chosen block's numbers.
 
@@ -292,6 +336,7 @@ class Parser:
         self.warnings: list[str] = []
         self.trailing: list[tuple[int, str]] = []
         self._blank_carry = False  # the last chunk of data lines read ended in blank lines
+        self._sink = _Sink([])  # the numbers of the block being read
 
     # -- metadata ----------------------------------------------------------------------------
     def meta_items(self, before: int | None = None) -> list[tuple[int, MetaItem]]:
@@ -477,28 +522,32 @@ class Parser:
             self._skip_rows(blk)
             return
         needed = self._needed(blk)
-        for role, _col in needed:
-            data.cols[role] = []
+        self._sink = _Sink([role for role, _col in needed])
         self._blank_carry = False
+        sized = False
         while True:
             got = reader.take_text(_CHUNK_CHARS)
             if got is None:
                 break
             text, n = got
             start = reader.lineno - n + 1
+            if not sized and n >= 1000:  # room for the rows the rest of the file will likely hold
+                left = reader.bytes_left()
+                if left is not None:
+                    self._sink.reserve(self._sink.n + n + int(1.02 * left * n / max(len(text), 1)) + 4096)
+                sized = True
             arrs = self._fast(text, n, blk, needed, dec, data)
             if arrs is not None:
-                self._keep_rows(blk, needed, data, arrs, np.arange(start, start + n, dtype=np.int32))
+                self._keep_rows(blk, arrs, np.arange(start, start + n, dtype=np.int32))
                 continue
             lines = text.split("\n")
             del text
             if self._rows_of_lines(lines, start, blk, needed, dec, data):
                 break
+        self._sink.into(data)
 
-    def _keep_rows(self, blk: Block, needed, data: ColumnData, arrs: list[np.ndarray], lnos: np.ndarray) -> None:
-        for (role, _col), arr in zip(needed, arrs, strict=True):
-            data.cols[role].append(arr)
-        data.lines.append(lnos)
+    def _keep_rows(self, blk: Block, arrs: list[np.ndarray], lnos: np.ndarray) -> None:
+        self._sink.add(arrs, lnos)
         blk.n_rows += len(lnos)
         blk.last_line = int(lnos[-1])
         self._blank_carry = False
@@ -510,7 +559,7 @@ class Parser:
             first = start + off
             arrs = self._fast("\n".join(piece), len(piece), blk, needed, dec, data)
             if arrs is not None:
-                self._keep_rows(blk, needed, data, arrs, np.arange(first, first + len(piece), dtype=np.int32))
+                self._keep_rows(blk, arrs, np.arange(first, first + len(piece), dtype=np.int32))
                 continue
             end = self._slow(piece, first, blk, needed, dec, data)
             if end is not None:
@@ -542,7 +591,7 @@ class Parser:
                 na_filter=False,
                 index_col=False,
             )
-            arrs = [np.array(df[i].to_numpy(dtype=np.float64), copy=True) for i in idx]
+            arrs = [df[i].to_numpy(dtype=np.float64) for i in idx]  # copied into the sink
         except Exception:  # any parser trouble -> the slow path finds the line
             return None
         del df
@@ -639,9 +688,7 @@ class Parser:
                             col.source)  # fmt: skip
         if rows:
             arr = np.asarray(rows, dtype=np.float64).reshape(-1, len(needed))
-            for j, (role, _col) in enumerate(needed):
-                data.cols[role].append(arr[:, j].copy())
-            data.lines.append(np.asarray(lnos, dtype=np.int32))
+            self._sink.add([arr[:, j] for j in range(len(needed))], np.asarray(lnos, dtype=np.int32))
             blk.n_rows += len(rows)
             blk.last_line = lnos[-1]
         self._blank_carry = end is None and blank_run is not None  # trailing blank lines: the next chunk decides
