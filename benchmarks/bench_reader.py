@@ -16,7 +16,6 @@ Run: ``python benchmarks/bench_reader.py [--quick]``.
 
 from __future__ import annotations
 
-import json
 import os
 import subprocess
 import sys

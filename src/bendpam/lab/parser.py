@@ -4,11 +4,11 @@
 kept as metadata candidates; a line of numbers after text starts a data :class:`Block` (its
 names row, an optional units row, the delimiter, the channels chosen by
 :func:`bendpam.lab.channels.choose_channels`); the best block (time, stroke and force, or
-stroke and force with a sampling rate) is read into :class:`ColumnData`, in chunks of lines by
-the C parser of :func:`pandas.read_csv`, a chunk it cannot read line by line to find the
-offending line.  :func:`parse_source` and :func:`parse_path` run the pass and return the
-:class:`Parsed` result, or raise the :class:`~bendpam.lab.read_error.ReadError` that says why no
-block could be read.
+stroke and force with a sampling rate) is read into :class:`ColumnData`, in blocks of text by
+the C parser of :func:`pandas.read_csv`; a block it cannot read is read in pieces, the odd piece
+line by line to find the offending line or the end of the block.  :func:`parse_source` and
+:func:`parse_path` run the pass and return the :class:`Parsed` result, or raise the
+:class:`~bendpam.lab.read_error.ReadError` that says why no block could be read.
 """
 
 from __future__ import annotations
