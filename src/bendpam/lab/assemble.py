@@ -166,7 +166,7 @@ def _drop_spikes(samples: _Samples, channels: Channels, label: Path | str, repai
         x = samples.values[role]
         name = channels[role]["source"]
         spikes = find_spikes(x)
-        absurd = np.flatnonzero(np.abs(x) > limits[role])
+        absurd = np.flatnonzero((x > limits[role]) | (x < -limits[role]))  # |x| > limit, without a copy of x
         bad = np.union1d(spikes, absurd)
         if bad.size:
             i = int(bad[0])

@@ -80,13 +80,11 @@ def _off_median5(x: np.ndarray, limit: float) -> np.ndarray:
     [2]
     """
     n = x.size
-    step = np.abs(np.diff(x)) > limit
-    near = np.zeros(n, dtype=bool)
-    near[:-1] = step
-    near[1:] |= step
-    del step
-    cand = np.flatnonzero(near)
-    del near
+    d = np.diff(x)
+    np.abs(d, out=d)
+    j = np.flatnonzero(d > limit)  # steps x[j] -> x[j + 1] larger than the limit
+    del d
+    cand = np.union1d(j, j + 1)
     if cand.size == 0:
         return np.empty(0, dtype=np.int64)
     if cand.size > n // 4:  # a column of steps: filter it whole
@@ -152,7 +150,8 @@ def time_problems(t: np.ndarray) -> TimeProblems:
     dt = np.diff(t)
     if (dt > 0).all():  # increasing throughout: nothing goes back, every step counts
         backwards = np.empty(0, dtype=np.int64)
-        pos = dt.copy()
+        # no step can be a gap when none is longer than the shortest gap: then dt itself is ordered in place
+        pos = dt if float(dt.max()) <= GAP_MIN_S else dt.copy()
     else:
         running = np.maximum.accumulate(t)
         backwards = np.flatnonzero(t[1:] <= running[:-1]) + 1
