@@ -23,7 +23,7 @@ GAP_FACTOR = 50.0
 GAP_MIN_S = 2.0
 
 
-def find_spikes(x: np.ndarray) -> np.ndarray:
+def find_spikes(x: np.ndarray, scratch: np.ndarray | None = None) -> np.ndarray:
     """Indices of isolated spikes in one column.
 
     A sample is a spike when its distance to the median of the 5 samples around it exceeds
@@ -36,6 +36,9 @@ def find_spikes(x: np.ndarray) -> np.ndarray:
     ----------
     x : numpy.ndarray
         The column (finite values).
+    scratch : numpy.ndarray, optional
+        A float array at least as long as ``x`` to work in (its contents are overwritten): the
+        checks of several columns of one length then share one temporary.
 
     Returns
     -------
@@ -56,18 +59,19 @@ def find_spikes(x: np.ndarray) -> np.ndarray:
     if n < 5:
         return np.empty(0, dtype=np.int64)
     k = max(2, int(np.ceil(0.005 * n)))  # leave out the k most extreme values on each side
-    part = np.partition(x, [k, n - 1 - k])
+    part = np.empty_like(x) if scratch is None else scratch[:n]
+    np.copyto(part, x)
+    part.partition([k, n - 1 - k])
     scale = float(part[n - 1 - k] - part[k])
-    del part
     # the floor, from the median magnitude, matters only for a column that is nearly constant
     biggest = max(float(x.max()), -float(x.min()))
     if scale < max(1e-9 * max(biggest, 1.0), 1e-12):
         mag = float(np.median(np.abs(x)))
         scale = max(scale, max(1e-9 * max(mag, 1.0), 1e-12))
-    return _off_median5(x, SPIKE_FACTOR * scale)
+    return _off_median5(x, SPIKE_FACTOR * scale, part)
 
 
-def _off_median5(x: np.ndarray, limit: float) -> np.ndarray:
+def _off_median5(x: np.ndarray, limit: float, scratch: np.ndarray | None = None) -> np.ndarray:
     """Indices ``i`` where ``|x[i] - median(x[i-2:i+3])| > limit`` (edges repeated), sorted.
 
     Such a sample differs by more than ``limit`` from at least 3 of its 4 neighbours, so from
@@ -80,7 +84,8 @@ def _off_median5(x: np.ndarray, limit: float) -> np.ndarray:
     [2]
     """
     n = x.size
-    d = np.diff(x)
+    d = np.empty(n - 1) if scratch is None else scratch[:n - 1]
+    np.subtract(x[1:], x[:-1], out=d)  # np.diff(x), in the scratch array
     np.abs(d, out=d)
     j = np.flatnonzero(d > limit)  # steps x[j] -> x[j + 1] larger than the limit
     del d
