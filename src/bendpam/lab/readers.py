@@ -29,7 +29,7 @@ The reader is layered, not a list of dialects:
 
 The numeric block is read in blocks of text (about 2 MB, no string per line) by the C parser of
 :func:`pandas.read_csv`, into buffers sized from the bytes left in the file, so a 450 MB export
-is read in bounded memory and linear time, within 2x of :func:`pandas.read_csv` itself; a block
+is read in bounded memory and linear time, in about 2x the time of :func:`pandas.read_csv`; a block
 the C parser cannot read is read in pieces of 2000 lines, and only the odd piece line by line,
 which finds the offending line.  Every failure is a :class:`ReadError`
 whose message is one line ``FILE:LINE: what was wrong, what was expected``.
