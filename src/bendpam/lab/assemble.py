@@ -167,7 +167,9 @@ def _drop_spikes(samples: _Samples, channels: Channels, label: Path | str, repai
         x = samples.values[role]
         name = channels[role]["source"]
         spikes = find_spikes(x, scratch)
-        absurd = np.flatnonzero((x > limits[role]) | (x < -limits[role]))  # |x| > limit, without a copy of x
+        lim = limits[role]
+        absurd = (np.flatnonzero((x > lim) | (x < -lim)) if (x.max() > lim or x.min() < -lim)
+                  else np.empty(0, dtype=np.int64))  # |x| > limit, without a copy of x
         bad = np.union1d(spikes, absurd)
         if bad.size:
             i = int(bad[0])
