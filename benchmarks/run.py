@@ -21,7 +21,7 @@ sys.path.insert(0, str(HERE))
 from _timing import Recorder, fmt_time, settle_allocator  # noqa: E402
 
 #: In run order: the start-up figures first (fresh processes), the heavy in-process ones after.
-BENCHMARKS = ("startup", "processing", "models", "fit_sweep", "scaling")
+BENCHMARKS = ("startup", "processing", "reader", "models", "fit_sweep", "scaling")
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -177,13 +177,16 @@ def _drop_spikes(samples: _Samples, channels: Channels, label: Path | str, repai
     limits = {"time": _MAX_TIME_S, "stroke": _MAX_STROKE_MM, "force": _MAX_FORCE_N}
     units_shown = {"time": "s", "stroke": "mm", "force": "N"}
     lines = samples.lines
+    scratch = np.empty(lines.size)  # one temporary for the three columns
     for role in ("time", "stroke", "force"):
         if channels[role]["source"] is None:
             continue
         x = samples.values[role]
         name = channels[role]["source"]
-        spikes = find_spikes(x)
-        absurd = np.flatnonzero(np.abs(x) > limits[role])
+        spikes = find_spikes(x, scratch)
+        lim = limits[role]
+        absurd = (np.flatnonzero((x > lim) | (x < -lim)) if (x.max() > lim or x.min() < -lim)
+                  else np.empty(0, dtype=np.int64))  # |x| > limit, without a copy of x
         bad = np.union1d(spikes, absurd)
         if bad.size:
             i = int(bad[0])

@@ -34,7 +34,7 @@ GAP_FACTOR = 50.0
 GAP_MIN_S = 2.0
 
 
-def find_spikes(x: np.ndarray) -> np.ndarray:
+def find_spikes(x: np.ndarray, scratch: np.ndarray | None = None) -> np.ndarray:
     """Indices of isolated spikes in one column.
 
     A sample is a spike when its distance to the median of the 5 samples around it exceeds
@@ -47,6 +47,9 @@ def find_spikes(x: np.ndarray) -> np.ndarray:
     ----------
     x : numpy.ndarray
         The column (finite values).
+    scratch : numpy.ndarray, optional
+        A float array at least as long as ``x`` to work in (its contents are overwritten): the
+        checks of several columns of one length then share one temporary.
 
     Returns
     -------
@@ -67,18 +70,49 @@ def find_spikes(x: np.ndarray) -> np.ndarray:
     if n < 5:
         return np.empty(0, dtype=np.int64)
     k = max(2, int(np.ceil(0.005 * n)))  # leave out the k most extreme values on each side
-    part = np.partition(x, [k, n - 1 - k])
+    part = np.empty_like(x) if scratch is None else scratch[:n]
+    np.copyto(part, x)
+    part.partition([k, n - 1 - k])
     scale = float(part[n - 1 - k] - part[k])
-    del part
-    mag = float(np.median(np.abs(x)))
-    floor = max(1e-9 * max(mag, 1.0), 1e-12)
-    scale = max(scale, floor)
-    from scipy import ndimage
+    # the floor, from the median magnitude, matters only for a column that is nearly constant
+    biggest = max(float(x.max()), -float(x.min()))
+    if scale < max(1e-9 * max(biggest, 1.0), 1e-12):
+        mag = float(np.median(np.abs(x)))
+        scale = max(scale, max(1e-9 * max(mag, 1.0), 1e-12))
+    return _off_median5(x, SPIKE_FACTOR * scale, part)
 
-    dev = ndimage.median_filter(x, size=5, mode="nearest")
-    np.subtract(x, dev, out=dev)
-    np.abs(dev, out=dev)
-    return np.flatnonzero(dev > SPIKE_FACTOR * scale).astype(np.int64)
+
+def _off_median5(x: np.ndarray, limit: float, scratch: np.ndarray | None = None) -> np.ndarray:
+    """Indices ``i`` where ``|x[i] - median(x[i-2:i+3])| > limit`` (edges repeated), sorted.
+
+    Such a sample differs by more than ``limit`` from at least 3 of its 4 neighbours, so from
+    ``x[i-1]`` or ``x[i+1]``: the medians are taken only there (the same numbers as
+    ``scipy.ndimage.median_filter(x, 5, mode="nearest")``, without filtering the whole column).
+
+    >>> import numpy as np
+    >>> x = np.array([1.0, 1.1, 9.0, 1.2, 1.0, 1.1, 1.0, 8.0, 8.0, 8.0, 1.1, 1.0, 1.2])  # a spike, a plateau
+    >>> _off_median5(x, 1.0).tolist()
+    [2]
+    """
+    n = x.size
+    d = np.empty(n - 1) if scratch is None else scratch[:n - 1]
+    np.subtract(x[1:], x[:-1], out=d)  # np.diff(x), in the scratch array
+    np.abs(d, out=d)
+    j = np.flatnonzero(d > limit)  # steps x[j] -> x[j + 1] larger than the limit
+    del d
+    cand = np.union1d(j, j + 1)
+    if cand.size == 0:
+        return np.empty(0, dtype=np.int64)
+    if cand.size > n // 4:  # a column of steps: filter it whole
+        from scipy import ndimage
+
+        dev = ndimage.median_filter(x, size=5, mode="nearest")
+        np.subtract(x, dev, out=dev)
+        np.abs(dev, out=dev)
+        return np.flatnonzero(dev > limit).astype(np.int64)
+    window = np.clip(cand[:, None] + np.arange(-2, 3), 0, n - 1)
+    med = np.sort(x[window], axis=1)[:, 2]
+    return cand[np.abs(x[cand] - med) > limit].astype(np.int64)
 
 
 @dataclass(frozen=True)
@@ -129,13 +163,20 @@ def time_problems(t: np.ndarray) -> TimeProblems:
     if t.size < 2:
         e = np.empty(0, dtype=np.int64)
         return TimeProblems(e, e, float("nan"))
-    running = np.maximum.accumulate(t)
-    backwards = np.flatnonzero(t[1:] <= running[:-1]) + 1
-    del running
     dt = np.diff(t)
-    pos = dt[dt > 0]
-    med = float(np.median(pos)) if pos.size else float("nan")
-    if pos.size:
+    if (dt > 0).all():  # increasing throughout: nothing goes back, every step counts
+        backwards = np.empty(0, dtype=np.int64)
+        # no step can be a gap when none is longer than the shortest gap: then dt itself is ordered in place
+        pos = dt if float(dt.max()) <= GAP_MIN_S else dt.copy()
+    else:
+        running = np.maximum.accumulate(t)
+        backwards = np.flatnonzero(t[1:] <= running[:-1]) + 1
+        del running
+        pos = dt[dt > 0]
+    any_step = pos.size > 0
+    med = float(np.median(pos, overwrite_input=True)) if any_step else float("nan")
+    del pos
+    if any_step:
         limit = max(GAP_FACTOR * med, GAP_MIN_S)
         gaps = np.flatnonzero(dt > limit) + 1
     else:

@@ -18,7 +18,9 @@ Metadata grammars (one per line, all seen in real files)::
 from __future__ import annotations
 
 import csv
+import io
 import math
+import os
 import re
 from collections import deque
 from collections.abc import Iterable, Iterator
@@ -408,6 +410,7 @@ class LineReader:
     """
 
     def __init__(self, lines: Iterable[str]) -> None:
+        self._src = lines
         self._it: Iterator[str] = iter(lines)
         self._pending: deque[str] = deque()
         self.lineno = 0  # number of the last line handed out
@@ -433,6 +436,55 @@ class LineReader:
             out.extend(raw.rstrip("\r\n") for raw in islice(self._it, n - len(out)))
         self.lineno += len(out)
         return out
+
+    def take_text(self, n_chars: int) -> tuple[str, int] | None:
+        """The next whole lines as one text of about ``n_chars`` characters: ``(text, line count)``, or None at the end.
+
+        The lines are joined with ``\\n`` (no line end after the last); ``lineno`` is then the
+        last one's.  Pushed-back lines come first, on their own; a text stream (one with
+        ``read``, opened with universal newlines) is then read in blocks without making a string
+        per line, any other iterable line by line.
+
+        >>> import io
+        >>> reader = LineReader(io.StringIO("a\\r\\nb\\rc\\nd", newline=None))
+        >>> reader.next(), reader.take_text(3), reader.lineno, reader.take_text(2)
+        ('a', ('b\\nc', 2), 3, ('d', 1))
+        >>> reader.push_back(["d"]); reader.take_text(100), reader.take_text(100)
+        (('d', 1), None)
+        """
+        if self._pending:
+            lines = list(self._pending)
+            self._pending.clear()
+        elif isinstance(self._src, io.TextIOBase):
+            text = self._src.read(n_chars)
+            if not text:
+                return None
+            if not text.endswith("\n"):
+                text += self._src.readline()
+            if text.endswith("\n"):
+                text = text[:-1]
+            n = text.count("\n") + 1
+            self.lineno += n
+            return text, n
+        else:
+            lines = self.take(max(1, n_chars // 32))
+            self.lineno -= len(lines)
+        if not lines:
+            return None
+        self.lineno += len(lines)
+        return "\n".join(lines), len(lines)
+
+    def bytes_left(self) -> int | None:
+        """Bytes of the file not read yet (about: the stream reads ahead), or None if not a file.
+
+        >>> LineReader(["0,1"]).bytes_left() is None
+        True
+        """
+        try:
+            raw = self._src.buffer  # type: ignore[attr-defined]  # a text file's bytes
+            return max(0, os.fstat(raw.fileno()).st_size - raw.tell())
+        except (AttributeError, OSError, ValueError, io.UnsupportedOperation):
+            return None
 
     def push_back(self, lines: list[str]) -> None:
         """Return ``lines`` (the last ones handed out, in order) to the reader."""

@@ -4,11 +4,11 @@
 kept as metadata candidates; a line of numbers after text starts a data :class:`Block` (its
 names row, an optional units row, the delimiter, the channels chosen by
 :func:`bendpam.lab.channels.choose_channels`); the best block (time, stroke and force, or
-stroke and force with a sampling rate) is read into :class:`ColumnData`, in chunks of lines by
-the C parser of :func:`pandas.read_csv`, a chunk it cannot read line by line to find the
-offending line.  :func:`parse_source` and :func:`parse_path` run the pass and return the
-:class:`Parsed` result, or raise the :class:`~bendpam.lab.read_error.ReadError` that says why no
-block could be read.
+stroke and force with a sampling rate) is read into :class:`ColumnData`, in blocks of text by
+the C parser of :func:`pandas.read_csv`; a block it cannot read is read in pieces, the odd piece
+line by line to find the offending line or the end of the block.  :func:`parse_source` and
+:func:`parse_path` run the pass and return the :class:`Parsed` result, or raise the
+:class:`~bendpam.lab.read_error.ReadError` that says why no block could be read.
 """
 
 from __future__ import annotations
@@ -59,7 +59,9 @@ from bendpam.lab.source import Source, open_source
 
 __all__ = ["Block", "ColumnData", "Parsed", "Parser", "parse_path", "parse_source"]
 
-_CHUNK_LINES = 100_000  # lines handed to the C parser at a time
+_CHUNK_LINES = 100_000  # lines looked at at a time when a block is only skipped
+_CHUNK_CHARS = 1 << 21  # characters of data lines handed to the C parser at a time
+_PIECE_LINES = 2_000  # lines per piece of a chunk that has odd lines (the odd piece is read line by line)
 _PEEK_LINES = 200  # data rows inspected for the decimal mark
 _RATE_KEY = re.compile(
     r"sampl|abtast|mess ?rate|data rate|acquisition rate|recording rate|aufzeichnungsrate|"
@@ -243,6 +245,52 @@ def _data_seps(line: str) -> list[str]:
     return out
 
 
+class _Sink:
+    """Growing buffers for the numbers of the block read, one per role and one of line numbers.
+
+    The rows of every chunk are copied in place (no list of chunks to join at the end, which would
+    hold the numbers twice); the buffers are sized from an estimate of the rows left (the bytes
+    left in the file at the bytes per line seen so far), which untouched pages of memory do not
+    cost, and grow by half when the estimate was short.
+    """
+
+    def __init__(self, roles: list[str]) -> None:
+        self.roles = roles
+        self.n = 0
+        self.bufs = {role: np.empty(0) for role in roles}
+        self.lines = np.empty(0, dtype=np.int32)
+
+    def reserve(self, rows: int) -> None:
+        """Room for at least ``rows`` rows in all."""
+        if rows <= self.lines.size:
+            return
+        for role in self.roles:
+            buf = np.empty(rows)
+            buf[:self.n] = self.bufs[role][:self.n]
+            self.bufs[role] = buf
+        lines = np.empty(rows, dtype=np.int32)
+        lines[:self.n] = self.lines[:self.n]
+        self.lines = lines
+
+    def add(self, arrs: list[np.ndarray], lnos: np.ndarray) -> None:
+        k = len(lnos)
+        if self.n + k > self.lines.size:
+            self.reserve(max(self.n + k, self.lines.size + self.lines.size // 2 + 4096))
+        for role, arr in zip(self.roles, arrs, strict=True):
+            self.bufs[role][self.n:self.n + k] = arr
+        self.lines[self.n:self.n + k] = lnos
+        self.n += k
+
+    def into(self, data: ColumnData) -> None:
+        """Hand the rows to ``data``: one more chunk per role (none when no row was read)."""
+        for role in self.roles:  # appended: the blocks that continue one test join its rows
+            chunks = data.cols.setdefault(role, [])
+            if self.n:
+                chunks.append(self.bufs[role][:self.n])
+        if self.n:
+            data.lines.append(self.lines[:self.n])
+
+
 class Parser:
     """One pass over the lines of an export: blocks, metadata and the chosen block's numbers.
 
@@ -314,6 +362,8 @@ class Parser:
         self.joined: list[Block] = []  # blocks after the chosen one that repeat its header, read with it
         self.specimen = specimen
         self.trailing: list[tuple[int, str]] = []
+        self._blank_carry = False  # the last chunk of data lines read ended in blank lines
+        self._sink = _Sink([])  # the numbers of the block being read
 
     # -- metadata ----------------------------------------------------------------------------
     def meta_items(self, before: int | None = None) -> list[tuple[int, MetaItem]]:
@@ -571,40 +621,64 @@ class Parser:
             self._skip_rows(blk)
             return
         needed = self._needed(blk)
-        for role, _col in needed:
-            data.cols.setdefault(role, [])
+        self._sink = _Sink([role for role, _col in needed])
+        self._blank_carry = False
+        sized = False
         while True:
-            lines = reader.take(_CHUNK_LINES)
-            if not lines:
+            got = reader.take_text(_CHUNK_CHARS)
+            if got is None:
                 break
-            start = reader.lineno - len(lines) + 1
-            arrs = self._fast(lines, blk, needed, dec)
-            if arrs is None and needed[-1][0] == "counter":
-                # the optional counter alone may be what the C parser cannot read
-                arrs = self._fast(lines, blk, needed[:-1], dec)
-                if arrs is not None:
-                    arrs.append(np.full(len(lines), np.nan))
-                    if data.counter_bad_line is None:
-                        data.counter_bad_line = start
+            text, n = got
+            start = reader.lineno - n + 1
+            if not sized and n >= 1000:  # room for the rows the rest of the file will likely hold
+                left = reader.bytes_left()
+                if left is not None:
+                    self._sink.reserve(self._sink.n + n + int(1.02 * left * n / max(len(text), 1)) + 4096)
+                sized = True
+            arrs = self._fast(text, n, blk, needed, dec, data)
             if arrs is not None:
-                for (role, _col), arr in zip(needed, arrs, strict=True):
-                    data.cols[role].append(arr)
-                data.lines.append(np.arange(start, start + len(lines), dtype=np.int32))
-                blk.n_rows += len(lines)
-                blk.last_line = start + len(lines) - 1
+                self._keep_rows(blk, arrs, np.arange(start, start + n, dtype=np.int32))
                 continue
-            end = self._slow(lines, start, blk, needed, dec, data)
-            if end is not None:
-                reader.push_back(lines[end:])
+            lines = text.split("\n")
+            del text
+            if self._rows_of_lines(lines, start, blk, needed, dec, data):
                 break
+        self._sink.into(data)
 
-    def _fast(self, lines: list[str], blk: Block, needed, dec: str) -> list[np.ndarray] | None:
+    def _keep_rows(self, blk: Block, arrs: list[np.ndarray], lnos: np.ndarray) -> None:
+        self._sink.add(arrs, lnos)
+        blk.n_rows += len(lnos)
+        blk.last_line = int(lnos[-1])
+        self._blank_carry = False
+
+    def _rows_of_lines(self, lines: list[str], start: int, blk: Block, needed, dec: str, data: ColumnData) -> bool:
+        """Read a chunk that has odd lines in pieces; True if the block ends in it (the rest pushed back)."""
+        for off in range(0, len(lines), _PIECE_LINES):
+            piece = lines[off:off + _PIECE_LINES]
+            first = start + off
+            arrs = self._fast("\n".join(piece), len(piece), blk, needed, dec, data)
+            if arrs is not None:
+                self._keep_rows(blk, arrs, np.arange(first, first + len(piece), dtype=np.int32))
+                continue
+            end = self._slow(piece, first, blk, needed, dec, data)
+            if end is not None:
+                self.reader.push_back(lines[off + end:])
+                return True
+        return False
+
+    def _fast(self, text: str, n: int, blk: Block, needed, dec: str, data: ColumnData) -> list[np.ndarray] | None:
+        """The needed columns of ``n`` lines of numbers by the C parser, or None if any line is odd.
+
+        Once the optional cycle counter is known to hold a non-number, it is no longer parsed
+        (NaN: the counter is left out anyway).
+        """
         if blk.sep == dec:
             return None
-        idx = [col.index for _role, col in needed]
+        counter_off = needed[-1][0] == "counter" and data.counter_bad_line is not None
+        idx = [col.index for _role, col in (needed[:-1] if counter_off else needed)]
         try:
             df = pd.read_csv(
-                io.BytesIO("\n".join(lines).encode("utf-8", "surrogatepass")),
+                io.BytesIO(text.encode("utf-8", "surrogatepass")),
                 sep=r"\s+" if blk.sep == " " else blk.sep,
                 decimal=dec,
                 header=None,
@@ -616,12 +690,14 @@ class Parser:
                 na_filter=False,
                 index_col=False,
             )
-            arrs = [np.array(df[i].to_numpy(dtype=np.float64), copy=True) for i in idx]
+            arrs = [df[i].to_numpy(dtype=np.float64) for i in idx]  # copied into the sink
         except Exception:  # any parser trouble -> the slow path finds the line
             return None
         del df
-        if any(len(a) != len(lines) or not np.isfinite(a).all() for a in arrs):
+        if any(len(a) != n or not np.isfinite(a).all() for a in arrs):
             return None
+        if counter_off:
+            arrs.append(np.full(n, np.nan))
         return arrs
 
     def _row_problem(self, role: str, col: ColumnInfo, cell: str | None, dec: str, blk: Block,
@@ -653,7 +729,7 @@ class Parser:
         sep = blk.sep
         rows: list[list[float]] = []
         lnos: list[int] = []
-        blank_run: int | None = None
+        blank_run: int | None = 0 if self._blank_carry else None  # blank lines ended the previous chunk
         names_norm = [normalize_name(n) for n in blk.names]
         end: int | None = None
         for k, line in enumerate(lines):
@@ -716,13 +792,10 @@ class Parser:
                             col.source)  # fmt: skip
         if rows:
             arr = np.asarray(rows, dtype=np.float64).reshape(-1, len(needed))
-            for j, (role, _col) in enumerate(needed):
-                data.cols[role].append(arr[:, j].copy())
-            data.lines.append(np.asarray(lnos, dtype=np.int32))
+            self._sink.add([arr[:, j] for j in range(len(needed))], np.asarray(lnos, dtype=np.int32))
             blk.n_rows += len(rows)
             blk.last_line = lnos[-1]
-        if end is None and blank_run is not None:
-            return None  # trailing blank lines: the next chunk decides
+        self._blank_carry = end is None and blank_run is not None  # trailing blank lines: the next chunk decides
         return end
 
     def _skip_rows(self, blk: Block) -> None:

@@ -47,7 +47,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from bendpam.errors import PlausibilityWarning, ProcessingError
+from bendpam.errors import InputError, PlausibilityWarning, ProcessingError
 from bendpam.lab.plausibility import check_result, compression_like
 from bendpam.lab.processed import (
     PressureResult,
@@ -106,18 +106,17 @@ def _segment_lowpass(x: np.ndarray, tp: np.ndarray, fs: float, cutoff: float, or
     sos = signal.butter(order, cutoff, btype="low", fs=fs, output="sos")
     edges = np.unique(np.concatenate([tp, [x.size - 1]]))
     out = fallback.copy()
-    acc = np.zeros(x.size)
-    cnt = np.zeros(x.size)
     need = 3 * (2 * sos.shape[0] + 1)
+    last_end, last_val = -1, 0.0
     for a, b in itertools.pairwise(edges):
         seg = x[a: b + 1]
         if seg.size <= need:
             continue
         y = signal.sosfiltfilt(sos, seg, padtype="odd", padlen=min(seg.size - 1, max(need, int(3 * fs / cutoff))))
-        acc[a: b + 1] += y
-        cnt[a: b + 1] += 1
-    done = cnt > 0
-    out[done] = acc[done] / cnt[done]
+        np.add(y, 0.0, out=out[a: b + 1])  # the sum of the one segment, as (0 + y) / 1 was
+        if a == last_end:  # the end point shared with the previous filtered segment: their mean
+            out[a] = ((0.0 + last_val) + y[0]) / 2.0
+        last_end, last_val = int(b), float(y[-1])
     return out
 
 
@@ -150,7 +149,8 @@ def find_turning_points(stroke: np.ndarray, threshold: float) -> tuple[np.ndarra
     nz = np.flatnonzero(d != 0.0)
     if nz.size == 0:
         return np.array([0]), np.array([False])
-    sg = np.sign(d[nz])
+    sg = d[nz] > 0.0  # the sign of each nonzero step, one byte each
+    del d
     change = np.flatnonzero(sg[1:] != sg[:-1])
     cand = np.concatenate([[0], nz[change] + 1, [n - 1]])
     vals = s[cand]
@@ -208,9 +208,11 @@ def _checked_arrays(time_s, stroke_mm, force_n, source: str) -> tuple[np.ndarray
 def _sampling(t: np.ndarray, opt: ProcessingOptions, source: str, notes: list[str]) -> tuple[float, float]:
     """Step 2's rates: the median sampling rate and the low-pass cutoff (Hz)."""
     dt = np.diff(t)
-    fs = 1.0 / float(np.median(dt))
-    if np.max(dt) > 5.0 / fs:
-        notes.append(f"irregular sampling: largest gap {np.max(dt):.3g} s at a median rate of {fs:.3g} Hz")
+    largest = float(np.max(dt))
+    fs = 1.0 / float(np.median(dt, overwrite_input=True))  # dt is not used after: no copy
+    del dt
+    if largest > 5.0 / fs:
+        notes.append(f"irregular sampling: largest gap {largest:.3g} s at a median rate of {fs:.3g} Hz")
     nyq = 0.5 * fs
     cutoff = (min(1.0, 0.4 * nyq) if opt.cutoff_hz is None else float(opt.cutoff_hz))
     if cutoff >= nyq:
@@ -224,10 +226,20 @@ def _orient(s_f: np.ndarray, f_f: np.ndarray, s_raw: np.ndarray, f_raw: np.ndarr
     if np.median(f_f) < 0:
         f_f, f_raw = -f_f, -f_raw
         notes.append("force sign flipped (compression recorded as negative)")
-    if np.ptp(f_f) > 0 and np.corrcoef(s_f, f_f)[0, 1] > 0:
+    if np.ptp(f_f) > 0 and _covariance(s_f, f_f) > 0:
         s_f, s_raw = -s_f, -s_raw
         notes.append("stroke direction flipped (stroke recorded as decreasing toward the free state)")
     return s_f, f_f, s_raw, f_raw
+
+
+def _covariance(x: np.ndarray, y: np.ndarray, block: int = 1 << 18) -> float:
+    """Sum of ``(x - mean x) * (y - mean y)`` (the sign of the correlation), in blocks (bounded memory).
+
+    >>> _covariance(np.array([0.0, 1.0, 2.0]), np.array([5.0, 3.0, 1.0]))
+    -4.0
+    """
+    mx, my = float(np.mean(x)), float(np.mean(y))
+    return float(sum(np.dot(x[i:i + block] - mx, y[i:i + block] - my) for i in range(0, x.size, block)))
 
 
 def _complete_cycles(tp: np.ndarray, is_max: np.ndarray, vals: np.ndarray, s0: float, back_tol: float,
@@ -271,6 +283,28 @@ def _segment(s_raw: np.ndarray, f_raw: np.ndarray, s_f: np.ndarray, f_f: np.ndar
     return s_z, f_f, cycles
 
 
+def _convert(fixture: Fixture, s_z: np.ndarray, f_f: np.ndarray, tare_n: float,
+             block: int = 1 << 20) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Step 4's eq 6-8 (:meth:`Fixture.convert`, element by element) in blocks of samples: bounded temporaries.
+
+    A value the fixture refuses is refused as in one call, naming its index in the whole record.
+
+    >>> beta, k, M = _convert(PAPER_FIXTURE, np.linspace(0.0, 5.0, 7), np.full(7, 10.0), 0.0, block=3)
+    >>> np.array_equal(M, PAPER_FIXTURE.convert(np.linspace(0.0, 5.0, 7), np.full(7, 10.0))[2])
+    True
+    """
+    n = s_z.size
+    if n <= block:
+        return fixture.convert(s_z, f_f, tare_n)
+    out = np.empty((3, n))
+    try:
+        for i in range(0, n, block):
+            out[:, i:i + block] = fixture.convert(s_z[i:i + block], f_f[i:i + block], tare_n)
+    except InputError:
+        return fixture.convert(s_z, f_f, tare_n)
+    return out[0], out[1], out[2]
+
+
 def _common_grid(cycles: list[tuple[int, int, int]], k: np.ndarray, grid_n: int, source: str) -> np.ndarray:
     """Step 5's common curvature grid: the range every branch of every cycle covers (1/mm)."""
     seg = [((b, c), (a, b)) for a, b, c in cycles]  # (loading: free->blocked, unloading: blocked->free)
@@ -310,19 +344,24 @@ def _cycle_results(cycles: list[tuple[int, int, int]], k: np.ndarray, M: np.ndar
 
 def _labelled_series(t: np.ndarray, s_z: np.ndarray, f_f: np.ndarray, beta: np.ndarray, k: np.ndarray,
                      M: np.ndarray, cycles: list[tuple[int, int, int]]) -> pd.DataFrame:
-    """The filtered, converted samples labelled with their cycle (1, 2, ...; -1: none) and branch."""
+    """The filtered, converted samples labelled with their cycle (1, 2, ...; -1: none) and branch.
+
+    The frame holds the arrays given (no copies); the branch is categorical (``""``, ``"unloading"``,
+    ``"loading"``: one byte a sample).
+    """
     cyc = np.full(t.size, -1)
-    br = np.full(t.size, "", dtype=object)
+    br = np.zeros(t.size, dtype=np.int8)  # 0: none, 1: unloading, 2: loading
     for ci, (a, b, c) in enumerate(cycles):
         cyc[a:c + 1] = ci + 1
-        br[a:b + 1] = "unloading"
-        br[b:c + 1] = "loading"
+        br[a:b + 1] = 1
+        br[b:c + 1] = 2
     import pandas as pd
 
+    names = pd.Categorical.from_codes(br, categories=["", "unloading", "loading"])
     return pd.DataFrame({
         "time_s": t, "stroke_mm": s_z, "force_n": f_f, "beta_rad": beta, "curvature_per_mm": k,
-        "moment_nmm": M, "cycle": cyc, "branch": br.astype(str),
-    })
+        "moment_nmm": M, "cycle": cyc, "branch": names,
+    }, copy=False)
 
 
 def process_series(
@@ -387,8 +426,9 @@ def process_series(
     s_f, f_f, s_raw, f_raw = _orient(s_f, f_f, s_raw, f_raw, notes)
 
     s_z, f_f, cycles = _segment(s_raw, f_raw, s_f, f_f, rng, fs, cutoff, opt, source, notes)
+    del s_f, s_raw, f_raw  # the whole-record filter and the raw samples are not needed after segmentation
 
-    beta, k, M = fixture.convert(s_z, f_f, opt.tare_n)
+    beta, k, M = _convert(fixture, s_z, f_f, opt.tare_n)
     grid = _common_grid(cycles, k, int(opt.grid_points), source)
     branches, bm, kf, loss, stored = _cycle_results(cycles, k, M, grid, fixture.L0_mm)
     with np.errstate(divide="ignore", invalid="ignore"):

@@ -31,9 +31,11 @@ The reader is layered, not a list of dialects:
    reported in :attr:`RawTest.warnings`; a dead stroke or force channel is replaced by a named
    one that moves.
 
-The numeric block is read in chunks of lines by the C parser of :func:`pandas.read_csv`, so
-a 500 MB export is read in bounded memory and linear time; a chunk the C parser cannot read is
-re-scanned line by line to find the offending line.  Every failure is a :class:`ReadError`
+The numeric block is read in blocks of text (about 2 MB, no string per line) by the C parser of
+:func:`pandas.read_csv`, into buffers sized from the bytes left in the file, so a 450 MB export
+is read in bounded memory and linear time, in about 2x the time of :func:`pandas.read_csv`; a block
+the C parser cannot read is read in pieces of 2000 lines, and only the odd piece line by line,
+which finds the offending line.  Every failure is a :class:`ReadError`
 whose message is one line ``FILE:LINE: what was wrong, what was expected``.
 
 The steps live in their own modules: :mod:`bendpam.lab.source` (file to lines),
