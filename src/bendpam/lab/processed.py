@@ -23,6 +23,7 @@ from bendpam.infra.accessors import figure as figure_by_name
 from bendpam.infra.budgets import check_input_file
 from bendpam.infra.display import summary_html, summary_text
 from bendpam.infra.manifest import verify_input
+from bendpam.lab.drift import DRIFT_METHODS, DriftEstimate
 from bendpam.physics.fixture import Fixture
 
 if TYPE_CHECKING:  # pandas and xarray are imported by the functions that use them (fast start-up of `fit`)
@@ -55,6 +56,8 @@ class ProcessingOptions:
     grid_points : points of the common curvature grid of the branches.
     tare_n : force subtracted before eq 7 (N), e.g. the self-weight read unpressurised.
     zero_stroke : count the stroke from the blocked turning points (True) or use it as recorded.
+    drift : the load-cell offset drift (:mod:`bendpam.lab.drift`): ``"none"`` estimates and reports it,
+    ``"linear"`` also subtracts the fitted linear offset before the conversion.
 
     Examples
     --------
@@ -72,8 +75,11 @@ class ProcessingOptions:
     grid_points: int = 101
     tare_n: float = 0.0
     zero_stroke: bool = True
+    drift: str = "none"
 
     def __post_init__(self) -> None:
+        if self.drift not in DRIFT_METHODS:
+            raise InputError(f"drift = {self.drift!r}; choose one of: {', '.join(DRIFT_METHODS)}")
         if self.cutoff_hz is not None and (not math.isfinite(self.cutoff_hz) or self.cutoff_hz < 0):
             raise InputError(f"cutoff_hz = {self.cutoff_hz!r} must be >= 0 Hz (0 switches the filter off)")
         if not 1 <= int(self.filter_order) <= 10:
@@ -125,6 +131,7 @@ class PressureResult:
     specimen: str | None = None  # the specimen's name when a file holds several
     replicate: int = 1  # 1, 2, ... among the tests at this pressure
     findings: list[dict] = field(default_factory=list)  # plausibility findings (bendpam.lab.plausibility)
+    drift: DriftEstimate | None = None  # the load-cell offset drift (bendpam.lab.drift)
 
     @property
     def mean_loading(self) -> np.ndarray:
@@ -191,6 +198,7 @@ class PressureResult:
             "replicate": self.replicate,
             "notes": list(self.notes),
             "warnings": [f["message"] for f in self.findings],
+            "drift": self.drift.to_dict() if self.drift is not None else None,
         }
 
 

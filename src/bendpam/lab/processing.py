@@ -48,6 +48,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from bendpam.errors import PlausibilityWarning, ProcessingError
+from bendpam.lab.drift import check_drift, drift_findings, moment_shift_nmm
 from bendpam.lab.plausibility import check_result, compression_like
 from bendpam.lab.processed import (
     PressureResult,
@@ -386,6 +387,7 @@ def process_series(
     s_f, f_f, s_raw, f_raw = _orient(s_f, f_f, s_raw, f_raw, notes)
 
     s_z, f_f, cycles = _segment(s_raw, f_raw, s_f, f_f, rng, fs, cutoff, opt, source, notes)
+    drift, f_f = check_drift(t, s_z, f_raw, f_f, cycles, opt.drift)  # bendpam.lab.drift
 
     beta, k, M = fixture.convert(s_z, f_f, opt.tare_n)
     grid = _common_grid(cycles, k, int(opt.grid_points), source)
@@ -399,8 +401,12 @@ def process_series(
     result = PressureResult(
         pressure_kpa=float(pressure_kpa), source=source, n_cycles=len(cycles), curvature_grid=grid,
         branches=branches, blocked_moments=bm, free_curvatures=kf, energy_loss_ratios=ratio, loop_energy=loss,
-        stored_energy=stored, sample_rate_hz=fs, cutoff_hz=cutoff, notes=notes, series=series,
+        stored_energy=stored, sample_rate_hz=fs, cutoff_hz=cutoff, notes=notes, series=series, drift=drift,
     )
+    if drift is not None:
+        drift.blocked_moment_nmm = result.blocked_moment[0]
+        drift.blocked_moment_shift_nmm = moment_shift_nmm(lambda s, f: fixture.convert(s, f, opt.tare_n)[2], s_z,
+                                                          f_f, M, t, cycles, drift, corrected=drift.corrected)
     _judge(result, fixture, cycles, k)
     return result
 
@@ -415,7 +421,7 @@ def _refuse_compression(s_raw: np.ndarray, f_raw: np.ndarray, threshold_mm: floa
 
 def _judge(result: PressureResult, fixture: Fixture, cycles: list[tuple[int, int, int]], k: np.ndarray) -> None:
     """The plausibility findings of a processed test, kept on it and warned about (PlausibilityWarning)."""
-    result.findings = check_result(result, fixture, _return_gaps(cycles, k))
+    result.findings = check_result(result, fixture, _return_gaps(cycles, k)) + drift_findings(result)
     for f in result.findings:
         warnings.warn(f["message"], PlausibilityWarning, stacklevel=3)
 

@@ -1,0 +1,317 @@
+"""Load-cell offset drift and zero checks of a cyclic bending test.
+
+A four-point-bending test repeats the same stroke path cycle after cycle, so, apart from noise, the
+force at a given place of a cycle (the free end, where the fixture reads about the detection load;
+the blocked end, where the force is largest) is the same in every cycle.  A load-cell offset that
+drifts adds the same ``a * t`` to every sample, and shows as a trend of those forces across cycles.
+
+:func:`estimate_drift` takes the samples near the four ends of every cycle (the end of the unloading
+and the start of the loading at the free state; the end of the loading and the start of the
+unloading at the blocked state: the samples within ``band_fraction`` (5 %) of the stroke range of the
+turning point), averages the force and the time of each, and fits ``F = c_end + a t`` by least
+squares with one intercept per end and one common slope ``a`` (N/s).  Its standard error is the
+larger of the residual one and the one the force noise alone gives (the noise from the differences
+of successive samples), so a few cycles do not make it small by chance.  The free ends alone and
+the blocked ends alone give their own slopes: an offset drift moves both alike, creep or a loop
+that settles moves the blocked ends more.
+
+The drift is *flagged* (:attr:`DriftEstimate.flagged`) when it is both significant (``|a| >= 3``
+standard errors) and large enough to bias a fit: over the test it reaches ``0.1 %`` of the blocked
+force (:data:`FLAG_FRACTION`).  A drift of 1 % of the blocked force over a test moved a fitted
+``alpha0`` by about 20 of its standard errors, so 0.1 % is about 2.
+
+The offset is taken as zero at the first sample (the machine is zeroed before the test);
+:meth:`DriftEstimate.offset_n` is the fitted offset ``a (t - t_0)`` that a correction subtracts.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+__all__ = ["DRIFT_METHODS", "FLAG_FRACTION", "FLAG_SIGMAS", "DriftEstimate", "estimate_drift",
+           "moment_shift_nmm"]
+
+#: The drift corrections processing knows: ``"none"`` (estimate and report only) and ``"linear"``.
+DRIFT_METHODS = ("none", "linear")
+#: A drift is flagged when over the test it reaches this fraction of the blocked force ...
+FLAG_FRACTION = 0.001
+#: ... and this many of its standard errors.
+FLAG_SIGMAS = 3.0
+#: The four ends of a cycle, in the order of :attr:`DriftEstimate.ends`.
+_ENDS = ("blocked, start of unloading", "free, end of unloading", "free, start of loading",
+         "blocked, end of loading")
+
+
+@dataclass
+class DriftEstimate:
+    """A linear load-cell offset drift fitted to one test (force positive toward the blocked state).
+
+    rate_n_per_s, rate_se_n_per_s : the drift ``a`` (N/s) and its standard error.
+    duration_s, t0_s : the test's duration and first time (s).  drift_n : ``a * duration_s`` (N).
+    noise_n : the force noise (standard deviation of one sample, N).
+    blocked_force_n : the mean force at the blocked ends (N).  points : the end windows used.
+    free_rate_n_per_s, blocked_rate_n_per_s : the slopes of the free ends alone and of the blocked ends alone.
+    blocked_moment_shift_nmm : how much correcting the drift moves the blocked moment (N*mm; set by processing).
+    corrected : whether processing subtracted the offset.  flagged : see the module docstring.
+
+    Examples
+    --------
+    >>> est = DriftEstimate(rate_n_per_s=1e-4, rate_se_n_per_s=1e-5, duration_s=300.0, t0_s=0.0, noise_n=0.05,
+    ...                     blocked_force_n=10.0, points=12)
+    >>> round(est.drift_n, 6), est.flagged            # N: 1e-4 N/s over 300 s is 0.3 % of 10 N, 10 SE
+    (0.03, True)
+    >>> est.offset_n(np.array([0.0, 150.0])).tolist()  # N
+    [0.0, 0.015]
+    """
+
+    rate_n_per_s: float
+    rate_se_n_per_s: float
+    duration_s: float
+    t0_s: float
+    noise_n: float
+    blocked_force_n: float
+    points: int
+    free_rate_n_per_s: float = math.nan
+    blocked_rate_n_per_s: float = math.nan
+    blocked_moment_shift_nmm: float = math.nan
+    blocked_moment_nmm: float = math.nan
+    corrected: bool = False
+
+    @property
+    def drift_n(self) -> float:
+        """The drift over the test (N)."""
+        return self.rate_n_per_s * self.duration_s
+
+    @property
+    def sigmas(self) -> float:
+        """``|a|`` in standard errors (NaN when the standard error is not known)."""
+        se = self.rate_se_n_per_s
+        return abs(self.rate_n_per_s) / se if math.isfinite(se) and se > 0 else math.nan
+
+    @property
+    def threshold_n(self) -> float:
+        """The drift over the test from which it biases a fit (N): :data:`FLAG_FRACTION` of the blocked force."""
+        return FLAG_FRACTION * abs(self.blocked_force_n)
+
+    @property
+    def flagged(self) -> bool:
+        """Significant (:data:`FLAG_SIGMAS`) and at least :attr:`threshold_n` over the test."""
+        s = self.sigmas
+        return bool(math.isfinite(s) and s >= FLAG_SIGMAS and abs(self.drift_n) >= self.threshold_n)
+
+    @property
+    def differs(self) -> bool:
+        """The free and the blocked ends drift differently (by more than 3 standard errors of the drift)."""
+        d = self.free_rate_n_per_s - self.blocked_rate_n_per_s
+        return bool(math.isfinite(d) and abs(d) > 3.0 * 2.0 * self.rate_se_n_per_s)
+
+    def offset_n(self, time_s) -> np.ndarray:
+        """The fitted offset ``a (t - t_0)`` at ``time_s`` (N), zero at the first sample."""
+        return self.rate_n_per_s * (np.asarray(time_s, dtype=float) - self.t0_s)
+
+    def message(self) -> str:
+        """The drift in words: its size against the noise and the blocked force, and what correcting it does."""
+        pct = 100.0 * self.drift_n / self.blocked_force_n if self.blocked_force_n else math.nan
+        text = (f"the load-cell offset drifts by {self.drift_n:+.3g} N over the test ({self.duration_s:.4g} s; "
+                f"{self.rate_n_per_s:+.3g} ± {self.rate_se_n_per_s:.2g} N/s, {self.sigmas:.1f} standard errors): "
+                f"{abs(self.drift_n) / self.noise_n if self.noise_n > 0 else math.inf:.2g} times the force noise "
+                f"({self.noise_n:.2g} N) and {pct:+.2g} % of the blocked force ({self.blocked_force_n:.4g} N)")
+        shift = self.blocked_moment_shift_nmm
+        if math.isfinite(shift):
+            rel = 100.0 * shift / self.blocked_moment_nmm if self.blocked_moment_nmm else math.nan
+            verb = "moved" if self.corrected else "would move"
+            text += f"; correcting it {verb} the blocked moment by {shift:+.3g} N*mm ({rel:+.2g} %)"
+        if self.differs:
+            text += (f"; the free ends ({self.free_rate_n_per_s:+.3g} N/s) and the blocked ends "
+                     f"({self.blocked_rate_n_per_s:+.3g} N/s) drift differently, so part of it is creep or a "
+                     "settling loop rather than an offset")
+        return text
+
+    def to_dict(self) -> dict:
+        """The estimate as a JSON-ready dict (with ``drift_n``, ``sigmas``, ``flagged`` and ``message``).
+
+        >>> sorted(DriftEstimate(0.0, 1e-5, 300.0, 0.0, 0.05, 10.0, 12).to_dict())[:3]
+        ['blocked_force_n', 'blocked_moment_nmm', 'blocked_moment_shift_nmm']
+        """
+        out = asdict(self)
+        out.update(drift_n=self.drift_n, sigmas=self.sigmas, threshold_n=self.threshold_n, flagged=self.flagged,
+                   message=self.message())
+        return out
+
+
+def _noise_n(force: np.ndarray) -> float:
+    """The white noise of one sample (N), from the median absolute difference of successive samples."""
+    d = np.diff(force)
+    if d.size < 2:
+        return math.nan
+    return float(1.4826 * np.median(np.abs(d - np.median(d))) / math.sqrt(2.0))
+
+
+def _end_windows(stroke: np.ndarray, cycles, band_mm: float) -> list[tuple[int, np.ndarray]]:
+    """``(end, sample indices)`` of the four end windows of every cycle ``(blocked, free, blocked)``.
+
+    The bands are common to all cycles (within ``band_mm`` of the median blocked and free turning
+    strokes), so every cycle's window covers the same part of the stroke path.
+    """
+    idx = np.asarray(cycles, dtype=int).reshape(-1, 3)
+    s_block = float(np.median(stroke[np.concatenate([idx[:, 0], idx[:, 2]])])) + band_mm
+    s_free = float(np.median(stroke[idx[:, 1]])) - band_mm
+    out = []
+    for a, b, c in idx:
+        unl = np.arange(a, b + 1)
+        load = np.arange(b + 1, c + 1)
+        s_u, s_l = stroke[unl], stroke[load]
+        out.append((0, unl[s_u <= s_block]))
+        out.append((1, unl[s_u >= s_free]))
+        out.append((2, load[s_l >= s_free]))
+        out.append((3, load[s_l <= s_block]))
+    return [(e, i) for e, i in out if i.size]
+
+
+def _slope(t: np.ndarray, f: np.ndarray, end: np.ndarray, keep: np.ndarray) -> tuple[float, float, float, int]:
+    """Least squares ``f = c_end + a t`` over the points ``keep``: ``(a, residual SE of a, sum of dt^2, dof)``."""
+    t, f, end = t[keep], f[keep], end[keep]
+    dt = t.copy()
+    df = f.copy()
+    for e in np.unique(end):  # within-end centring: one intercept per end
+        m = end == e
+        dt[m] -= dt[m].mean()
+        df[m] -= df[m].mean()
+    sxx = float(dt @ dt)
+    dof = t.size - np.unique(end).size - 1
+    if sxx <= 0.0:
+        return math.nan, math.nan, 0.0, dof
+    a = float(dt @ df) / sxx
+    if dof < 1:
+        return a, math.nan, sxx, dof
+    resid = df - a * dt
+    return a, math.sqrt(float(resid @ resid) / dof / sxx), sxx, dof
+
+
+def estimate_drift(time_s, stroke_mm, force_n, cycles, *, band_fraction: float = 0.05) -> DriftEstimate | None:
+    """Fit a linear load-cell offset drift to one test from the force at the ends of its cycles.
+
+    Parameters
+    ----------
+    time_s, stroke_mm, force_n : array_like
+        The samples (s, mm, N), the stroke growing toward the free state and the force positive at the
+        blocked state (as processing orients them); the raw force, not filtered, so its noise is known.
+    cycles : list of (int, int, int)
+        Each cycle's sample indices ``(blocked, free, blocked)``, as processing finds them.
+    band_fraction : float
+        The end windows: the samples within this fraction of the stroke range of each turning point.
+
+    Returns
+    -------
+    DriftEstimate, or None when there are no cycles.
+
+    Examples
+    --------
+    Three triangular cycles of 100 s with a force of 10 N at the blocked state, 0.2 N at the free
+    state, and a drift of 1e-4 N/s (0.03 N over the test, 0.3 % of the blocked force):
+
+    >>> t = np.arange(0.0, 300.0, 0.05)
+    >>> s = 10.0 * (1.0 - np.abs(((t / 100.0) % 1.0) * 2.0 - 1.0))        # mm: 0 -> 10 -> 0 per cycle
+    >>> f = 10.0 - 0.98 * s + 1e-4 * t + np.random.default_rng(1).normal(0.0, 0.02, t.size)
+    >>> cycles = [(2000 * i, 2000 * i + 1000, 2000 * (i + 1)) for i in range(2)] + [(4000, 5000, 5999)]
+    >>> est = estimate_drift(t, s, f, cycles)
+    >>> abs(est.rate_n_per_s - 1e-4) < 2 * est.rate_se_n_per_s, est.flagged
+    (True, True)
+    """
+    t = np.asarray(time_s, dtype=float)
+    s = np.asarray(stroke_mm, dtype=float)
+    f = np.asarray(force_n, dtype=float)
+    if not cycles or t.size < 2:
+        return None
+    windows = _end_windows(s, cycles, band_fraction * float(np.ptp(s)))
+    end = np.array([e for e, _ in windows])
+    tw = np.array([t[idx].mean() for _, idx in windows])
+    fw = np.array([f[idx].mean() for _, idx in windows])
+    nw = np.array([idx.size for _, idx in windows], dtype=float)
+    noise = _noise_n(f)
+    everything = np.ones(end.size, dtype=bool)
+    a, se_resid, _sxx, _dof = _slope(tw, fw, end, everything)
+    # the noise alone: each window mean has noise / sqrt(n); the slope's variance sums over the centred times
+    centred = tw.copy()
+    for e in np.unique(end):
+        centred[end == e] -= tw[end == e].mean()
+    den = float(centred @ centred)
+    se_noise = math.sqrt(float(np.sum(centred**2 * noise**2 / nw))) / den if den > 0 else math.nan
+    se = max(x for x in (se_resid, se_noise) if math.isfinite(x)) if math.isfinite(se_resid) or \
+        math.isfinite(se_noise) else math.nan
+    if not math.isfinite(a):
+        return None
+    free = (end == 1) | (end == 2)
+    blocked = ~free
+    return DriftEstimate(
+        rate_n_per_s=a, rate_se_n_per_s=se, duration_s=float(t[-1] - t[0]), t0_s=float(t[0]), noise_n=noise,
+        blocked_force_n=float(fw[blocked].mean()) if blocked.any() else float(np.max(f)), points=int(end.size),
+        free_rate_n_per_s=_slope(tw, fw, end, free)[0] if free.sum() > 2 else math.nan,
+        blocked_rate_n_per_s=_slope(tw, fw, end, blocked)[0] if blocked.sum() > 2 else math.nan,
+    )
+
+
+def moment_shift_nmm(convert, stroke_mm, force_n, moment_nmm, time_s, cycles, estimate: DriftEstimate,
+                     *, corrected: bool) -> float:
+    """How much correcting the drift moves the blocked moment (N*mm): the mean over the cycles at their maxima.
+
+    ``convert(stroke, force) -> moment`` is the fixture's conversion; ``force_n`` and ``moment_nmm``
+    are what processing used (corrected already when ``corrected``).  The shift is corrected minus
+    uncorrected, at each cycle's sample of largest moment.
+
+    >>> est = DriftEstimate(1e-3, 1e-4, 100.0, 0.0, 0.01, 10.0, 12)
+    >>> m = np.array([300.0, 200.0, 310.0])
+    >>> round(moment_shift_nmm(lambda s, f: 30.0 * f, np.zeros(3), m / 30.0, m, np.array([0.0, 50.0, 100.0]),
+    ...                        [(0, 1, 2)], est, corrected=False), 6)   # N*mm: -0.1 N at t = 100 s times 30 mm
+    -3.0
+    """
+    m = np.asarray(moment_nmm, dtype=float)
+    idx = np.array([a + int(np.argmax(m[a:c + 1])) for a, _b, c in cycles], dtype=int)
+    off = estimate.offset_n(np.asarray(time_s, dtype=float)[idx])
+    f = np.asarray(force_n, dtype=float)[idx]
+    s = np.asarray(stroke_mm, dtype=float)[idx]
+    other = np.asarray(convert(s, f + off if corrected else f - off), dtype=float)
+    shift = m[idx] - other if corrected else other - m[idx]
+    return float(np.mean(shift))
+
+
+def check_drift(time_s, stroke_mm, force_raw_n, force_n, cycles, method: str = "none"
+                ) -> tuple[DriftEstimate | None, np.ndarray]:  # fmt: skip
+    """Processing's drift step: the estimate from the raw force, and the force to go on with.
+
+    ``method`` is one of :data:`DRIFT_METHODS`: ``"none"`` returns ``force_n`` as it is,
+    ``"linear"`` subtracts the fitted offset from it (and marks the estimate corrected).
+
+    >>> t = np.arange(0.0, 300.0, 0.05)
+    >>> s = 10.0 * (1.0 - np.abs(((t / 100.0) % 1.0) * 2.0 - 1.0))
+    >>> f = 10.0 - 0.98 * s + 1e-3 * t
+    >>> cycles = [(2000 * i, 2000 * i + 1000, 2000 * (i + 1)) for i in range(2)] + [(4000, 5000, 5999)]
+    >>> est, fixed = check_drift(t, s, f, f, cycles, "linear")
+    >>> est.corrected, round(float(np.ptp(fixed - (10.0 - 0.98 * s))), 9)       # N: the drift is gone
+    (True, 0.0)
+    """
+    est = estimate_drift(time_s, stroke_mm, force_raw_n, cycles)
+    if est is None or method == "none":
+        return est, force_n
+    est.corrected = True
+    return est, np.asarray(force_n, dtype=float) - est.offset_n(time_s)
+
+
+def drift_findings(result) -> list[dict]:
+    """A finding (as :func:`bendpam.lab.plausibility.check_result` makes them) when the test's drift is flagged.
+
+    >>> from types import SimpleNamespace as NS
+    >>> est = DriftEstimate(1e-4, 1e-5, 300.0, 0.0, 0.05, 10.0, 12)
+    >>> [f["check"] for f in drift_findings(NS(source="a.csv", pressure_kpa=150.0, drift=est))]
+    ['drift']
+    """
+    est = getattr(result, "drift", None)
+    if est is None or not est.flagged:
+        return []
+    what = "corrected" if est.corrected else "not corrected"
+    return [{"test": result.source, "pressure_kpa": float(result.pressure_kpa), "check": "drift",
+             "value": float(est.drift_n), "bound": float(est.threshold_n), "unit": "N",
+             "message": f"{result.source} ({result.pressure_kpa:g} kPa): {est.message()} ({what})"}]
