@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
+from enum import Enum
 from typing import Annotated, Optional
 
 import typer
@@ -119,6 +120,13 @@ def _print_suggestions(paths: list[Path], as_json: bool) -> None:
         typer.echo(("\n" if i else "") + d, nl=False)
 
 
+class DriftMethod(str, Enum):
+    """``--drift``: the load-cell offset drift correction (:data:`bendpam.lab.drift.DRIFT_METHODS`)."""
+
+    none = "none"
+    linear = "linear"
+
+
 @app.command()
 def process(
     inputs: Annotated[list[Path], typer.Argument(help="Raw test files, or a folder of them.", show_default=False)],
@@ -142,6 +150,10 @@ def process(
     rate_hz: RateOpt = None,
     repair: RepairOpt = False,
     format_file: FormatFileOpt = None,
+    drift: Annotated[DriftMethod, typer.Option(
+        "--drift",
+        help="Load-cell offset drift: none = estimate and report it; linear = also subtract the fitted linear "
+             "offset before processing.")] = DriftMethod.none,
     as_json: Annotated[bool, typer.Option("--json", help="Print summary.json to stdout.")] = False,
     keep_going: Annotated[bool, typer.Option(
         "--keep-going", help="Skip the files that cannot be read or processed (each reported) instead of refusing.")]
@@ -167,7 +179,7 @@ def process(
     pressures = _file_pressures(pressure_kpa, files)
     fx = Fixture.from_string(fixture, L0_mm=l0_mm, name="--fixture")
     opts = ProcessingOptions(cutoff_hz=cutoff_hz, reversal_fraction=reversal_fraction, grid_points=grid_points,
-                             tare_n=tare_n)
+                             tare_n=tare_n, drift=DriftMethod(drift).value)
     fig_name = f"figure4.{fig_format.value if fig_format is not None else 'png'}"
     if fig_format is not None and not figure:
         raise UserError(f"--format {fig_format.value}: there is no figure with --no-figure")
@@ -247,6 +259,8 @@ def _print_table2(summ: dict) -> None:
             typer.echo(f"         note: {note}")
         for warning in r.get("warnings", []):
             typer.echo(f"         warning: {warning}")
+        if (r.get("drift") or {}).get("flagged") and not r["drift"].get("corrected"):
+            typer.echo("         note: --drift linear subtracts the fitted offset")
         last = k + 1 == len(tests) or float(tests[k + 1]["pressure_kpa"]) != float(r["pressure_kpa"])
         if several and last:
             typer.echo(

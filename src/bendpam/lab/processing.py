@@ -41,6 +41,7 @@ a set); what they produce, :class:`~bendpam.lab.processed.PressureResult` and
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import warnings
 from typing import TYPE_CHECKING
@@ -547,14 +548,15 @@ def number_replicates(results: list[PressureResult]) -> list[PressureResult]:
 
 
 def process_tests(tests, *, fixture: Fixture = PAPER_FIXTURE, options: ProcessingOptions | None = None,
-                  keep_series: bool = True) -> ProcessedSet:
+                  keep_series: bool = True, drift: str | None = None) -> ProcessedSet:
     """Process several raw tests (``RawTest`` objects from :func:`bendpam.lab.read_test`).
 
     Every test needs a pressure (from the reader: option, metadata or filename).  Several tests at
     one pressure (specimens, repeats) are replicates: each is kept and numbered
     (:attr:`PressureResult.replicate`), :meth:`ProcessedSet.replicates` gives their mean and spread,
     and a fit uses every one.  The first test that cannot be processed raises; to go on past it,
-    see :func:`bendpam.lab.batch.process_files`.
+    see :func:`bendpam.lab.batch.process_files`.  ``drift`` (``"none"`` or ``"linear"``), when given,
+    replaces ``options.drift`` (:mod:`bendpam.lab.drift`).
 
     Examples
     --------
@@ -575,6 +577,8 @@ def process_tests(tests, *, fixture: Fixture = PAPER_FIXTURE, options: Processin
     >>> round(processed.deadband()[0])                  # kPa: the x-intercept (P_start = 68 kPa)
     68
     """
+    if drift is not None:
+        options = dataclasses.replace(options or ProcessingOptions(), drift=drift)
     results = [process_one(rt, fixture=fixture, options=options, keep_series=keep_series) for rt in tests]
     if not results:
         raise ProcessingError("no tests to process")
