@@ -54,6 +54,7 @@ class DriftEstimate:
     noise_n : the force noise (standard deviation of one sample, N).
     blocked_force_n : the mean force at the blocked ends (N).  points : the end windows used.
     free_rate_n_per_s, blocked_rate_n_per_s : the slopes of the free ends alone and of the blocked ends alone.
+    difference_se_n_per_s : the standard error of their difference.
     blocked_moment_shift_nmm : how much correcting the drift moves the blocked moment (N*mm; set by processing).
     corrected : whether processing subtracted the offset.  flagged : see the module docstring.
 
@@ -76,6 +77,7 @@ class DriftEstimate:
     points: int
     free_rate_n_per_s: float = math.nan
     blocked_rate_n_per_s: float = math.nan
+    difference_se_n_per_s: float = math.nan
     blocked_moment_shift_nmm: float = math.nan
     blocked_moment_nmm: float = math.nan
     corrected: bool = False
@@ -104,9 +106,9 @@ class DriftEstimate:
 
     @property
     def differs(self) -> bool:
-        """The free and the blocked ends drift differently (by more than 3 standard errors of the drift)."""
+        """The free and the blocked ends drift differently (by more than 3 standard errors of the difference)."""
         d = self.free_rate_n_per_s - self.blocked_rate_n_per_s
-        return bool(math.isfinite(d) and abs(d) > 3.0 * 2.0 * self.rate_se_n_per_s)
+        return bool(math.isfinite(d) and abs(d) > 3.0 * self.difference_se_n_per_s)
 
     def offset_n(self, time_s) -> np.ndarray:
         """The fitted offset ``a (t - t_0)`` at ``time_s`` (N), zero at the first sample."""
@@ -171,9 +173,14 @@ def _end_windows(stroke: np.ndarray, cycles, band_mm: float) -> list[tuple[int, 
     return [(e, i) for e, i in out if i.size]
 
 
-def _slope(t: np.ndarray, f: np.ndarray, end: np.ndarray, keep: np.ndarray) -> tuple[float, float, float, int]:
-    """Least squares ``f = c_end + a t`` over the points ``keep``: ``(a, residual SE of a, sum of dt^2, dof)``."""
-    t, f, end = t[keep], f[keep], end[keep]
+def _slope(t: np.ndarray, f: np.ndarray, n: np.ndarray, end: np.ndarray, noise: float,
+           keep: np.ndarray) -> tuple[float, float]:
+    """Least squares ``f = c_end + a t`` over the window means ``keep``: ``(a, its standard error)``.
+
+    The standard error is the larger of the residual one (when there are degrees of freedom) and the
+    one the noise alone gives (each window mean of ``n`` samples has ``noise / sqrt(n)``).
+    """
+    t, f, n, end = t[keep], f[keep], n[keep], end[keep]
     dt = t.copy()
     df = f.copy()
     for e in np.unique(end):  # within-end centring: one intercept per end
@@ -181,14 +188,14 @@ def _slope(t: np.ndarray, f: np.ndarray, end: np.ndarray, keep: np.ndarray) -> t
         dt[m] -= dt[m].mean()
         df[m] -= df[m].mean()
     sxx = float(dt @ dt)
-    dof = t.size - np.unique(end).size - 1
     if sxx <= 0.0:
-        return math.nan, math.nan, 0.0, dof
+        return math.nan, math.nan
     a = float(dt @ df) / sxx
-    if dof < 1:
-        return a, math.nan, sxx, dof
+    dof = t.size - np.unique(end).size - 1
     resid = df - a * dt
-    return a, math.sqrt(float(resid @ resid) / dof / sxx), sxx, dof
+    se_resid = math.sqrt(float(resid @ resid) / dof / sxx) if dof >= 1 else math.nan
+    se_noise = math.sqrt(float(np.sum(dt**2 * noise**2 / n))) / sxx
+    return a, max((x for x in (se_resid, se_noise) if math.isfinite(x)), default=math.nan)
 
 
 def estimate_drift(time_s, stroke_mm, force_n, cycles, *, band_fraction: float = 0.05) -> DriftEstimate | None:
@@ -206,7 +213,7 @@ def estimate_drift(time_s, stroke_mm, force_n, cycles, *, band_fraction: float =
 
     Returns
     -------
-    DriftEstimate, or None when there are no cycles.
+    DriftEstimate, or None with fewer than two cycles (nothing to compare).
 
     Examples
     --------
@@ -232,25 +239,18 @@ def estimate_drift(time_s, stroke_mm, force_n, cycles, *, band_fraction: float =
     fw = np.array([f[idx].mean() for _, idx in windows])
     nw = np.array([idx.size for _, idx in windows], dtype=float)
     noise = _noise_n(f)
-    everything = np.ones(end.size, dtype=bool)
-    a, se_resid, _sxx, _dof = _slope(tw, fw, end, everything)
-    # the noise alone: each window mean has noise / sqrt(n); the slope's variance sums over the centred times
-    centred = tw.copy()
-    for e in np.unique(end):
-        centred[end == e] -= tw[end == e].mean()
-    den = float(centred @ centred)
-    se_noise = math.sqrt(float(np.sum(centred**2 * noise**2 / nw))) / den if den > 0 else math.nan
-    se = max(x for x in (se_resid, se_noise) if math.isfinite(x)) if math.isfinite(se_resid) or \
-        math.isfinite(se_noise) else math.nan
+    a, se = _slope(tw, fw, nw, end, noise, np.ones(end.size, dtype=bool))
     if not math.isfinite(a):
         return None
     free = (end == 1) | (end == 2)
     blocked = ~free
+    a_free, se_free = _slope(tw, fw, nw, end, noise, free)
+    a_blocked, se_blocked = _slope(tw, fw, nw, end, noise, blocked)
     return DriftEstimate(
         rate_n_per_s=a, rate_se_n_per_s=se, duration_s=float(t[-1] - t[0]), t0_s=float(t[0]), noise_n=noise,
         blocked_force_n=float(fw[blocked].mean()) if blocked.any() else float(np.max(f)), points=int(end.size),
-        free_rate_n_per_s=_slope(tw, fw, end, free)[0] if free.sum() > 2 else math.nan,
-        blocked_rate_n_per_s=_slope(tw, fw, end, blocked)[0] if blocked.sum() > 2 else math.nan,
+        free_rate_n_per_s=a_free, blocked_rate_n_per_s=a_blocked,
+        difference_se_n_per_s=math.hypot(se_free, se_blocked),
     )
 
 
