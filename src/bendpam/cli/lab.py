@@ -127,6 +127,11 @@ class DriftMethod(str, Enum):
     linear = "linear"
 
 
+DriftOpt = Annotated[DriftMethod, typer.Option(
+    "--drift", help="Load-cell offset drift: none = estimate and report it; linear = also subtract the fitted "
+                    "linear offset before processing.")]
+
+
 @app.command()
 def process(
     inputs: Annotated[list[Path], typer.Argument(help="Raw test files, or a folder of them.", show_default=False)],
@@ -150,10 +155,7 @@ def process(
     rate_hz: RateOpt = None,
     repair: RepairOpt = False,
     format_file: FormatFileOpt = None,
-    drift: Annotated[DriftMethod, typer.Option(
-        "--drift",
-        help="Load-cell offset drift: none = estimate and report it; linear = also subtract the fitted linear "
-             "offset before processing.")] = DriftMethod.none,
+    drift: DriftOpt = DriftMethod.none,
     as_json: Annotated[bool, typer.Option("--json", help="Print summary.json to stdout.")] = False,
     keep_going: Annotated[bool, typer.Option(
         "--keep-going", help="Skip the files that cannot be read or processed (each reported) instead of refusing.")]
@@ -168,13 +170,7 @@ def process(
     from bendpam.lab.processed import ProcessingOptions
     from bendpam.physics.fixture import Fixture
 
-    if out is None:
-        raise UserError("give an output folder with --out OUTDIR")
-    _check_l0(l0_mm)
-    if format_file is not None:
-        from bendpam.lab import load_declaration
-
-        load_declaration(format_file)  # refused before any file is read
+    out = _check_process_inputs(out, l0_mm, format_file)
     files = collect_raw_files(inputs)
     pressures = _file_pressures(pressure_kpa, files)
     fx = Fixture.from_string(fixture, L0_mm=l0_mm, name="--fixture")
@@ -201,12 +197,7 @@ def process(
                 save_figure(processed.plot(), o.path(fig_name))
             bar.advance()
     except FilesRefused as exc:  # every bad file, one line each; raised before anything is written
-        for problem in exc.problems:
-            typer.echo(f"bendpam: error: {_flags(problem)}", err=True)
-        if len(exc.problems) > 1:
-            typer.echo(f"bendpam: error: {len(exc.problems)} of {len(files)} file(s) cannot be processed; nothing "
-                       "written (--keep-going skips them)", err=True)
-        raise typer.Exit(2) from None
+        _refused(exc.problems, len(files))
     except ProcessingError as exc:
         raise UserError(_flags(str(exc))) from None
     if as_json:
@@ -216,6 +207,28 @@ def process(
         typer.echo(_flags(file_line(info)))
     _print_table2(processed.summary())
     echo_wrote(f"wrote {out}/ (curves.nc, curves.csv, summary.json{', ' + fig_name if figure else ''})")
+
+
+def _check_process_inputs(out: Path | None, l0_mm: float, format_file: Path | None) -> Path:
+    """``process``'s checks before any file is read: an output folder (returned), --l0-mm, --format-file."""
+    if out is None:
+        raise UserError("give an output folder with --out OUTDIR")
+    _check_l0(l0_mm)
+    if format_file is not None:
+        from bendpam.lab import load_declaration
+
+        load_declaration(format_file)  # refused before any file is read
+    return out
+
+
+def _refused(problems: list[str], n_files: int) -> None:
+    """Every file that refused the set, one ``bendpam: error:`` line each, then exit 2 (nothing was written)."""
+    for problem in problems:
+        typer.echo(f"bendpam: error: {_flags(problem)}", err=True)
+    if len(problems) > 1:
+        typer.echo(f"bendpam: error: {len(problems)} of {n_files} file(s) cannot be processed; nothing "
+                   "written (--keep-going skips them)", err=True)
+    raise typer.Exit(2) from None
 
 
 def _flags(message: str) -> str:

@@ -31,8 +31,8 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-__all__ = ["DRIFT_METHODS", "FLAG_FRACTION", "FLAG_SIGMAS", "DriftEstimate", "estimate_drift",
-           "moment_shift_nmm"]
+__all__ = ["DRIFT_METHODS", "FLAG_FRACTION", "FLAG_SIGMAS", "DriftEstimate", "check_drift", "drift_findings",
+           "estimate_drift", "moment_shift_nmm"]
 
 #: The drift corrections processing knows: ``"none"`` (estimate and report only) and ``"linear"``.
 DRIFT_METHODS = ("none", "linear")

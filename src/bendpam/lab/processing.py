@@ -404,11 +404,7 @@ def process_series(
         branches=branches, blocked_moments=bm, free_curvatures=kf, energy_loss_ratios=ratio, loop_energy=loss,
         stored_energy=stored, sample_rate_hz=fs, cutoff_hz=cutoff, notes=notes, series=series, drift=drift,
     )
-    if drift is not None:
-        drift.blocked_moment_nmm = result.blocked_moment[0]
-        drift.blocked_moment_shift_nmm = moment_shift_nmm(lambda s, f: fixture.convert(s, f, opt.tare_n)[2], s_z,
-                                                          f_f, M, t, cycles, drift, corrected=drift.corrected)
-    _judge(result, fixture, cycles, k)
+    _judge(result, fixture, cycles, k, (t, s_z, f_f, M), opt.tare_n)
     return result
 
 
@@ -420,8 +416,19 @@ def _refuse_compression(s_raw: np.ndarray, f_raw: np.ndarray, threshold_mm: floa
         raise NotABendingTest(f"{source}: not a cyclic bending test (no complete cycle): {why}")
 
 
-def _judge(result: PressureResult, fixture: Fixture, cycles: list[tuple[int, int, int]], k: np.ndarray) -> None:
-    """The plausibility findings of a processed test, kept on it and warned about (PlausibilityWarning)."""
+def _judge(result: PressureResult, fixture: Fixture, cycles: list[tuple[int, int, int]], k: np.ndarray,
+           samples: tuple[np.ndarray, ...], tare_n: float) -> None:
+    """The plausibility findings of a processed test, kept on it and warned about (PlausibilityWarning).
+
+    With a drift estimate (:mod:`bendpam.lab.drift`), first how much correcting it moves the blocked
+    moment, from ``samples`` = (time, stroke, force, moment) as processing used them.
+    """
+    drift = result.drift
+    if drift is not None:
+        drift.blocked_moment_nmm = result.blocked_moment[0]
+        t, s_z, f_f, M = samples
+        drift.blocked_moment_shift_nmm = moment_shift_nmm(lambda s, f: fixture.convert(s, f, tare_n)[2], s_z, f_f, M,
+                                                          t, cycles, drift, corrected=drift.corrected)
     result.findings = check_result(result, fixture, _return_gaps(cycles, k)) + drift_findings(result)
     for f in result.findings:
         warnings.warn(f["message"], PlausibilityWarning, stacklevel=3)
