@@ -14,7 +14,7 @@ from bendpam.cli import main
 from bendpam.errors import InputError
 from bendpam.lab import RawTest
 from bendpam.lab.drift import FLAG_FRACTION, DriftEstimate, estimate_drift
-from bendpam.lab.processed import ProcessingOptions
+from bendpam.lab.processed import ProcessingOptions, load_processed, write_processed
 from bendpam.lab.processing import process_series, process_tests
 from bendpam.lab.simulate import SimulationSettings, simulate_test
 from bendpam.lab.writers import write_test
@@ -165,6 +165,20 @@ def test_process_tests_drift_argument_and_summary():
     assert d["corrected"] and d["flagged"]
     assert json.loads(json.dumps(d))["rate_n_per_s"] == d["rate_n_per_s"]
     assert any(w["check"] == "drift" for w in summary["warnings"])
+
+
+def test_drift_survives_the_processed_files(tmp_path):
+    _, drifted, _, _ = drifting(seed=1)
+    raws = [RawTest(drifted, __import__("pathlib").Path("be_150kPa.csv"), "csv", pressure_kpa=P_KPA)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        processed = process_tests(raws, keep_series=False)
+    write_processed(processed, tmp_path, figure=False)
+    back = load_processed(tmp_path).results[0]
+    before = processed.results[0].drift
+    assert (back.drift.rate_n_per_s, back.drift.rate_se_n_per_s) == (before.rate_n_per_s, before.rate_se_n_per_s)
+    assert back.drift.message() == before.message()
+    assert back.drift.flagged and [f["check"] for f in back.findings] == ["drift"]
 
 
 def test_report_words_a_drift_as_a_load_cell_fault():

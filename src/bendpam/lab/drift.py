@@ -27,7 +27,7 @@ The offset is taken as zero at the first sample (the machine is zeroed before th
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, fields
 
 import numpy as np
 
@@ -109,6 +109,22 @@ class DriftEstimate:
         """The free and the blocked ends drift differently (by more than 3 standard errors of the difference)."""
         d = self.free_rate_n_per_s - self.blocked_rate_n_per_s
         return bool(math.isfinite(d) and abs(d) > 3.0 * self.difference_se_n_per_s)
+
+    @classmethod
+    def from_dict(cls, data) -> DriftEstimate | None:
+        """An estimate from :meth:`to_dict` (the derived keys are ignored); ``None`` for anything else.
+
+        >>> est = DriftEstimate(1e-4, 1e-5, 300.0, 0.0, 0.05, 10.0, 12, corrected=True)
+        >>> DriftEstimate.from_dict(est.to_dict()) == est, DriftEstimate.from_dict(None)
+        (True, None)
+        """
+        if not isinstance(data, dict):
+            return None
+        names = {f.name for f in fields(cls)}
+        try:
+            return cls(**{k: v for k, v in data.items() if k in names})
+        except TypeError:
+            return None
 
     def offset_n(self, time_s) -> np.ndarray:
         """The fitted offset ``a (t - t_0)`` at ``time_s`` (N), zero at the first sample."""

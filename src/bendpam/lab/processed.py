@@ -447,6 +447,8 @@ class ProcessedSet:
             sources="; ".join(r.source for r in self.results),
             specimens="; ".join(r.specimen or "" for r in self.results),
             plausibility_json=json.dumps([r.findings for r in self.results], allow_nan=True),
+            drift_json=json.dumps([r.drift.to_dict() if r.drift is not None else None for r in self.results],
+                                  allow_nan=True),
         )
         return ds
 
@@ -641,6 +643,7 @@ def load_processed(path) -> ProcessedSet:
     sources = str(ds.attrs.get("sources", "")).split("; ")
     specimens = str(ds.attrs.get("specimens", "")).split("; ")
     findings = _stored_findings(ds.attrs.get("plausibility_json"))
+    drifts = _stored_drifts(ds.attrs.get("drift_json"))
     replicate = ds["replicate"].values if "replicate" in ds.data_vars else None
     for i, P in enumerate(ds["pressure_kpa"].values):
         bmc = ds["blocked_moment_cycle_nmm"].values[i]
@@ -660,6 +663,7 @@ def load_processed(path) -> ProcessedSet:
             specimen=(specimens[i] or None) if i < len(specimens) else None,
             replicate=int(replicate[i]) if replicate is not None else 1,
             findings=findings[i] if i < len(findings) else [],
+            drift=drifts[i] if i < len(drifts) else None,
         ))
     return ProcessedSet(results=results, fixture=fx, options=ProcessingOptions())
 
@@ -679,3 +683,20 @@ def _stored_findings(text) -> list[list[dict]]:
     except ValueError:
         return []
     return [list(v) if isinstance(v, list) else [] for v in value] if isinstance(value, list) else []
+
+
+def _stored_drifts(text) -> list[DriftEstimate | None]:
+    """The per-test drift estimates stored in a ``curves.nc`` (none in files older than 0.4).
+
+    >>> _stored_drifts('[null, {"rate_n_per_s": 0.001}]'), _stored_drifts("[")
+    ([None, None], [])
+    """
+    import json
+
+    if not text:
+        return []
+    try:
+        value = json.loads(str(text))
+    except ValueError:
+        return []
+    return [DriftEstimate.from_dict(v) for v in value] if isinstance(value, list) else []
