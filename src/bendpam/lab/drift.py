@@ -5,10 +5,15 @@ force at a given place of a cycle (the free end, where the fixture reads about t
 the blocked end, where the force is largest) is the same in every cycle.  A load-cell offset that
 drifts adds the same ``a * t`` to every sample, and shows as a trend of those forces across cycles.
 
-:func:`estimate_drift` takes the samples near the four ends of every cycle (the end of the unloading
+:func:`estimate_drift` reads the force near the four ends of every cycle (the end of the unloading
 and the start of the loading at the free state; the end of the loading and the start of the
-unloading at the blocked state: the samples within ``band_fraction`` (5 %) of the stroke range of the
-turning point), averages the force and the time of each, and fits ``F = c_end + a t`` by least
+unloading at the blocked state).  Each end is a band of stroke common to all cycles, from 1 % to
+10 % of the stroke range (``band_fraction``) away from the median turning stroke (the very tips,
+where the cycles turn at slightly different strokes or dwell, are left out).  Each cycle's force
+and time are interpolated on one stroke grid over the band and averaged, so every cycle is read at
+the same strokes whatever the phase of its sampling.  With three cycles or more the first cycle's
+unloading is left out: it starts from the state before any cycling, and a hysteresis loop (or the
+Mullins softening of a rubber) settles during it.  Then ``F = c_end + a t`` is fitted by least
 squares with one intercept per end and one common slope ``a`` (N/s).  Its standard error is the
 larger of the residual one and the one the force noise alone gives (the noise from the differences
 of successive samples), so a few cycles do not make it small by chance.  The free ends alone and
@@ -40,6 +45,11 @@ DRIFT_METHODS = ("none", "linear")
 FLAG_FRACTION = 0.001
 #: ... and this many of its standard errors.
 FLAG_SIGMAS = 3.0
+#: Use the first cycle's unloading when there are three cycles or more?  No: it starts from the state
+#: before any cycling (a transient of the loop).
+FIRST_UNLOADING = False
+#: Points of the stroke grid of an end band (dense: its mean is close to the mean of every sample there).
+_GRID = 256
 #: The four ends of a cycle, in the order of :attr:`DriftEstimate.ends`.
 _ENDS = ("blocked, start of unloading", "free, end of unloading", "free, start of loading",
          "blocked, end of loading")
@@ -168,25 +178,37 @@ def _noise_n(force: np.ndarray) -> float:
     return float(1.4826 * np.median(np.abs(d - np.median(d))) / math.sqrt(2.0))
 
 
-def _end_windows(stroke: np.ndarray, cycles, band_mm: float) -> list[tuple[int, np.ndarray]]:
-    """``(end, sample indices)`` of the four end windows of every cycle ``(blocked, free, blocked)``.
+def _end_windows(time: np.ndarray, stroke: np.ndarray, force: np.ndarray, cycles, band_mm: float,
+                 first_unloading: bool) -> tuple[np.ndarray, ...]:
+    """The end windows of every cycle ``(blocked, free, blocked)``: ``(end, mean time, mean force, samples)``.
 
-    The bands are common to all cycles (within ``band_mm`` of the median blocked and free turning
-    strokes), so every cycle's window covers the same part of the stroke path.
+    The bands are common to all cycles: from 10 % to 100 % of ``band_mm`` away from the median
+    blocked and free turning strokes (the very tips, where the cycles' turning points differ, are
+    left out).  Each window's force and time are interpolated on one stroke grid over its band and
+    averaged there, so every cycle is read at the same strokes whatever the phase of its sampling.
     """
     idx = np.asarray(cycles, dtype=int).reshape(-1, 3)
-    s_block = float(np.median(stroke[np.concatenate([idx[:, 0], idx[:, 2]])])) + band_mm
-    s_free = float(np.median(stroke[idx[:, 1]])) - band_mm
-    out = []
-    for a, b, c in idx:
-        unl = np.arange(a, b + 1)
-        load = np.arange(b + 1, c + 1)
-        s_u, s_l = stroke[unl], stroke[load]
-        out.append((0, unl[s_u <= s_block]))
-        out.append((1, unl[s_u >= s_free]))
-        out.append((2, load[s_l >= s_free]))
-        out.append((3, load[s_l <= s_block]))
-    return [(e, i) for e, i in out if i.size]
+    s0 = float(np.median(stroke[np.concatenate([idx[:, 0], idx[:, 2]])]))
+    s1 = float(np.median(stroke[idx[:, 1]]))
+    blocked = np.linspace(s0 + 0.1 * band_mm, s0 + band_mm, _GRID)
+    free = np.linspace(s1 - band_mm, s1 - 0.1 * band_mm, _GRID)
+    grids = {0: blocked, 1: free, 2: free, 3: blocked}
+    rows = []
+    for j, (a, b, c) in enumerate(idx):
+        for end, i0, i1 in ((0, a, b), (1, a, b), (2, b, c), (3, b, c)):
+            if end < 2 and j == 0 and not first_unloading and len(idx) >= 3:
+                continue
+            g = grids[end]
+            seg = np.arange(i0, i1 + 1)
+            inside = seg[(stroke[seg] >= g[0]) & (stroke[seg] <= g[-1])]
+            if inside.size < 2 or stroke[seg].min() > g[0] or stroke[seg].max() < g[-1]:
+                continue  # this cycle does not cover the band
+            o = np.argsort(stroke[inside], kind="stable")
+            xs = stroke[inside][o]
+            rows.append((end, float(np.interp(g, xs, time[inside][o]).mean()),
+                         float(np.interp(g, xs, force[inside][o]).mean()), inside.size))
+    arr = np.array(rows, dtype=float).reshape(-1, 4)
+    return arr[:, 0].astype(int), arr[:, 1], arr[:, 2], arr[:, 3]
 
 
 def _slope(t: np.ndarray, f: np.ndarray, n: np.ndarray, end: np.ndarray, noise: float,
@@ -214,7 +236,7 @@ def _slope(t: np.ndarray, f: np.ndarray, n: np.ndarray, end: np.ndarray, noise: 
     return a, max((x for x in (se_resid, se_noise) if math.isfinite(x)), default=math.nan)
 
 
-def estimate_drift(time_s, stroke_mm, force_n, cycles, *, band_fraction: float = 0.05) -> DriftEstimate | None:
+def estimate_drift(time_s, stroke_mm, force_n, cycles, *, band_fraction: float = 0.1) -> DriftEstimate | None:
     """Fit a linear load-cell offset drift to one test from the force at the ends of its cycles.
 
     Parameters
@@ -225,7 +247,8 @@ def estimate_drift(time_s, stroke_mm, force_n, cycles, *, band_fraction: float =
     cycles : list of (int, int, int)
         Each cycle's sample indices ``(blocked, free, blocked)``, as processing finds them.
     band_fraction : float
-        The end windows: the samples within this fraction of the stroke range of each turning point.
+        The end bands: from a tenth of this fraction to this fraction of the stroke range away from
+        the median turning strokes.
 
     Returns
     -------
@@ -249,11 +272,9 @@ def estimate_drift(time_s, stroke_mm, force_n, cycles, *, band_fraction: float =
     f = np.asarray(force_n, dtype=float)
     if not cycles or t.size < 2:
         return None
-    windows = _end_windows(s, cycles, band_fraction * float(np.ptp(s)))
-    end = np.array([e for e, _ in windows])
-    tw = np.array([t[idx].mean() for _, idx in windows])
-    fw = np.array([f[idx].mean() for _, idx in windows])
-    nw = np.array([idx.size for _, idx in windows], dtype=float)
+    end, tw, fw, nw = _end_windows(t, s, f, cycles, band_fraction * float(np.ptp(s)), FIRST_UNLOADING)
+    if end.size == 0:
+        return None
     noise = _noise_n(f)
     a, se = _slope(tw, fw, nw, end, noise, np.ones(end.size, dtype=bool))
     if not math.isfinite(a):
