@@ -22,8 +22,8 @@ that settles moves the blocked ends more.
 
 The drift is *flagged* (:attr:`DriftEstimate.flagged`) when it is both significant (``|a| >= 3``
 standard errors) and large enough to bias a fit: over the test it reaches ``0.1 %`` of the blocked
-force (:data:`FLAG_FRACTION`).  A drift of 1 % of the blocked force over a test moved a fitted
-``alpha0`` by about 20 of its standard errors, so 0.1 % is about 2.
+force (:data:`FLAG_FRACTION`).  On independent test data a drift of 1 % of the blocked force over
+a test moved a fitted ``alpha0`` by about 20 of its standard errors, so 0.1 % is about 2.
 
 The offset is taken as zero at the first sample (the machine is zeroed before the test);
 :meth:`DriftEstimate.offset_n` is the fitted offset ``a (t - t_0)`` that a correction subtracts.
@@ -211,6 +211,14 @@ def _end_windows(time: np.ndarray, stroke: np.ndarray, force: np.ndarray, cycles
     return arr[:, 0].astype(int), arr[:, 1], arr[:, 2], arr[:, 3]
 
 
+def _blocked_force_n(stroke: np.ndarray, force: np.ndarray, cycles, band_fraction: float) -> float:
+    """The force at the blocked state (N): the mean of the samples within a tenth of the band of its stroke."""
+    idx = np.asarray(cycles, dtype=int).reshape(-1, 3)
+    s0 = float(np.median(stroke[np.concatenate([idx[:, 0], idx[:, 2]])]))
+    tip = stroke <= s0 + 0.1 * band_fraction * float(np.ptp(stroke))
+    return float(force[tip].mean()) if tip.any() else float(np.max(force))
+
+
 def _slope(t: np.ndarray, f: np.ndarray, n: np.ndarray, end: np.ndarray, noise: float,
            keep: np.ndarray) -> tuple[float, float]:
     """Least squares ``f = c_end + a t`` over the window means ``keep``: ``(a, its standard error)``.
@@ -285,7 +293,7 @@ def estimate_drift(time_s, stroke_mm, force_n, cycles, *, band_fraction: float =
     a_blocked, se_blocked = _slope(tw, fw, nw, end, noise, blocked)
     return DriftEstimate(
         rate_n_per_s=a, rate_se_n_per_s=se, duration_s=float(t[-1] - t[0]), t0_s=float(t[0]), noise_n=noise,
-        blocked_force_n=float(fw[blocked].mean()) if blocked.any() else float(np.max(f)), points=int(end.size),
+        blocked_force_n=_blocked_force_n(s, f, cycles, band_fraction), points=int(end.size),
         free_rate_n_per_s=a_free, blocked_rate_n_per_s=a_blocked,
         difference_se_n_per_s=math.hypot(se_free, se_blocked),
     )
