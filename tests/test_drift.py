@@ -213,3 +213,38 @@ def test_cli_drift_flag_and_json(capsys, tmp_path):
     assert on_disk["pressures"][0]["drift"]["corrected"]
     code, out, err = run(capsys, "process", str(raw), "--out", str(tmp_path / "bad"), "--drift", "quadratic")
     assert code == 2 and "--drift" in err
+
+
+def test_force_recorded_negative_is_estimated_in_processing_orientation():
+    # compression recorded as negative: processing flips the force, so an offset growing in the record
+    # (+rate) is a drift of -rate toward the blocked state, and the correction still recovers the moment
+    clean, _, truth, rate = drifting(seed=4)
+    flipped = clean.copy()
+    flipped["force_n"] = -clean["force_n"] + rate * clean["time_s"]
+    res = process(flipped, drift="linear")
+    assert abs(res.drift.rate_n_per_s + rate) <= 3 * res.drift.rate_se_n_per_s
+    assert any("force sign flipped" in n for n in res.notes)
+    assert abs(res.blocked_moment[0] - truth["blocked_moment_nmm"]) <= 0.01 * truth["blocked_moment_nmm"]
+
+
+def test_corrected_alpha0_lands_within_two_se_of_the_truth():
+    # issue 23: a drifting test is flagged, and with the linear correction its alpha0 is within 2 SE of the truth
+    from pathlib import Path
+
+    from bendpam.identify.fitting import fit
+
+    rng = np.random.default_rng(11)
+    raws = []
+    for p in (100.0, 150.0, 200.0):
+        data, truth = simulate_test(BE, p, settings=SimulationSettings(hysteresis=0.0, rate_hz=5.0), rng=rng)
+        data["force_n"] += 0.01 * truth["blocked_moment_nmm"] / (PAPER_FIXTURE.d_mm / 2) / truth["duration_s"] \
+            * data["time_s"]
+        raws.append(RawTest(data, Path(f"be_{p:g}kPa.csv"), "csv", pressure_kpa=p))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        processed = process_tests(raws, keep_series=False, drift="linear",
+                                  options=ProcessingOptions(grid_points=41))
+        alpha0 = fit(processed, BE).parameters["alpha0"]
+    assert sum(r.drift.flagged for r in processed.results) >= 2  # the shortest test (100 kPa, 85 s) is marginal
+    assert all(r.drift.corrected for r in processed.results)
+    assert abs(alpha0.value - BE.alpha0_deg) <= 2 * alpha0.stderr
