@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+from enum import Enum
 from pathlib import Path
 from typing import Annotated, Optional
 
@@ -119,6 +120,18 @@ def _print_suggestions(paths: list[Path], as_json: bool) -> None:
         typer.echo(("\n" if i else "") + d, nl=False)
 
 
+class DriftMethod(str, Enum):
+    """``--drift``: the load-cell offset drift correction (:data:`bendpam.lab.drift.DRIFT_METHODS`)."""
+
+    none = "none"
+    linear = "linear"
+
+
+DriftOpt = Annotated[DriftMethod, typer.Option(
+    "--drift", help="Load-cell offset drift: none = estimate and report it; linear = also subtract the fitted "
+                    "linear offset before processing.")]
+
+
 @app.command()
 def process(
     inputs: Annotated[list[Path], typer.Argument(help="Raw test files, or a folder of them.", show_default=False)],
@@ -142,6 +155,7 @@ def process(
     rate_hz: RateOpt = None,
     repair: RepairOpt = False,
     format_file: FormatFileOpt = None,
+    drift: DriftOpt = DriftMethod.none,
     as_json: Annotated[bool, typer.Option("--json", help="Print summary.json to stdout.")] = False,
     keep_going: Annotated[bool, typer.Option(
         "--keep-going", help="Skip the files that cannot be read or processed (each reported) instead of refusing.")]
@@ -156,18 +170,12 @@ def process(
     from bendpam.lab.processed import ProcessingOptions
     from bendpam.physics.fixture import Fixture
 
-    if out is None:
-        raise UserError("give an output folder with --out OUTDIR")
-    _check_l0(l0_mm)
-    if format_file is not None:
-        from bendpam.lab import load_declaration
-
-        load_declaration(format_file)  # refused before any file is read
+    out = _check_process_inputs(out, l0_mm, format_file)
     files = collect_raw_files(inputs)
     pressures = _file_pressures(pressure_kpa, files)
     fx = Fixture.from_string(fixture, L0_mm=l0_mm, name="--fixture")
     opts = ProcessingOptions(cutoff_hz=cutoff_hz, reversal_fraction=reversal_fraction, grid_points=grid_points,
-                             tare_n=tare_n)
+                             tare_n=tare_n, drift=DriftMethod(drift).value)
     fig_name = f"figure4.{fig_format.value if fig_format is not None else 'png'}"
     if fig_format is not None and not figure:
         raise UserError(f"--format {fig_format.value}: there is no figure with --no-figure")
@@ -189,12 +197,7 @@ def process(
                 save_figure(processed.plot(), o.path(fig_name))
             bar.advance()
     except FilesRefused as exc:  # every bad file, one line each; raised before anything is written
-        for problem in exc.problems:
-            typer.echo(f"bendpam: error: {_flags(problem)}", err=True)
-        if len(exc.problems) > 1:
-            typer.echo(f"bendpam: error: {len(exc.problems)} of {len(files)} file(s) cannot be processed; nothing "
-                       "written (--keep-going skips them)", err=True)
-        raise typer.Exit(2) from None
+        _refused(exc.problems, len(files))
     except ProcessingError as exc:
         raise UserError(_flags(str(exc))) from None
     if as_json:
@@ -204,6 +207,28 @@ def process(
         typer.echo(_flags(file_line(info)))
     _print_table2(processed.summary())
     echo_wrote(f"wrote {out}/ (curves.nc, curves.csv, summary.json{', ' + fig_name if figure else ''})")
+
+
+def _check_process_inputs(out: Path | None, l0_mm: float, format_file: Path | None) -> Path:
+    """``process``'s checks before any file is read: an output folder (returned), --l0-mm, --format-file."""
+    if out is None:
+        raise UserError("give an output folder with --out OUTDIR")
+    _check_l0(l0_mm)
+    if format_file is not None:
+        from bendpam.lab import load_declaration
+
+        load_declaration(format_file)  # refused before any file is read
+    return out
+
+
+def _refused(problems: list[str], n_files: int) -> None:
+    """Every file that refused the set, one ``bendpam: error:`` line each, then exit 2 (nothing was written)."""
+    for problem in problems:
+        typer.echo(f"bendpam: error: {_flags(problem)}", err=True)
+    if len(problems) > 1:
+        typer.echo(f"bendpam: error: {len(problems)} of {n_files} file(s) cannot be processed; nothing "
+                   "written (--keep-going skips them)", err=True)
+    raise typer.Exit(2) from None
 
 
 def _flags(message: str) -> str:
@@ -247,6 +272,8 @@ def _print_table2(summ: dict) -> None:
             typer.echo(f"         note: {note}")
         for warning in r.get("warnings", []):
             typer.echo(f"         warning: {warning}")
+        if (r.get("drift") or {}).get("flagged") and not r["drift"].get("corrected"):
+            typer.echo("         note: --drift linear subtracts the fitted offset")
         last = k + 1 == len(tests) or float(tests[k + 1]["pressure_kpa"]) != float(r["pressure_kpa"])
         if several and last:
             typer.echo(

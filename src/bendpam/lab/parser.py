@@ -826,7 +826,6 @@ class Parser:
                 return
 
 
-
 def _no_header_error(p: Parser) -> ReadError:
     label = p.label
     partial = [b for b in p.blocks if b.choice is not None and b.choice.n_roles >= 2]
@@ -867,15 +866,7 @@ def _no_header_error(p: Parser) -> ReadError:
         assert b.choice is not None
         ch = b.choice
         found = ", ".join(f"{r} {ch.chosen[r].source!r}" for r in ROLES if r in ch.chosen)
-        missing = [r for r in ROLES if r not in ch.chosen]
-        if missing == ["time"]:
-            return ReadError(
-                f"header row has no time column (found {found}) and no sampling rate is known; "
-                "expected a time column, a sampling rate in the metadata (e.g. 'Sample rate: "
-                "100 Hz') or the rate_hz option",
-                label,
-                b.header_line,
-            )
+        missing = [r for r in ROLES if r not in ch.chosen]  # stroke or force (time alone is made up)
         return ReadError(
             f"header row has no {' or '.join(missing)} column (found {found}); expected a "
             f"column named after {' and '.join(missing)} (accepted names: {ACCEPTED_NAMES})",

@@ -23,6 +23,7 @@ from bendpam.infra.accessors import figure as figure_by_name
 from bendpam.infra.budgets import check_input_file
 from bendpam.infra.display import summary_html, summary_text
 from bendpam.infra.manifest import verify_input
+from bendpam.lab.drift import DRIFT_METHODS, DriftEstimate
 from bendpam.physics.fixture import Fixture
 
 if TYPE_CHECKING:  # pandas and xarray are imported by the functions that use them (fast start-up of `fit`)
@@ -55,6 +56,8 @@ class ProcessingOptions:
     grid_points : points of the common curvature grid of the branches.
     tare_n : force subtracted before eq 7 (N), e.g. the self-weight read unpressurised.
     zero_stroke : count the stroke from the blocked turning points (True) or use it as recorded.
+    drift : the load-cell offset drift (:mod:`bendpam.lab.drift`): ``"none"`` estimates and reports it,
+    ``"linear"`` also subtracts the fitted linear offset before the conversion.
 
     Examples
     --------
@@ -72,8 +75,11 @@ class ProcessingOptions:
     grid_points: int = 101
     tare_n: float = 0.0
     zero_stroke: bool = True
+    drift: str = "none"
 
     def __post_init__(self) -> None:
+        if self.drift not in DRIFT_METHODS:
+            raise InputError(f"drift = {self.drift!r}; choose one of: {', '.join(DRIFT_METHODS)}")
         if self.cutoff_hz is not None and (not math.isfinite(self.cutoff_hz) or self.cutoff_hz < 0):
             raise InputError(f"cutoff_hz = {self.cutoff_hz!r} must be >= 0 Hz (0 switches the filter off)")
         if not 1 <= int(self.filter_order) <= 10:
@@ -125,6 +131,7 @@ class PressureResult:
     specimen: str | None = None  # the specimen's name when a file holds several
     replicate: int = 1  # 1, 2, ... among the tests at this pressure
     findings: list[dict] = field(default_factory=list)  # plausibility findings (bendpam.lab.plausibility)
+    drift: DriftEstimate | None = None  # the load-cell offset drift (bendpam.lab.drift)
 
     @property
     def mean_loading(self) -> np.ndarray:
@@ -191,6 +198,7 @@ class PressureResult:
             "replicate": self.replicate,
             "notes": list(self.notes),
             "warnings": [f["message"] for f in self.findings],
+            "drift": self.drift.to_dict() if self.drift is not None else None,
         }
 
 
@@ -439,6 +447,8 @@ class ProcessedSet:
             sources="; ".join(r.source for r in self.results),
             specimens="; ".join(r.specimen or "" for r in self.results),
             plausibility_json=json.dumps([r.findings for r in self.results], allow_nan=True),
+            drift_json=json.dumps([r.drift.to_dict() if r.drift is not None else None for r in self.results],
+                                  allow_nan=True),
         )
         return ds
 
@@ -633,6 +643,7 @@ def load_processed(path) -> ProcessedSet:
     sources = str(ds.attrs.get("sources", "")).split("; ")
     specimens = str(ds.attrs.get("specimens", "")).split("; ")
     findings = _stored_findings(ds.attrs.get("plausibility_json"))
+    drifts = _stored_drifts(ds.attrs.get("drift_json"))
     replicate = ds["replicate"].values if "replicate" in ds.data_vars else None
     for i, P in enumerate(ds["pressure_kpa"].values):
         bmc = ds["blocked_moment_cycle_nmm"].values[i]
@@ -652,6 +663,7 @@ def load_processed(path) -> ProcessedSet:
             specimen=(specimens[i] or None) if i < len(specimens) else None,
             replicate=int(replicate[i]) if replicate is not None else 1,
             findings=findings[i] if i < len(findings) else [],
+            drift=drifts[i] if i < len(drifts) else None,
         ))
     return ProcessedSet(results=results, fixture=fx, options=ProcessingOptions())
 
@@ -671,3 +683,20 @@ def _stored_findings(text) -> list[list[dict]]:
     except ValueError:
         return []
     return [list(v) if isinstance(v, list) else [] for v in value] if isinstance(value, list) else []
+
+
+def _stored_drifts(text) -> list[DriftEstimate | None]:
+    """The per-test drift estimates stored in a ``curves.nc`` (none in files older than 0.4).
+
+    >>> _stored_drifts('[null, {"rate_n_per_s": 0.001}]'), _stored_drifts("[")
+    ([None, None], [])
+    """
+    import json
+
+    if not text:
+        return []
+    try:
+        value = json.loads(str(text))
+    except ValueError:
+        return []
+    return [DriftEstimate.from_dict(v) for v in value] if isinstance(value, list) else []

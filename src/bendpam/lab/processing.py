@@ -41,6 +41,7 @@ a set); what they produce, :class:`~bendpam.lab.processed.PressureResult` and
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import warnings
 from typing import TYPE_CHECKING
@@ -48,6 +49,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from bendpam.errors import InputError, PlausibilityWarning, ProcessingError
+from bendpam.lab.drift import check_drift, drift_findings, moment_shift_nmm
 from bendpam.lab.plausibility import check_result, compression_like
 from bendpam.lab.processed import (
     PressureResult,
@@ -416,9 +418,7 @@ def process_series(
     t, s_raw, f_raw = _checked_arrays(time_s, stroke_mm, force_n, source)
     notes: list[str] = []
     fs, cutoff = _sampling(t, opt, source, notes)
-    s_f = _lowpass(s_raw, fs, cutoff, int(opt.filter_order))
-    f_f = _lowpass(f_raw, fs, cutoff, int(opt.filter_order))
-
+    s_f, f_f = (_lowpass(x, fs, cutoff, int(opt.filter_order)) for x in (s_raw, f_raw))
     rng = float(np.ptp(s_f))
     if rng <= 0:
         raise ProcessingError(f"{source}: the stroke does not move; no cycles to process")
@@ -426,6 +426,7 @@ def process_series(
     s_f, f_f, s_raw, f_raw = _orient(s_f, f_f, s_raw, f_raw, notes)
 
     s_z, f_f, cycles = _segment(s_raw, f_raw, s_f, f_f, rng, fs, cutoff, opt, source, notes)
+    drift, f_f = check_drift(t, s_z, f_raw, f_f, cycles, opt.drift)  # bendpam.lab.drift
     del s_f, s_raw, f_raw  # the whole-record filter and the raw samples are not needed after segmentation
 
     beta, k, M = _convert(fixture, s_z, f_f, opt.tare_n)
@@ -440,9 +441,9 @@ def process_series(
     result = PressureResult(
         pressure_kpa=float(pressure_kpa), source=source, n_cycles=len(cycles), curvature_grid=grid,
         branches=branches, blocked_moments=bm, free_curvatures=kf, energy_loss_ratios=ratio, loop_energy=loss,
-        stored_energy=stored, sample_rate_hz=fs, cutoff_hz=cutoff, notes=notes, series=series,
+        stored_energy=stored, sample_rate_hz=fs, cutoff_hz=cutoff, notes=notes, series=series, drift=drift,
     )
-    _judge(result, fixture, cycles, k)
+    _judge(result, fixture, cycles, k, (t, s_z, f_f, M), opt.tare_n)
     return result
 
 
@@ -454,9 +455,20 @@ def _refuse_compression(s_raw: np.ndarray, f_raw: np.ndarray, threshold_mm: floa
         raise NotABendingTest(f"{source}: not a cyclic bending test (no complete cycle): {why}")
 
 
-def _judge(result: PressureResult, fixture: Fixture, cycles: list[tuple[int, int, int]], k: np.ndarray) -> None:
-    """The plausibility findings of a processed test, kept on it and warned about (PlausibilityWarning)."""
-    result.findings = check_result(result, fixture, _return_gaps(cycles, k))
+def _judge(result: PressureResult, fixture: Fixture, cycles: list[tuple[int, int, int]], k: np.ndarray,
+           samples: tuple[np.ndarray, ...], tare_n: float) -> None:
+    """The plausibility findings of a processed test, kept on it and warned about (PlausibilityWarning).
+
+    With a drift estimate (:mod:`bendpam.lab.drift`), first how much correcting it moves the blocked
+    moment, from ``samples`` = (time, stroke, force, moment) as processing used them.
+    """
+    drift = result.drift
+    if drift is not None:
+        drift.blocked_moment_nmm = result.blocked_moment[0]
+        t, s_z, f_f, M = samples
+        drift.blocked_moment_shift_nmm = moment_shift_nmm(lambda s, f: fixture.convert(s, f, tare_n)[2], s_z, f_f, M,
+                                                          t, cycles, drift, corrected=drift.corrected)
+    result.findings = check_result(result, fixture, _return_gaps(cycles, k)) + drift_findings(result)
     for f in result.findings:
         warnings.warn(f["message"], PlausibilityWarning, stacklevel=3)
 
@@ -611,14 +623,15 @@ def number_replicates(results: list[PressureResult]) -> list[PressureResult]:
 
 
 def process_tests(tests, *, fixture: Fixture = PAPER_FIXTURE, options: ProcessingOptions | None = None,
-                  keep_series: bool = True) -> ProcessedSet:
+                  keep_series: bool = True, drift: str | None = None) -> ProcessedSet:
     """Process several raw tests (``RawTest`` objects from :func:`bendpam.lab.read_test`).
 
     Every test needs a pressure (from the reader: option, metadata or filename).  Several tests at
     one pressure (specimens, repeats) are replicates: each is kept and numbered
     (:attr:`PressureResult.replicate`), :meth:`ProcessedSet.replicates` gives their mean and spread,
     and a fit uses every one.  The first test that cannot be processed raises; to go on past it,
-    see :func:`bendpam.lab.batch.process_files`.
+    see :func:`bendpam.lab.batch.process_files`.  ``drift`` (``"none"`` or ``"linear"``), when given,
+    replaces ``options.drift`` (:mod:`bendpam.lab.drift`).
 
     Examples
     --------
@@ -639,6 +652,8 @@ def process_tests(tests, *, fixture: Fixture = PAPER_FIXTURE, options: Processin
     >>> round(processed.deadband()[0])                  # kPa: the x-intercept (P_start = 68 kPa)
     68
     """
+    if drift is not None:
+        options = dataclasses.replace(options or ProcessingOptions(), drift=drift)
     results = [process_one(rt, fixture=fixture, options=options, keep_series=keep_series) for rt in tests]
     if not results:
         raise ProcessingError("no tests to process")

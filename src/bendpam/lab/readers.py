@@ -342,13 +342,18 @@ def read_test(
         return tests[0]
     raw = _read_one(path, pressure_kpa=pressure_kpa, dialect=dialect, columns=columns, rate_hz=rate_hz,
                     repair=repair)  # fmt: skip
+    _refuse_several(raw, pressure_kpa=pressure_kpa, dialect=dialect, columns=columns, rate_hz=rate_hz, repair=repair)
+    return raw
+
+
+def _refuse_several(raw: RawTest, **kw: Any) -> None:
+    """read_test's refusal of a file that holds several tests (specimens, sheets or blocks), naming them."""
     labels = _specimen_labels(raw)
     if len(labels) > 1:
         raise ReadError(f"holds {len(labels)} specimens side by side ({', '.join(labels[:4])}"
                         f"{', ...' if len(labels) > 4 else ''}); read them with read_tests",
                         raw.path, raw.header_line)  # fmt: skip
-    sheets = _other_sheets(raw, pressure_kpa=pressure_kpa, dialect=dialect, columns=columns, rate_hz=rate_hz,
-                           repair=repair)  # fmt: skip
+    sheets = _other_sheets(raw, **kw)
     if sheets:
         names = ", ".join(repr(s) for s in [raw.metadata.get("sheet"), *[t.metadata.get("sheet") for t in sheets]])
         raise ReadError(f"holds {len(sheets) + 1} tests on the sheets {names}; read them with read_tests",
@@ -358,7 +363,6 @@ def read_test(
         lines = ", ".join(str(t.header_line) for t in parts[1:4])
         raise ReadError(f"holds {len(parts)} tests in separate blocks (time restarts in the blocks at line(s) "
                         f"{lines}); read them with read_tests", raw.path, parts[1].header_line)  # fmt: skip
-    return raw
 
 
 def _read_one(path: str | os.PathLike, *, pressure_kpa: float | None, dialect: str | None,

@@ -37,7 +37,8 @@ class ReportWarning:
     ----------
     kind : ``"fit-failed"``, ``"poor-fit"``, ``"not-converged"``, ``"at-bound"``, ``"correlated"``,
         ``"fold"``, ``"deadband"`` or ``"direction"`` (:data:`bendpam.identify.diagnose.KINDS`), or
-        ``"implausible"`` (a test no bending actuator gives: :func:`plausibility_warnings`).
+        ``"implausible"`` (a test no bending actuator gives: :func:`plausibility_warnings`) or ``"drift"`` (a
+        load-cell offset that drifts, :mod:`bendpam.lab.drift`).
     title : one line (plain text with symbols such as α₀ and P_start).
     meaning : what it means for the results.
     action : what to try.
@@ -214,6 +215,14 @@ def plausibility_warnings(processed) -> list[ReportWarning]:
     """
     out = []
     for f in getattr(processed, "findings", []):
+        if f.get("check") == "drift":  # bendpam.lab.drift: an instrument fault, not an implausible actuator
+            out.append(ReportWarning(
+                "drift", f"Load-cell drift: {f['message']}",
+                "The force reading drifts across the cycles by more than the fit can tolerate; the blocked moment "
+                "and the fitted parameters are biased by it unless it was corrected.",
+                "Re-zero the load cell and let it warm up before testing, or process the test with the linear "
+                "drift correction."))
+            continue
         out.append(ReportWarning(
             "implausible", f"Implausible test: {f['message']}",
             "These numbers cannot come from a bending actuator in this fixture; the tables, the fits and the "

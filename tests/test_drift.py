@@ -1,0 +1,250 @@
+"""Load-cell offset drift (bendpam.lab.drift): estimated from the cycle ends, flagged, corrected on request."""
+
+import json
+import math
+import warnings
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from bendpam import presets
+from bendpam.cli import main
+from bendpam.errors import InputError
+from bendpam.lab import RawTest
+from bendpam.lab.drift import FLAG_FRACTION, DriftEstimate, estimate_drift
+from bendpam.lab.processed import ProcessingOptions, load_processed, write_processed
+from bendpam.lab.processing import process_series, process_tests
+from bendpam.lab.simulate import SimulationSettings, simulate_test
+from bendpam.lab.writers import write_test
+from bendpam.physics.fixture import PAPER_FIXTURE
+from bendpam.present.report.findings import plausibility_warnings
+
+BE = presets.be_pam()
+P_KPA = 150.0
+
+
+def drifting(seed: int, fraction: float = 0.01):
+    """A simulated test at 150 kPa with an offset drifting by ``fraction`` of the blocked force over the test.
+
+    Returns ``(data without drift, data with drift, truth, drift rate N/s)``.  The blocked force is
+    the blocked moment over the lever at beta = 0, d/2 (eq 7), and the offset is zero at t = 0.
+    """
+    data, truth = simulate_test(BE, P_KPA, settings=SimulationSettings(seed=seed))
+    blocked_force_n = truth["blocked_moment_nmm"] / (PAPER_FIXTURE.d_mm / 2.0)
+    rate = fraction * blocked_force_n / truth["duration_s"]
+    drifted = data.copy()
+    drifted["force_n"] = data["force_n"] + rate * data["time_s"]
+    return data, drifted, truth, rate
+
+
+def process(data, drift="none"):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return process_series(data["time_s"], data["stroke_mm"], data["force_n"], P_KPA, keep_series=False,
+                              options=ProcessingOptions(drift=drift), source="sim.csv")
+
+
+def triangle_test(rate_n_per_s: float, shape, offset_n: float = 0.0, cycles: int = 3):
+    """Noiseless triangular cycles (10 mm, 100 s each) with a force ``shape(stroke)`` per branch plus a drift."""
+    t = np.arange(0.0, 100.0 * cycles + 0.05, 0.05) + 0.0123  # no sample on a window's edge
+    phase = (t / 100.0) % 1.0
+    s = 10.0 * (1.0 - np.abs(phase * 2.0 - 1.0))
+    loading = phase >= 0.5
+    f = shape(s) + np.where(loading, 0.3, 0.0) * (1.0 - s / 10.0) + offset_n + rate_n_per_s * t
+    cyc = [(2000 * i, 2000 * i + 1000, 2000 * (i + 1)) for i in range(cycles)]
+    return t, s, f, cyc
+
+
+@settings(max_examples=25, deadline=None)
+@given(rate=st.floats(-1e-2, 1e-2), offset=st.floats(-5.0, 5.0), stiffness=st.floats(0.2, 2.0))
+def test_noiseless_drift_is_recovered_exactly(rate, offset, stiffness):
+    # any loop that repeats from cycle to cycle, any constant offset: the slope is the drift itself
+    t, s, f, cyc = triangle_test(rate, lambda s: 12.0 - stiffness * s, offset)
+    est = estimate_drift(t, s, f, cyc)
+    assert est is not None
+    assert est.rate_n_per_s == pytest.approx(rate, abs=1e-12)
+    assert est.free_rate_n_per_s == pytest.approx(rate, abs=1e-12)
+    assert est.blocked_rate_n_per_s == pytest.approx(rate, abs=1e-12)
+    assert not est.differs
+
+
+def test_constant_offset_is_no_drift():
+    t, s, f, cyc = triangle_test(0.0, lambda s: 12.0 - s, offset_n=0.7)
+    f = f + np.random.default_rng(3).normal(0.0, 0.05, t.size)
+    est = estimate_drift(t, s, f, cyc)
+    assert abs(est.rate_n_per_s) < 3 * est.rate_se_n_per_s
+    assert not est.flagged
+
+
+def test_creep_at_the_blocked_end_is_told_apart():
+    # a force that relaxes in proportion to itself (creep) moves the blocked ends, not the free ones
+    t, s, f, cyc = triangle_test(0.0, lambda s: 12.0 - 1.15 * s)
+    f = f * (1.0 - 1e-4 * t) + np.random.default_rng(4).normal(0.0, 0.01, t.size)
+    est = estimate_drift(t, s, f, cyc)
+    assert est.differs
+    assert "creep" in est.message()
+
+
+def test_single_cycle_has_no_estimate():
+    t, s, f, cyc = triangle_test(1e-3, lambda s: 12.0 - s, cycles=1)
+    assert estimate_drift(t, s, f, cyc) is None  # 4 windows, one per end: nothing to compare
+
+
+def test_one_percent_drift_estimated_within_its_se_and_flagged():
+    _, drifted, truth, rate = drifting(seed=6)
+    res = process(drifted)
+    est = res.drift
+    # rate: 1 % of 2 * 204.35 N*mm / 35 mm = 0.1168 N over 262.5 s
+    assert rate == pytest.approx(0.01 * 2 * truth["blocked_moment_nmm"] / 35.0 / truth["duration_s"])
+    assert abs(est.rate_n_per_s - rate) <= est.rate_se_n_per_s
+    assert est.flagged and not est.corrected
+    assert est.drift_n == pytest.approx(0.01 * est.blocked_force_n, rel=0.25)
+    flagged = [f for f in res.findings if f["check"] == "drift"]
+    assert len(flagged) == 1
+    msg = flagged[0]["message"]
+    assert "times the force noise" in msg and "of the blocked force" in msg and "would move the blocked moment" in msg
+    assert est.blocked_moment_shift_nmm < 0  # an offset growing toward compression inflates the later maxima
+
+
+def test_drift_estimates_are_calibrated_over_seeds():
+    zs = []
+    for seed in range(10):
+        _, drifted, _, rate = drifting(seed)
+        est = process(drifted).drift
+        zs.append((est.rate_n_per_s - rate) / est.rate_se_n_per_s)
+        assert est.flagged
+    zs = np.array(zs)
+    assert np.all(np.abs(zs) < 3.5)
+    assert 0.5 < math.sqrt(float(np.mean(zs**2))) < 2.0
+
+
+def test_linear_correction_recovers_the_blocked_moment():
+    clean, drifted, truth, _ = drifting(seed=2)
+    raw = process(drifted)
+    fixed = process(drifted, drift="linear")
+    nodrift = process(clean)
+    true_bm = truth["blocked_moment_nmm"]
+    assert fixed.drift.corrected
+    assert abs(fixed.blocked_moment[0] - true_bm) <= 0.01 * true_bm
+    # the correction removes the drift's bias: closer to the no-drift processing than without it
+    bias_fixed = abs(fixed.blocked_moment[0] - nodrift.blocked_moment[0])
+    assert bias_fixed < abs(raw.blocked_moment[0] - nodrift.blocked_moment[0])
+    # and it moves the blocked moment by what the report said it would
+    assert fixed.blocked_moment[0] - raw.blocked_moment[0] == pytest.approx(raw.drift.blocked_moment_shift_nmm,
+                                                                           abs=0.1)
+    assert "moved the blocked moment" in fixed.drift.message()
+
+
+def test_no_drift_is_not_flagged_over_seeds():
+    flagged = [process(simulate_test(BE, P_KPA, settings=SimulationSettings(seed=seed))[0]).drift.flagged
+               for seed in range(10)]
+    assert sum(flagged) <= 1
+
+
+def test_flag_needs_size_as_well_as_significance():
+    small = DriftEstimate(rate_n_per_s=1e-6, rate_se_n_per_s=1e-8, duration_s=300.0, t0_s=0.0, noise_n=0.01,
+                          blocked_force_n=10.0, points=12)
+    assert small.sigmas > 3 and abs(small.drift_n) < FLAG_FRACTION * 10.0
+    assert not small.flagged
+
+
+def test_option_is_checked():
+    with pytest.raises(InputError, match="drift = 'quadratic'; choose one of: none, linear"):
+        ProcessingOptions(drift="quadratic")
+
+
+def test_process_tests_drift_argument_and_summary():
+    _, drifted, _, _ = drifting(seed=1)
+    raws = [RawTest(drifted, __import__("pathlib").Path("be_150kPa.csv"), "csv", pressure_kpa=P_KPA)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        summary = process_tests(raws, keep_series=False, drift="linear").summary()
+    d = summary["pressures"][0]["drift"]
+    assert d["corrected"] and d["flagged"]
+    assert json.loads(json.dumps(d))["rate_n_per_s"] == d["rate_n_per_s"]
+    assert any(w["check"] == "drift" for w in summary["warnings"])
+
+
+def test_drift_survives_the_processed_files(tmp_path):
+    _, drifted, _, _ = drifting(seed=1)
+    raws = [RawTest(drifted, __import__("pathlib").Path("be_150kPa.csv"), "csv", pressure_kpa=P_KPA)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        processed = process_tests(raws, keep_series=False)
+    write_processed(processed, tmp_path, figure=False)
+    back = load_processed(tmp_path).results[0]
+    before = processed.results[0].drift
+    assert (back.drift.rate_n_per_s, back.drift.rate_se_n_per_s) == (before.rate_n_per_s, before.rate_se_n_per_s)
+    assert back.drift.message() == before.message()
+    assert back.drift.flagged and [f["check"] for f in back.findings] == ["drift"]
+
+
+def test_report_words_a_drift_as_a_load_cell_fault():
+    _, drifted, _, _ = drifting(seed=1)
+    res = process(drifted)
+    warns = plausibility_warnings(type("S", (), {"findings": res.findings})())
+    assert [w.kind for w in warns] == ["drift"]
+    assert warns[0].title.startswith("Load-cell drift: sim.csv (150 kPa)")
+
+
+def run(capsys, *args):
+    code = main(list(args))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_cli_drift_flag_and_json(capsys, tmp_path):
+    _, drifted, truth, _ = drifting(seed=3)
+    raw = tmp_path / "raw"
+    raw.mkdir()
+    write_test(raw / "be_150kPa.csv", drifted, "csv", pressure_kpa=P_KPA)
+    code, out, err = run(capsys, "process", str(raw), "--out", str(tmp_path / "plain"), "--no-figure")
+    assert code == 0, err
+    assert "load-cell offset drifts" in out and "--drift linear subtracts" in out
+    code, out, err = run(capsys, "process", str(raw), "--out", str(tmp_path / "fixed"), "--no-figure",
+                         "--drift", "linear", "--json")
+    assert code == 0, err
+    d = json.loads(out)["pressures"][0]
+    assert d["drift"]["corrected"] and d["drift"]["flagged"]
+    assert abs(d["blocked_moment_nmm"] - truth["blocked_moment_nmm"]) <= 0.01 * truth["blocked_moment_nmm"]
+    on_disk = json.loads((tmp_path / "fixed" / "summary.json").read_text())
+    assert on_disk["pressures"][0]["drift"]["corrected"]
+    code, out, err = run(capsys, "process", str(raw), "--out", str(tmp_path / "bad"), "--drift", "quadratic")
+    assert code == 2 and "--drift" in err
+
+
+def test_force_recorded_negative_is_estimated_in_processing_orientation():
+    # compression recorded as negative: processing flips the force, so an offset growing in the record
+    # (+rate) is a drift of -rate toward the blocked state, and the correction still recovers the moment
+    clean, _, truth, rate = drifting(seed=4)
+    flipped = clean.copy()
+    flipped["force_n"] = -clean["force_n"] + rate * clean["time_s"]
+    res = process(flipped, drift="linear")
+    assert abs(res.drift.rate_n_per_s + rate) <= 3 * res.drift.rate_se_n_per_s
+    assert any("force sign flipped" in n for n in res.notes)
+    assert abs(res.blocked_moment[0] - truth["blocked_moment_nmm"]) <= 0.01 * truth["blocked_moment_nmm"]
+
+
+def test_corrected_alpha0_lands_within_two_se_of_the_truth():
+    # issue 23: a drifting test is flagged, and with the linear correction its alpha0 is within 2 SE of the truth
+    from pathlib import Path
+
+    from bendpam.identify.fitting import fit
+
+    rng = np.random.default_rng(11)
+    raws = []
+    for p in (100.0, 150.0, 200.0):
+        data, truth = simulate_test(BE, p, settings=SimulationSettings(hysteresis=0.0, rate_hz=5.0), rng=rng)
+        data["force_n"] += 0.01 * truth["blocked_moment_nmm"] / (PAPER_FIXTURE.d_mm / 2) / truth["duration_s"] \
+            * data["time_s"]
+        raws.append(RawTest(data, Path(f"be_{p:g}kPa.csv"), "csv", pressure_kpa=p))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        processed = process_tests(raws, keep_series=False, drift="linear",
+                                  options=ProcessingOptions(grid_points=41))
+        alpha0 = fit(processed, BE).parameters["alpha0"]
+    assert sum(r.drift.flagged for r in processed.results) >= 2  # the shortest test (100 kPa, 85 s) is marginal
+    assert all(r.drift.corrected for r in processed.results)
+    assert abs(alpha0.value - BE.alpha0_deg) <= 2 * alpha0.stderr
