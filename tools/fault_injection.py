@@ -99,6 +99,18 @@ def strict_json(text: str):
     return json.loads(text, parse_constant=_no_constant)
 
 
+#: The last line of a refusal of several input files (issue 22: every bad file named at once).
+_COUNT_LINE = re.compile(r"bendpam: error: \d+ of \d+ file\(s\) cannot be processed")
+
+
+def _per_file_refusal(errors: list[str]) -> bool:
+    """One line per bad input file (each naming a different file), then the count line."""
+    if len(errors) < 3 or not _COUNT_LINE.match(errors[-1]):
+        return False
+    files = [ln[len("bendpam: error: "):].split(":", 1)[0] for ln in errors[:-1]]
+    return len(set(files)) == len(files)
+
+
 def classify(r: Run) -> tuple[str, str]:
     """``(kind, detail)``: kind is ok, error, interrupt, traceback, internal, hang, bad-json or bad-error."""
     err_lines = [ln for ln in r.stderr.splitlines() if ln.strip()]
@@ -120,6 +132,8 @@ def classify(r: Run) -> tuple[str, str]:
         others = [ln for ln in err_lines if not ln.startswith(("bendpam: error:", *NOTE_PREFIXES))]
         if len(errors) == 1 and not others and err_lines[-1] == errors[0]:
             return "error", errors[0]
+        if not others and _per_file_refusal(errors) and err_lines[-1] == errors[-1]:
+            return "error", errors[-1]
         return "bad-error", r.stderr.strip()[-800:]
     if r.rc in (130, 143):
         if err_lines and (err_lines[-1] == INTERRUPT_LINE or err_lines[-1].startswith(INTERRUPT_AFTER)):

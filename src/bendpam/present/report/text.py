@@ -242,6 +242,9 @@ SYMBOLS: dict[str, Symbol] = {
     "lambda_max": Symbol("λ_max", "λ<sub>max</sub>", "", "largest allowed principal stretch of the bladder"),
     "P_max": Symbol("P_max", "P<sub>max</sub>", "kPa", "burst limit: the highest pressure the actuator is "
                     "evaluated at"),
+    "P_tested": Symbol("P_tested", "P<sub>tested</sub>", "kPa", "pressures of the tests the actuator was fitted "
+                       "on (lowest, highest)"),
+    "fit": Symbol("fit", "fit", "", "the fit the actuator comes from (fit.json hash, processed set, date, version)"),
 }
 _FIELD_KEY = {
     "alpha0_deg": "alpha0", "R0_mm": "R0", "t0_mm": "t0", "L0_mm": "L0", "frame_thickness_mm": "h_f",
@@ -250,6 +253,7 @@ _FIELD_KEY = {
     "bladder_area_mm2": "A_bl", "frame_inertia_mm4": "I_f", "frame_stiffness_nmm2": "EI_f",
     "shear_modulus_kpa": "mu", "theta_h_deg": "theta_h", "a0_nmm": "a0", "a1_nmm_per_kpa": "a1",
     "frame_strength_mpa": "sigma_f", "bladder_stretch_limit": "lambda_max", "max_pressure_kpa": "P_max",
+    "tested_pressure_kpa": "P_tested", "fit_identity": "fit",
 }
 #: Unit suffixes of field names (longest first) -> the unit as shown.
 _UNIT_SUFFIX = (("_nmm_per_kpa", "N·mm/kPa"), ("_per_mm", "1/mm"), ("_nmm2", "N·mm²"), ("_nmm", "N·mm"),
