@@ -16,6 +16,9 @@ SIGINT is ignored instead and logging is off: a Ctrl-C at the terminal reaches e
 group, and the parent alone answers it, shutting its workers down quietly (their errors reach the
 parent through Dask all the same).
 
+``bendpam --version`` alone is answered here, without building the command line (the same line as
+``bendpam.cli.app``'s ``--version``: :func:`bendpam.infra.manifest.bendpam_version`).
+
 What remains outside Python's reach is the interpreter's own start-up (before any line of the
 console script runs): a signal there gets the system's default action.
 """
@@ -65,6 +68,11 @@ install()
 def main() -> int:
     """Run the ``bendpam`` command line; returns its exit status."""
     install()  # (again: a caller may have changed them after importing this module)
+    if sys.argv[1:] == ["--version"]:  # the one answer that needs neither Typer nor the commands (start-up)
+        from bendpam.infra.manifest import bendpam_version
+
+        print(f"bendpam {bendpam_version()}")
+        return 0
     from bendpam.cli.app import main as run
 
     return run()

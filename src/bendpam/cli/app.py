@@ -15,7 +15,7 @@ Every output a command writes (through :func:`bendpam.cli.options.output_set` /
 it returns with status 0, or all rolled back.
 """
 
-from __future__ import annotations
+# no ``from __future__ import annotations``: Typer reads the annotations of the commands as objects (start-up)
 
 import logging
 import sys
@@ -44,13 +44,9 @@ app = typer.Typer(
 
 def _version(value: bool) -> None:
     if value:
-        from importlib.metadata import PackageNotFoundError, version
+        from bendpam.infra.manifest import bendpam_version  # (bendpam_entry answers a lone --version the same way)
 
-        try:
-            v = version("bendpam")
-        except PackageNotFoundError:  # pragma: no cover - running from a source tree
-            from bendpam.version import __version__ as v
-        typer.echo(f"bendpam {v}")
+        typer.echo(f"bendpam {bendpam_version()}")
         raise typer.Exit(0)
 
 
