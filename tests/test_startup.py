@@ -127,3 +127,26 @@ def test_fit_with_its_figure_imports_no_pyplot(processed_dir, tmp_path):
     assert (tmp_path / "fit" / "figure7.png").is_file()
     assert "matplotlib" in modules
     assert loaded(modules, "matplotlib.pyplot") == [] and loaded(modules, "scipy.io") == []
+
+
+@pytest.mark.parametrize("columns", ["80", "60", "200"])
+def test_root_help_is_typers_own_text(columns, monkeypatch):
+    """``bendpam --help`` (built from option-less copies of the commands) is exactly what Typer prints."""
+    import typer.main
+
+    from bendpam.cli import app
+    from bendpam.cli.app import root_help
+
+    monkeypatch.setenv("COLUMNS", columns)
+    light = root_help()
+    group = typer.main.get_command(app)  # built after root_help(): the app is left as it was
+    assert light == group.get_help(typer.Context(group, info_name="bendpam"))
+    assert all(len(group.commands[c].params) > 3 for c in ("predict", "fit", "sweep"))
+
+
+def test_no_arguments_and_help_print_the_root_help(capsys):
+    from bendpam.cli.app import main, root_help
+
+    for argv in ([], ["--help"]):
+        assert main(argv) == 0
+        assert capsys.readouterr().out == root_help() + "\n"
