@@ -96,8 +96,8 @@ def commands(rec: Recorder, quick: bool, e: dict[str, str], cwd: str) -> None:
             ", ".join(sorted(set(heavy_after(["--help"], e, cwd)) | set(heavy_after(["--version"], e, cwd)))) or "none",
             "", "none", not ({"numpy", "pandas", "matplotlib.pyplot", "scipy.io"}
                              & (set(heavy_after(["--help"], e, cwd)) | set(heavy_after(["--version"], e, cwd)))))
-    rec.row("`bendpam predict`: pandas imported", "pandas" in heavy_after(args["predict"], e, cwd), "", "no",
-            "pandas" not in heavy_after(args["predict"], e, cwd))
+    pandas = "pandas" in heavy_after(args["predict"], e, cwd)
+    rec.row("`bendpam predict`: pandas imported", "yes" if pandas else "no", "", "no", not pandas)
 
 
 def fit(rec: Recorder, quick: bool, e: dict[str, str], cwd: str) -> None:
