@@ -71,7 +71,14 @@ def main() -> int:
     if sys.argv[1:] == ["--version"]:  # the one answer that needs neither Typer nor the commands (start-up)
         from bendpam.infra.manifest import bendpam_version
 
-        print(f"bendpam {bendpam_version()}")
+        try:
+            sys.stdout.write(f"bendpam {bendpam_version()}\n")
+            sys.stdout.flush()
+        except AttributeError:  # no stdout (closed): nothing to print to, as Typer's echo
+            pass
+        except OSError as exc:  # a full disk, a closed pipe: one line, as bendpam.cli.app.main says it
+            os.write(2, f"bendpam: error: {exc.strerror or exc}\n".encode("utf-8", "replace"))
+            return 2
         return 0
     from bendpam.cli.app import main as run
 

@@ -205,18 +205,20 @@ def main(argv: list[str] | None = None) -> int:
     >>> main(["predict", "--preset", "xx-pam", "--pressure-kpa", "100"])   # one line on stderr
     2
     """
-    args = list(sys.argv[1:] if argv is None else argv)
-    if not args or args == ["--help"]:  # (nothing runs: no output group, no signal handling needed)
-        typer.echo(root_help())
-        return 0
     from bendpam.errors import BendpamError
     from bendpam.infra.signals import Interrupted, forget_written, interrupted_line, interrupts, quiet_logging
 
+    args = list(sys.argv[1:] if argv is None else argv)
+    if not args:
+        args = ["--help"]
     debug = "--debug" in args
     forget_written()
     tokens = (RUN_ARGS.set(list(args)), RUN_COMMAND.set(None), RUN_FORCE.set(False))
     shown = _SHOWN.set(frozenset())
     try:
+        if args == ["--help"]:  # the list of commands: built without their options (start-up; root_help)
+            typer.echo(root_help())
+            return 0
         args = _lift_force(args)
         with interrupts(on_signal=quiet_logging), warnings.catch_warnings():
             warnings.showwarning = _show_warning
