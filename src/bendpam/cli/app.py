@@ -196,6 +196,16 @@ def root_help() -> str:
     return group.get_help(typer.Context(group, info_name="bendpam"))
 
 
+def _print_root_help() -> int:
+    """Print :func:`root_help`; a full disk or a closed pipe is one line and exit status 2, as in :func:`main`."""
+    try:
+        typer.echo(root_help())
+    except OSError as exc:
+        typer.echo(f"bendpam: error: {exc.strerror or _one_line(exc)}", err=True)
+        return 2
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point: run the app; user errors are one line and exit code 2, bugs exit code 1.
 
@@ -205,20 +215,17 @@ def main(argv: list[str] | None = None) -> int:
     >>> main(["predict", "--preset", "xx-pam", "--pressure-kpa", "100"])   # one line on stderr
     2
     """
+    args = list(sys.argv[1:] if argv is None else argv)
+    if not args or args == ["--help"]:  # nothing runs: no output group, no signal handling (start-up)
+        return _print_root_help()
     from bendpam.errors import BendpamError
     from bendpam.infra.signals import Interrupted, forget_written, interrupted_line, interrupts, quiet_logging
 
-    args = list(sys.argv[1:] if argv is None else argv)
-    if not args:
-        args = ["--help"]
     debug = "--debug" in args
     forget_written()
     tokens = (RUN_ARGS.set(list(args)), RUN_COMMAND.set(None), RUN_FORCE.set(False))
     shown = _SHOWN.set(frozenset())
     try:
-        if args == ["--help"]:  # the list of commands: built without their options (start-up; root_help)
-            typer.echo(root_help())
-            return 0
         args = _lift_force(args)
         with interrupts(on_signal=quiet_logging), warnings.catch_warnings():
             warnings.showwarning = _show_warning
