@@ -1,6 +1,7 @@
 """The ``bendpam`` console script: signal handlers first, then the package.
 
-Importing bendpam (NumPy and the models) takes a few tenths of a second.  A Ctrl-C or SIGTERM in
+Importing the command line (Typer, the commands; NumPy and the models once a command runs) takes
+a tenth of a second or more.  A Ctrl-C or SIGTERM in
 that window would otherwise end in a ``KeyboardInterrupt`` traceback or a silent kill.  The first
 statements of this tiny module (outside the package, so that importing it imports nothing else)
 install handlers that end the process with one line and the exit status of an interrupted command
