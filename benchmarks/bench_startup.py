@@ -1,9 +1,17 @@
-"""Start-up benchmark: wall time of short CLI commands and what ``import bendpam`` pulls in.
+"""Start-up benchmark: short CLI commands side by side with ``python -c "import typer"``.
 
-* ``bendpam --help``, ``bendpam --version`` and ``bendpam predict --preset be-pam --pressure-kpa 200``,
-  each in a fresh process (median of 7 after one warm-up run, so the OS file cache is warm);
-* ``python -c "import bendpam"`` alone, and the heavy modules it leaves in ``sys.modules``;
-* the largest cumulative imports under ``python -X importtime -c "import bendpam"``.
+* ``python -c pass``, ``python -c "import typer"``, ``bendpam --help``, ``bendpam --version`` and
+  ``bendpam predict --preset be-pam --pressure-kpa 150``, each in a fresh process, their repeats
+  interleaved (median of 15 after one warm-up run each); the targets are ratios to
+  ``import typer`` (<= 1.2 for ``--help`` and ``--version``: the command line costs about what
+  the library that parses it costs);
+* what each of those commands leaves in ``sys.modules`` (NumPy, pandas, pyplot, ``scipy.io``...);
+* ``bendpam fit`` on 25 simulated pressures with and without its figure (interleaved, median of 5);
+* ``python -c "import bendpam"`` and the heavy modules it imports.
+
+Every process runs with bytecode caching on, in a private cache folder (``PYTHONPYCACHEPREFIX``),
+as an installed package would (a checkout run with ``PYTHONDONTWRITEBYTECODE`` recompiles every
+module each time), and with this checkout's ``src`` first on ``PYTHONPATH``.
 
 Run: ``python benchmarks/bench_startup.py [--quick]``.
 """
@@ -11,65 +19,130 @@ Run: ``python benchmarks/bench_startup.py [--quick]``.
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).parent))
-from _timing import Recorder, bendpam_cli, header, standalone, wall
+from _timing import Recorder, bendpam_cli, compare, header, standalone
 
-HEAVY = ("matplotlib", "xarray", "pandas", "dask", "scipy.stats", "scipy.optimize", "scipy.integrate",
-         "scipy.interpolate", "scipy.signal", "netCDF4", "h5netcdf", "typer", "rich")
-TARGETS = {"--help": 0.3, "--version": 0.3, "predict": 0.8}
+ROOT = Path(__file__).resolve().parent.parent
+HEAVY = ("numpy", "pandas", "matplotlib", "matplotlib.pyplot", "scipy", "scipy.io", "xarray", "dask", "pydantic")
+RATIO_TARGET = 1.2  # --help and --version against `python -c "import typer"`
+FIT_TARGET_S = 1.0  # `bendpam fit` on 25 pressures with its figure
+
+LIST_MODULES = """
+import json, sys
+sys.argv = ["bendpam", *json.loads(sys.argv[1])]
+import bendpam_entry
+rc = bendpam_entry.main()
+print(json.dumps([m for m in {heavy!r} if m in sys.modules]), file=sys.stderr)
+"""
 
 
-def import_report() -> tuple[list[str], list[tuple[float, str]]]:
+def env(cache: str) -> dict[str, str]:
+    """This checkout's sources first, bytecode cached in ``cache`` (as in an installed package)."""
+    e = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+    e["PYTHONPATH"] = os.pathsep.join([str(ROOT / "src"), *filter(None, [os.environ.get("PYTHONPATH")])])
+    e["PYTHONPYCACHEPREFIX"] = cache
+    return e
+
+
+def runner(cmd: list[str], e: dict[str, str], cwd: str):
+    def run():
+        p = subprocess.run(cmd, env=e, cwd=cwd, capture_output=True, text=True)
+        if p.returncode != 0:
+            raise RuntimeError(f"{' '.join(cmd)} exited {p.returncode}: {p.stderr.strip()[-400:]}")
+
+    return run
+
+
+def heavy_after(args: list[str], e: dict[str, str], cwd: str) -> list[str]:
+    p = subprocess.run([sys.executable, "-c", LIST_MODULES.format(heavy=HEAVY), json.dumps(args)], env=e, cwd=cwd,
+                       capture_output=True, text=True, check=True)
+    return json.loads(p.stderr.strip().splitlines()[-1])
+
+
+def commands(rec: Recorder, quick: bool, e: dict[str, str], cwd: str) -> None:
+    cli = bendpam_cli()
+    reps = 5 if quick else 15
+    header(f"Start-up: fresh processes side by side, interleaved, median of {reps}")
+    args = {"--help": ["--help"], "--version": ["--version"],
+            "predict": ["predict", "--preset", "be-pam", "--pressure-kpa", "150"]}
+    cands = {"python -c pass": [sys.executable, "-c", "pass"],
+             "import typer": [sys.executable, "-c", "import typer"],
+             **{name: [cli, *a] for name, a in args.items()}}
+    st = compare({name: runner(cmd, e, cwd) for name, cmd in cands.items()}, repeats=reps, warmup=1)
+    typer_s = st["import typer"].median
+    for name, s in st.items():
+        ratio = s.median / typer_s
+        print(f"  {name:16} {s}   {ratio:.2f} x import typer")
+        rec.record("startup", name, s)
+    for name in ("--help", "--version"):
+        ratio = st[name].median / typer_s
+        rec.record("startup", f"{name} / import typer", ratio)
+        rec.row(f"`bendpam {name}` / `python -c 'import typer'`", ratio, "x", f"<= {RATIO_TARGET:g}",
+                ratio <= RATIO_TARGET, f"{st[name].median * 1e3:.0f} ms vs {typer_s * 1e3:.0f} ms")
+    rec.row("`bendpam predict --preset be-pam --pressure-kpa 150`", st["predict"].median, "s", "", None,
+            f"{st['predict'].median / typer_s:.1f} x import typer")
+    print("  heavy modules loaded by each command:")
+    for name, a in args.items():
+        heavy = heavy_after(a, e, cwd)
+        print(f"    {name:10} {', '.join(heavy) or 'none'}")
+        rec.record("startup", f"heavy modules: {name}", heavy)
+    rec.row("`bendpam --help`, `--version`: NumPy, pandas, pyplot, scipy.io imported",
+            ", ".join(sorted(set(heavy_after(["--help"], e, cwd)) | set(heavy_after(["--version"], e, cwd)))) or "none",
+            "", "none", not ({"numpy", "pandas", "matplotlib.pyplot", "scipy.io"}
+                             & (set(heavy_after(["--help"], e, cwd)) | set(heavy_after(["--version"], e, cwd)))))
+    pandas = "pandas" in heavy_after(args["predict"], e, cwd)
+    rec.row("`bendpam predict`: pandas imported", "yes" if pandas else "no", "", "no", not pandas)
+
+
+def fit(rec: Recorder, quick: bool, e: dict[str, str], cwd: str) -> None:
+    cli = bendpam_cli()
+    reps = 3 if quick else 5
+    header(f"`bendpam fit` on 25 simulated pressures: with and without its figure, interleaved, median of {reps}")
+    with tempfile.TemporaryDirectory() as d:
+        raw, proc = Path(d) / "raw", Path(d) / "proc"
+        runner([cli, "simulate-test", "--preset", "be-pam", "--pressure-kpa", "100:220:25", "--out", str(raw)], e,
+               cwd)()
+        runner([cli, "process", str(raw), "--out", str(proc), "--no-figure", "--quiet"], e, cwd)()
+        base = [cli, "fit", str(proc), "--preset", "be-pam", "--quiet", "--out"]
+        st = compare({"with figure": runner([*base, str(Path(d) / "fit-a")], e, cwd),
+                      "--no-figure": runner([*base, str(Path(d) / "fit-b"), "--no-figure"], e, cwd)},
+                     repeats=reps, warmup=1)
+        heavy = {"with figure": heavy_after([*base[1:], str(Path(d) / "fit-c")], e, cwd),
+                 "--no-figure": heavy_after([*base[1:], str(Path(d) / "fit-d"), "--no-figure"], e, cwd)}
+    for name, s in st.items():
+        print(f"  {name:12} {s}   heavy modules: {', '.join(heavy[name]) or 'none'}")
+        rec.record("fit", name, s)
+        rec.record("fit", f"heavy modules: {name}", heavy[name])
+    rec.row("`bendpam fit`, 25 pressures, with its figure", st["with figure"].median, "s", f"<= {FIT_TARGET_S:g} s",
+            st["with figure"].median <= FIT_TARGET_S, f"--no-figure {st['--no-figure'].median:.2f} s")
+    rec.row("`bendpam fit`: pyplot / scipy.io imported",
+            ", ".join(sorted({m for h in heavy.values() for m in h} & {"matplotlib.pyplot", "scipy.io"})) or "none",
+            "", "none", not ({m for h in heavy.values() for m in h} & {"matplotlib.pyplot", "scipy.io"}))
+
+
+def import_report(e: dict[str, str], cwd: str) -> list[str]:
     code = f"import json, sys, bendpam; print(json.dumps([m for m in {list(HEAVY)!r} if m in sys.modules]))"
-    heavy = json.loads(subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                                      check=True).stdout)
-    p = subprocess.run([sys.executable, "-X", "importtime", "-c", "import bendpam"], capture_output=True, text=True,
-                       check=True)
-    rows = []
-    for line in p.stderr.splitlines():
-        if not line.startswith("import time:") or "|" not in line:
-            continue
-        parts = [x.strip() for x in line[len("import time:"):].split("|")]
-        try:
-            rows.append((int(parts[1]) / 1e6, parts[2]))
-        except ValueError:
-            continue
-    top = [r for r in rows if not r[1].startswith(" ")]  # top-level imports only
-    return heavy, sorted(top, reverse=True)[:8]
+    return json.loads(subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                                     env=e, cwd=cwd).stdout)
 
 
 def run(rec: Recorder, quick: bool) -> None:
-    cli = bendpam_cli()
-    reps = 3 if quick else 7
-    header(f"Start-up: fresh processes, median of {reps}")
-    cmds = {"--help": [cli, "--help"], "--version": [cli, "--version"],
-            "predict": [cli, "predict", "--preset", "be-pam", "--pressure-kpa", "200"],
-            "import bendpam": [sys.executable, "-c", "import bendpam"]}
-    if not quick:
-        cmds["python -c pass"] = [sys.executable, "-c", "pass"]
-    for name, cmd in cmds.items():
-        s = wall(cmd, repeats=reps, warmup=0 if quick else 1)
-        print(f"  {name:16} {s}")
-        rec.record("startup", name, s)
-        if name in TARGETS:
-            t = TARGETS[name]
-            rec.row(f"`bendpam {name}` wall time" if name != "predict" else
-                    "`bendpam predict --preset be-pam --pressure-kpa 200`", s.median, "s", f"< {t:g} s", s.median < t)
-        elif name == "import bendpam":
-            rec.row("`python -c 'import bendpam'` wall time", s.median, "s", "", None)
-    heavy, top = import_report()
-    print(f"  heavy modules after `import bendpam`: {', '.join(heavy) or 'none'}")
-    print("  largest top-level imports (-X importtime, cumulative):")
-    for t, mod in top:
-        print(f"    {t * 1e3:7.1f} ms  {mod}")
-    rec.record("startup", "heavy_modules", heavy)
-    rec.record("startup", "importtime_top", [{"module": m, "cumulative_s": t} for t, m in top])
-    rec.row("heavy modules imported by `import bendpam`", ", ".join(heavy) or "none", "", "none of the big ones",
-            not any(m in heavy for m in ("matplotlib", "xarray", "pandas", "dask", "scipy.stats", "scipy.optimize")))
+    with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as cwd:
+        e = env(cache)
+        rec.record("startup", "environment", {"PYTHONPYCACHEPREFIX": "a private folder (bytecode cached)",
+                                              "PYTHONPATH": "this checkout's src first", "cli": bendpam_cli()})
+        commands(rec, quick, e, cwd)
+        heavy = import_report(e, cwd)
+        print(f"  heavy modules after `import bendpam`: {', '.join(heavy) or 'none'}")
+        rec.record("startup", "heavy_modules", heavy)
+        rec.row("heavy modules imported by `import bendpam`", ", ".join(heavy) or "none", "", "none", not heavy)
+        fit(rec, quick, e, cwd)
 
 
 if __name__ == "__main__":

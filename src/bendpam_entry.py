@@ -1,6 +1,7 @@
 """The ``bendpam`` console script: signal handlers first, then the package.
 
-Importing bendpam (NumPy and the models) takes a few tenths of a second.  A Ctrl-C or SIGTERM in
+Importing the command line (Typer, the commands; NumPy and the models once a command runs) takes
+a tenth of a second or more.  A Ctrl-C or SIGTERM in
 that window would otherwise end in a ``KeyboardInterrupt`` traceback or a silent kill.  The first
 statements of this tiny module (outside the package, so that importing it imports nothing else)
 install handlers that end the process with one line and the exit status of an interrupted command
@@ -15,6 +16,9 @@ In a worker process that a command starts with :mod:`multiprocessing` (the Dask 
 SIGINT is ignored instead and logging is off: a Ctrl-C at the terminal reaches every process of the
 group, and the parent alone answers it, shutting its workers down quietly (their errors reach the
 parent through Dask all the same).
+
+``bendpam --version`` alone is answered here, without building the command line (the same line as
+``bendpam.cli.app``'s ``--version``: :func:`bendpam.infra.manifest.bendpam_version`).
 
 What remains outside Python's reach is the interpreter's own start-up (before any line of the
 console script runs): a signal there gets the system's default action.
@@ -65,6 +69,18 @@ install()
 def main() -> int:
     """Run the ``bendpam`` command line; returns its exit status."""
     install()  # (again: a caller may have changed them after importing this module)
+    if sys.argv[1:] == ["--version"]:  # the one answer that needs neither Typer nor the commands (start-up)
+        from bendpam.infra.manifest import bendpam_version
+
+        try:
+            sys.stdout.write(f"bendpam {bendpam_version()}\n")
+            sys.stdout.flush()
+        except AttributeError:  # no stdout (closed): nothing to print to, as Typer's echo
+            pass
+        except OSError as exc:  # a full disk, a closed pipe: one line, as bendpam.cli.app.main says it
+            os.write(2, f"bendpam: error: {exc.strerror or exc}\n".encode("utf-8", "replace"))
+            return 2
+        return 0
     from bendpam.cli.app import main as run
 
     return run()

@@ -187,7 +187,7 @@ def test_internal_error_is_one_line_exit_1(capsys, monkeypatch):
     def boom(*args, **kwargs):
         raise ZeroDivisionError("deliberate")
 
-    monkeypatch.setattr(bendpam.predict, "prediction_table", boom)
+    monkeypatch.setattr(bendpam.predict, "prediction_columns", boom)  # what `bendpam predict` calls
     code, out, err = run(capsys, "predict", "--preset", "be-pam", "--pressure-kpa", "100")
     assert code == 1 and out == ""
     assert err.startswith("bendpam: internal error (ZeroDivisionError: deliberate)") and err.count("\n") == 1, err

@@ -12,13 +12,15 @@ Quick start::
     bendpam.free_curvature(a, [100.0, 200.0]).angle_deg
     law = bendpam.MomentLaw.of(a, "energy")         # the moment law as one object
 
-Heavy modules (SciPy's optimisers, xarray, pandas, matplotlib, Dask) are imported only by the
-functions that need them, so ``import bendpam`` and the command line start quickly.
+``import bendpam`` imports nothing but the errors and the version: every other name here (the
+models, NumPy with them) is imported the first time it is used, and heavy modules (SciPy's
+optimisers, xarray, pandas, matplotlib, Dask) only by the functions that need them, so the
+command line starts quickly (``bendpam --help`` does not import NumPy).
 """
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from bendpam import errors
 from bendpam.errors import (
@@ -33,26 +35,34 @@ from bendpam.errors import (
     PlausibilityWarning,
     ProcessingError,
 )
-from bendpam.physics import braid, material, models, presets
-from bendpam.physics.actuator import NEUTRAL_ANGLE_DEG, Actuator, ModelParams
-from bendpam.physics.braid import CurvatureLimits, Kinematics, curvature_limits
-from bendpam.physics.law import FreeBending, FreeBranch, MomentLaw, MomentTable, StableBranch
-from bendpam.physics.limits import Limits, limits
-from bendpam.physics.material import MooneyRivlin
-from bendpam.predict import (
-    active_pressure_kpa,
-    blocked_moment,
-    free_branch,
-    free_curvature,
-    internal_stresses,
-    kinematics,
-    moment,
-    moment_terms,
-    prediction_table,
-    tangent_stiffness,
-)
-from bendpam.validate import UnitWarning
 from bendpam.version import __version__ as __version__
+
+if TYPE_CHECKING:  # what the lazy names below are, for type checkers and editors
+    from bendpam.design.inverse import design_actuator
+    from bendpam.identify.fitting import fit
+    from bendpam.lab.processing import process_tests
+    from bendpam.lab.readers import read_test
+    from bendpam.lab.simulate import simulate_test
+    from bendpam.physics import braid, material, models, presets
+    from bendpam.physics.actuator import NEUTRAL_ANGLE_DEG, Actuator, ModelParams
+    from bendpam.physics.braid import CurvatureLimits, Kinematics, curvature_limits
+    from bendpam.physics.law import FreeBending, FreeBranch, MomentLaw, MomentTable, StableBranch
+    from bendpam.physics.limits import Limits, limits
+    from bendpam.physics.material import MooneyRivlin
+    from bendpam.predict import (
+        active_pressure_kpa,
+        blocked_moment,
+        free_branch,
+        free_curvature,
+        internal_stresses,
+        kinematics,
+        moment,
+        moment_terms,
+        prediction_table,
+        tangent_stiffness,
+    )
+    from bendpam.sweeps import sweep
+    from bendpam.validate import UnitWarning
 
 __all__ = [
     "NEUTRAL_ANGLE_DEG",
@@ -104,8 +114,21 @@ __all__ = [
     "tangent_stiffness",
 ]
 
-# Functions whose modules import heavy dependencies are loaded on first use.
-_LAZY = {
+# Everything else is loaded on first use (PEP 562), NumPy included: the command line's ``--help`` and
+# ``--version`` import this package and must not pay for the numerics.  name: (module, attribute or
+# None for the module itself).
+_LAZY: dict[str, tuple[str, str | None]] = {
+    **{name: (f"physics.{name}", None) for name in ("braid", "material", "models", "presets")},
+    **{name: ("physics.actuator", name) for name in ("NEUTRAL_ANGLE_DEG", "Actuator", "ModelParams")},
+    **{name: ("physics.braid", name) for name in ("CurvatureLimits", "Kinematics", "curvature_limits")},
+    **{name: ("physics.law", name) for name in ("FreeBending", "FreeBranch", "MomentLaw", "MomentTable",
+                                                "StableBranch")},
+    **{name: ("physics.limits", name) for name in ("Limits", "limits")},
+    "MooneyRivlin": ("physics.material", "MooneyRivlin"),
+    **{name: ("predict", name) for name in ("active_pressure_kpa", "blocked_moment", "free_branch",
+                                            "free_curvature", "internal_stresses", "kinematics", "moment",
+                                            "moment_terms", "prediction_table", "tangent_stiffness")},
+    "UnitWarning": ("validate", "UnitWarning"),
     "sweep": ("sweeps", "sweep"),
     "design_actuator": ("design.inverse", "design_actuator"),
     "fit": ("identify.fitting", "fit"),
@@ -138,3 +161,7 @@ def __getattr__(name: str) -> Any:
         globals()[name] = value
         return value
     raise AttributeError(f"module 'bendpam' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))

@@ -44,6 +44,7 @@ __all__ = [
     "kinematics",
     "moment",
     "moment_terms",
+    "prediction_columns",
     "prediction_table",
     "tangent_stiffness",
 ]
@@ -352,6 +353,35 @@ def _stress_dataset(actuator: Actuator, arrays: dict[str, np.ndarray], P: np.nda
 # ------------------------------------------------------------------------------------------------
 # tables
 # ------------------------------------------------------------------------------------------------
+def prediction_columns(actuator: Actuator, pressure_kpa, model: str | None = None, *, eq19_factor: bool = True,
+                       order: int = DEFAULT_ORDER) -> dict[str, np.ndarray]:
+    """The columns of :func:`prediction_table` as a dict of NumPy arrays (no pandas: a few rows print faster).
+
+    >>> import bendpam
+    >>> cols = prediction_columns(bendpam.physics.presets.be_pam(), [100, 200])
+    >>> list(cols)[:3], cols["pressure_kpa"].tolist()
+    (['pressure_kpa', 'blocked_moment_nmm', 'free_curvature_per_mm'], [100.0, 200.0])
+    """
+    from bendpam.physics.limits import OUTPUTS, limits
+
+    law = _law(actuator, model, eq19_factor, order)
+    P = np.atleast_1d(law.check_pressure(pressure_kpa))
+    if P.ndim != 1:
+        raise InputError(f"pressure_kpa must be a number or a 1-D list of pressures, got shape {P.shape}")
+    fb = law.free_curvature(P)
+    lim = limits(actuator, P, law.model, eq19_factor=eq19_factor, order=order)  # warns outside the tested range
+    return {
+        "pressure_kpa": P,
+        "blocked_moment_nmm": law.blocked_moment(P),
+        "free_curvature_per_mm": fb.curvature_per_mm,
+        "free_angle_deg": fb.angle_deg,
+        **{name: getattr(lim, name) for name in OUTPUTS},
+        "status": fb.status,
+        "note": fb.reason,
+        "limit_note": lim.notes,
+    }
+
+
 def prediction_table(actuator: Actuator, pressure_kpa, model: str | None = None, *, eq19_factor: bool = True,
                      order: int = DEFAULT_ORDER) -> Any:
     """Blocked moment, free bending and the structural limits at each pressure, as a :class:`pandas.DataFrame`.
@@ -364,6 +394,7 @@ def prediction_table(actuator: Actuator, pressure_kpa, model: str | None = None,
     ``min_margin``; ``status``, ``note`` (the reason where there is no equilibrium) and
     ``limit_note`` (each limit the prediction is past, empty within every limit).
     Signs follow the paper: k' > 0 toward the frame, so BC-PAM values are negative.
+    :func:`prediction_columns` gives the same columns without pandas.
 
     >>> import bendpam
     >>> bendpam.prediction_table(bendpam.physics.presets.be_pam(), [100, 200]).columns.tolist()[:3]
@@ -371,23 +402,4 @@ def prediction_table(actuator: Actuator, pressure_kpa, model: str | None = None,
     """
     import pandas as pd
 
-    from bendpam.physics.limits import OUTPUTS, limits
-
-    law = _law(actuator, model, eq19_factor, order)
-    P = np.atleast_1d(law.check_pressure(pressure_kpa))
-    if P.ndim != 1:
-        raise InputError(f"pressure_kpa must be a number or a 1-D list of pressures, got shape {P.shape}")
-    fb = law.free_curvature(P)
-    lim = limits(actuator, P, law.model, eq19_factor=eq19_factor, order=order)  # warns outside the tested range
-    return pd.DataFrame(
-        {
-            "pressure_kpa": P,
-            "blocked_moment_nmm": law.blocked_moment(P),
-            "free_curvature_per_mm": fb.curvature_per_mm,
-            "free_angle_deg": fb.angle_deg,
-            **{name: getattr(lim, name) for name in OUTPUTS},
-            "status": fb.status,
-            "note": fb.reason,
-            "limit_note": lim.notes,
-        }
-    )
+    return pd.DataFrame(prediction_columns(actuator, pressure_kpa, model, eq19_factor=eq19_factor, order=order))

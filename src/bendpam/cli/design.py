@@ -14,7 +14,6 @@ import math
 from pathlib import Path
 from typing import Annotated, Any, Optional
 
-import numpy as np
 import typer
 
 from bendpam.cli.options import (
@@ -48,6 +47,8 @@ L0Opt = Annotated[Optional[float], typer.Option("--l0-mm", help="Active length L
 
 def _record(row: dict[str, Any]) -> dict[str, Any]:
     """A table row as a JSON record: numbers as floats (NaN as null, infinity kept), empty notes as null."""
+    import numpy as np
+
     out: dict[str, Any] = {}
     for k, v in row.items():
         if isinstance(v, bool | np.bool_):

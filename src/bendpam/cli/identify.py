@@ -1,6 +1,6 @@
 """``bendpam fit`` and ``bendpam fit-material``: identification from processed tests."""
 
-from __future__ import annotations
+# no ``from __future__ import annotations``: Typer reads the annotations of the commands as objects (start-up)
 
 import json
 from pathlib import Path

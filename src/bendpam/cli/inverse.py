@@ -3,7 +3,7 @@
 The work is :func:`bendpam.design.inverse.design_actuator`.
 """
 
-from __future__ import annotations
+# no ``from __future__ import annotations``: Typer reads the annotations of the commands as objects (start-up)
 
 from pathlib import Path
 from typing import Annotated, Optional

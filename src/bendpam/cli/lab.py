@@ -1,6 +1,6 @@
 """``bendpam process`` and ``bendpam simulate-test``: raw cyclic tests in and out."""
 
-from __future__ import annotations
+# no ``from __future__ import annotations``: Typer reads the annotations of the commands as objects (start-up)
 
 import re
 from enum import Enum

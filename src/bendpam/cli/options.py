@@ -22,7 +22,6 @@ from typer.core import TyperArgument, TyperCommand
 
 from bendpam.errors import InputError
 from bendpam.infra.budgets import MAX_OPTION_VALUES, value_limit
-from bendpam.validate import file_format
 
 if TYPE_CHECKING:
     from bendpam.infra.outputs import OutputFile, OutputSet
@@ -74,6 +73,7 @@ __all__ = [
     "pressure_kpa",
     "pressures_kpa",
     "print_json",
+    "table_rows",
     "use_bendpam_commands",
 ]
 
@@ -497,17 +497,31 @@ def fmt_num(x, fmt: str) -> str:
     return format(float(x), fmt) if ok else "—".rjust(int(width) if width else 1)
 
 
-def format_prediction_table(df, title: str) -> str:
-    """The text table of ``predict``.
+def table_rows(table) -> list[Any]:
+    """The rows of a table of columns (a dict of equal-length sequences, or a DataFrame), each with the
+    columns as attributes.
 
-    >>> import pandas as pd
-    >>> row = dict(pressure_kpa=150.0, blocked_moment_nmm=200.0, free_curvature_per_mm=0.01, free_angle_deg=30.0,
-    ...            note="")
-    >>> print(format_prediction_table(pd.DataFrame([row]), "BE-PAM").splitlines()[-1])
+    >>> [r.b for r in table_rows({"a": [1, 2], "b": ["x", "y"]})]
+    ['x', 'y']
+    """
+    from types import SimpleNamespace
+
+    columns = {str(k): list(table[k]) for k in table}
+    n = len(next(iter(columns.values()), []))
+    return [SimpleNamespace(**{k: v[i] for k, v in columns.items()}) for i in range(n)]
+
+
+def format_prediction_table(table, title: str) -> str:
+    """The text table of ``predict``, from the columns of :func:`bendpam.predict.prediction_columns`
+    (or the DataFrame of :func:`~bendpam.predict.prediction_table`).
+
+    >>> cols = dict(pressure_kpa=[150.0], blocked_moment_nmm=[200.0], free_curvature_per_mm=[0.01],
+    ...             free_angle_deg=[30.0], note=[""])
+    >>> print(format_prediction_table(cols, "BE-PAM").splitlines()[-1])
          150            200.00        0.01000         30.00
     """
     lines = [title, f"{'P (kPa)':>8}  {'M_blocked (N·mm)':>16}  {'k_free (1/mm)':>13}  {'θ_free (deg)':>12}  note"]
-    for r in df.itertuples():
+    for r in table_rows(table):
         lines.append(
             f"{r.pressure_kpa:8.4g}  {fmt_num(r.blocked_moment_nmm, '16.2f')}  "
             f"{fmt_num(r.free_curvature_per_mm, '13.5f')}  {fmt_num(r.free_angle_deg, '12.2f')}  {r.note}"
@@ -726,6 +740,8 @@ def output_format(path: Path | None, fmt: str | Enum | None, formats: tuple[str,
     """
     if path is None:
         return None
+    from bendpam.validate import file_format  # (validate imports NumPy: not at start-up)
+
     return file_format(path, fmt, formats, option=option, format_option=format_option, default=default)
 
 

@@ -1,13 +1,12 @@
 """``bendpam predict``, ``curve``, ``stresses``, ``actuator`` and ``demo``."""
 
-from __future__ import annotations
+# no ``from __future__ import annotations``: Typer reads the annotations of the commands as objects (start-up)
 
 import math
 import time
 from pathlib import Path
 from typing import Annotated, Optional
 
-import numpy as np
 import typer
 
 from bendpam.cli.app import app
@@ -31,9 +30,9 @@ from bendpam.cli.options import (
     output_format,
     pressures_kpa,
     print_json,
+    table_rows,
 )
 from bendpam.cli.options import pressure_kpa as checked_pressure
-from bendpam.physics.limits import OUTPUTS as LIMIT_OUTPUTS
 
 
 def _data_or_figure(out: Path, fmt, data_formats: tuple[str, ...]) -> str:
@@ -64,12 +63,13 @@ def predict(
 ):
     """Blocked moment and free bending curvature/angle at each pressure (and, with --cycle, the loop)."""
     from bendpam.physics.law import MomentLaw
-    from bendpam.predict import prediction_table
+    from bendpam.physics.limits import OUTPUTS as LIMIT_OUTPUTS
+    from bendpam.predict import prediction_columns  # (a few rows: no pandas DataFrame)
 
     act = load_actuator(preset, actuator, model)
     P = pressures_kpa(pressure_kpa)
     mname = model_for(act, model)
-    df = prediction_table(act, P, mname)
+    df = prediction_columns(act, P, mname)
     br = MomentLaw.of(act, mname).free_branch()
     loop = _loop_model(actuator, loop_law, loop_a0_nmm, loop_a1_nmm_per_kpa, loop_angle_deg) if cycle else None
     cycles = None
@@ -97,7 +97,7 @@ def predict(
                     "limit_note": r.limit_note or None,
                     **({"cycle": _cycle_json(cycles[i])} if cycles is not None else {}),
                 }
-                for i, r in enumerate(df.itertuples())
+                for i, r in enumerate(table_rows(df))
             ],
             **({"hysteresis": loop.to_dict()} if loop is not None else {}),
         }
@@ -143,7 +143,7 @@ def _limits_table(df) -> list[str]:
     lines = ["limits (safety factors, >= 1 within the limit; inf: no demand or no limit given)",
              f"{'P (kPa)':>8}  {'N_frame (N)':>11}  {'σ_frame (MPa)':>13}  {'strength':>8}  {'buckling':>8}  "
              f"{'lock-up':>8}  {'stretch':>7}  {'(max)':>6}  {'min':>6}"]
-    for r in df.itertuples():
+    for r in table_rows(df):
         lines.append(f"{r.pressure_kpa:8.4g}  {fmt_num(r.frame_axial_force_n, '11.2f')}  "
                      f"{fmt_num(r.frame_stress_mpa, '13.2f')}  {_margin(r.frame_strength_margin, 8)}  "
                      f"{_margin(r.buckling_margin, 8)}  {_margin(r.lockup_margin, 8)}  "
@@ -154,7 +154,7 @@ def _limits_table(df) -> list[str]:
 
 def _warn_limits(df) -> None:
     """One ``bendpam: warning:`` line on stderr per limit a prediction is past."""
-    for note in df.limit_note:
+    for note in df["limit_note"]:
         for line in filter(None, str(note).split("; ")):
             typer.echo(f"bendpam: warning: past a limit: {line}", err=True)
 
@@ -187,6 +187,8 @@ def curve(
     fig_format: FigureFormatOpt = None,
 ):
     """Moment-curvature curves M(P, k') as CSV or a figure."""
+    import numpy as np
+
     if out is None:
         raise UserError("give an output file with --out FILE.csv or --out FILE.png")
     kind = _data_or_figure(out, fig_format, ("csv",))
@@ -280,6 +282,8 @@ def demo(
                                           "tables.")] = False,
 ):
     """Predictions for the paper's BE-PAM and BC-PAM with both models, and a moment-curvature figure."""
+    import numpy as np
+
     from bendpam.physics import presets
     from bendpam.physics.law import MomentLaw
     from bendpam.predict import prediction_table

@@ -1,13 +1,13 @@
 """``bendpam sweep``: actuator parameters crossed with pressures, in-process or on Dask."""
 
-from __future__ import annotations
+# no ``from __future__ import annotations``: Typer reads the annotations of the commands as objects (start-up)
 
+import math
 import os
 from enum import Enum
 from pathlib import Path
 from typing import Annotated, Any, Optional
 
-import numpy as np
 import typer
 
 from bendpam.cli.app import app
@@ -188,7 +188,7 @@ def sweep_in_memory(out: Path | None, data_fmt: str | None, act: Any, P: list[fl
     from bendpam.infra.progress import Progress
     from bendpam.sweeps import sweep, write_sweep
 
-    n_cases = int(np.prod([len(v) for v in grids.values()] or [1]))
+    n_cases = math.prod(len(v) for v in grids.values())
     with Progress(n_cases, "sweep", quiet=quiet) as bar:
         ds = sweep(act, P, model, chunk_cases=chunk_cases, scheduler=scheduler, workers=workers,
                    progress=bar.advance, max_memory_gib=max_memory_gib, **grids)
@@ -196,7 +196,7 @@ def sweep_in_memory(out: Path | None, data_fmt: str | None, act: Any, P: list[fl
         with output_file(out, [actuator]) as f:
             write_sweep(ds, f.path, data_fmt)
         shape = " x ".join(f"{d}={n}" for d, n in ds.sizes.items())
-        rows = f", {int(np.prod(list(ds.sizes.values())))} rows" if data_fmt != "nc" else ""
+        rows = f", {math.prod(ds.sizes.values())} rows" if data_fmt != "nc" else ""
         echo_wrote(f"wrote {out} ({shape}{rows})")
     return ds
 
@@ -221,7 +221,7 @@ def write_store(out: Path, act: Any, P: list[float], model: str, grids: dict[str
     from bendpam.infra.progress import Progress
     from bendpam.sweep_store import sweep_zarr
 
-    n_cases = int(np.prod([len(v) for v in grids.values()] or [1]))
+    n_cases = math.prod(len(v) for v in grids.values())
     inputs = [actuator] if actuator is not None else []
     try:
         with Progress(n_cases, "sweep", quiet=quiet) as bar:
@@ -316,6 +316,8 @@ def check_budgets(n_params: int, n_pressures: int, n_cases: int, chunk_cases: in
 def sweep_grid(param: list[str] | None, pressure_kpa: list[str] | None, max_points: int | None,
                chunk_cases: int) -> tuple[dict[str, Any], list[float], int]:
     """``(grids, pressures, n_cases)`` from --param and --pressure-kpa, within --max-points and the block size."""
+    import numpy as np
+
     from bendpam.sweeps import SWEEP_PARAMETERS
 
     params = dict(parse_param(p) for p in (param or []))
@@ -325,7 +327,7 @@ def sweep_grid(param: list[str] | None, pressure_kpa: list[str] | None, max_poin
     if not pressure_kpa:
         raise UserError("give the pressures with --pressure-kpa, e.g. 100:250:16")
     P = pressures_kpa(pressure_kpa)
-    n_points = len(P) * int(np.prod([len(v) for v in params.values()] or [1]))
+    n_points = len(P) * math.prod(len(v) for v in params.values())
     if max_points is not None and n_points > max_points:
         raise UserError(f"the sweep has {n_points} (case, pressure) points, more than --max-points {max_points}; "
                         "raise --max-points to run it")

@@ -25,7 +25,6 @@ Two uses:
 from __future__ import annotations
 
 import datetime as _dt
-import importlib.metadata
 import json
 import os
 import re
@@ -87,6 +86,8 @@ def bendpam_version() -> str:
     >>> bendpam_version().count(".") >= 1
     True
     """
+    import importlib.metadata  # (not at import: the command line's start-up does without it)
+
     try:
         return importlib.metadata.version("bendpam")
     except importlib.metadata.PackageNotFoundError:

@@ -1,0 +1,163 @@
+"""Start-up (issue 24, item 6): what the short commands import, checked in fresh interpreters.
+
+``bendpam --help`` and ``--version`` import no NumPy (nor pandas, pyplot, ``scipy.io``);
+``bendpam predict`` prints its few rows without pandas; ``bendpam fit`` imports no pyplot (no
+matplotlib at all without a figure) and reads bendpam's own ``curves.nc`` without ``scipy.io``.
+Each command runs through the console script's entry (:func:`bendpam_entry.main`) in a new
+process, which then lists ``sys.modules``.  No timings here: ``benchmarks/bench_startup.py``
+measures them.
+"""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+RUN = """
+import json, sys
+sys.argv = ["bendpam", *json.loads(sys.argv[1])]
+import bendpam_entry
+rc = bendpam_entry.main()
+with open({out!r}, "w") as f:
+    json.dump({{"rc": rc, "modules": sorted(sys.modules)}}, f)
+"""
+
+
+def modules_after(args: list[str], tmp_path: Path, cwd: Path | None = None) -> tuple[set[str], str]:
+    """The modules loaded once ``bendpam ARGS`` has run in a fresh interpreter, and its stdout."""
+    out = tmp_path / f"modules-{len(list(tmp_path.glob('modules-*')))}.json"
+    r = subprocess.run([sys.executable, "-c", RUN.format(out=str(out)), json.dumps(args)], capture_output=True,
+                       text=True, cwd=cwd or tmp_path, timeout=300)
+    assert r.returncode == 0, r.stderr
+    got = json.loads(out.read_text())
+    assert got["rc"] == 0, r.stderr
+    return set(got["modules"]), r.stdout
+
+
+def loaded(modules: set[str], name: str) -> list[str]:
+    return sorted(m for m in modules if m == name or m.startswith(name + "."))
+
+
+NOT_AT_START = ["numpy", "pandas", "matplotlib", "scipy", "xarray", "dask"]
+
+
+@pytest.mark.parametrize("args", [["--help"], ["--version"], ["predict", "--help"]])
+def test_help_and_version_import_no_numpy(args, tmp_path):
+    modules, stdout = modules_after(args, tmp_path)
+    assert "bendpam" in modules
+    for heavy in NOT_AT_START:
+        assert loaded(modules, heavy) == [], f"`bendpam {' '.join(args)}` imports {heavy}"
+    assert stdout.startswith("bendpam 0.") if args == ["--version"] else "Usage: bendpam" in stdout
+
+
+def test_import_bendpam_alone_imports_no_numpy(tmp_path):
+    code = "import json, sys, bendpam; print(json.dumps(sorted(sys.modules)))"
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert loaded(set(json.loads(r.stdout)), "numpy") == []
+
+
+def test_the_lazy_facade_still_gives_every_name():
+    import bendpam
+
+    for name in bendpam.__all__:
+        assert getattr(bendpam, name) is not None, name
+    assert bendpam.MomentLaw is __import__("bendpam.physics.law", fromlist=["MomentLaw"]).MomentLaw
+    assert set(bendpam.__all__) <= set(dir(bendpam))
+    with pytest.raises(AttributeError, match="no attribute 'no_such_name'"):
+        _ = bendpam.no_such_name
+
+
+def test_predict_prints_without_pandas(tmp_path):
+    modules, stdout = modules_after(["predict", "--preset", "be-pam", "--pressure-kpa", "150"], tmp_path)
+    assert "numpy" in modules and "bendpam.physics.law" in modules  # it did compute
+    for heavy in ("pandas", "matplotlib", "xarray", "dask", "scipy.io"):
+        assert loaded(modules, heavy) == [], f"`bendpam predict` imports {heavy}"
+    row = next(line for line in stdout.splitlines() if line.strip().startswith("150 "))
+    assert len(row.split()) >= 4  # P, blocked moment, free curvature, free angle
+
+
+def test_predict_table_is_the_dataframe_table():
+    """The CLI's table from the columns equals the one from the DataFrame (the same numbers, rows, text)."""
+    import bendpam
+    from bendpam.cli.options import format_prediction_table, table_rows
+    from bendpam.predict import prediction_columns
+
+    a = bendpam.physics.presets.be_pam()
+    P = [0.0, 100.0, 150.0, 250.0]  # 0 kPa: below the deadband, no bending (a note)
+    cols, df = prediction_columns(a, P), bendpam.prediction_table(a, P)
+    assert list(cols) == df.columns.tolist()
+    assert format_prediction_table(cols, "t") == format_prediction_table(df, "t")
+    rows = table_rows(cols)
+    assert [r.pressure_kpa for r in rows] == P
+    assert [r.note for r in rows] == df["note"].tolist() and [r.limit_note for r in rows] == df["limit_note"].tolist()
+
+
+@pytest.fixture(scope="module")
+def processed_dir(tmp_path_factory):
+    """A small processed set (2 pressures, 2 cycles) written by bendpam."""
+    import bendpam
+    from bendpam.lab import RawTest
+    from bendpam.lab.processing import process_tests, write_processed
+    from bendpam.lab.simulate import SimulationSettings, simulate_test
+
+    be, settings = bendpam.physics.presets.be_pam(), SimulationSettings(cycles=2, rate_hz=5.0, seed=1)
+    raws = [RawTest(simulate_test(be, p, settings=settings)[0], Path(f"be_{p:g}kPa.csv"), "csv", pressure_kpa=p)
+            for p in (100.0, 200.0)]
+    folder = tmp_path_factory.mktemp("startup") / "proc"
+    write_processed(process_tests(raws, keep_series=False), folder, figure=False)
+    return folder
+
+
+@pytest.mark.slow
+def test_fit_without_a_figure_imports_no_matplotlib_and_no_scipy_io(processed_dir, tmp_path):
+    modules, _ = modules_after(["fit", str(processed_dir), "--preset", "be-pam", "--out", str(tmp_path / "fit"),
+                                "--no-figure", "--quiet"], tmp_path)
+    assert (tmp_path / "fit" / "fit.json").is_file()
+    for heavy in ("matplotlib", "scipy.io", "pandas", "xarray"):
+        assert loaded(modules, heavy) == [], f"`bendpam fit --no-figure` imports {heavy}"
+
+
+@pytest.mark.slow
+def test_fit_with_its_figure_imports_no_pyplot(processed_dir, tmp_path):
+    modules, _ = modules_after(["fit", str(processed_dir), "--preset", "be-pam", "--out", str(tmp_path / "fit"),
+                                "--quiet"], tmp_path)
+    assert (tmp_path / "fit" / "figure7.png").is_file()
+    assert "matplotlib" in modules
+    assert loaded(modules, "matplotlib.pyplot") == [] and loaded(modules, "scipy.io") == []
+
+
+@pytest.mark.parametrize("columns", ["80", "60", "200"])
+def test_root_help_is_typers_own_text(columns, monkeypatch):
+    """``bendpam --help`` (built from option-less copies of the commands) is exactly what Typer prints."""
+    import typer.main
+
+    from bendpam.cli import app
+    from bendpam.cli.app import root_help
+
+    monkeypatch.setenv("COLUMNS", columns)
+    light = root_help()
+    group = typer.main.get_command(app)  # built after root_help(): the app is left as it was
+    assert light == group.get_help(typer.Context(group, info_name="bendpam"))
+    assert all(len(group.commands[c].params) > 3 for c in ("predict", "fit", "sweep"))
+
+
+def test_no_arguments_and_help_print_the_root_help(capsys):
+    from bendpam.cli.app import main, root_help
+
+    for argv in ([], ["--help"]):
+        assert main(argv) == 0
+        assert capsys.readouterr().out == root_help() + "\n"
+
+
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs /dev/full")
+@pytest.mark.parametrize("args", [["--help"], ["--version"], []])
+def test_a_full_stdout_is_one_error_line(args, tmp_path):
+    """The short paths (root help, the entry's --version) keep the command line's error handling."""
+    code = "import sys, bendpam_entry; sys.argv = ['bendpam', *sys.argv[1:]]; sys.exit(bendpam_entry.main())"
+    with open("/dev/full", "w") as full:
+        r = subprocess.run([sys.executable, "-c", code, *args], stdout=full, stderr=subprocess.PIPE, text=True,
+                           cwd=tmp_path, timeout=120)
+    assert r.returncode == 2 and r.stderr == "bendpam: error: No space left on device\n", r.stderr
