@@ -554,19 +554,21 @@ class _Curves:
 
 
 def _read_curves(nc):
-    """A ``curves.nc`` as :class:`_Curves`: bendpam's NetCDF-3 reader (what bendpam writes), else xarray.
+    """A ``curves.nc`` as :class:`_Curves`: SciPy's NetCDF-3 reader (what bendpam writes), else xarray.
 
-    NetCDF-3 files are read by :func:`bendpam.infra.netcdf3.read_netcdf3` (NumPy alone; every
-    variable is float64 or int with NaN as the fill value, so no CF decoding is needed), which spares
-    ``bendpam fit`` importing xarray, pandas, Dask and :mod:`scipy.io`.  Other files (NetCDF-4) go
-    through xarray.
+    SciPy's reader is used for NetCDF-3 files (xarray's own scipy backend reads them the same way;
+    every variable is float64 or int with NaN as the fill value, so no CF decoding is needed), which
+    spares ``bendpam fit`` importing xarray, pandas and Dask.  Other files (NetCDF-4) go through xarray.
     """
     with open(nc, "rb") as fh:
         magic = fh.read(3)
     if magic == b"CDF":
-        from bendpam.infra.netcdf3 import read_netcdf3
+        from scipy.io import netcdf_file
 
-        return _Curves(*read_netcdf3(nc))
+        with netcdf_file(nc, "r", mmap=False) as f:
+            values = {k: np.array(v.data) for k, v in f.variables.items()}
+            attrs = {k: (v.decode("utf-8") if isinstance(v, bytes) else v) for k, v in f._attributes.items()}
+        return _Curves(values, attrs)
     import xarray as xr
 
     with xr.open_dataset(nc) as ds:
