@@ -13,3 +13,13 @@ layer may use them.  None imports a POSIX-only module at module level.
 * :mod:`.fsops`: temporaries, flushing, hashing and the folder swap;
 * :mod:`.atomic`, :mod:`.progress`, :mod:`.accessors`, :mod:`.display` (short summaries of results).
 """
+
+
+def __getattr__(name: str):
+    """Submodules on first use (``bendpam.infra.outputs``), as an import statement would give them."""
+    import importlib
+    import importlib.util
+
+    if importlib.util.find_spec(f"{__name__}.{name}") is not None:
+        return importlib.import_module(f".{name}", __name__)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -73,4 +73,9 @@ def __getattr__(name: str):
         value = getattr(importlib.import_module(f".{_FROM[name]}", __name__), name)
         globals()[name] = value
         return value
+    import importlib
+    import importlib.util
+
+    if importlib.util.find_spec(f"{__name__}.{name}") is not None:  # a submodule, as an import gives it
+        return importlib.import_module(f".{name}", __name__)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -18,3 +18,13 @@ layers.
 * :mod:`~bendpam.physics.hysteresis`: loop models around the quasi-static law.
 * :mod:`~bendpam.physics.roots`: the vectorised root finders (bracketed Newton, Illinois) they share.
 """
+
+
+def __getattr__(name: str):
+    """Submodules on first use (``bendpam.physics.presets``), as an import statement would give them."""
+    import importlib
+    import importlib.util
+
+    if importlib.util.find_spec(f"{__name__}.{name}") is not None:
+        return importlib.import_module(f".{name}", __name__)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
