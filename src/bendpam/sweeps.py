@@ -333,15 +333,7 @@ def sweep(base_actuator: Actuator, pressure_kpa, model: str | None = None, *, ch
     >>> ds["free_angle_deg"].round(1).values.tolist()      # rows: braid angle, columns: pressure
     [[50.1, 77.8], [68.7, 114.2], [80.2, 137.1]]
     """
-    instance("base_actuator", base_actuator, Actuator, "a bendpam.Actuator")
-    model = str(resolve_model(base_actuator, model))  # a plain name: it goes to workers and the attributes
-    P = np.atleast_1d(check_pressure(pressure_kpa, limit_kpa=base_actuator.max_pressure_kpa))
-    if P.ndim != 1 or P.size == 0:
-        raise InputError("pressure_kpa must be a non-empty 1-D list of pressures >= 0 kPa")
-    base_actuator.outside_tested(P)
-    grids_d = _grid_values(params)
-    names = list(grids_d)
-    grids = [grids_d[n] for n in names]
+    model, P, names, grids = _arguments(base_actuator, pressure_kpa, model, params)
     shape = tuple(g.size for g in grids)
     chunk_cases = int(chunk_cases)
     if chunk_cases < 1:
@@ -436,6 +428,21 @@ def _natural_chunks(shape: tuple[int, ...], chunk_cases: int) -> tuple[tuple[int
 
 
 _COUPLED = ({"t0_mm", "R0_mm", "R0_start_mm"}, {"C10_kpa", "C01_kpa"})
+
+
+def _arguments(base_actuator: Actuator, pressure_kpa, model: str | None, params: dict
+               ) -> tuple[str, np.ndarray, list[str], list[np.ndarray]]:  # fmt: skip
+    """The checked arguments of a sweep: the model's plain name, the pressures (kPa), the swept names
+    and their values; warns outside the actuator's tested range (:func:`sweep`, :func:`plan_sweep`)."""
+    instance("base_actuator", base_actuator, Actuator, "a bendpam.Actuator")
+    model = str(resolve_model(base_actuator, model))  # a plain name: it goes to workers and the attributes
+    P = np.atleast_1d(check_pressure(pressure_kpa, limit_kpa=base_actuator.max_pressure_kpa))
+    if P.ndim != 1 or P.size == 0:
+        raise InputError("pressure_kpa must be a non-empty 1-D list of pressures >= 0 kPa")
+    base_actuator.outside_tested(P)
+    grids_d = _grid_values(params)
+    names = list(grids_d)
+    return model, P, names, [grids_d[n] for n in names]
 
 
 def _prevalidate(base, names, grids) -> None:
@@ -601,15 +608,7 @@ def plan_sweep(base_actuator: Actuator, pressure_kpa, model: str | None = None, 
     >>> plan.names, plan.shape, plan.chunks, plan.n_blocks
     (['alpha0_deg', 't0_mm'], (2, 3), ((1, 1), (3,)), 2)
     """
-    instance("base_actuator", base_actuator, Actuator, "a bendpam.Actuator")
-    model = str(resolve_model(base_actuator, model))  # a plain name, as in sweep()
-    P = np.atleast_1d(check_pressure(pressure_kpa, limit_kpa=base_actuator.max_pressure_kpa))
-    if P.ndim != 1 or P.size == 0:
-        raise InputError("pressure_kpa must be a non-empty 1-D list of pressures >= 0 kPa")
-    base_actuator.outside_tested(P)
-    grids_d = _grid_values(params)
-    names = list(grids_d)
-    grids = [grids_d[n] for n in names]
+    model, P, names, grids = _arguments(base_actuator, pressure_kpa, model, params)
     chunk_cases = int(chunk_cases)
     if chunk_cases < 1:
         raise InputError(f"chunk_cases = {chunk_cases} must be >= 1")

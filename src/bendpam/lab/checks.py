@@ -2,8 +2,9 @@
 
 Nothing read from a file reaches a result unchecked.  :func:`find_spikes` finds isolated
 samples that lie orders of magnitude off their neighbours (a glitch such as ``2,451502E9`` in a
-column of ``2,45``); :func:`time_problems` finds time that does not increase and gaps in the
-sampling.  Both work on whole columns with NumPy (linear time, a few temporary arrays).
+column of ``2,45``); :func:`time_structure` finds samples out of order, clock restarts, repeated stamps and
+gaps in the sampling; :func:`padding_rows` the padding after the samples.  They work on whole
+columns with NumPy (linear time, a few temporary arrays).
 """
 
 from __future__ import annotations
@@ -17,11 +18,9 @@ __all__ = [
     "GAP_FACTOR",
     "GAP_MIN_S",
     "SPIKE_FACTOR",
-    "TimeProblems",
     "TimeStructure",
     "find_spikes",
     "padding_rows",
-    "time_problems",
     "time_structure",
 ]
 
@@ -113,75 +112,6 @@ def _off_median5(x: np.ndarray, limit: float, scratch: np.ndarray | None = None)
     window = np.clip(cand[:, None] + np.arange(-2, 3), 0, n - 1)
     med = np.sort(x[window], axis=1)[:, 2]
     return cand[np.abs(x[cand] - med) > limit].astype(np.int64)
-
-
-@dataclass(frozen=True)
-class TimeProblems:
-    """Where time does not increase, and where it jumps.
-
-    Attributes
-    ----------
-    backwards : numpy.ndarray
-        Indices ``i`` with ``t[i] <= max(t[:i])`` (time repeats or goes back).
-    gaps : numpy.ndarray
-        Indices ``i`` with ``t[i] - t[i-1]`` a gap (see :data:`GAP_FACTOR`).
-    median_step_s : float
-        Median positive time step (s), NaN if none.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> problems = time_problems(np.array([0.0, 0.1, 0.2, 0.2, 0.3, 30.0, 30.1]))   # s
-    >>> problems.backwards.tolist(), problems.gaps.tolist(), problems.median_step_s
-    ([3], [5], 0.1)
-    """
-
-    backwards: np.ndarray
-    gaps: np.ndarray
-    median_step_s: float
-
-
-def time_problems(t: np.ndarray) -> TimeProblems:
-    """Find time that does not increase and gaps in a time column (s).
-
-    Parameters
-    ----------
-    t : numpy.ndarray
-        Time in s, finite.
-
-    Returns
-    -------
-    TimeProblems
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> problems = time_problems(np.array([0.0, 0.05, 0.1, 0.08, 0.15]))     # s: one step back
-    >>> problems.backwards.tolist(), problems.gaps.tolist()
-    ([3], [])
-    """
-    if t.size < 2:
-        e = np.empty(0, dtype=np.int64)
-        return TimeProblems(e, e, float("nan"))
-    dt = np.diff(t)
-    if (dt > 0).all():  # increasing throughout: nothing goes back, every step counts
-        backwards = np.empty(0, dtype=np.int64)
-        # no step can be a gap when none is longer than the shortest gap: then dt itself is ordered in place
-        pos = dt if float(dt.max()) <= GAP_MIN_S else dt.copy()
-    else:
-        running = np.maximum.accumulate(t)
-        backwards = np.flatnonzero(t[1:] <= running[:-1]) + 1
-        del running
-        pos = dt[dt > 0]
-    any_step = pos.size > 0
-    med = float(np.median(pos, overwrite_input=True)) if any_step else float("nan")
-    del pos
-    if any_step:
-        limit = max(GAP_FACTOR * med, GAP_MIN_S)
-        gaps = np.flatnonzero(dt > limit) + 1
-    else:
-        gaps = np.empty(0, dtype=np.int64)
-    return TimeProblems(backwards.astype(np.int64), gaps.astype(np.int64), med)
 
 
 @dataclass(frozen=True)
