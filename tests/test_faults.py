@@ -76,8 +76,9 @@ def test_set_problem_detects_a_mixture(tmp_path):
 @pytest.mark.slow  # about 45 subprocesses, each importing bendpam (1-2 s apiece): 20-40 s
 def test_bad_command_lines(inputs):
     tally = fi.Tally()
-    cases = fi.bad_command_lines(inputs)[::2]  # the tool runs them all
-    assert len(cases) >= 40
+    every = fi.bad_command_lines(inputs)  # a third of them, spread over the list, and the sizes checked below
+    cases = [c for i, c in enumerate(every) if i % 3 == 0 or "--workers" in c or "30000000" in c]
+    assert len(cases) >= 28
     results = fi.run_cases(tally, cases, inputs["work"], jobs=3, timeout=TIMEOUT)
     _assert_clean(tally)
     # the absurd sizes are refused, not attempted
@@ -129,7 +130,7 @@ def test_signal_gives_exit_code_and_one_line(inputs, tmp_path, sig, code):
 def test_random_kills_keep_output_sets_whole(inputs, tmp_path, command):
     tally = fi.Tally()
     max_delay = {"process": 2.5, "fit": 3.0, "report": 4.0, "sweep": 2.5}[command]
-    fi.kill_series(tally, command, inputs, tmp_path, n=3, seed=sorted(fi.KILL_COMMANDS).index(command),
+    fi.kill_series(tally, command, inputs, tmp_path, n=2, seed=sorted(fi.KILL_COMMANDS).index(command),
                    max_delay=max_delay, startup_fraction=0.0)
     _assert_clean(tally)
 
