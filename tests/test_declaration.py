@@ -34,15 +34,18 @@ DECLS = REAL / "declarations"
 SPREADSHEET = (".xlsx", ".xls")
 
 
-def _truth() -> dict[str, tuple[Path, dict]]:
+def _truth(*folders: Path) -> dict[str, tuple[Path, dict]]:
     out = {}
-    for folder in (REAL, REAL / "dev"):  # the development set only: holdout/ is scored once by the integrator
+    for folder in folders:
         for name, entry in tomllib.loads((folder / "truth.toml").read_text(encoding="utf-8")).items():
             out[name] = (folder / name, entry)
     return out
 
 
-TRUTH = _truth()
+TRUTH = _truth(REAL, REAL / "dev")  # the development set (detection and drafts are tested on it)
+#: The holdout (scored once, 2026-11-25; its declarations were written after that, from --suggest drafts)
+HOLDOUT = _truth(REAL / "holdout")
+EVERY = {**TRUTH, **HOLDOUT}
 # The time checks shared with detection (bendpam.lab.assemble) still refuse these files on this branch;
 # issue 22 item 3 (leniency) makes gaps and repeated time stamps warnings instead.
 GAPS = {"hilhorst_ZwickTXII_EN_Invar_LT_05_01.TRA", "pymechtest_Bluehill3_Tens_No_Yield_Specimen_RawData_1.csv",
@@ -79,17 +82,26 @@ def check_against_truth(tests, entry, names=None):
 # ------------------------------------------------------------------------------------------------
 # the corpus: a hand-written declaration for every development file
 # ------------------------------------------------------------------------------------------------
-def test_every_delimited_and_spreadsheet_development_file_has_a_declaration():
-    missing = [name for name, (_p, e) in TRUTH.items()
+def test_every_delimited_and_spreadsheet_file_has_a_declaration():
+    missing = [name for name, (_p, e) in EVERY.items()
                if e["verdict"] == "read" and not (DECLS / f"{name}.toml").exists()]
     assert missing == []
-    orphans = [p.name for p in DECLS.glob("*.toml") if p.name[:-5] not in TRUTH]
-    assert orphans == []  # no declaration of a holdout file
+    orphans = [p.name for p in DECLS.glob("*.toml") if p.name[:-5] not in EVERY]
+    assert orphans == []
+
+
+#: Files a declaration cannot read yet, and why (holdout files, declared after the holdout was scored).
+NOT_DECLARABLE = {
+    "rlmtp_catman_EN_cyclic_Temperature_LP6_070119.xlsx": "two sampling rates in one sheet: the last row has no "
+    "Load value (the slower channel ended first), and a declaration cannot accept empty cells yet",
+}
 
 
 @pytest.mark.parametrize("name", sorted(p.name[:-5] for p in DECLS.glob("*.toml")))
 def test_declaration_reads_the_file_as_its_truth_entry(name):
-    path, entry = TRUTH[name]
+    if name in NOT_DECLARABLE:
+        pytest.xfail(NOT_DECLARABLE[name])
+    path, entry = EVERY[name]
     decl = DECLS / f"{name}.toml"
     if entry["verdict"] == "refuse":
         with pytest.raises(ReadError) as err:
