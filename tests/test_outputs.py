@@ -790,3 +790,28 @@ def test_a_plain_set_on_the_target_removes_a_kept_staging_folder(tmp_path):
 def test_resume_key_must_be_a_printable_string(tmp_path):
     with pytest.raises(InputError, match="resume_key"):
         OutputSet(tmp_path / "out", resume_key="")
+
+
+def test_a_signal_inside_a_weakref_callback_stops_the_run_at_the_next_output(capsys, tmp_path):
+    # a SIGINT that Python handles while a finalizer or weakref callback runs (garbage collection)
+    # cannot raise there: Python would print "Exception ignored in ..." and go on. interrupts()
+    # keeps it, and the output's commit raises it: nothing is written, no traceback is printed.
+    import signal
+    import weakref
+
+    from bendpam.infra.signals import Interrupted, interrupts
+
+    class Thing:
+        pass
+
+    reached = []
+    with pytest.raises(Interrupted) as info:
+        with interrupts(), OutputSet(tmp_path / "out") as out:
+            out.write_text("a.txt", "a")
+            thing = Thing()
+            _ref = weakref.ref(thing, lambda _r: signal.raise_signal(signal.SIGINT))
+            del thing  # the callback runs here, and the signal's handler inside it
+            reached.append("after the callback")
+    assert info.value.exit_code == 130 and info.value.signum == signal.SIGINT
+    assert reached == ["after the callback"] and not (tmp_path / "out").exists()
+    assert "Exception ignored" not in capsys.readouterr().err

@@ -59,7 +59,14 @@ from bendpam.infra.manifest import (
     verify_input,
 )
 from bendpam.infra.registry import record_file, written_by_bendpam
-from bendpam.infra.signals import HeldSignals, Interrupted, interrupts, is_interruption, record_written
+from bendpam.infra.signals import (
+    HeldSignals,
+    Interrupted,
+    interrupts,
+    is_interruption,
+    raise_pending,
+    record_written,
+)
 from bendpam.infra.targets import (
     OutputRefused,
     check_against_inputs,
@@ -199,6 +206,13 @@ class _Output:
         """Commit on success (or, in a group, put in place), else clean up; never swallows."""
         if self._state != "open":
             return False
+        if exc is None:
+            try:
+                raise_pending()  # a signal Python could not raise inside a finalizer
+            except Interrupted as pending:
+                exc = pending
+                self._abort(exc)
+                raise
         if exc is not None:
             self._abort(exc)
             return False

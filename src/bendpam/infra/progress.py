@@ -31,6 +31,8 @@ from collections.abc import Callable
 from types import TracebackType
 from typing import Any
 
+from bendpam.infra.signals import raise_pending
+
 __all__ = ["DEFAULT_INTERVAL_S", "INTERVAL_ENV", "Progress", "format_duration"]
 
 #: Seconds between two plain progress lines unless the environment variable below says otherwise.
@@ -220,6 +222,8 @@ class Progress:
     # -- counting -----------------------------------------------------------------------------
     def advance(self, n: int = 1, description: str | None = None) -> None:
         """Count ``n`` more units as done (thread-safe); optionally change the description."""
+        if threading.current_thread() is threading.main_thread():
+            raise_pending()  # a signal that came inside a finalizer stops the run here
         with self._lock:
             self.completed += int(n)
             if description is not None:

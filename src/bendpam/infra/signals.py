@@ -19,6 +19,7 @@ import contextlib
 import logging
 import os
 import signal
+import sys
 import threading
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -34,6 +35,7 @@ __all__ = [
     "interrupts",
     "is_interruption",
     "quiet_logging",
+    "raise_pending",
     "record_written",
     "written",
 ]
@@ -150,14 +152,46 @@ def interrupts(on_signal: Callable[[int], None] | None = None) -> Iterator[None]
         raise Interrupted(EXIT_CODES.get(signum, 128 + signum), signum)
 
     saved: dict[int, Any] = {}
+    previous_hook = sys.unraisablehook
+
+    def _redeliver(unraisable: Any) -> None:
+        # the signal came while a finalizer or weakref callback ran (during garbage collection),
+        # where Python prints the exception instead of raising it: keep it, silently, for the next
+        # checkpoint (raise_pending: each output's commit, each progress step)
+        if isinstance(unraisable.exc_value, Interrupted):
+            _PENDING.append(unraisable.exc_value)
+            return
+        previous_hook(unraisable)
+
     try:
         for sig in SIGNALS:
             if signal.getsignal(sig) is not signal.SIG_IGN:
                 saved[sig] = signal.signal(sig, _raise)
+        sys.unraisablehook = _redeliver
         yield
     finally:
+        sys.unraisablehook = previous_hook
         for sig, previous in saved.items():
             signal.signal(sig, previous if previous is not None else signal.SIG_DFL)
+
+
+#: Interruptions Python could not raise (they came inside a finalizer), for :func:`raise_pending`.
+_PENDING: list[Interrupted] = []
+
+
+def raise_pending() -> None:
+    """Raise the :class:`Interrupted` of a signal that arrived inside a finalizer, if one did.
+
+    A signal handled while garbage collection runs a finalizer or weakref callback cannot raise
+    there (Python would print "Exception ignored" and go on); :func:`interrupts` keeps it and the
+    output blocks and progress steps call this, so the run still stops with its one line.
+
+    >>> raise_pending()   # nothing pending: nothing happens
+    """
+    if _PENDING:
+        exc = _PENDING.pop(0)
+        _PENDING.clear()
+        raise exc
 
 
 class HeldSignals:
