@@ -674,15 +674,7 @@ def _stored_findings(text) -> list[list[dict]]:
     >>> _stored_findings('[[], [{"check": "loss-ratio"}]]')[1][0]["check"], _stored_findings(None)
     ('loss-ratio', [])
     """
-    import json
-
-    if not text:
-        return []
-    try:
-        value = json.loads(str(text))
-    except ValueError:
-        return []
-    return [list(v) if isinstance(v, list) else [] for v in value] if isinstance(value, list) else []
+    return [list(v) if isinstance(v, list) else [] for v in _stored_list(text)]
 
 
 def _stored_drifts(text) -> list[DriftEstimate | None]:
@@ -690,6 +682,15 @@ def _stored_drifts(text) -> list[DriftEstimate | None]:
 
     >>> _stored_drifts('[null, {"rate_n_per_s": 0.001}]'), _stored_drifts("[")
     ([None, None], [])
+    """
+    return [DriftEstimate.from_dict(v) for v in _stored_list(text)]
+
+
+def _stored_list(text) -> list:
+    """A JSON list stored as a ``curves.nc`` attribute; ``[]`` when absent or unreadable.
+
+    >>> _stored_list("[1, 2]"), _stored_list("{}"), _stored_list(None)
+    ([1, 2], [], [])
     """
     import json
 
@@ -699,4 +700,4 @@ def _stored_drifts(text) -> list[DriftEstimate | None]:
         value = json.loads(str(text))
     except ValueError:
         return []
-    return [DriftEstimate.from_dict(v) for v in value] if isinstance(value, list) else []
+    return value if isinstance(value, list) else []
