@@ -120,7 +120,7 @@ def _role_hits(lines: list[str]) -> int:
     for line in lines:
         for cell in _SPLIT.split(line):
             cell = cell.strip().strip('"').strip()
-            if not cell or len(cell) > 60:
+            if not cell or len(cell) > 60 or mojibake_score(cell):  # a garbled name is no evidence
                 continue
             name, unit = split_name_unit(cell)
             if any(c.role in ("time", "stroke", "force", "counter")
