@@ -1,0 +1,290 @@
+"""The calibration study of bendpam's error bars (issue 23): do the fit's standard errors hold?
+
+    python tools/calibration_study.py [--seeds 10] [--cases none stiction ...] [--jobs 1] [--out FILE]
+
+For every case of :data:`raw_generators.CASES` and every seed, raw test files are made by the
+independent generators (``tools/raw_generators.py``: loop laws and instrument faults bendpam does not
+assume), then read, processed and fitted through bendpam's Python API with the defaults of
+``bendpam process`` and ``bendpam fit`` (a drift case is processed twice: with the linear drift
+correction and without it, to show what the flag is for).  Per case it reports, for alpha0, the
+shear modulus mu = 2 (C10 + C01) and the shape C01 / (C10 + C01):
+
+* bias: the mean of (fitted - true) over the seeds (mu in % of the truth);
+* mean SE: the mean of the fit's standard errors (statistical and systematic, as the fit reports them);
+* SD: the seed-to-seed standard deviation of the fitted values;
+* SE/SD: well-calibrated error bars give about 1 (the issue's target: at most 3);
+* coverage: the share of runs whose ``|fitted - true| <= 2 SE`` (target: at least 85 %);
+* for the shape, how often the fit called it determined, and the coverage among those;
+* the tests whose drift was flagged, and the runs that failed (read, process or fit refused).
+
+It writes the numbers as JSON (``--out``, default ``benchmarks/results/calibration.json``) and the
+tables into ``docs/calibration.md`` between its two markers (``--docs``; ``--no-docs`` leaves the page).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import platform
+import sys
+import tempfile
+import time
+import traceback
+import warnings
+from concurrent.futures import ProcessPoolExecutor
+from datetime import UTC, datetime
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import raw_generators as gen  # noqa: E402
+
+from bendpam.infra.atomic import atomic_write_text, json_safe  # noqa: E402
+from bendpam.version import __version__  # noqa: E402
+
+START, END = "<!-- calibration-table:start -->", "<!-- calibration-table:end -->"
+COVERAGE_TARGET, RATIO_TARGET = 0.85, 3.0
+
+
+# ------------------------------------------------------------------------------------------------
+# one run
+# ------------------------------------------------------------------------------------------------
+def _fit_record(result) -> dict:
+    """The numbers of one fit: alpha0, mu, shape with their standard errors, and the loop law's shift."""
+    a = result.parameters["alpha0"]
+    m = result.material
+    shift = (result.hysteresis.law_shift.get("alpha0_deg") if result.hysteresis is not None else None)
+    return {"alpha0_deg": a.value, "se_alpha0_deg": a.stderr,
+            "alpha0_law_shift_deg": shift,
+            "mu_kpa": m.shear_modulus_kpa if m else None, "se_mu_kpa": m.se_shear_modulus_kpa if m else None,
+            "shape": m.shape if m else None, "se_shape": m.se_shape if m else None,
+            "shape_determined": bool(m.shape_identified) if m else False,
+            "converged": bool(result.converged), "loop": result.metrics.curves}
+
+
+def run_one(case_name: str, seed: int, case: gen.Case | None = None) -> list[dict]:
+    """Generate, read, process and fit one case and seed: one record per processing variant."""
+    from bendpam.identify.fitting import fit
+    from bendpam.lab import read_test
+    from bendpam.lab.processing import process_tests
+    from bendpam.physics.fixture import Fixture
+
+    case = case or gen.CASES[case_name]
+    variants = ["linear", "none"] if case.drift_fraction else ["none"]
+    records = []
+    with tempfile.TemporaryDirectory(prefix="bendpam-calib-") as folder, warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        t0 = time.perf_counter()
+        try:
+            truth = gen.generate_set(case, seed, folder)
+            raws = [read_test(Path(folder) / name) for name in truth["files"]]
+        except Exception as exc:  # a failed run is counted, with its reason
+            return [{"case": case_name, "variant": v, "seed": seed, "failed": f"generate/read: {_why(exc)}"}
+                    for v in variants]
+        for drift in variants:
+            rec = {"case": case_name, "variant": drift, "seed": seed, "truth": {
+                k: truth[k] for k in ("alpha0_deg", "shear_modulus_kpa", "shape")}}
+            try:
+                ps = process_tests(raws, fixture=Fixture(L0_mm=truth["fixture_L0_mm"]), keep_series=False,
+                                   drift=drift)
+                rec["drift_flagged"] = sum(bool(r.drift is not None and r.drift.flagged) for r in ps.results)
+                rec["tests"] = len(ps.results)
+                rec.update(_fit_record(fit(ps, gen.start_actuator(case))))
+            except Exception as exc:
+                rec["failed"] = f"process/fit: {_why(exc)}"
+            rec["seconds"] = time.perf_counter() - t0
+            records.append(rec)
+    return records
+
+
+def _why(exc: BaseException) -> str:
+    text = str(exc).splitlines()[0] if str(exc) else ""
+    where = traceback.extract_tb(exc.__traceback__)[-1] if exc.__traceback__ else None
+    return f"{type(exc).__name__}: {text}" + (f" ({Path(where.filename).name}:{where.lineno})" if where else "")
+
+
+# ------------------------------------------------------------------------------------------------
+# the summary
+# ------------------------------------------------------------------------------------------------
+def _stats(est, se, truth, scale: float = 1.0) -> dict:
+    """Bias, mean SE, seed-to-seed SD, SE/SD, 2-SE coverage (``scale`` turns the numbers into the table's unit)."""
+    est, se = np.asarray(est, float), np.asarray(se, float)
+    ok = np.isfinite(est) & np.isfinite(se)
+    if not ok.any():
+        return {"n": 0}
+    err = est[ok] - truth
+    sd = float(np.std(est[ok], ddof=1)) if ok.sum() > 1 else math.nan
+    mse = float(np.mean(se[ok]))
+    return {"n": int(ok.sum()), "bias": float(np.mean(err)) * scale, "mean_se": mse * scale, "sd": sd * scale,
+            "se_over_sd": mse / sd if sd > 0 else math.inf, "coverage": float(np.mean(np.abs(err) <= 2.0 * se[ok])),
+            "bias_in_se": float(np.mean(err)) / mse if mse > 0 else math.inf,
+            "rms_z": float(np.sqrt(np.mean((err / se[ok]) ** 2)))}
+
+
+def summarise(records: list[dict]) -> list[dict]:
+    """One row per case and processing variant, in the order of the records."""
+    rows: dict[tuple[str, str], list[dict]] = {}
+    for r in records:
+        rows.setdefault((r["case"], r["variant"]), []).append(r)
+    out = []
+    for (name, variant), recs in rows.items():
+        good = [r for r in recs if "failed" not in r]
+        case = gen.CASES.get(name)
+        row = {"case": name, "variant": variant, "runs": len(recs), "failed": len(recs) - len(good),
+               "failures": sorted({r["failed"] for r in recs if "failed" in r})}
+        if case is not None:
+            row.update(loop=case.loop, preset=case.preset, model=case.model, pressures_kpa=list(case.pressures_kpa),
+                       noise_fraction=case.noise_fraction, noise_ar1=case.noise_ar1,
+                       drift_fraction=case.drift_fraction, dialect=case.dialect)
+        if good:
+            t = good[0]["truth"]
+            col = lambda k: [np.nan if r.get(k) is None else r[k] for r in good]  # noqa: E731
+            row["alpha0"] = _stats(col("alpha0_deg"), col("se_alpha0_deg"), t["alpha0_deg"])
+            row["mu"] = _stats(col("mu_kpa"), col("se_mu_kpa"), t["shear_modulus_kpa"],
+                               100.0 / t["shear_modulus_kpa"])
+            row["shape"] = _stats(col("shape"), col("se_shape"), t["shape"])
+            det = [r for r in good if r["shape_determined"] and r.get("se_shape") is not None]
+            row["shape_determined"] = len(det)
+            row["shape_determined_covered"] = sum(abs(r["shape"] - t["shape"]) <= 2.0 * r["se_shape"] for r in det)
+            row["drift_flagged"] = sum(r["drift_flagged"] for r in good)
+            row["tests"] = sum(r["tests"] for r in good)
+            row["seconds_per_run"] = float(np.mean([r["seconds"] for r in good]))
+        out.append(row)
+    return out
+
+
+def _label(row: dict) -> str:
+    if row["variant"] == "linear":
+        return f"{row['case']} (corrected)"
+    return f"{row['case']} (not corrected)" if row.get("drift_fraction") else row["case"]
+
+
+def _f(x, fmt: str) -> str:
+    return "-" if x is None or (isinstance(x, float) and not math.isfinite(x)) else format(x, fmt)
+
+
+def _pct(x) -> str:
+    return "-" if x is None or not math.isfinite(x) else f"{100 * x:.0f} %"
+
+
+def _mark(row: dict, key: str) -> str:
+    s = row.get(key) or {}
+    if not s.get("n"):
+        return "-"
+    ok = s["coverage"] >= COVERAGE_TARGET and s["se_over_sd"] <= RATIO_TARGET
+    return "yes" if ok else "**no**"
+
+
+def tables(rows: list[dict], meta: dict) -> str:
+    """The markdown tables of the summary (alpha0, mu, shape and drift)."""
+    lines = [f"{meta['seeds']} seeds per case; bendpam {meta['version']} (commit {meta['commit']}); "
+             f"{meta['runs']} runs in {meta['wall_s']:.0f} s on {meta['jobs']} process(es).", "",
+             "| case | actuator, pressures (kPa) | noise (AR(1)) | runs (failed) | α0 bias (deg) | α0 mean SE "
+             "| α0 SD | SE/SD | α0 coverage | μ bias (%) | μ mean SE (%) | μ SD (%) | SE/SD | μ coverage | target met |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        a, m = r.get("alpha0") or {}, r.get("mu") or {}
+        met = "yes" if _mark(r, "alpha0") == "yes" and _mark(r, "mu") == "yes" else "**no**"
+        lines.append(
+            f"| {_label(r)} | {r.get('preset', '')} {r.get('model', '')}, "
+            f"{', '.join(f'{p:g}' for p in r.get('pressures_kpa', []))} | "
+            f"{100 * r.get('noise_fraction', 0):.1f} % ({r.get('noise_ar1', 0):g}) | {r['runs']} ({r['failed']}) | "
+            f"{_f(a.get('bias'), '+.3f')} | {_f(a.get('mean_se'), '.3f')} | {_f(a.get('sd'), '.3f')} | "
+            f"{_f(a.get('se_over_sd'), '.2g')} | {_pct(a.get('coverage'))} | {_f(m.get('bias'), '+.2f')} | "
+            f"{_f(m.get('mean_se'), '.2f')} | {_f(m.get('sd'), '.2f')} | {_f(m.get('se_over_sd'), '.2g')} | "
+            f"{_pct(m.get('coverage'))} | {met} |")
+    lines += ["", "| case | shape truth | shape bias | shape mean SE | shape SD | shape coverage | "
+              "called determined | truth within 2 SE when determined | tests with drift flagged |",
+              "|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        s = r.get("shape") or {}
+        det = r.get("shape_determined", 0)
+        lines.append(
+            f"| {_label(r)} | {_truth_shape(r)} | {_f(s.get('bias'), '+.3f')} | {_f(s.get('mean_se'), '.3f')} | "
+            f"{_f(s.get('sd'), '.3f')} | {_pct(s.get('coverage'))} | {det} of {r['runs'] - r['failed']} | "
+            f"{r.get('shape_determined_covered', 0)} of {det} | {r.get('drift_flagged', 0)} of {r.get('tests', 0)} |")
+    fails = [f"{_label(r)}: {', '.join(r['failures'])}" for r in rows if r["failures"]]
+    if fails:
+        lines += ["", "Failed runs: " + "; ".join(fails) + "."]
+    return "\n".join(lines)
+
+
+def _truth_shape(row: dict) -> str:
+    case = gen.CASES.get(row["case"])
+    return f"{case.shape:g}" if case else "-"
+
+
+# ------------------------------------------------------------------------------------------------
+# the command
+# ------------------------------------------------------------------------------------------------
+def run_study(case_names, seeds: int, jobs: int = 1, first_seed: int = 0, cases: dict | None = None) -> tuple:
+    """``(records, rows, meta)`` of the study over ``case_names`` x ``seeds`` (``cases`` overrides the case set)."""
+    cases = cases or gen.CASES
+    tasks = [(name, first_seed + s, cases[name]) for name in case_names for s in range(seeds)]
+    t0 = time.perf_counter()
+    if jobs > 1:
+        with ProcessPoolExecutor(max_workers=jobs) as pool:
+            parts = list(pool.map(run_one, *zip(*tasks, strict=True)))
+    else:
+        parts = [run_one(*task) for task in tasks]
+    wall = time.perf_counter() - t0
+    records = [r for p in parts for r in p]
+    meta = {"seeds": seeds, "first_seed": first_seed, "cases": list(case_names), "jobs": jobs, "wall_s": wall,
+            "runs": len(records), "version": __version__, "commit": _commit(),
+            "date": datetime.now(UTC).strftime("%Y-%m-%dT%H:%M:%SZ"), "python": platform.python_version(),
+            "machine": platform.machine()}
+    return records, summarise(records), meta
+
+
+def _commit() -> str:
+    import subprocess
+
+    try:
+        out = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
+                             timeout=10, check=False)
+        return out.stdout.strip() or "unknown"
+    except (OSError, subprocess.SubprocessError):
+        return "unknown"
+
+
+def write_docs(path: Path, text: str) -> None:
+    """Put ``text`` between the page's markers (the rest of the page is left as it is)."""
+    page = path.read_text(encoding="utf-8")
+    i, j = page.find(START), page.find(END)
+    if i < 0 or j < i:
+        raise SystemExit(f"calibration_study: {path} has no {START} ... {END} markers")
+    atomic_write_text(path, page[: i + len(START)] + "\n" + text + "\n" + page[j:])
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--seeds", type=int, default=10, help="seeds per case (default 10)")
+    ap.add_argument("--first-seed", type=int, default=0)
+    ap.add_argument("--cases", nargs="+", default=list(gen.CASES), choices=list(gen.CASES), metavar="CASE",
+                    help=f"cases to run (default all: {', '.join(gen.CASES)})")
+    ap.add_argument("--jobs", type=int, default=1, help="processes (default 1; the machine may be shared)")
+    ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results" / "calibration.json",
+                    help="JSON of every run and the summary")
+    ap.add_argument("--docs", type=Path, default=ROOT / "docs" / "calibration.md", help="page to put the tables in")
+    ap.add_argument("--no-docs", action="store_true", help="leave the docs page as it is")
+    args = ap.parse_args(argv)
+    if args.seeds < 2 or args.jobs < 1:
+        ap.error("--seeds must be at least 2 and --jobs at least 1")
+    records, rows, meta = run_study(args.cases, args.seeds, args.jobs, args.first_seed)
+    text = tables(rows, meta)
+    print(text)
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    atomic_write_text(args.out, json.dumps(json_safe({"meta": meta, "summary": rows, "runs": records}), indent=1,
+                                           allow_nan=False))
+    if not args.no_docs:
+        write_docs(args.docs, text)
+    print(f"wrote {args.out}" + ("" if args.no_docs else f" and the tables in {args.docs}"))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
