@@ -142,7 +142,10 @@ def summarise(records: list[dict]) -> list[dict]:
                        drift_fraction=case.drift_fraction, dialect=case.dialect)
         if good:
             t = good[0]["truth"]
-            col = lambda k: [np.nan if r.get(k) is None else r[k] for r in good]  # noqa: E731
+
+            def col(k, good=good):
+                return [np.nan if r.get(k) is None else r[k] for r in good]
+
             row["alpha0"] = _stats(col("alpha0_deg"), col("se_alpha0_deg"), t["alpha0_deg"])
             row["mu"] = _stats(col("mu_kpa"), col("se_mu_kpa"), t["shear_modulus_kpa"],
                                100.0 / t["shear_modulus_kpa"])
@@ -184,7 +187,8 @@ def tables(rows: list[dict], meta: dict) -> str:
     lines = [f"{meta['seeds']} seeds per case; bendpam {meta['version']} (commit {meta['commit']}); "
              f"{meta['runs']} runs in {meta['wall_s']:.0f} s on {meta['jobs']} process(es).", "",
              "| case | actuator, pressures (kPa) | noise (AR(1)) | runs (failed) | α0 bias (deg) | α0 mean SE "
-             "| α0 SD | SE/SD | α0 coverage | μ bias (%) | μ mean SE (%) | μ SD (%) | SE/SD | μ coverage | target met |",
+             "| α0 SD | SE/SD | α0 coverage"
+             " | μ bias (%) | μ mean SE (%) | μ SD (%) | SE/SD | μ coverage | target met |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         a, m = r.get("alpha0") or {}, r.get("mu") or {}

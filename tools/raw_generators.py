@@ -52,7 +52,7 @@ Loop laws (all written here from their textbook forms):
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -241,8 +241,9 @@ CASES = {c.name: c for c in (
          loop="maxwell-creep", loop_fraction=0.06, noise_fraction=0.01, dwell_s=5.0, dialect="testxpert"),
     Case("stiction", pressures_kpa=(100.0, 125.0, 150.0, 175.0, 200.0), loop="stiction", loop_fraction=0.05,
          noise_fraction=0.005, noise_ar1=0.8, dialect="bluehill"),
-    Case("viscous", preset="bc-pam", geometry={"R0_mm": 9.0, "R0_start_mm": 9.1, "t0_mm": 2.3}, pressures_kpa=(50.0, 80.0, 110.0),
-         d_alpha0_deg=-0.6, loop="viscous", loop_fraction=0.05, noise_fraction=0.02, dialect="csv"),
+    Case("viscous", preset="bc-pam", geometry={"R0_mm": 9.0, "R0_start_mm": 9.1, "t0_mm": 2.3},
+         pressures_kpa=(50.0, 80.0, 110.0), d_alpha0_deg=-0.6, loop="viscous", loop_fraction=0.05,
+         noise_fraction=0.02, dialect="csv"),
     Case("backlash", geometry={"R0_mm": 8.0, "L0_mm": 150.0}, pressures_kpa=(90.0, 110.0, 130.0, 150.0, 170.0, 190.0),
          d_alpha0_deg=-0.7, shape=0.4, loop="backlash", loop_fraction=0.04, noise_fraction=0.01, dialect="testxpert"),
     Case("bouc-wen", pressures_kpa=(100.0, 140.0, 180.0, 220.0), mu_factor=0.95, loop="bouc-wen", loop_fraction=0.06,
@@ -316,7 +317,7 @@ def _path(s_free: float, case: Case):
 
 
 def machine_test(case: Case, truth: Truth, pressure_kpa: float, rng: np.random.Generator, rig: Rig):
-    """One raw test: ``(time s, stroke mm, force N, info)`` with the noise-free force and the free stroke in ``info``."""
+    """One raw test: ``(time s, stroke mm, force N, info)``; ``info`` has the free stroke and the blocked force."""
     act = truth.actuator
     sign = act.bend_sign or 1
     law = bendpam.MomentLaw.of(act, case.model)
@@ -399,9 +400,9 @@ def generate_set(case: Case, seed: int, folder) -> dict:
 
     Files are named ``{preset}_{P}kPa{suffix}`` and carry the pressure in their header.
 
-    >>> import tempfile
+    >>> import dataclasses, tempfile
     >>> with tempfile.TemporaryDirectory() as folder:
-    ...     truth = generate_set(replace(CASES["stiction"], pressures_kpa=(150.0,), cycles=2), 1, folder)
+    ...     truth = generate_set(dataclasses.replace(CASES["stiction"], pressures_kpa=(150.0,), cycles=2), 1, folder)
     ...     names = sorted(p.name for p in Path(folder).iterdir())
     >>> names, round(truth["alpha0_deg"], 2)
     (['be-pam_150kPa.csv'], 70.5)
