@@ -85,7 +85,9 @@ def run_one(case_name: str, seed: int, case: gen.Case | None = None) -> list[dic
         except Exception as exc:  # a failed run is counted, with its reason
             return [{"case": case_name, "variant": v, "seed": seed, "failed": f"generate/read: {_why(exc)}"}
                     for v in variants]
+        t_gen = time.perf_counter() - t0
         for drift in variants:
+            t1 = time.perf_counter()
             rec = {"case": case_name, "variant": drift, "seed": seed, "truth": {
                 k: truth[k] for k in ("alpha0_deg", "shear_modulus_kpa", "shape")}}
             try:
@@ -96,7 +98,7 @@ def run_one(case_name: str, seed: int, case: gen.Case | None = None) -> list[dic
                 rec.update(_fit_record(fit(ps, gen.start_actuator(case))))
             except Exception as exc:
                 rec["failed"] = f"process/fit: {_why(exc)}"
-            rec["seconds"] = time.perf_counter() - t0
+            rec["seconds"] = t_gen + time.perf_counter() - t1  # generating and reading, then this variant
             records.append(rec)
     return records
 
@@ -238,21 +240,33 @@ def run_study(case_names, seeds: int, jobs: int = 1, first_seed: int = 0, cases:
     wall = time.perf_counter() - t0
     records = [r for p in parts for r in p]
     meta = {"seeds": seeds, "first_seed": first_seed, "cases": list(case_names), "jobs": jobs, "wall_s": wall,
-            "runs": len(records), "version": __version__, "commit": _commit(),
+            "runs": len(records), "version": __version__, "commit": _commit(), "bendpam": _where(),
             "date": datetime.now(UTC).strftime("%Y-%m-%dT%H:%M:%SZ"), "python": platform.python_version(),
             "machine": platform.machine()}
     return records, summarise(records), meta
 
 
 def _commit() -> str:
+    """The commit of the bendpam under test (the repository its package was imported from), ``+`` when modified."""
     import subprocess
 
+    import bendpam
+
+    where = str(Path(bendpam.__file__).resolve().parent)
     try:
-        out = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
-                             timeout=10, check=False)
-        return out.stdout.strip() or "unknown"
+        head = subprocess.run(["git", "-C", where, "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
+                              timeout=10, check=False).stdout.strip()
+        dirty = subprocess.run(["git", "-C", where, "status", "--porcelain", "--", "."], capture_output=True,
+                               text=True, timeout=10, check=False).stdout.strip()
+        return (head + ("+" if dirty else "")) or "unknown"
     except (OSError, subprocess.SubprocessError):
         return "unknown"
+
+
+def _where() -> str:
+    import bendpam
+
+    return str(Path(bendpam.__file__).resolve().parent)
 
 
 def write_docs(path: Path, text: str) -> None:
