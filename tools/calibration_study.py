@@ -96,11 +96,44 @@ def run_one(case_name: str, seed: int, case: gen.Case | None = None) -> list[dic
                 rec["drift_flagged"] = sum(bool(r.drift is not None and r.drift.flagged) for r in ps.results)
                 rec["tests"] = len(ps.results)
                 rec.update(_fit_record(fit(ps, gen.start_actuator(case))))
+                if drift == "linear":
+                    rec.update(_drift_propagation(raws, ps, Fixture(L0_mm=truth["fixture_L0_mm"]), case))
             except Exception as exc:
                 rec["failed"] = f"process/fit: {_why(exc)}"
             rec["seconds"] = t_gen + time.perf_counter() - t1  # generating and reading, then this variant
             records.append(rec)
     return records
+
+
+def _drift_propagation(raws, processed, fixture, case: gen.Case) -> dict:
+    """What the drift corrections' own uncertainty adds to alpha0's and mu's SE (a diagnostic the fit lacks).
+
+    Each test's force is corrected by its fitted drift rate, once as estimated and once with one test's rate moved
+    by its standard error (processed without a further correction, refitted): the shifts, added in quadrature over
+    the tests (their drift estimates are independent), are the standard errors the correction contributes.
+    """
+    import dataclasses
+
+    from bendpam.identify.fitting import fit
+    from bendpam.lab.processing import process_tests
+
+    est = {float(r.pressure_kpa): r.drift for r in processed.results}
+
+    def refit(moved: int | None) -> tuple[float, float]:
+        shifted = []
+        for i, raw in enumerate(raws):
+            e = est[float(raw.pressure_kpa)]
+            rate = e.rate_n_per_s + (e.rate_se_n_per_s if i == moved else 0.0)
+            d = raw.data
+            force = d["force_n"] - rate * (d["time_s"] - e.t0_s)
+            shifted.append(dataclasses.replace(raw, data=d.assign(force_n=force)))
+        r = fit(process_tests(shifted, fixture=fixture, keep_series=False, drift="none"), gen.start_actuator(case))
+        return r.parameters["alpha0"].value, r.material.shear_modulus_kpa
+
+    a0, m0 = refit(None)
+    shifts = np.array([np.subtract(refit(i), (a0, m0)) for i in range(len(raws))])
+    return {"se_alpha0_drift_deg": float(np.sqrt(np.sum(shifts[:, 0] ** 2))),
+            "se_mu_drift_kpa": float(np.sqrt(np.sum(shifts[:, 1] ** 2)))}
 
 
 def _why(exc: BaseException) -> str:
@@ -152,6 +185,11 @@ def summarise(records: list[dict]) -> list[dict]:
             row["mu"] = _stats(col("mu_kpa"), col("se_mu_kpa"), t["shear_modulus_kpa"],
                                100.0 / t["shear_modulus_kpa"])
             row["shape"] = _stats(col("shape"), col("se_shape"), t["shape"])
+            if all(r.get("se_alpha0_drift_deg") is not None for r in good):
+                se_a = np.hypot(col("se_alpha0_deg"), col("se_alpha0_drift_deg"))
+                row["alpha0_drift_se"] = _stats(col("alpha0_deg"), se_a, t["alpha0_deg"])
+                row["mu_drift_se"] = _stats(col("mu_kpa"), np.hypot(col("se_mu_kpa"), col("se_mu_drift_kpa")),
+                                            t["shear_modulus_kpa"], 100.0 / t["shear_modulus_kpa"])
             det = [r for r in good if r["shape_determined"] and r.get("se_shape") is not None]
             row["shape_determined"] = len(det)
             row["shape_determined_covered"] = sum(abs(r["shape"] - t["shape"]) <= 2.0 * r["se_shape"] for r in det)
@@ -213,10 +251,26 @@ def tables(rows: list[dict], meta: dict) -> str:
             f"| {_label(r)} | {_truth_shape(r)} | {_f(s.get('bias'), '+.3f')} | {_f(s.get('mean_se'), '.3f')} | "
             f"{_f(s.get('sd'), '.3f')} | {_pct(s.get('coverage'))} | {det} of {r['runs'] - r['failed']} | "
             f"{r.get('shape_determined_covered', 0)} of {det} | {r.get('drift_flagged', 0)} of {r.get('tests', 0)} |")
+    lines += _drift_table(rows)
     fails = [f"{_label(r)}: {', '.join(r['failures'])}" for r in rows if r["failures"]]
     if fails:
         lines += ["", "Failed runs: " + "; ".join(fails) + "."]
     return "\n".join(lines)
+
+
+def _drift_table(rows: list[dict]) -> list[str]:
+    """The drift cases with the correction's own uncertainty added to the fit's SE (a diagnostic)."""
+    drift = [r for r in rows if r.get("alpha0_drift_se")]
+    if not drift:
+        return []
+    lines = ["", "| case | α0 mean SE, fit + drift correction | α0 coverage with it | SE/SD | "
+             "μ mean SE (%), fit + drift correction | μ coverage with it | SE/SD |", "|---|---|---|---|---|---|---|"]
+    for r in drift:
+        a, m = r["alpha0_drift_se"], r["mu_drift_se"]
+        lines.append(f"| {_label(r)} | {_f(a.get('mean_se'), '.3f')} | {_pct(a.get('coverage'))} | "
+                     f"{_f(a.get('se_over_sd'), '.2g')} | {_f(m.get('mean_se'), '.2f')} | {_pct(m.get('coverage'))} | "
+                     f"{_f(m.get('se_over_sd'), '.2g')} |")
+    return lines
 
 
 def _truth_shape(row: dict) -> str:
