@@ -1,8 +1,9 @@
 """The calibration study of bendpam's error bars (issue 23): do the fit's standard errors hold?
 
-    python tools/calibration_study.py [--seeds 10] [--cases none stiction ...] [--jobs 1] [--out FILE]
+    python tools/calibration_study.py [--seeds 10] [--set main|holdout] [--cases CASE ...] [--jobs 1] [--out FILE]
 
-For every case of :data:`raw_generators.CASES` and every seed, raw test files are made by the
+For every case of :data:`raw_generators.CASES` (or of :data:`raw_generators.HOLDOUT` with ``--set holdout``:
+cases kept out of any tuning) and every seed, raw test files are made by the
 independent generators (``tools/raw_generators.py``: loop laws and instrument faults bendpam does not
 assume), then read, processed and fitted through bendpam's Python API with the defaults of
 ``bendpam process`` and ``bendpam fit`` (a drift case is processed twice: with the linear drift
@@ -47,6 +48,16 @@ from bendpam.infra.atomic import atomic_write_text, json_safe  # noqa: E402
 from bendpam.version import __version__  # noqa: E402
 
 START, END = "<!-- calibration-table:start -->", "<!-- calibration-table:end -->"
+#: The case sets: ``main`` (:data:`raw_generators.CASES`, what the error bars are tuned and judged on) and
+#: ``holdout`` (:data:`raw_generators.HOLDOUT`, other parameters and combined faults, kept out of any tuning).
+SETS = {"main": gen.CASES, "holdout": gen.HOLDOUT}
+ALL_CASES = {**gen.CASES, **gen.HOLDOUT}
+
+
+def markers(case_set: str) -> tuple[str, str]:
+    """The docs page's markers of a case set's tables."""
+    return (START, END) if case_set == "main" else (f"<!-- calibration-{case_set}:start -->",
+                                                     f"<!-- calibration-{case_set}:end -->")
 COVERAGE_TARGET, RATIO_TARGET = 0.85, 3.0
 
 
@@ -73,7 +84,7 @@ def run_one(case_name: str, seed: int, case: gen.Case | None = None) -> list[dic
     from bendpam.lab.processing import process_tests
     from bendpam.physics.fixture import Fixture
 
-    case = case or gen.CASES[case_name]
+    case = case or ALL_CASES[case_name]
     variants = ["linear", "none"] if case.drift_fraction else ["none"]
     records = []
     with tempfile.TemporaryDirectory(prefix="bendpam-calib-") as folder, warnings.catch_warnings():
@@ -83,12 +94,12 @@ def run_one(case_name: str, seed: int, case: gen.Case | None = None) -> list[dic
             truth = gen.generate_set(case, seed, folder)
             raws = [read_test(Path(folder) / name) for name in truth["files"]]
         except Exception as exc:  # a failed run is counted, with its reason
-            return [{"case": case_name, "variant": v, "seed": seed, "failed": f"generate/read: {_why(exc)}"}
-                    for v in variants]
+            return [{"case": case_name, "variant": v, "seed": seed, "case_info": _case_info(case),
+                     "failed": f"generate/read: {_why(exc)}"} for v in variants]
         t_gen = time.perf_counter() - t0
         for drift in variants:
             t1 = time.perf_counter()
-            rec = {"case": case_name, "variant": drift, "seed": seed, "truth": {
+            rec = {"case": case_name, "variant": drift, "seed": seed, "case_info": _case_info(case), "truth": {
                 k: truth[k] for k in ("alpha0_deg", "shear_modulus_kpa", "shape")}}
             try:
                 ps = process_tests(raws, fixture=Fixture(L0_mm=truth["fixture_L0_mm"]), keep_series=False,
@@ -136,6 +147,14 @@ def _drift_propagation(raws, processed, fixture, case: gen.Case) -> dict:
             "se_mu_drift_kpa": float(np.sqrt(np.sum(shifts[:, 1] ** 2)))}
 
 
+def _case_info(case: gen.Case) -> dict:
+    """What the table says of a case (its actuator, pressures, loop, noise, drift, truth of the shape)."""
+    keys = ("loop", "loop_fraction", "preset", "model", "pressures_kpa", "noise_fraction", "noise_ar1",
+            "drift_fraction", "dialect", "cycles", "rate_hz")
+    info = {k: (list(v) if isinstance(v, tuple) else v) for k in keys for v in [getattr(case, k)]}
+    return {**info, "true_shape": case.shape}
+
+
 def _why(exc: BaseException) -> str:
     text = str(exc).splitlines()[0] if str(exc) else ""
     where = traceback.extract_tb(exc.__traceback__)[-1] if exc.__traceback__ else None
@@ -168,13 +187,8 @@ def summarise(records: list[dict]) -> list[dict]:
     out = []
     for (name, variant), recs in rows.items():
         good = [r for r in recs if "failed" not in r]
-        case = gen.CASES.get(name)
         row = {"case": name, "variant": variant, "runs": len(recs), "failed": len(recs) - len(good),
-               "failures": sorted({r["failed"] for r in recs if "failed" in r})}
-        if case is not None:
-            row.update(loop=case.loop, preset=case.preset, model=case.model, pressures_kpa=list(case.pressures_kpa),
-                       noise_fraction=case.noise_fraction, noise_ar1=case.noise_ar1,
-                       drift_fraction=case.drift_fraction, dialect=case.dialect)
+               "failures": sorted({r["failed"] for r in recs if "failed" in r}), **recs[0]["case_info"]}
         if good:
             t = good[0]["truth"]
 
@@ -274,8 +288,7 @@ def _drift_table(rows: list[dict]) -> list[str]:
 
 
 def _truth_shape(row: dict) -> str:
-    case = gen.CASES.get(row["case"])
-    return f"{case.shape:g}" if case else "-"
+    return f"{row['true_shape']:g}" if "true_shape" in row else "-"
 
 
 # ------------------------------------------------------------------------------------------------
@@ -283,7 +296,7 @@ def _truth_shape(row: dict) -> str:
 # ------------------------------------------------------------------------------------------------
 def run_study(case_names, seeds: int, jobs: int = 1, first_seed: int = 0, cases: dict | None = None) -> tuple:
     """``(records, rows, meta)`` of the study over ``case_names`` x ``seeds`` (``cases`` overrides the case set)."""
-    cases = cases or gen.CASES
+    cases = cases or ALL_CASES
     tasks = [(name, first_seed + s, cases[name]) for name in case_names for s in range(seeds)]
     t0 = time.perf_counter()
     if jobs > 1:
@@ -323,38 +336,47 @@ def _where() -> str:
     return str(Path(bendpam.__file__).resolve().parent)
 
 
-def write_docs(path: Path, text: str) -> None:
-    """Put ``text`` between the page's markers (the rest of the page is left as it is)."""
+def write_docs(path: Path, text: str, case_set: str = "main") -> None:
+    """Put ``text`` between the page's markers of ``case_set`` (the rest of the page is left as it is)."""
+    start, end = markers(case_set)
     page = path.read_text(encoding="utf-8")
-    i, j = page.find(START), page.find(END)
+    i, j = page.find(start), page.find(end)
     if i < 0 or j < i:
-        raise SystemExit(f"calibration_study: {path} has no {START} ... {END} markers")
-    atomic_write_text(path, page[: i + len(START)] + "\n" + text + "\n" + page[j:])
+        raise SystemExit(f"calibration_study: {path} has no {start} ... {end} markers")
+    atomic_write_text(path, page[: i + len(start)] + "\n" + text + "\n" + page[j:])
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--seeds", type=int, default=10, help="seeds per case (default 10)")
     ap.add_argument("--first-seed", type=int, default=0)
-    ap.add_argument("--cases", nargs="+", default=list(gen.CASES), choices=list(gen.CASES), metavar="CASE",
-                    help=f"cases to run (default all: {', '.join(gen.CASES)})")
+    ap.add_argument("--set", dest="case_set", choices=list(SETS), default="main",
+                    help="main (default): the cases the error bars are judged on; holdout: other parameters and "
+                    "combined faults, kept out of any tuning")
+    ap.add_argument("--cases", nargs="+", choices=list(ALL_CASES), metavar="CASE",
+                    help=f"cases to run (default: the whole set; main: {', '.join(gen.CASES)}; holdout: "
+                    f"{', '.join(gen.HOLDOUT)})")
     ap.add_argument("--jobs", type=int, default=1, help="processes (default 1; the machine may be shared)")
-    ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results" / "calibration.json",
-                    help="JSON of every run and the summary")
+    ap.add_argument("--out", type=Path, help="JSON of every run and the summary (default "
+                    "benchmarks/results/calibration.json, calibration-holdout.json for the holdout set)")
     ap.add_argument("--docs", type=Path, default=ROOT / "docs" / "calibration.md", help="page to put the tables in")
     ap.add_argument("--no-docs", action="store_true", help="leave the docs page as it is")
     args = ap.parse_args(argv)
     if args.seeds < 2 or args.jobs < 1:
         ap.error("--seeds must be at least 2 and --jobs at least 1")
-    records, rows, meta = run_study(args.cases, args.seeds, args.jobs, args.first_seed)
+    cases = args.cases or list(SETS[args.case_set])
+    out = args.out or ROOT / "benchmarks" / "results" / (
+        "calibration.json" if args.case_set == "main" else f"calibration-{args.case_set}.json")
+    records, rows, meta = run_study(cases, args.seeds, args.jobs, args.first_seed)
+    meta["set"] = args.case_set
     text = tables(rows, meta)
     print(text)
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    atomic_write_text(args.out, json.dumps(json_safe({"meta": meta, "summary": rows, "runs": records}), indent=1,
-                                           allow_nan=False))
+    out.parent.mkdir(parents=True, exist_ok=True)
+    atomic_write_text(out, json.dumps(json_safe({"meta": meta, "summary": rows, "runs": records}), indent=1,
+                                      allow_nan=False))
     if not args.no_docs:
-        write_docs(args.docs, text)
-    print(f"wrote {args.out}" + ("" if args.no_docs else f" and the tables in {args.docs}"))
+        write_docs(args.docs, text, args.case_set)
+    print(f"wrote {out}" + ("" if args.no_docs else f" and the tables in {args.docs}"))
     return 0
 
 
