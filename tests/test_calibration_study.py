@@ -185,3 +185,22 @@ def test_the_docs_page_names_the_command_that_regenerates_it():
     for case_set in study.SETS:
         start, end = study.markers(case_set)
         assert page.index(start) < page.index(end)
+
+
+def test_the_study_fits_as_the_commands_do(small_study, tmp_path):
+    """``bendpam process --drift linear`` then ``bendpam fit`` on the generated files give the study's alpha0."""
+    import json
+
+    from bendpam.cli import main
+
+    raw = tmp_path / "raw"
+    raw.mkdir()
+    gen.generate_set(SMALL["drift"], 1, raw)
+    assert main(["process", str(raw), "--out", str(tmp_path / "p"), "--drift", "linear", "--no-figure",
+                 "--quiet"]) == 0
+    assert main(["fit", str(tmp_path / "p"), "--preset", "be-pam", "--no-figure", "--quiet", "--out",
+                 str(tmp_path / "f")]) == 0
+    cli = json.loads((tmp_path / "f" / "fit.json").read_text(encoding="utf-8"))
+    rec = next(r for r in small_study[0] if (r["case"], r["variant"], r["seed"]) == ("drift", "linear", 1))
+    assert cli["parameters"]["alpha0_deg"]["value"] == pytest.approx(rec["alpha0_deg"], abs=1e-6)
+    assert cli["parameters"]["alpha0_deg"]["stderr"] == pytest.approx(rec["se_alpha0_deg"], rel=1e-4)
