@@ -77,8 +77,12 @@ def _fit_record(result) -> dict:
             "converged": bool(result.converged), "loop": result.metrics.curves}
 
 
-def run_one(case_name: str, seed: int, case: gen.Case | None = None) -> list[dict]:
-    """Generate, read, process and fit one case and seed: one record per processing variant."""
+def run_one(case_name: str, seed: int, case: gen.Case | None = None, fit_options: dict | None = None) -> list[dict]:
+    """Generate, read, process and fit one case and seed: one record per processing variant.
+
+    ``fit_options`` are keywords of :func:`bendpam.identify.fitting.fit` (default: those of ``bendpam fit``).
+    """
+    fit_kw = dict(fit_options or {})
     from bendpam.identify.fitting import fit
     from bendpam.lab import read_test
     from bendpam.lab.processing import process_tests
@@ -106,9 +110,9 @@ def run_one(case_name: str, seed: int, case: gen.Case | None = None) -> list[dic
                                    drift=drift)
                 rec["drift_flagged"] = sum(bool(r.drift is not None and r.drift.flagged) for r in ps.results)
                 rec["tests"] = len(ps.results)
-                rec.update(_fit_record(fit(ps, gen.start_actuator(case))))
+                rec.update(_fit_record(fit(ps, gen.start_actuator(case), **fit_kw)))
                 if drift == "linear":
-                    rec.update(_drift_propagation(raws, ps, Fixture(L0_mm=truth["fixture_L0_mm"]), case))
+                    rec.update(_drift_propagation(raws, ps, Fixture(L0_mm=truth["fixture_L0_mm"]), case, fit_kw))
             except Exception as exc:
                 rec["failed"] = f"process/fit: {_why(exc)}"
             rec["seconds"] = t_gen + time.perf_counter() - t1  # generating and reading, then this variant
@@ -116,7 +120,7 @@ def run_one(case_name: str, seed: int, case: gen.Case | None = None) -> list[dic
     return records
 
 
-def _drift_propagation(raws, processed, fixture, case: gen.Case) -> dict:
+def _drift_propagation(raws, processed, fixture, case: gen.Case, fit_kw: dict) -> dict:
     """What the drift corrections' own uncertainty adds to alpha0's and mu's SE (a diagnostic the fit lacks).
 
     Each test's force is corrected by its fitted drift rate, once as estimated and once with one test's rate moved
@@ -138,7 +142,8 @@ def _drift_propagation(raws, processed, fixture, case: gen.Case) -> dict:
             d = raw.data
             force = d["force_n"] - rate * (d["time_s"] - e.t0_s)
             shifted.append(dataclasses.replace(raw, data=d.assign(force_n=force)))
-        r = fit(process_tests(shifted, fixture=fixture, keep_series=False, drift="none"), gen.start_actuator(case))
+        r = fit(process_tests(shifted, fixture=fixture, keep_series=False, drift="none"), gen.start_actuator(case),
+                **fit_kw)
         return r.parameters["alpha0"].value, r.material.shear_modulus_kpa
 
     a0, m0 = refit(None)
@@ -239,7 +244,8 @@ def _mark(row: dict, key: str) -> str:
 def tables(rows: list[dict], meta: dict) -> str:
     """The markdown tables of the summary (alpha0, mu, shape and drift)."""
     lines = [f"{meta['seeds']} seeds per case; bendpam {meta['version']} (commit {meta['commit']}); "
-             f"{meta['runs']} runs in {meta['wall_s']:.0f} s on {meta['jobs']} process(es).", "",
+             f"{meta['runs']} runs in {meta['wall_s']:.0f} s on {meta['jobs']} process(es)"
+             + (f"; fit options {meta['fit_options']}" if meta.get("fit_options") else "") + ".", "",
              "| case | actuator, pressures (kPa) | noise (AR(1)) | runs (failed) | α0 bias (deg) | α0 mean SE "
              "| α0 SD | SE/SD | α0 coverage"
              " | μ bias (%) | μ mean SE (%) | μ SD (%) | SE/SD | μ coverage | target met |",
@@ -294,10 +300,11 @@ def _truth_shape(row: dict) -> str:
 # ------------------------------------------------------------------------------------------------
 # the command
 # ------------------------------------------------------------------------------------------------
-def run_study(case_names, seeds: int, jobs: int = 1, first_seed: int = 0, cases: dict | None = None) -> tuple:
+def run_study(case_names, seeds: int, jobs: int = 1, first_seed: int = 0, cases: dict | None = None,
+              fit_options: dict | None = None) -> tuple:
     """``(records, rows, meta)`` of the study over ``case_names`` x ``seeds`` (``cases`` overrides the case set)."""
     cases = cases or ALL_CASES
-    tasks = [(name, first_seed + s, cases[name]) for name in case_names for s in range(seeds)]
+    tasks = [(name, first_seed + s, cases[name], fit_options) for name in case_names for s in range(seeds)]
     t0 = time.perf_counter()
     if jobs > 1:
         with ProcessPoolExecutor(max_workers=jobs) as pool:
@@ -306,7 +313,8 @@ def run_study(case_names, seeds: int, jobs: int = 1, first_seed: int = 0, cases:
         parts = [run_one(*task) for task in tasks]
     wall = time.perf_counter() - t0
     records = [r for p in parts for r in p]
-    meta = {"seeds": seeds, "first_seed": first_seed, "cases": list(case_names), "jobs": jobs, "wall_s": wall,
+    meta = {"fit_options": dict(fit_options or {}),
+            "seeds": seeds, "first_seed": first_seed, "cases": list(case_names), "jobs": jobs, "wall_s": wall,
             "runs": len(records), "version": __version__, "commit": _commit(), "bendpam": _where(),
             "date": datetime.now(UTC).strftime("%Y-%m-%dT%H:%M:%SZ"), "python": platform.python_version(),
             "machine": platform.machine()}
@@ -346,6 +354,21 @@ def write_docs(path: Path, text: str, case_set: str = "main") -> None:
     atomic_write_text(path, page[: i + len(start)] + "\n" + text + "\n" + page[j:])
 
 
+def _fit_options(ap: argparse.ArgumentParser, items: list[str]) -> dict:
+    import ast
+
+    out = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        try:
+            out[key.strip()] = ast.literal_eval(value.strip())
+        except (ValueError, SyntaxError):
+            ap.error(f"--fit {item!r}: expected KEY=VALUE with a Python literal value")
+        if not sep or not key.strip().isidentifier():
+            ap.error(f"--fit {item!r}: expected KEY=VALUE")
+    return out
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--seeds", type=int, default=10, help="seeds per case (default 10)")
@@ -357,6 +380,9 @@ def main(argv=None) -> int:
                     help=f"cases to run (default: the whole set; main: {', '.join(gen.CASES)}; holdout: "
                     f"{', '.join(gen.HOLDOUT)})")
     ap.add_argument("--jobs", type=int, default=1, help="processes (default 1; the machine may be shared)")
+    ap.add_argument("--fit", dest="fit_options", action="append", default=[], metavar="KEY=VALUE",
+                    help="a keyword of bendpam.identify.fitting.fit, as a Python literal (law_uncertainty=False, "
+                    "hysteresis_law='dahl'); repeatable; the default is the defaults of `bendpam fit`")
     ap.add_argument("--out", type=Path, help="JSON of every run and the summary (default "
                     "benchmarks/results/calibration.json, calibration-holdout.json for the holdout set)")
     ap.add_argument("--docs", type=Path, default=ROOT / "docs" / "calibration.md", help="page to put the tables in")
@@ -367,7 +393,8 @@ def main(argv=None) -> int:
     cases = args.cases or list(SETS[args.case_set])
     out = args.out or ROOT / "benchmarks" / "results" / (
         "calibration.json" if args.case_set == "main" else f"calibration-{args.case_set}.json")
-    records, rows, meta = run_study(cases, args.seeds, args.jobs, args.first_seed)
+    fit_options = _fit_options(ap, args.fit_options)
+    records, rows, meta = run_study(cases, args.seeds, args.jobs, args.first_seed, fit_options=fit_options)
     meta["set"] = args.case_set
     text = tables(rows, meta)
     print(text)
