@@ -36,7 +36,7 @@ from bendpam.errors import InputError
 from bendpam.export.mjcf import MujocoModel, mujoco_model
 from bendpam.sim.mujoco import PamController, import_mujoco
 
-__all__ = ["QVEL_TOL", "Validation", "validate"]
+__all__ = ["QVEL_TOL", "MujocoExport", "Validation", "mujoco", "validate"]
 
 #: a quasi-static run has settled when every hinge turns slower than this, rad/s
 QVEL_TOL = 1e-6
@@ -291,3 +291,79 @@ def validate(exported: MujocoModel, *, pressures_kpa=None, tip_force_n=None, sph
         pull = _pullout_run(exported, sphere_mm, p_top if pullout_pressure_kpa is None else pullout_pressure_kpa)
         pull_err = pull["error_pct"]
     return Validation(free, free_err, loaded, loaded["tip_error_pct_of_length"], pull, pull_err, notes)
+
+
+_validate = validate  # (the name ``validate`` is an argument of :func:`mujoco`)
+
+
+@dataclass(frozen=True)
+class MujocoExport:
+    """An export: the device's model, one model per sphere, and the validation figures (None if not run).
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> ex = mujoco(bendpam.physics.presets.be_pam(), "finger", validate=False)
+    >>> sorted(ex.files())
+    ['actuator.toml', 'export.json', 'finger.xml']
+    """
+
+    model: MujocoModel
+    sphere_models: dict[float, MujocoModel]
+    validation: Validation | None
+
+    def to_dict(self) -> dict[str, Any]:
+        """The model's description, its files and the validation figures (``export.json``), JSON-ready."""
+        d = self.model.to_dict() | {"spheres_mm": sorted(self.sphere_models),
+                                    "files": sorted(self._models()) + ["actuator.toml", "export.json"]}
+        if self.validation is not None:
+            d["validation"] = self.validation.to_dict()
+        return d
+
+    def _models(self) -> dict[str, str]:
+        dev = self.model.device
+        return {f"{dev}.xml": self.model.xml} | {f"{dev}-sphere-{d:g}mm.xml": m.xml
+                                                 for d, m in self.sphere_models.items()}
+
+    def files(self) -> dict[str, str]:
+        """Every file of the export by name: the MJCF models, ``actuator.toml`` and ``export.json``."""
+        from bendpam.infra.outputs import to_json
+
+        return self._models() | {"actuator.toml": self.model.actuator.to_toml(), "export.json": to_json(self.to_dict())}
+
+    def save(self, folder, *, force: bool = False) -> list[str]:
+        """Write :meth:`files` into ``folder`` as one output set (staged, swapped in whole, with a manifest)."""
+        from bendpam.infra.outputs import OutputSet
+
+        files = self.files()
+        with OutputSet(folder, force=force, producer="bendpam.export.mujoco") as o:
+            for name, text in files.items():
+                o.write_text(name, text)
+        return sorted(files)
+
+
+def mujoco(actuator, device: str = "finger", *, law_model: str | None = None, segments: int | None = None,
+           tip_error_pct: float = 1.0, pressures_kpa=None, spheres_mm=(), validate: bool = True,
+           **options: Any) -> MujocoExport:
+    """Export ``actuator``'s finger or gripper to MuJoCo: the models and, with ``validate``, the figures.
+
+    The device's model is :func:`bendpam.export.mujoco_model` (``options`` go to it: ``gripper``,
+    ``finger``, ``densities``); one more model per sphere of ``spheres_mm`` (mm, gripper only);
+    :func:`validate` checks the device against bendpam (the pull-out on the first sphere, or 200 mm).
+    ``.save(folder)`` writes the files.
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> ex = bendpam.export.mujoco(bendpam.physics.presets.be_pam().replace(L0_mm=130.0), "gripper",
+    ...                            spheres_mm=[200.0], validate=False)
+    >>> sorted(ex.files())[:2], ex.model.segments
+    (['actuator.toml', 'export.json'], 8)
+    """
+    base = mujoco_model(actuator, device, law_model=law_model, segments=segments, tip_error_pct=tip_error_pct,
+                        pressures_kpa=pressures_kpa, **options)
+    diam = [float(d) for d in np.atleast_1d(np.asarray(spheres_mm, dtype=float))]
+    spheres = {d: mujoco_model(actuator, device, law_model=base.law_model, segments=base.segments,
+                               pressures_kpa=base.pressures_kpa, sphere_mm=d, **options) for d in diam}
+    val = _validate(base, sphere_mm=diam[0] if diam else 200.0) if validate else None
+    return MujocoExport(base, spheres, val)
