@@ -36,7 +36,7 @@ from bendpam.errors import InputError
 from bendpam.export.mjcf import MujocoModel, mujoco_model
 from bendpam.sim.mujoco import PamController, import_mujoco
 
-__all__ = ["QVEL_TOL", "MujocoExport", "Validation", "mujoco", "validate"]
+__all__ = ["QVEL_TOL", "MujocoExport", "Validation", "mujoco", "pullout", "validate"]
 
 #: a quasi-static run has settled when every hinge turns slower than this, rad/s
 QVEL_TOL = 1e-6
@@ -217,9 +217,21 @@ def _sphere_force_n(run: _Run, sphere: int) -> float:
     return fz
 
 
-def _pullout_run(exported: MujocoModel, diameter_mm: float, P: float) -> dict[str, Any]:
+def pullout(exported: MujocoModel, diameter_mm: float, pressure_kpa: float) -> dict[str, Any]:
+    """The pull-out of a sphere (mm) at a pressure (kPa) in MuJoCo, beside :func:`bendpam.design.grasp.solve_grasp`.
+
+    ``exported`` is a gripper export; the sphere is fixed where the open gripper lands on it.  Returns
+    the grip forces of both (N), MuJoCo's closed force and peak lift, bendpam's, and ``error_pct``.
+
+    >>> import bendpam                                                                  # doctest: +SKIP
+    >>> gripper = mujoco_model(bendpam.physics.presets.be_pam().replace(L0_mm=130.0), "gripper")  # doctest: +SKIP
+    >>> abs(pullout(gripper, 200.0, 160.0)["error_pct"]) < 5.0                          # doctest: +SKIP
+    True
+    """
     gr = exported.gripper
-    assert gr is not None
+    if gr is None:
+        raise InputError("a pull-out needs a gripper export (device 'gripper')")
+    P = float(pressure_kpa)
     ref = solve_grasp(gr, diameter_mm, P)
     ex = mujoco_model(exported.actuator, "gripper", law_model=exported.law_model, segments=exported.segments,
                       pressures_kpa=exported.pressures_kpa, sphere_mm=diameter_mm, gripper=gr)
@@ -288,7 +300,7 @@ def validate(exported: MujocoModel, *, pressures_kpa=None, tip_force_n=None, sph
     free_err = max((r["tip_error_pct_of_length"] for r in free), default=math.nan)
     pull, pull_err = None, None
     if exported.device == "gripper":
-        pull = _pullout_run(exported, sphere_mm, p_top if pullout_pressure_kpa is None else pullout_pressure_kpa)
+        pull = pullout(exported, sphere_mm, p_top if pullout_pressure_kpa is None else pullout_pressure_kpa)
         pull_err = pull["error_pct"]
     return Validation(free, free_err, loaded, loaded["tip_error_pct_of_length"], pull, pull_err, notes)
 
