@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-mujoco = pytest.importorskip("mujoco", reason="MuJoCo's Python bindings are not installed (pip install bendpam[mujoco])")
+mujoco = pytest.importorskip("mujoco", reason="MuJoCo's bindings are not installed (pip install bendpam[mujoco])")
 
 import bendpam  # noqa: E402
 from bendpam.cli import main  # noqa: E402

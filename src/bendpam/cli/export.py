@@ -101,7 +101,8 @@ def mujoco_cmd(
 
 def _print_summary(s: dict[str, Any]) -> None:
     typer.echo(f"{s['device']} of {s['actuator']} ({s['model'].replace('_', '-')} model), L0 = {s['L0_mm']:g} mm: "
-               f"{s['segments']} hinges of {s['segment_length_mm']:g} mm, {s['mass_per_actuator_g']:.1f} g per actuator, "
+               f"{s['segments']} hinges of {s['segment_length_mm']:g} mm, {s['mass_per_actuator_g']:.1f} g per "
+               "actuator, "
                f"time step {s['timestep_s']:g} s")
     typer.echo(f"discretisation: free-shape tip error {s['discretisation_tip_error_pct_of_length']:.3f} % of L0 "
                f"over {', '.join(f'{p:g}' for p in s['pressures_kpa'])} kPa")

@@ -41,7 +41,6 @@ import numpy as np
 
 from bendpam.design.finger import Finger, free_tip_trajectory
 from bendpam.design.gripper import Gripper
-from bendpam.design.rod import sinc
 from bendpam.errors import InputError
 from bendpam.physics.actuator import Actuator, bladder_area_mm2
 from bendpam.physics.law import MomentLaw
@@ -74,7 +73,7 @@ class Densities:
     --------
     >>> import bendpam
     >>> round(Densities().mass_per_length_g_per_mm(bendpam.physics.presets.be_pam()), 4)   # g/mm
-    0.1348
+    0.1413
     """
 
     bladder_kg_m3: float = 1100.0
@@ -174,10 +173,10 @@ def chain_tip_xy(finger: Finger, curvature_per_mm, segments: int) -> np.ndarray:
     """
     n = int(segments)
     h = finger.length / n
-    k = np.broadcast_to(np.asarray(curvature_per_mm, dtype=float), np.shape(curvature_per_mm)[:-1] + (n,)) \
+    k = np.broadcast_to(np.asarray(curvature_per_mm, dtype=float), (*np.shape(curvature_per_mm)[:-1], n)) \
         if np.ndim(curvature_per_mm) else np.full(n, float(curvature_per_mm))
     th = finger.frame_side * k * h  # hinge angles, rad
-    phi = finger.base_angle + np.concatenate([np.zeros(th.shape[:-1] + (1,)), np.cumsum(th, axis=-1)], axis=-1)
+    phi = finger.base_angle + np.concatenate([np.zeros((*th.shape[:-1], 1)), np.cumsum(th, axis=-1)], axis=-1)
     lengths = np.full(n + 1, h)
     lengths[[0, -1]] = 0.5 * h
     x = finger.base_xy_mm[0] + np.sum(lengths * np.cos(phi), axis=-1)
@@ -196,7 +195,7 @@ def default_pressures_kpa(actuator: Actuator, law_model: str | None = None, coun
 
     >>> import bendpam
     >>> default_pressures_kpa(bendpam.physics.presets.bc_pam()).round(1).tolist()     # the fold at 134.2 kPa
-    [40.0, 71.9, 103.7, 135.6, 167.5]
+    [40.0, 61.9, 83.7, 105.6, 127.5]
     """
     law = MomentLaw.of(actuator, law_model)
     tested = getattr(actuator, "tested_pressure_kpa", None)
@@ -282,7 +281,7 @@ class _Chain:
         self.r_out = a.R0_mm + a.braid_thickness_mm
         self.b, self.c = finger.bend, finger.frame_side
         self.off = contact_offset_mm
-        self.depth = 2.0 * float(a.R0_start_mm)  # contact box thickness: one tube diameter
+        self.depth = 2.0 * float(a.params.R0_start)  # contact box thickness: one tube diameter
         self.mu = mu
         self.pad_mass_g = (dens.pad_kg_m3 * 1e-6 * finger.fingertip_mm * 2.0 * self.r_out * dens.pad_thickness_mm)
         self.pad_t = dens.pad_thickness_mm
@@ -323,7 +322,7 @@ class _Chain:
                           size=_fmt(0.5 * ell * _MM, r * _MM, 0.5 * self.depth * _MM),
                           **(self._contact() | {"rgba": "0.3 0.3 0.3 1"}))
 
-    def _contact(self) -> dict[str, str]:
+    def _contact(self) -> dict[str, Any]:
         return {"contype": "1", "conaffinity": "2", "condim": "3", "friction": _fmt(self.mu, 0.005, 0.0001),
                 "mass": "0", "rgba": "0.85 0.55 0.2 1"}
 
@@ -408,7 +407,7 @@ def mujoco_model(actuator: Actuator, device: str = "finger", *, law_model: str |
     root = _root_element(actuator, device, n, dt)
     names = _write_device(root, chain, f, gr, sphere_mm)
     xml = ET.tostring(root, encoding="unicode")
-    return MujocoModel(xml=xml, device=device, actuator=actuator, law_model=f.model, segments=n, chains=names,
+    return MujocoModel(xml=xml, device=device, actuator=actuator, law_model=str(f.model), segments=n, chains=names,
                        finger=f, gripper=gr, sphere_mm=sphere_mm, pressures_kpa=tuple(float(p) for p in P),
                        discretisation_tip_error_pct_of_length=err, mass_g=chain.mass_g, timestep_s=dt)
 
@@ -460,6 +459,7 @@ def _write_device(root: ET.Element, chain: _Chain, f: Finger, gr: Gripper | None
     ET.SubElement(default, "joint", damping=_fmt(_damping(chain)), armature="0")
     world = ET.SubElement(root, "worldbody")
     ET.SubElement(world, "light", pos="0 0 1", dir="0 0 -1", directional="true")
+    names: tuple[str, ...]
     if gr is None:
         names = ("pam0",)
         x0, y0 = f.base_xy_mm

@@ -49,13 +49,13 @@ _PREFIX = "bendpam:"
 def import_mujoco():
     """The ``mujoco`` module, or one line saying how to install it.
 
-    >>> import_mujoco().__name__        # doctest: +SKIP
+    >>> import_mujoco().__name__
     'mujoco'
     """
     try:
         import mujoco
     except ImportError:
-        raise InputError("MuJoCo is not installed: pip install \"bendpam[mujoco]\" (MuJoCo's Python bindings)") from None
+        raise InputError("MuJoCo is not installed: pip install \"bendpam[mujoco]\" (MuJoCo's bindings)") from None
     return mujoco
 
 
@@ -109,7 +109,7 @@ def chains_of(model) -> list[PamChain]:
         side = _PREFIX + chain + ":frame_side"
         if side not in names:
             raise InputError(f"the model has {nm} but no {side}: not a bendpam export")
-        c = int(round(float(model.numeric(side).data[0])))
+        c = round(float(model.numeric(side).data[0]))
         dofs, qpos = [], []
         j = 1
         while True:
@@ -223,12 +223,14 @@ class PamController:
 
     Examples
     --------
-    >>> import bendpam, mujoco                                        # doctest: +SKIP
-    >>> from bendpam.export import mujoco_model                     # doctest: +SKIP
-    >>> xml = mujoco_model(bendpam.physics.presets.be_pam(), "finger", segments=8).xml   # doctest: +SKIP
-    >>> m = mujoco.MjModel.from_xml_string(xml); d = mujoco.MjData(m)                   # doctest: +SKIP
-    >>> ctl = PamController(m, bendpam.physics.presets.be_pam())      # doctest: +SKIP
-    >>> ctl.set_pressure_kpa(150.0); ctl.step(m, d, 2000)             # doctest: +SKIP
+    >>> import bendpam, mujoco
+    >>> from bendpam.export import mujoco_model
+    >>> xml = mujoco_model(bendpam.physics.presets.be_pam(), "finger", segments=8).xml
+    >>> m = mujoco.MjModel.from_xml_string(xml); d = mujoco.MjData(m)
+    >>> ctl = PamController(m, bendpam.physics.presets.be_pam())
+    >>> ctl.set_pressure_kpa(150.0); ctl.step(m, d, 100)             # 5 ms of a step to 150 kPa
+    >>> [c.name for c in ctl.chains], ctl.curvature_per_mm(d).shape
+    (['pam0'], (8,))
     """
 
     def __init__(self, model, actuators, *, law_model: str | None = None, loop=None):
@@ -278,10 +280,13 @@ class PamController:
     def set_pressure_kpa(self, pressure_kpa) -> None:
         """Set the pressure of every chain (a scalar for all, or one per chain), kPa; checked like every pressure.
 
-        >>> ctl = PamController.__new__(PamController)
-        >>> ctl.chains, ctl._max_p, ctl.pressure_kpa = [None, None], np.array([2000.0, 2000.0]), np.zeros(2)
-        >>> ctl.set_pressure_kpa([100.0, 150.0]); ctl.pressure_kpa.tolist()
-        [100.0, 150.0]
+        >>> import bendpam, mujoco
+        >>> from bendpam.export import mujoco_model
+        >>> act = bendpam.physics.presets.be_pam().replace(L0_mm=130.0)
+        >>> m = mujoco.MjModel.from_xml_string(mujoco_model(act, "gripper", segments=4).xml)
+        >>> ctl = PamController(m, act)
+        >>> ctl.set_pressure_kpa([100.0, 150.0, 200.0]); ctl.pressure_kpa.tolist()
+        [100.0, 150.0, 200.0]
         """
         p = float_array("pressure_kpa", pressure_kpa, "kPa")
         if p.ndim > 1 or p.size not in (1, len(self.chains)):
