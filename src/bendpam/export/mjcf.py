@@ -220,16 +220,12 @@ def segments_for(finger: Finger, pressures_kpa, tip_error_pct: float = 1.0) -> t
     (8, True)
     """
     target = number("tip_error_pct", tip_error_pct, 0.0, 50.0, lo_open=True, unit="% of L0")
-    free = free_tip_trajectory(finger, pressures_kpa)
-    ok = np.isfinite(free["free_curvature_per_mm"].to_numpy())
-    if not np.any(ok):
+    k, exact = _free_tips(finger, pressures_kpa)
+    if not k.size:
         raise InputError("no pressure of the export has a free shape (all above the fold): give lower pressures")
-    k = free["free_curvature_per_mm"].to_numpy()[ok]
-    exact = np.stack([free["tip_x_mm"].to_numpy()[ok], free["tip_y_mm"].to_numpy()[ok]], -1)
     err = math.inf
     for n in range(2, _SEGMENTS_MAX + 1):
-        tip = chain_tip_xy(finger, np.repeat(k[:, None], n, axis=1), n)
-        err = float(np.max(np.hypot(*(tip - exact).T))) / finger.length * 100.0
+        err = _free_error_pct(finger, k, exact, n)
         if err <= 0.5 * target:
             return n, err
     return _SEGMENTS_MAX, err
@@ -390,14 +386,13 @@ def mujoco_model(actuator: Actuator, device: str = "finger", *, law_model: str |
         f = finger or Finger(actuator, law_model)
     P = default_pressures_kpa(actuator, f.model) if pressures_kpa is None else np.atleast_1d(
         np.asarray(pressures_kpa, dtype=float))
-    est_n, est_err = segments_for(f, P, tip_error_pct)
     if segments is None:
-        n, err = est_n, est_err
+        n, err = segments_for(f, P, tip_error_pct)
     else:
         if isinstance(segments, bool) or not isinstance(segments, int | np.integer) or not 2 <= segments <= 200:
             raise InputError(f"segments = {segments!r} is outside the allowed range [2, 200] (an integer)")
         n = int(segments)
-        err = _free_error_pct(f, P, n)
+        err = _free_error_pct(f, *_free_tips(f, P), n)
     if sphere_mm is not None:
         sphere_mm = number("sphere_mm", sphere_mm, 0.0, 1e4, lo_open=True, unit="mm")
     offset = gr.contact_offset_mm if gr is not None else Gripper(actuator, f.model).contact_offset_mm
@@ -412,13 +407,20 @@ def mujoco_model(actuator: Actuator, device: str = "finger", *, law_model: str |
                        discretisation_tip_error_pct_of_length=err, mass_g=chain.mass_g, timestep_s=dt)
 
 
-def _free_error_pct(f: Finger, P, n: int) -> float:
+def _free_tips(f: Finger, P) -> tuple[np.ndarray, np.ndarray]:
+    """The free curvatures (1/mm) and bendpam's free fingertip points (mm) at the pressures with a free shape."""
     free = free_tip_trajectory(f, P)
     ok = np.isfinite(free["free_curvature_per_mm"].to_numpy())
-    k = free["free_curvature_per_mm"].to_numpy()[ok]
     exact = np.stack([free["tip_x_mm"].to_numpy()[ok], free["tip_y_mm"].to_numpy()[ok]], -1)
+    return free["free_curvature_per_mm"].to_numpy()[ok], exact
+
+
+def _free_error_pct(f: Finger, k: np.ndarray, exact: np.ndarray, n: int) -> float:
+    """The largest distance between the n-hinge chain's free tips and bendpam's, % of L0 (NaN without any)."""
+    if not k.size:
+        return math.nan
     tip = chain_tip_xy(f, np.repeat(k[:, None], n, axis=1), n)
-    return float(np.max(np.hypot(*(tip - exact).T))) / f.length * 100.0 if k.size else math.nan
+    return float(np.max(np.hypot(*(tip - exact).T))) / f.length * 100.0
 
 
 def _timestep_s(f: Finger, chain: _Chain, P) -> float:
