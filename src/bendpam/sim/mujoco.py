@@ -179,27 +179,31 @@ class HingeTable:
         # p(t) = ((c0 t + c1) t + c2) t + c3 on t in [0, 1]
         c0 = 2.0 * (y0 - y1) + d0 + d1
         c1 = 3.0 * (y1 - y0) - 2.0 * d0 - d1
-        self._coef = np.ascontiguousarray(np.stack([c0, c1, d0, y0], 1))  # (n - 1, 4, 2)
+        coef = np.stack([c0, c1, d0, y0], 1)  # (n - 1, 4, 2)
+        self._cA = np.ascontiguousarray(coef[:, :, 0])
+        self._cB = np.ascontiguousarray(coef[:, :, 1])
         self._inv_dk = 1.0 / dk
         self._last = float(n - 1) - 1e-9
         km = 0.5 * (k[1:] + k[:-1])
         Ae, Be, _, _ = self.table.derivatives(km)
-        v = self._eval(km)
         scale = 500.0 * np.abs(Ae) + np.abs(Be) + 1e-300
-        self.max_rel_error = float(np.max((500.0 * np.abs(v[:, 0] - Ae) + np.abs(v[:, 1] - Be)) / scale))
-
-    def _eval(self, k: np.ndarray) -> np.ndarray:
-        u = (k - self.k_min) * self._inv_dk
-        np.clip(u, 0.0, self._last, out=u)
-        j = u.astype(np.intp)
-        t = (u - j)[:, None]
-        c = self._coef[j]
-        return ((c[:, 0] * t + c[:, 1]) * t + c[:, 2]) * t + c[:, 3]
+        ones = np.ones_like(km)
+        err_a = np.abs(self.moment_nmm(ones, km) - self.moment_nmm(0.0 * ones, km) - Ae)
+        err_b = np.abs(-self.moment_nmm(0.0 * ones, km) - Be)
+        self.max_rel_error = float(np.max((500.0 * err_a + err_b) / scale))
 
     def moment_nmm(self, active_pressure_kpa: np.ndarray, curvature_per_mm: np.ndarray) -> np.ndarray:
-        """``M = P_a A(k') - B(k')`` (N*mm) for 1-D float arrays of active pressure (kPa) and curvature (1/mm)."""
-        v = self._eval(curvature_per_mm)
-        return active_pressure_kpa * v[:, 0] - v[:, 1]
+        """``M = P_a A(k') - B(k')`` (N*mm) for 1-D float arrays of active pressure (kPa) and curvature (1/mm).
+
+        The interval's two cubics are combined with the pressure first (``P_a c_A - c_B``), then one
+        Horner evaluation gives ``M``.
+        """
+        u = (curvature_per_mm - self.k_min) * self._inv_dk
+        np.clip(u, 0.0, self._last, out=u)
+        j = u.astype(np.intp)
+        u -= j
+        w = active_pressure_kpa[:, None] * self._cA[j] - self._cB[j]
+        return ((w[:, 0] * u + w[:, 1]) * u + w[:, 2]) * u + w[:, 3]
 
 
 class PamController:
