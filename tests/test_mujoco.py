@@ -120,6 +120,20 @@ def test_sphere_models_and_refusals(tmp_path, capsys):
     assert not (tmp_path / "x").exists()
 
 
+def test_a_fitted_loop_goes_into_the_exported_actuator_file(tmp_path, capsys):
+    loop = LoopModel(a0_nmm=1.5, a1_nmm_per_kpa=0.02, theta_h_deg=8.0)
+    src = tmp_path / "fit.toml"
+    src.write_text(BE.to_toml() + "\n[hysteresis]\na0_nmm = 1.5\na1_nmm_per_kpa = 0.02\ntheta_h_deg = 8.0\n")
+    out = tmp_path / "exp"
+    assert main(["export", "mujoco", "--actuator", str(src), "--no-validate", "--segments", "4",
+                 "--out", str(out), "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["hysteresis"]["a0_nmm"] == 1.5 and "validation" not in summary
+    assert LoopModel.from_toml(out / "actuator.toml") == loop
+    m = mujoco.MjModel.from_xml_path(str(out / "finger.xml"))
+    assert m.njnt == 4
+
+
 def test_docs_simulation_block_runs(tmp_path, monkeypatch):
     """The page's own-simulation block runs as written (the pull-out block is the test above at one pressure)."""
     monkeypatch.chdir(tmp_path)

@@ -86,8 +86,13 @@ def mujoco_cmd(
     if D and device != "gripper":
         raise UserError("--spheres: the spheres are objects of the gripper's grasp tests; give --device gripper")
     P = pressures_kpa(pressure_kpa, None) if pressure_kpa else None
+    loop = None
+    if actuator is not None:  # a fit's [hysteresis] table goes along, for the simulation
+        from bendpam.physics.hysteresis import LoopModel
+
+        loop = LoopModel.from_toml(actuator)
     res = mujoco(act, device, law_model=model_for(act, model), segments=segments, tip_error_pct=tip_error_pct,
-                 pressures_kpa=P, spheres_mm=D, validate=validate)
+                 pressures_kpa=P, spheres_mm=D, validate=validate, loop=loop)
     summary = res.to_dict()
     with output_set(out, [actuator]) as o:
         for name, text in res.files().items():

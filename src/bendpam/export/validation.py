@@ -34,6 +34,7 @@ from bendpam.design.finger import FingerLoads, free_tip_trajectory, solve_finger
 from bendpam.design.grasp import solve_grasp
 from bendpam.errors import InputError
 from bendpam.export.mjcf import MujocoModel, mujoco_model
+from bendpam.physics.hysteresis import LoopModel
 from bendpam.sim.mujoco import PamController, import_mujoco
 
 __all__ = ["QVEL_TOL", "MujocoExport", "Validation", "mujoco", "pullout", "validate"]
@@ -332,11 +333,14 @@ class MujocoExport:
     model: MujocoModel
     sphere_models: dict[float, MujocoModel]
     validation: Validation | None
+    loop: LoopModel | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """The model's description, its files and the validation figures (``export.json``), JSON-ready."""
         d = self.model.to_dict() | {"spheres_mm": sorted(self.sphere_models),
                                     "files": [*sorted(self._models()), "actuator.toml", "export.json"]}
+        if self.loop is not None:
+            d["hysteresis"] = self.loop.to_dict()
         if self.validation is not None:
             d["validation"] = self.validation.to_dict()
         return d
@@ -348,9 +352,14 @@ class MujocoExport:
 
     def files(self) -> dict[str, str]:
         """Every file of the export by name: the MJCF models, ``actuator.toml`` and ``export.json``."""
+        import tomli_w
+
         from bendpam.infra.outputs import to_json
 
-        return self._models() | {"actuator.toml": self.model.actuator.to_toml(), "export.json": to_json(self.to_dict())}
+        toml = self.model.actuator.to_toml()
+        if self.loop is not None:  # the fitted loop, for PamController(..., loop=LoopModel.from_toml(...))
+            toml += "\n" + tomli_w.dumps({"hysteresis": self.loop.to_dict()})
+        return self._models() | {"actuator.toml": toml, "export.json": to_json(self.to_dict())}
 
     def save(self, folder, *, force: bool = False) -> list[str]:
         """Write :meth:`files` into ``folder`` as one output set (staged, swapped in whole, with a manifest)."""
@@ -365,13 +374,15 @@ class MujocoExport:
 
 def mujoco(actuator, device: str = "finger", *, law_model: str | None = None, segments: int | None = None,
            tip_error_pct: float = 1.0, pressures_kpa=None, spheres_mm=(), validate: bool = True,
-           **options: Any) -> MujocoExport:
+           loop: LoopModel | None = None, **options: Any) -> MujocoExport:
     """Export ``actuator``'s finger or gripper to MuJoCo: the models and, with ``validate``, the figures.
 
     The device's model is :func:`bendpam.export.mujoco_model` (``options`` go to it: ``gripper``,
     ``finger``, ``densities``); one more model per sphere of ``spheres_mm`` (mm, gripper only);
-    :func:`validate` checks the device against bendpam (the pull-out on the first sphere, or 200 mm).
-    ``.save(folder)`` writes the files.
+    :func:`validate` checks the device against bendpam (the pull-out on the first sphere, or 200 mm;
+    without the loop: bendpam's statics are the loop-free law).  ``loop``, a fitted hysteresis loop,
+    is written into ``actuator.toml`` beside the actuator for the simulation
+    (``PamController(model, actuator, loop=LoopModel.from_toml(path))``).  ``.save(folder)`` writes the files.
 
     Examples
     --------
@@ -387,4 +398,6 @@ def mujoco(actuator, device: str = "finger", *, law_model: str | None = None, se
     spheres = {d: mujoco_model(actuator, device, law_model=base.law_model, segments=base.segments,
                                pressures_kpa=base.pressures_kpa, sphere_mm=d, **options) for d in diam}
     val = _validate(base, sphere_mm=diam[0] if diam else 200.0) if validate else None
-    return MujocoExport(base, spheres, val)
+    if loop is not None and not isinstance(loop, LoopModel):
+        raise InputError(f"loop must be a bendpam.physics.hysteresis.LoopModel, got {type(loop).__name__}")
+    return MujocoExport(base, spheres, val, loop)
