@@ -4,7 +4,8 @@ For the paper's BE-PAM finger (8 hinges) and three-finger gripper (3 x 7 hinges,
 contact), at 150 kPa, the candidates are timed side by side (interleaved repeats, medians):
 
 * ``mj_step``: MuJoCo's step alone (the torques left as they are);
-* ``apply``: the law's torques for every hinge written into ``qfrc_applied`` (what a simulation adds);
+* ``apply``: the law's torques for every hinge written into ``qfrc_applied`` (what a simulation adds),
+  with the compiled engine (Numba) and with NumPy;
 * ``apply + mj_step``: one step of a simulation driven by bendpam.
 
 The overhead is ``apply`` against ``mj_step``; no target is asserted.  The gripper is settled on
@@ -19,9 +20,8 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).parent))
-from _timing import Recorder, compare, header
-
 import mujoco
+from _timing import Recorder, compare, header
 
 import bendpam
 from bendpam.export import mujoco_model
@@ -33,9 +33,11 @@ def _case(name: str, actuator, device: str, rec: Recorder, steps: int, repeats: 
     m = mujoco.MjModel.from_xml_string(ex.xml)
     d = mujoco.MjData(m)
     m.opt.gravity[:] = 0.0
-    ctl = PamController(m, actuator)
+    ctl = PamController(m, actuator, engine="numba")
     ctl.set_pressure_kpa(150.0)
     ctl.step(m, d, 2000)  # settle (the gripper onto the sphere)
+    slow = PamController(m, actuator, engine="numpy")
+    slow.set_pressure_kpa(150.0)
 
     def bare():
         for _ in range(steps):
@@ -45,20 +47,25 @@ def _case(name: str, actuator, device: str, rec: Recorder, steps: int, repeats: 
         for _ in range(steps):
             ctl.apply(d)
 
+    def apply_numpy():
+        for _ in range(steps):
+            slow.apply(d)
+
     def both():
         for _ in range(steps):
             ctl.apply(d)
             mujoco.mj_step(m, d)
 
-    st = compare({"mj_step": (bare, steps), "apply": (apply, steps), "apply + mj_step": (both, steps)},
-                 repeats=repeats)
+    st = compare({"mj_step": (bare, steps), "apply": (apply, steps), "apply (numpy)": (apply_numpy, steps),
+                  "apply + mj_step": (both, steps)}, repeats=repeats)
     us = {k: v.median / steps * 1e6 for k, v in st.items()}
     header(f"{name}: {len(ctl.chains)} chain(s), {ctl.dofs.size} hinges, {d.ncon} contacts")
     for k, v in us.items():
         print(f"  {k:16} {v:8.2f} us per step")
     print(f"  overhead of the law: {us['apply'] / us['mj_step']:.2f} x a bare mj_step")
     rec.record("per_step_us", name, us | {"hinges": int(ctl.dofs.size), "contacts": int(d.ncon)})
-    rec.row(f"{name}: apply per step", us["apply"], "us", "", None, f"bare mj_step {us['mj_step']:.1f} us")
+    rec.row(f"{name}: apply per step", us["apply"], "us", "", None,
+            f"bare mj_step {us['mj_step']:.1f} us, NumPy engine {us['apply (numpy)']:.1f} us")
 
 
 def main(quick: bool = False) -> None:

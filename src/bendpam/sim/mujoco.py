@@ -18,6 +18,11 @@ friction state ``z`` driven by its equivalent bending angle ``k'_j L0`` and the 
 ``c (M(P, k'_j) - A(P) z_j)``: the Prandtl-Ishlinskii stops or Dahl's law advanced exactly over
 each step's increment.
 
+Two engines give the same numbers: ``"numpy"`` (a dozen NumPy operations for all hinges at once)
+and ``"numba"`` (the same arithmetic in one compiled loop, when Numba is installed: the ``mujoco``
+extra brings it; compiled on the first step, about 2 s).  ``engine="auto"`` (default) takes Numba
+where it is installed.
+
 The pressure of each actuator is the control input (kPa, :meth:`PamController.set_pressure_kpa`):
 no pneumatic dynamics.  The chains, their segment lengths and frame sides are read from the
 model's ``<custom>`` numerics that the export writes (``bendpam:NAME:segment_length_mm``,
@@ -31,6 +36,7 @@ Units: kPa, mm, N*mm, 1/mm at the interface; radians for hinge angles (MuJoCo's 
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from typing import Any
 
@@ -41,7 +47,7 @@ from bendpam.physics.actuator import Actuator
 from bendpam.physics.law import MomentLaw
 from bendpam.validate import float_array
 
-__all__ = ["HingeTable", "PamChain", "PamController", "chains_of", "import_mujoco"]
+__all__ = ["ENGINES", "HingeTable", "PamChain", "PamController", "chains_of", "import_mujoco"]
 
 _PREFIX = "bendpam:"
 
@@ -220,6 +226,8 @@ class PamController:
         The model of the moment law (None: each actuator's own).
     loop : LoopModel or dict of name to LoopModel, optional
         A fitted hysteresis loop (linear amplitude), for all chains or per chain name.
+    engine : {"auto", "numpy", "numba"}
+        How the torques are evaluated (the same numbers): ``"auto"`` takes Numba where installed.
 
     Attributes
     ----------
@@ -237,7 +245,7 @@ class PamController:
     (['pam0'], (8,))
     """
 
-    def __init__(self, model, actuators, *, law_model: str | None = None, loop=None):
+    def __init__(self, model, actuators, *, law_model: str | None = None, loop=None, engine: str = "auto"):
         self.chains = chains_of(model)
         acts = self._per_chain("actuators", actuators, Actuator, required=True)
         loops = self._per_chain("loop", loop, None, required=False)
@@ -266,6 +274,8 @@ class PamController:
         self.pressure_kpa = np.zeros(len(self.chains))
         self._pa = np.zeros(self.dofs.size)  # active pressure of every hinge, kPa
         self._loop = _LoopState(acts, loops, self._chain_of_hinge, law_model) if any(loops) else None
+        self.engine = _engine(engine)
+        self._fast = _FastPath(self) if self.engine == "numba" else None
 
     def _per_chain(self, what: str, value, kind, required: bool) -> list:
         names = [c.name for c in self.chains]
@@ -313,6 +323,11 @@ class PamController:
 
         ``advance`` moves the hysteresis state to this state (done once per step by :meth:`apply`).
         """
+        if self._fast is not None:
+            M = self._fast.moments(data.qpos, self._pa)
+            if self._loop is not None:
+                M = M - self._loop.friction_nmm(self._pa, self.curvature_per_mm(data), advance)
+            return M
         k = self.curvature_per_mm(data)
         if len(self._groups) == 1:
             M = self._groups[0][0].moment_nmm(self._pa, k)
@@ -326,6 +341,9 @@ class PamController:
 
     def apply(self, data) -> None:
         """Write the hinge torques ``c M`` into ``data.qfrc_applied`` (N*m), before a ``mj_step``."""
+        if self._fast is not None and self._loop is None:
+            self._fast.apply(data.qpos, self._pa, data.qfrc_applied)
+            return
         data.qfrc_applied[self._dof_ix] = self._tau_scale * self.moments_nmm(data, advance=True)
 
     def step(self, model, data, nstep: int = 1) -> None:
@@ -334,6 +352,99 @@ class PamController:
         for _ in range(int(nstep)):
             self.apply(data)
             mujoco.mj_step(model, data)
+
+
+#: the ways :class:`PamController` evaluates the torques (the same numbers)
+ENGINES = ("auto", "numpy", "numba")
+
+
+def _engine(name: str) -> str:
+    """``"numba"`` where asked for (or ``"auto"`` and Numba is installed), else ``"numpy"``."""
+    if name not in ENGINES:
+        raise InputError(f"engine = {name!r} is not known; choose one of {', '.join(ENGINES)}")
+    if name == "numpy":
+        return name
+    if _kernels() is None:
+        if name == "numba":
+            raise InputError("engine 'numba' needs Numba: pip install \"bendpam[mujoco]\"")
+        return "numpy"
+    return "numba"
+
+
+@functools.cache
+def _kernels():
+    """The compiled per-step kernels (Numba, compiled on first use), or None without Numba."""
+    try:
+        import numba
+    except ImportError:
+        return None
+
+    @numba.njit(cache=False, nogil=True)
+    def moments(qpos, qadr, c_over_h, k0, inv_dk, last, off, cA, cB, pa, out):  # pragma: no cover - compiled
+        for i in range(qadr.size):
+            u = (c_over_h[i] * qpos[qadr[i]] - k0[i]) * inv_dk[i]
+            u = min(max(u, 0.0), last[i])
+            j = int(u)
+            t = u - j
+            j += off[i]
+            p = pa[i]
+            w0 = p * cA[j, 0] - cB[j, 0]
+            w1 = p * cA[j, 1] - cB[j, 1]
+            w2 = p * cA[j, 2] - cB[j, 2]
+            w3 = p * cA[j, 3] - cB[j, 3]
+            out[i] = ((w0 * t + w1) * t + w2) * t + w3
+
+    @numba.njit(cache=False, nogil=True)
+    def apply(qpos, qadr, dadr, c_over_h, k0, inv_dk, last, off, cA, cB, pa, scale, qfrc):  # pragma: no cover
+        for i in range(qadr.size):
+            u = (c_over_h[i] * qpos[qadr[i]] - k0[i]) * inv_dk[i]
+            u = min(max(u, 0.0), last[i])
+            j = int(u)
+            t = u - j
+            j += off[i]
+            p = pa[i]
+            w0 = p * cA[j, 0] - cB[j, 0]
+            w1 = p * cA[j, 1] - cB[j, 1]
+            w2 = p * cA[j, 2] - cB[j, 2]
+            w3 = p * cA[j, 3] - cB[j, 3]
+            qfrc[dadr[i]] = scale[i] * (((w0 * t + w1) * t + w2) * t + w3)
+
+    return moments, apply
+
+
+class _FastPath:
+    """Every hinge of a controller in one compiled loop: the :class:`HingeTable` arithmetic, tables concatenated."""
+
+    def __init__(self, ctl: PamController):
+        kern = _kernels()
+        assert kern is not None
+        self._moments, self._apply = kern
+        nh = ctl.dofs.size
+        self.qadr = np.ascontiguousarray(ctl.qpos, dtype=np.int64)
+        self.dadr = np.ascontiguousarray(ctl.dofs, dtype=np.int64)
+        self.c_over_h = np.ascontiguousarray(ctl._c_over_h)
+        self.scale = np.ascontiguousarray(ctl._tau_scale)
+        self.k0, self.inv_dk, self.last = np.empty(nh), np.empty(nh), np.empty(nh)
+        self.off = np.empty(nh, dtype=np.int64)
+        cA, cB, start = [], [], 0
+        for table, sel in ctl._groups:
+            ix = slice(None) if sel is None else sel
+            self.k0[ix], self.inv_dk[ix], self.last[ix] = table.k_min, table._inv_dk, table._last
+            self.off[ix] = start
+            cA.append(table._cA)
+            cB.append(table._cB)
+            start += table._cA.shape[0]
+        self.cA, self.cB = np.ascontiguousarray(np.concatenate(cA)), np.ascontiguousarray(np.concatenate(cB))
+        self.out = np.empty(nh)
+
+    def moments(self, qpos, pa) -> np.ndarray:
+        self._moments(qpos, self.qadr, self.c_over_h, self.k0, self.inv_dk, self.last, self.off, self.cA, self.cB,
+                      pa, self.out)
+        return self.out.copy()
+
+    def apply(self, qpos, pa, qfrc) -> None:
+        self._apply(qpos, self.qadr, self.dadr, self.c_over_h, self.k0, self.inv_dk, self.last, self.off, self.cA,
+                    self.cB, pa, self.scale, qfrc)
 
 
 def _as_slice(ix: np.ndarray):
