@@ -119,8 +119,8 @@ def _print_summary(s: dict[str, Any]) -> None:
                f"{v['loaded_tip_error_pct_of_length']:.3f} % of L0")
     pull = v.get("pullout")
     if pull:
+        err = "no grip in bendpam" if pull["error_pct"] is None else f"{pull['error_pct']:+.2f} %"
         typer.echo(f"pull-out of a {pull['diameter_mm']:g} mm sphere at {pull['pressure_kpa']:g} kPa: MuJoCo "
-                   f"{pull['mujoco_grip_force_n']:.3f} N, bendpam {pull['bendpam_grip_force_n']:.3f} N "
-                   f"({pull['error_pct']:+.2f} %)")
+                   f"{pull['mujoco_grip_force_n']:.3f} N, bendpam {pull['bendpam_grip_force_n']:.3f} N ({err})")
     for note in v.get("notes") or []:
         typer.echo(f"note: {note}")
