@@ -119,9 +119,11 @@ def test_export_finger_cli_writes_a_loadable_model_and_its_validation(tmp_path, 
     assert bendpam.Actuator.from_toml(out / "actuator.toml") == BE
 
 
-def test_gripper_validation_and_pullout_within_five_percent():
+def test_gripper_validation_and_pullout_within_five_percent(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
     ex = mujoco_model(BE.replace(L0_mm=130.0), "gripper")
     v = validate(ex, pressures_kpa=[120.0, 160.0], sphere_mm=200.0, pullout_pressure_kpa=160.0)
+    assert list(tmp_path.iterdir()) == [] and v.notes == []  # no MUJOCO_LOG.TXT, no warning
     assert v.free_shape_tip_error_pct_of_length <= 1.0
     assert v.loaded_tip_error_pct_of_length <= 1.0
     assert v.pullout is not None and v.pullout["bendpam_contact"] == "tip"

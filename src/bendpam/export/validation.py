@@ -24,7 +24,9 @@ bendpam's grip force.
 
 from __future__ import annotations
 
+import contextlib
 import math
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -141,6 +143,19 @@ class _Run:
         return self.d.site_xpos[mj.mj_name2id(self.m, mj.mjtObj.mjOBJ_SITE, name)] * 1e3
 
 
+@contextlib.contextmanager
+def _mujoco_warnings() -> Iterator[list[str]]:
+    """Collect MuJoCo's warnings (for the notes) instead of letting it write MUJOCO_LOG.TXT in the working folder."""
+    mj = import_mujoco()
+    old = mj.get_mju_user_warning()
+    seen: list[str] = []
+    mj.set_mju_user_warning(lambda msg: seen.append(" ".join(str(msg).split())))
+    try:
+        yield seen
+    finally:
+        mj.set_mju_user_warning(old)
+
+
 def _tip_error(tip_mm: np.ndarray, exact_xy, L: float) -> float:
     return float(math.hypot(tip_mm[0] - exact_xy[0], tip_mm[2] - exact_xy[1])) / L * 100.0
 
@@ -233,7 +248,12 @@ def pullout(exported: MujocoModel, diameter_mm: float, pressure_kpa: float) -> d
     gr = exported.gripper
     if gr is None:
         raise InputError("a pull-out needs a gripper export (device 'gripper')")
-    P = float(pressure_kpa)
+    with _mujoco_warnings() as warned:
+        out = _pullout(exported, gr, float(diameter_mm), float(pressure_kpa))
+    return out | {"mujoco_warnings": sorted(set(warned))}
+
+
+def _pullout(exported: MujocoModel, gr, diameter_mm: float, P: float) -> dict[str, Any]:
     ref = solve_grasp(gr, diameter_mm, P)
     ex = mujoco_model(exported.actuator, "gripper", law_model=exported.law_model, segments=exported.segments,
                       pressures_kpa=exported.pressures_kpa, sphere_mm=diameter_mm, gripper=gr)
@@ -293,12 +313,14 @@ def validate(exported: MujocoModel, *, pressures_kpa=None, tip_force_n=None, sph
     if exported.device != "finger":
         single = mujoco_model(exported.actuator, "finger", law_model=exported.law_model, segments=exported.segments,
                               pressures_kpa=exported.pressures_kpa, finger=exported.finger)
-    run = _Run(single)
-    free = _free_runs(run, single, P)
+    with _mujoco_warnings() as warned:
+        run = _Run(single)
+        free = _free_runs(run, single, P)
+        if free:
+            loaded = _loaded_run(run, single, max(r["pressure_kpa"] for r in free), tip_force_n)
     if not free:
         raise InputError("no pressure of the validation has a free shape (all above the fold): give lower pressures")
-    p_top = max(r["pressure_kpa"] for r in free)  # the highest pressure with a free shape
-    loaded = _loaded_run(run, single, p_top, tip_force_n)
+    p_top = max(r["pressure_kpa"] for r in free)  # the highest pressure with a free shape (the loaded run's)
     notes = [f"the run at {r['pressure_kpa']:g} kPa did not settle to |qvel| < {QVEL_TOL:g} rad/s"
              for r in [*free, loaded] if not r["settled"]]
     notes += [f"the {name} tip error {err:.3g} % of L0 is above 1 %" for name, err in (
@@ -309,9 +331,11 @@ def validate(exported: MujocoModel, *, pressures_kpa=None, tip_force_n=None, sph
     if exported.device == "gripper":
         pull = pullout(exported, sphere_mm, p_top if pullout_pressure_kpa is None else pullout_pressure_kpa)
         pull_err = pull["error_pct"]
+        warned += pull["mujoco_warnings"]
         if pull_err is not None and abs(pull_err) > 5.0:
             notes.append(f"MuJoCo's pull-out force differs from bendpam's by {pull_err:+.3g} % (more than 5 %): "
                          "MuJoCo's soft friction lets the fingertip creep along the sphere before it slips")
+    notes += [f"MuJoCo warned: {w}" for w in sorted(set(warned))]
     return Validation(free, free_err, loaded, loaded["tip_error_pct_of_length"], pull, pull_err, notes)
 
 
