@@ -350,8 +350,8 @@ RANKS = {
     "bendpam.errors": 0, "bendpam.validate": 0, "bendpam.version": 0,
     "bendpam.infra": 0.5,
     "bendpam.physics": 1,
-    "bendpam.predict": 2, "bendpam.sweeps": 2, "bendpam.sweep_store": 2,
-    "bendpam.lab": 3, "bendpam.identify": 3, "bendpam.design": 3,
+    "bendpam.predict": 2, "bendpam.sweeps": 2, "bendpam.sweep_store": 2, "bendpam.sim": 2,
+    "bendpam.lab": 3, "bendpam.identify": 3, "bendpam.design": 3, "bendpam.export": 3,
     "bendpam.present": 4,
     "bendpam.cli": 5,
     "bendpam": 6,  # the facade (bendpam/__init__.py) re-exports from every layer

@@ -37,6 +37,15 @@ EXTRA_COMMANDS: tuple[str, ...] = (
     "bendpam curve --actuator be.toml --pressure-kpa 100 150 200 --out curves.png",
 )
 
+#: Pages whose first ```python block draws figures: the block runs in its own empty folder (after the
+#: walkthrough) and these files of that folder are published with the site under the same names.
+PAGE_FIGURES: dict[Path, tuple[str, ...]] = {
+    ROOT / "docs" / "mujoco.md": ("mujoco-grip.png",),  # needs the mujoco extra
+}
+
+#: A ```python code block of a Markdown page (its body is group 1).
+PYTHON_BLOCK = re.compile(r"^```python\n(.*?)^```\n", re.MULTILINE | re.DOTALL)
+
 #: Files of the walkthrough folder published with the site: name on the site <- path in the folder.
 FIGURES: dict[str, str] = {
     "curves.png": "curves.png",
@@ -148,6 +157,28 @@ def run_commands(commands: list[str], folder: Path) -> list[dict]:
     return results
 
 
+def run_page_figures(out_dir: Path) -> list[str]:
+    """Run the first ```python block of each page of :data:`PAGE_FIGURES` and copy its figures to ``out_dir``."""
+    os.environ.setdefault("MPLBACKEND", "Agg")
+    names: list[str] = []
+    here = Path.cwd()
+    for page, files in PAGE_FIGURES.items():
+        block = PYTHON_BLOCK.search(page.read_text(encoding="utf-8"))
+        if block is None:
+            raise RuntimeError(f"{page.name} has no ```python block to draw {', '.join(files)}")
+        with tempfile.TemporaryDirectory(prefix="bendpam-page-") as tmp:
+            os.chdir(tmp)
+            try:
+                with contextlib.redirect_stdout(io.StringIO()):
+                    exec(compile(block.group(1), str(page), "exec"), {"__name__": "__docs__"})
+            finally:
+                os.chdir(here)
+            for name in files:
+                shutil.copyfile(Path(tmp) / name, out_dir / name)
+                names.append(name)
+    return names
+
+
 def generate(out_dir: Path) -> dict:
     """Run the walkthrough and the extra commands; write the figures and ``outputs.json`` to ``out_dir``."""
     out_dir = Path(out_dir)
@@ -158,7 +189,9 @@ def generate(out_dir: Path) -> dict:
         results = run_commands([*walkthrough_commands(), *EXTRA_COMMANDS], folder)
         for name, rel in FIGURES.items():
             shutil.copyfile(folder / rel, out_dir / name)
-    record = {"commands": results, "files": sorted(FIGURES), "seconds": round(time.perf_counter() - t0, 1)}
+    page_files = run_page_figures(out_dir)
+    record = {"commands": results, "files": sorted([*FIGURES, *page_files]),
+              "seconds": round(time.perf_counter() - t0, 1)}
     (out_dir / "outputs.json").write_text(json.dumps(record, indent=1), encoding="utf-8")
     return record
 

@@ -101,7 +101,7 @@ def on_config(config, **kwargs):
 def _sources_key() -> str:
     h = hashlib.sha256()
     paths = sorted((ROOT / "src").rglob("*.py"))
-    paths += [docs_figures.SCRIPT, Path(docs_figures.__file__)]
+    paths += [docs_figures.SCRIPT, Path(docs_figures.__file__), *docs_figures.PAGE_FIGURES]
     for p in paths:
         h.update(str(p.relative_to(ROOT)).encode())
         h.update(p.read_bytes())

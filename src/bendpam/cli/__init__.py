@@ -8,12 +8,13 @@
 * :mod:`.sweep`: ``sweep``;
 * :mod:`.design`: ``finger``, ``grasp``, ``wrist``;
 * :mod:`.inverse`: ``design`` (inverse design from targets);
-* :mod:`.report`: ``report``.
+* :mod:`.report`: ``report``;
+* :mod:`.export`: ``export mujoco`` (a finger or gripper as a MuJoCo model).
 """
 
 from __future__ import annotations
 
-from bendpam.cli import design, identify, inverse, lab, predict, report, sweep  # noqa: F401  (registers the commands)
+from bendpam.cli import design, export, identify, inverse, lab, predict, report, sweep  # noqa: F401  (registers the commands)
 from bendpam.cli.app import app, main
 from bendpam.cli.options import use_bendpam_commands
 

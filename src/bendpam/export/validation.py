@@ -1,0 +1,427 @@
+r"""Quasi-static MuJoCo runs of an export against bendpam's planar rod and its pull-out.
+
+Each run is a copy of the exported model made quasi-static: gravity off (bendpam's finger and grasp
+statics are weightless), a 1 ms step, and a joint damping that makes every hinge overdamped
+(at least three times ``sqrt(K I)`` with ``K`` the blocked-state hinge stiffness and ``I`` the
+hinge's diagonal inertia, and at least ``2 K dt``), so that after a pressure ramp the chain creeps
+into its equilibrium; a run ends when ``max |qvel|`` is below :data:`QVEL_TOL`.  The torques are
+those of :class:`bendpam.sim.mujoco.PamController`, as in any simulation of the export.
+
+* **Free shape**: the pressures of the export in ascending order (a ramp of 100 steps to each, then
+  the creep); the fingertip point (site ``pam0_tip``) against :func:`bendpam.design.finger.free_tip_trajectory`.
+* **Loaded shape**: at the highest pressure, a tip force at the fingertip point against the bending
+  (its moment about the base a quarter of the blocked moment, unless given), ramped over 100 steps,
+  against :func:`bendpam.design.finger.solve_finger`.
+* **Pull-out** (gripper): the fingers close on the fixed sphere frictionless (as bendpam's grasp
+  statics), then the friction is switched to the gripper's ``mu`` (elliptic cones, MuJoCo's
+  no-slip pass so that a sticking contact does not creep) and the palm (a mocap body) is lifted
+  0.01 mm per step; the grip force is the peak upward force of the fingers on the sphere, against
+  :func:`bendpam.design.grasp.solve_grasp`.
+
+Errors: tip errors as the distance between the tips in % of L0, the pull-out error in % of
+bendpam's grip force.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from bendpam.design.finger import FingerLoads, free_tip_trajectory, solve_finger
+from bendpam.design.grasp import solve_grasp
+from bendpam.errors import InputError
+from bendpam.export.mjcf import MujocoModel, mujoco_model
+from bendpam.physics.hysteresis import LoopModel
+from bendpam.sim.mujoco import PamController, import_mujoco
+
+__all__ = ["QVEL_TOL", "MujocoExport", "Validation", "mujoco", "pullout", "validate"]
+
+#: a quasi-static run has settled when every hinge turns slower than this, rad/s
+QVEL_TOL = 1e-6
+_DT = 1e-3
+_RAMP = 100
+_CREEP = 4000
+
+
+@dataclass(frozen=True)
+class Validation:
+    """The figures of :func:`validate` (tip errors in % of L0, pull-out error in % of bendpam's force).
+
+    Attributes
+    ----------
+    free : one dict per pressure (``pressure_kpa``, the tips of both, ``tip_error_pct_of_length``,
+        ``bend_angle_error_deg``, ``settled``).
+    free_shape_tip_error_pct_of_length : the largest free-shape tip error.
+    loaded : the loaded case (pressure, tip force, tips, error, settled).
+    loaded_tip_error_pct_of_length : its tip error.
+    pullout : the pull-out case (diameter, pressure, both grip forces, error), None for a finger.
+    gripper_pullout_error_pct : MuJoCo's grip force against bendpam's, %, None for a finger.
+
+    Examples
+    --------
+    >>> v = Validation([], 0.1, {}, 0.2)
+    >>> v.to_dict()["loaded_tip_error_pct_of_length"]
+    0.2
+    """
+
+    free: list[dict[str, Any]]
+    free_shape_tip_error_pct_of_length: float
+    loaded: dict[str, Any]
+    loaded_tip_error_pct_of_length: float
+    pullout: dict[str, Any] | None = None
+    gripper_pullout_error_pct: float | None = None
+    notes: list[str] = field(default_factory=list)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The figures as a JSON-ready dict (units in the key names)."""
+        return {"free_shape_tip_error_pct_of_length": _r(self.free_shape_tip_error_pct_of_length),
+                "loaded_tip_error_pct_of_length": _r(self.loaded_tip_error_pct_of_length),
+                "gripper_pullout_error_pct": None if self.gripper_pullout_error_pct is None
+                else _r(self.gripper_pullout_error_pct),
+                "free": self.free, "loaded": self.loaded, "pullout": self.pullout, "notes": self.notes}
+
+
+def _r(v: float) -> float | None:
+    return None if v is None or not math.isfinite(v) else round(float(v), 6)
+
+
+class _Run:
+    """A quasi-static copy of an exported model with its controller."""
+
+    def __init__(self, exported: MujocoModel):
+        mj = import_mujoco()
+        self.mj = mj
+        self.m = mj.MjModel.from_xml_string(exported.xml)
+        self.d = mj.MjData(self.m)
+        m = self.m
+        m.opt.gravity[:] = 0.0
+        m.opt.timestep = _DT
+        m.opt.cone = mj.mjtCone.mjCONE_ELLIPTIC
+        m.opt.impratio = 10.0
+        m.opt.noslip_iterations = 10
+        m.geom_solref[:] = [5 * _DT, 1.0]
+        mj.mj_forward(m, self.d)
+        full = np.zeros((m.nv, m.nv))
+        mj.mj_fullM(m, self.d, full)
+        self.ctl = PamController(m, exported.actuator, law_model=exported.law_model)
+        f = exported.finger
+        h = f.length / exported.segments
+        k_stiff = abs(float(f.law.tabulated().tangent_stiffness(float(max(exported.pressures_kpa)), 0.0))) / h * 1e-3
+        m.dof_damping[:] = np.maximum(3.0 * np.sqrt(k_stiff * np.diag(full)), 2.0 * _DT * k_stiff)
+        self.P = 0.0
+
+    def step(self) -> None:
+        self.ctl.apply(self.d)
+        self.mj.mj_step(self.m, self.d)
+
+    def ramp_to(self, pressure_kpa: float, steps: int = _RAMP) -> bool:
+        """Ramp the pressure linearly, then creep until settled; returns whether it settled."""
+        p0 = self.P
+        for i in range(steps):
+            self.ctl.set_pressure_kpa(p0 + (pressure_kpa - p0) * (i + 1) / steps)
+            self.step()
+        self.P = pressure_kpa
+        return self.creep()
+
+    def creep(self, before=None) -> bool:
+        for _ in range(_CREEP):
+            if before is not None:
+                before()
+            self.step()
+            if float(np.max(np.abs(self.d.qvel))) < QVEL_TOL:
+                return True
+        return False
+
+    def site(self, name: str) -> np.ndarray:
+        mj = self.mj
+        self.mj.mj_forward(self.m, self.d)
+        return self.d.site_xpos[mj.mj_name2id(self.m, mj.mjtObj.mjOBJ_SITE, name)] * 1e3
+
+
+@contextlib.contextmanager
+def _mujoco_warnings() -> Iterator[list[str]]:
+    """Collect MuJoCo's warnings (for the notes) instead of letting it write MUJOCO_LOG.TXT in the working folder."""
+    mj = import_mujoco()
+    old = mj.get_mju_user_warning()
+    seen: list[str] = []
+    mj.set_mju_user_warning(lambda msg: seen.append(" ".join(str(msg).split())))
+    try:
+        yield seen
+    finally:
+        mj.set_mju_user_warning(old)
+
+
+def _tip_error(tip_mm: np.ndarray, exact_xy, L: float) -> float:
+    return float(math.hypot(tip_mm[0] - exact_xy[0], tip_mm[2] - exact_xy[1])) / L * 100.0
+
+
+def _free_runs(run: _Run, exported: MujocoModel, P: np.ndarray) -> list[dict[str, Any]]:
+    f = exported.finger
+    exact = free_tip_trajectory(f, P)
+    rows = []
+    for p in np.sort(P):
+        j = int(np.flatnonzero(exact["pressure_kpa"].to_numpy() == p)[0])
+        ex = (float(exact["tip_x_mm"].iloc[j]), float(exact["tip_y_mm"].iloc[j]))
+        settled = run.ramp_to(float(p))
+        if not all(math.isfinite(v) for v in ex):
+            continue
+        tip = run.site("pam0_tip")
+        bend = f.bend * float(np.sum(run.d.qpos[run.ctl._qpos_ix]))
+        rows.append({"pressure_kpa": float(p), "mujoco_tip_x_mm": _r(tip[0]), "mujoco_tip_y_mm": _r(tip[2]),
+                     "bendpam_tip_x_mm": _r(ex[0]), "bendpam_tip_y_mm": _r(ex[1]),
+                     "tip_error_pct_of_length": _r(_tip_error(tip, ex, f.length)),
+                     "bend_angle_error_deg": _r(math.degrees(bend) - float(exact["bend_angle_deg"].iloc[j])),
+                     "settled": settled})
+    return rows
+
+
+def _loaded_run(run: _Run, exported: MujocoModel, P: float, tip_force_n) -> dict[str, Any]:
+    f = exported.finger
+    if tip_force_n is None:
+        mb = abs(float(f.law.moment(P, 0.0)))
+        a = f.base_angle
+        F = 0.25 * mb / f.length
+        tip_force_n = (f.bend * F * math.sin(a), -f.bend * F * math.cos(a))
+    fx, fy = (float(v) for v in tip_force_n)
+    shape = solve_finger(f, P, FingerLoads(tip_force_n=(fx, fy)))
+    if not shape.equilibrium:
+        raise InputError(f"the finger has no equilibrium under the tip force ({fx:g}, {fy:g}) N at {P:g} kPa: "
+                         f"{shape.note}; give a smaller tip force")
+    mj = run.mj
+    sid = mj.mj_name2id(run.m, mj.mjtObj.mjOBJ_SITE, "pam0_tip")
+    bid = int(run.m.site_bodyid[sid])
+    state = {"i": 0}
+
+    def load():
+        state["i"] += 1
+        s = min(1.0, state["i"] / _RAMP)
+        force = np.array([fx, 0.0, fy]) * s
+        mj.mj_kinematics(run.m, run.d)
+        mj.mj_comPos(run.m, run.d)
+        r = run.d.site_xpos[sid] - run.d.xipos[bid]
+        run.d.xfrc_applied[bid, :3] = force
+        run.d.xfrc_applied[bid, 3:] = np.cross(r, force)
+
+    for _ in range(_RAMP):
+        load()
+        run.step()
+    settled = run.creep(load)
+    tip = run.site("pam0_tip")
+    err = _tip_error(tip, shape.tip_xy, f.length)
+    return {"pressure_kpa": P, "tip_force_n": [fx, fy], "mujoco_tip_x_mm": _r(tip[0]), "mujoco_tip_y_mm": _r(tip[2]),
+            "bendpam_tip_x_mm": _r(shape.tip_xy[0]), "bendpam_tip_y_mm": _r(shape.tip_xy[1]),
+            "tip_error_pct_of_length": _r(err), "settled": settled}
+
+
+def _sphere_force_n(run: _Run, sphere: int) -> float:
+    """Upward force of the fingers on the sphere, N."""
+    mj, d = run.mj, run.d
+    f6 = np.zeros(6)
+    fz = 0.0
+    for i in range(d.ncon):
+        c = d.contact[i]
+        if sphere not in (c.geom1, c.geom2):
+            continue
+        mj.mj_contactForce(run.m, d, i, f6)
+        fw = c.frame.reshape(3, 3).T @ f6[:3]  # on geom2, from geom1
+        fz += float(fw[2]) if c.geom2 == sphere else -float(fw[2])
+    return fz
+
+
+def pullout(exported: MujocoModel, diameter_mm: float, pressure_kpa: float) -> dict[str, Any]:
+    """The pull-out of a sphere (mm) at a pressure (kPa) in MuJoCo, beside :func:`bendpam.design.grasp.solve_grasp`.
+
+    ``exported`` is a gripper export; the sphere is fixed where the open gripper lands on it.  Returns
+    the grip forces of both (N), MuJoCo's closed force and peak lift, bendpam's, and ``error_pct``.
+
+    >>> import bendpam
+    >>> gripper = mujoco_model(bendpam.physics.presets.be_pam().replace(L0_mm=130.0), "gripper")
+    >>> r = pullout(gripper, 200.0, 160.0)                       # a 200 mm sphere at 160 kPa
+    >>> r["bendpam_contact"], abs(r["error_pct"]) < 5.0            # grip forces within 5 %
+    ('tip', True)
+    """
+    gr = exported.gripper
+    if gr is None:
+        raise InputError("a pull-out needs a gripper export (device 'gripper')")
+    with _mujoco_warnings() as warned:
+        out = _pullout(exported, gr, float(diameter_mm), float(pressure_kpa))
+    return out | {"mujoco_warnings": sorted(set(warned))}
+
+
+def _pullout(exported: MujocoModel, gr, diameter_mm: float, P: float) -> dict[str, Any]:
+    ref = solve_grasp(gr, diameter_mm, P)
+    ex = mujoco_model(exported.actuator, "gripper", law_model=exported.law_model, segments=exported.segments,
+                      pressures_kpa=exported.pressures_kpa, sphere_mm=diameter_mm, gripper=gr)
+    run = _Run(ex)
+    mj = run.mj
+    sphere = mj.mj_name2id(run.m, mj.mjtObj.mjOBJ_GEOM, "sphere")
+    mu = run.m.geom_friction[:, 0].copy()
+    run.m.geom_friction[:, 0] = 0.0  # frictionless closing, as bendpam's grasp statics
+    settled = run.ramp_to(P, 3 * _RAMP)
+    closed = _sphere_force_n(run, sphere)
+    run.m.geom_friction[:, 0] = mu
+    z0 = float(run.d.mocap_pos[0, 2])
+    peak, lift_at_peak, lift = closed, 0.0, 0.0
+    for i in range(8000):
+        lift = (i + 1) * 0.01
+        run.d.mocap_pos[0, 2] = z0 + lift * 1e-3
+        run.step()
+        fz = _sphere_force_n(run, sphere)
+        if fz > peak:
+            peak, lift_at_peak = fz, lift
+        if run.d.ncon == 0 or (fz < 0.5 * peak and lift > 1.0):
+            break
+    want = float(ref.grip_force_n)
+    err = (peak - want) / want * 100.0 if want > 0 else math.nan
+    return {"diameter_mm": diameter_mm, "pressure_kpa": P, "mujoco_grip_force_n": _r(peak),
+            "bendpam_grip_force_n": _r(want), "mujoco_closed_force_n": _r(closed),
+            "mujoco_peak_lift_mm": _r(lift_at_peak), "bendpam_peak_lift_mm": _r(ref.peak_lift_mm),
+            "bendpam_contact": ref.contact, "error_pct": _r(err), "settled": settled}
+
+
+def validate(exported: MujocoModel, *, pressures_kpa=None, tip_force_n=None, sphere_mm: float = 200.0,
+             pullout_pressure_kpa: float | None = None) -> Validation:
+    """Quasi-static MuJoCo runs of ``exported`` against bendpam (see the module docstring).
+
+    Parameters
+    ----------
+    exported : MujocoModel
+        From :func:`bendpam.export.mujoco_model`.  For a gripper, the free and loaded shapes are
+        those of one of its fingers on its own; the pull-out uses the whole gripper.
+    pressures_kpa : the free-shape pressures (kPa); default: the export's.
+    tip_force_n : (Fx, Fy) in the finger's plane (N); default: against the bending, a quarter of
+        the blocked moment about the base.
+    sphere_mm, pullout_pressure_kpa : the pull-out's sphere (mm, default 200) and pressure (kPa,
+        default the export's highest).
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> v = validate(mujoco_model(bendpam.physics.presets.be_pam(), "finger"), pressures_kpa=[150.0])
+    >>> v.free_shape_tip_error_pct_of_length < 1.0, v.loaded_tip_error_pct_of_length < 1.0   # % of L0
+    (True, True)
+    """
+    if not isinstance(exported, MujocoModel):
+        raise InputError(f"exported must be a MujocoModel (bendpam.export.mujoco_model), got {type(exported).__name__}")
+    P = np.asarray(exported.pressures_kpa if pressures_kpa is None else np.atleast_1d(pressures_kpa), dtype=float)
+    single = exported
+    if exported.device != "finger":
+        single = mujoco_model(exported.actuator, "finger", law_model=exported.law_model, segments=exported.segments,
+                              pressures_kpa=exported.pressures_kpa, finger=exported.finger)
+    with _mujoco_warnings() as warned:
+        run = _Run(single)
+        free = _free_runs(run, single, P)
+        if free:
+            loaded = _loaded_run(run, single, max(r["pressure_kpa"] for r in free), tip_force_n)
+    if not free:
+        raise InputError("no pressure of the validation has a free shape (all above the fold): give lower pressures")
+    p_top = max(r["pressure_kpa"] for r in free)  # the highest pressure with a free shape (the loaded run's)
+    notes = [f"the run at {r['pressure_kpa']:g} kPa did not settle to |qvel| < {QVEL_TOL:g} rad/s"
+             for r in [*free, loaded] if not r["settled"]]
+    notes += [f"the {name} tip error {err:.3g} % of L0 is above 1 %" for name, err in (
+        ("free-shape", max((r["tip_error_pct_of_length"] for r in free), default=0.0)),
+        ("loaded", loaded["tip_error_pct_of_length"])) if err > 1.0]
+    free_err = max((r["tip_error_pct_of_length"] for r in free), default=math.nan)
+    pull, pull_err = None, None
+    if exported.device == "gripper":
+        pull = pullout(exported, sphere_mm, p_top if pullout_pressure_kpa is None else pullout_pressure_kpa)
+        pull_err = pull["error_pct"]
+        warned += pull["mujoco_warnings"]
+        if pull_err is not None and abs(pull_err) > 5.0:
+            notes.append(f"MuJoCo's pull-out force differs from bendpam's by {pull_err:+.3g} % (more than 5 %): "
+                         "MuJoCo's soft friction lets the fingertip creep along the sphere before it slips")
+    notes += [f"MuJoCo warned: {w}" for w in sorted(set(warned))]
+    return Validation(free, free_err, loaded, loaded["tip_error_pct_of_length"], pull, pull_err, notes)
+
+
+_validate = validate  # (the name ``validate`` is an argument of :func:`mujoco`)
+
+
+@dataclass(frozen=True)
+class MujocoExport:
+    """An export: the device's model, one model per sphere, and the validation figures (None if not run).
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> ex = mujoco(bendpam.physics.presets.be_pam(), "finger", validate=False)
+    >>> sorted(ex.files())
+    ['actuator.toml', 'export.json', 'finger.xml']
+    """
+
+    model: MujocoModel
+    sphere_models: dict[float, MujocoModel]
+    validation: Validation | None
+    loop: LoopModel | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        """The model's description, its files and the validation figures (``export.json``), JSON-ready."""
+        d = self.model.to_dict() | {"spheres_mm": sorted(self.sphere_models),
+                                    "files": [*sorted(self._models()), "actuator.toml", "export.json"]}
+        if self.loop is not None:
+            d["hysteresis"] = self.loop.to_dict()
+        if self.validation is not None:
+            d["validation"] = self.validation.to_dict()
+        return d
+
+    def _models(self) -> dict[str, str]:
+        dev = self.model.device
+        return {f"{dev}.xml": self.model.xml} | {f"{dev}-sphere-{d:g}mm.xml": m.xml
+                                                 for d, m in self.sphere_models.items()}
+
+    def files(self) -> dict[str, str]:
+        """Every file of the export by name: the MJCF models, ``actuator.toml`` and ``export.json``."""
+        import tomli_w
+
+        from bendpam.infra.outputs import to_json
+
+        toml = self.model.actuator.to_toml()
+        if self.loop is not None:  # the fitted loop, for PamController(..., loop=LoopModel.from_toml(...))
+            toml += "\n" + tomli_w.dumps({"hysteresis": self.loop.to_dict()})
+        return self._models() | {"actuator.toml": toml, "export.json": to_json(self.to_dict())}
+
+    def save(self, folder, *, force: bool = False) -> list[str]:
+        """Write :meth:`files` into ``folder`` as one output set (staged, swapped in whole, with a manifest)."""
+        from bendpam.infra.outputs import OutputSet
+
+        files = self.files()
+        with OutputSet(folder, force=force, producer="bendpam.export.mujoco") as o:
+            for name, text in files.items():
+                o.write_text(name, text)
+        return sorted(files)
+
+
+def mujoco(actuator, device: str = "finger", *, law_model: str | None = None, segments: int | None = None,
+           tip_error_pct: float = 1.0, pressures_kpa=None, spheres_mm=(), validate: bool = True,
+           loop: LoopModel | None = None, **options: Any) -> MujocoExport:
+    """Export ``actuator``'s finger or gripper to MuJoCo: the models and, with ``validate``, the figures.
+
+    The device's model is :func:`bendpam.export.mujoco_model` (``options`` go to it: ``gripper``,
+    ``finger``, ``densities``); one more model per sphere of ``spheres_mm`` (mm, gripper only);
+    :func:`validate` checks the device against bendpam (the pull-out on the first sphere, or 200 mm;
+    without the loop: bendpam's statics are the loop-free law).  ``loop``, a fitted hysteresis loop,
+    is written into ``actuator.toml`` beside the actuator for the simulation
+    (``PamController(model, actuator, loop=LoopModel.from_toml(path))``).  ``.save(folder)`` writes the files.
+
+    Examples
+    --------
+    >>> import bendpam
+    >>> ex = bendpam.export.mujoco(bendpam.physics.presets.be_pam().replace(L0_mm=130.0), "gripper",
+    ...                            spheres_mm=[200.0], validate=False)
+    >>> sorted(ex.files())[:2], ex.model.segments
+    (['actuator.toml', 'export.json'], 7)
+    """
+    base = mujoco_model(actuator, device, law_model=law_model, segments=segments, tip_error_pct=tip_error_pct,
+                        pressures_kpa=pressures_kpa, **options)
+    diam = [float(d) for d in np.atleast_1d(np.asarray(spheres_mm, dtype=float))]
+    spheres = {d: mujoco_model(actuator, device, law_model=base.law_model, segments=base.segments,
+                               pressures_kpa=base.pressures_kpa, sphere_mm=d, **options) for d in diam}
+    val = _validate(base, sphere_mm=diam[0] if diam else 200.0) if validate else None
+    if loop is not None and not isinstance(loop, LoopModel):
+        raise InputError(f"loop must be a bendpam.physics.hysteresis.LoopModel, got {type(loop).__name__}")
+    return MujocoExport(base, spheres, val, loop)

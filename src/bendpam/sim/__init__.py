@@ -1,0 +1,1 @@
+"""Runtime pieces that put bendpam's moment law inside simulators (:mod:`bendpam.sim.mujoco`)."""

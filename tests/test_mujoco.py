@@ -1,0 +1,164 @@
+"""MuJoCo export (issue 27): the hinge torques, the MJCF, and the quasi-static validation against bendpam."""
+
+import json
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+mujoco = pytest.importorskip("mujoco", reason="MuJoCo's bindings are not installed (pip install bendpam[mujoco])")
+
+import bendpam  # noqa: E402
+from bendpam.cli import main  # noqa: E402
+from bendpam.export import mujoco_model, validate  # noqa: E402
+from bendpam.export.mjcf import chain_tip_xy  # noqa: E402
+from bendpam.physics.hysteresis import LoopModel  # noqa: E402
+from bendpam.sim.mujoco import HingeTable, PamController  # noqa: E402
+
+DOCS = Path(__file__).resolve().parent.parent / "docs" / "mujoco.md"
+BE = bendpam.physics.presets.be_pam()
+
+
+def _model(exported):
+    m = mujoco.MjModel.from_xml_string(exported.xml)
+    return m, mujoco.MjData(m)
+
+
+@pytest.mark.parametrize("preset", ["be", "bc"])
+def test_hinge_torques_are_the_moment_law(preset):
+    """Hinge j at angle theta gets c M(P, c theta / h) (N*m), the law's exact value to the table's error."""
+    act = BE if preset == "be" else bendpam.physics.presets.bc_pam()
+    ex = mujoco_model(act, "finger", segments=5)
+    m, d = _model(ex)
+    ctl = PamController(m, act)
+    c = ex.finger.frame_side
+    h = act.L0_mm / 5
+    k = np.array([0.0, 0.002, 0.005, 0.008, -0.001]) * act.bend_sign
+    d.qpos[:] = c * k * h
+    ctl.set_pressure_kpa(120.0)
+    ctl.apply(d)
+    want = c * bendpam.MomentLaw.of(act).moment(120.0, k) * 1e-3
+    np.testing.assert_allclose(d.qfrc_applied, want, rtol=1e-5, atol=1e-9)
+    assert np.all(np.sign(d.qfrc_applied[:2]) == np.sign(want[:2]))
+
+
+def test_numba_and_numpy_engines_give_the_same_torques():
+    """Two laws in one model (a stiffer bladder on one finger), hinge angles beyond lock-up included."""
+    pytest.importorskip("numba", reason="Numba is not installed (pip install bendpam[mujoco])")
+    act = BE.replace(L0_mm=130.0)
+    other = act.replace(C01_kpa=600.0)
+    m, d = _model(mujoco_model(act, "gripper", segments=4))
+    acts = {"pam0": act, "pam1": other, "pam2": act}
+    fast, slow = PamController(m, acts, engine="numba"), PamController(m, acts, engine="numpy")
+    assert len(fast._groups) == 2 and fast.engine == "numba"
+    rng = np.random.default_rng(3)
+    d.qpos[:] = rng.uniform(-0.6, 1.2, m.nq)
+    for ctl in (fast, slow):
+        ctl.set_pressure_kpa([150.0, 180.0, 90.0])
+    np.testing.assert_allclose(fast.moments_nmm(d), slow.moments_nmm(d), rtol=1e-12, atol=1e-9)
+    fast.apply(d)
+    q_fast = d.qfrc_applied.copy()
+    slow.apply(d)
+    np.testing.assert_allclose(q_fast, d.qfrc_applied, rtol=1e-12, atol=1e-12)
+
+
+def test_hinge_table_agrees_with_the_moment_table():
+    table = bendpam.MomentLaw.of(BE).tabulated()
+    ht = HingeTable(table)
+    rng = np.random.default_rng(1)
+    lim = table.limits
+    k = rng.uniform(float(lim.k_min), float(lim.k_max), 500)
+    P = rng.uniform(0.0, 300.0, 500)
+    scale = 500.0 * np.abs(table.coefficients(k)[0]) + np.abs(table.coefficients(k)[1])
+    err = np.abs(ht.moment_nmm(np.maximum(P - BE.P_start_kpa, 0.0), k) - table.moment(P, k)) / scale
+    assert err.max() < 1e-6
+
+
+def test_hysteresis_opposes_the_motion():
+    """After a bending motion longer than the loop's angle, z = +1: every hinge's moment is M - A."""
+    loop = LoopModel(a0_nmm=2.0, a1_nmm_per_kpa=0.05, theta_h_deg=5.0)
+    ex = mujoco_model(BE, "finger", segments=4)
+    m, d = _model(ex)
+    ctl = PamController(m, BE, loop=loop)
+    ctl.set_pressure_kpa(168.0)  # 100 kPa active: A = 2 + 5 = 7 N*mm
+    h = BE.L0_mm / 4
+    for k in np.linspace(0.0, 0.004, 20):  # k' L0 from 0 to 33 deg, more than 5 deg
+        d.qpos[:] = ex.finger.frame_side * k * h
+        ctl.apply(d)
+    M = ctl.moments_nmm(d)
+    np.testing.assert_allclose(M, bendpam.MomentLaw.of(BE).moment(168.0, 0.004) - 7.0, rtol=1e-6)
+
+
+def test_chain_tip_converges_as_one_over_n_squared():
+    f = ex_f = mujoco_model(BE, "finger", segments=4).finger
+    k = 0.012
+    th = f.frame_side * k * f.length
+    exact = np.array([math.sin(th), 1.0 - math.cos(th)]) / (f.frame_side * k)  # circular arc of length L0
+    e = [np.hypot(*(chain_tip_xy(ex_f, k, n) - exact)) for n in (8, 16, 32)]
+    assert 3.8 < e[0] / e[1] < 4.2 and 3.8 < e[1] / e[2] < 4.2
+
+
+def test_export_finger_cli_writes_a_loadable_model_and_its_validation(tmp_path, capsys):
+    out = tmp_path / "be-finger"
+    assert main(["export", "mujoco", "--preset", "be-pam", "--device", "finger", "--out", str(out), "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    model = mujoco.MjModel.from_xml_path(str(out / "finger.xml"))
+    assert model.njnt == summary["segments"] == 8
+    assert json.loads((out / "export.json").read_text()) == summary
+    v = summary["validation"]
+    assert 0 < v["free_shape_tip_error_pct_of_length"] <= 1.0
+    assert 0 < v["loaded_tip_error_pct_of_length"] <= 1.0
+    assert v["gripper_pullout_error_pct"] is None
+    assert all(r["settled"] for r in v["free"]) and v["loaded"]["settled"]
+    # the MuJoCo free angle is bendpam's (the chain's angles sum to k' L0 exactly)
+    assert max(abs(r["bend_angle_error_deg"]) for r in v["free"]) < 1e-3
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert {"finger.xml", "actuator.toml", "export.json"} <= {f["path"] for f in manifest["files"]}
+    assert bendpam.Actuator.from_toml(out / "actuator.toml") == BE
+
+
+def test_gripper_validation_and_pullout_within_five_percent(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    ex = mujoco_model(BE.replace(L0_mm=130.0), "gripper")
+    v = validate(ex, pressures_kpa=[120.0, 160.0], sphere_mm=200.0, pullout_pressure_kpa=160.0)
+    assert list(tmp_path.iterdir()) == [] and v.notes == []  # no MUJOCO_LOG.TXT, no warning
+    assert v.free_shape_tip_error_pct_of_length <= 1.0
+    assert v.loaded_tip_error_pct_of_length <= 1.0
+    assert v.pullout is not None and v.pullout["bendpam_contact"] == "tip"
+    assert abs(v.gripper_pullout_error_pct) <= 5.0
+
+
+def test_sphere_models_and_refusals(tmp_path, capsys):
+    ex = mujoco_model(BE.replace(L0_mm=130.0), "gripper", sphere_mm=80.0)
+    m, d = _model(ex)
+    sphere = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "sphere")
+    assert m.geom_size[sphere][0] == pytest.approx(0.04)
+    assert len(PamController(m, BE).chains) == 3
+    code = main(["export", "mujoco", "--preset", "be-pam", "--spheres", "200", "--out", str(tmp_path / "x")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "--device gripper" in err[0]
+    assert not (tmp_path / "x").exists()
+
+
+def test_a_fitted_loop_goes_into_the_exported_actuator_file(tmp_path, capsys):
+    loop = LoopModel(a0_nmm=1.5, a1_nmm_per_kpa=0.02, theta_h_deg=8.0)
+    src = tmp_path / "fit.toml"
+    src.write_text(BE.to_toml() + "\n[hysteresis]\na0_nmm = 1.5\na1_nmm_per_kpa = 0.02\ntheta_h_deg = 8.0\n")
+    out = tmp_path / "exp"
+    assert main(["export", "mujoco", "--actuator", str(src), "--no-validate", "--segments", "4",
+                 "--out", str(out), "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["hysteresis"]["a0_nmm"] == 1.5 and "validation" not in summary
+    assert LoopModel.from_toml(out / "actuator.toml") == loop
+    m = mujoco.MjModel.from_xml_path(str(out / "finger.xml"))
+    assert m.njnt == 4
+
+
+def test_docs_simulation_block_runs(tmp_path, monkeypatch):
+    """The page's own-simulation block runs as written (the pull-out block is the test above at one pressure)."""
+    monkeypatch.chdir(tmp_path)
+    blocks = re.findall(r"```python\n(.*?)```", DOCS.read_text(encoding="utf-8"), re.S)
+    assert len(blocks) == 2 and "pullout(gripper, 200.0, p)" in blocks[0]
+    exec(compile(blocks[1], str(DOCS), "exec"), {})
