@@ -855,10 +855,13 @@ def format_inspection(info: Mapping[str, Any]) -> str:
         return f"{name}\n  error: {info['error']}"
     out = [str(name)]
     delim = _DELIM_NAMES.get(str(info.get("delimiter")), repr(info.get("delimiter")))
-    out.append(
-        f"  format {info.get('format')}, encoding {info.get('encoding')}, delimiter {delim}, "
-        f"decimal {info.get('decimal')!r}, header at line {info.get('header_line')}"
-    )
+    if info.get("format") == "zs2":  # binary: no delimiter or header line of its own
+        out.append(f"  format zs2 (native Zwick testXpert file), specimen {info.get('specimen')!r}")
+    else:
+        out.append(
+            f"  format {info.get('format')}, encoding {info.get('encoding')}, delimiter {delim}, "
+            f"decimal {info.get('decimal')!r}, header at line {info.get('header_line')}"
+        )
     out.append(f"  {info.get('n_samples')} samples")
     tests = info.get("tests") or []
     if tests:

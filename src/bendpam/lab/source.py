@@ -167,7 +167,7 @@ def _open_zs2(path: Path) -> list[Source]:
     """One source per tested specimen of a native Zwick file (:mod:`bendpam.lab.zwick`), named like a sheet."""
     sources = []
     for name, lines in zs2_sheets(path):
-        first = next((ln for ln in lines if ln.strip()), "")
+        first = getattr(lines, "first", "")  # the 'Specimen' line, without writing the table
         sources.append(Source(path, "zs2", lines, first, is_excel=True, sheet=name))
     return sources
 

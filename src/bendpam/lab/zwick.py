@@ -24,6 +24,7 @@ from __future__ import annotations
 import os
 import re
 import zlib
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -55,8 +56,8 @@ class Zs2Specimen:
     name : str
         The specimen's name (``"specimen k"`` when the series gives none).
     channels : list of (str, numpy.ndarray)
-        Channel name and values as stored (SI base units; float32 or float64 as in the file), in
-        the file's order.
+        Channel name and values as stored (SI base units; single or double floats as in the
+        file), in the file's order.
     time_channel : int or None
         Index in :attr:`channels` of the channel the file marks as its time base.
     notes : list of str
@@ -336,17 +337,35 @@ def _lines(spec: Zs2Specimen) -> list[str]:
             "Values\tas stored by testXpert, in SI base units (s, m, N)"]  # fmt: skip
     head += [f"Note\t{_cell(note)}" for note in spec.notes]
     head += ["\t".join(_cell(n) for n, _a in spec.channels), "\t".join(units)]
-    # the shortest text that gives back each value in its own precision (a single float as testXpert shows it)
-    text = np.column_stack([a.astype(str) for _n, a in spec.channels])
-    return head + ["\t".join(row) for row in text.tolist()]
+    return head + ["\t".join(row) for row in zip(*(_texts(a) for _n, a in spec.channels), strict=True)]
 
 
-def zs2_sheets(path: str | os.PathLike) -> list[tuple[str, list[str]]]:
+def _texts(values: np.ndarray) -> list[str]:
+    """Each value as text that reads back to the stored value: 9 significant digits for a single float."""
+    if values.dtype == np.float32:
+        return list(map("{:.9g}".format, values.astype(np.float64).tolist()))
+    return list(map(repr, values.astype(np.float64).tolist()))
+
+
+class _Lines:
+    """The lines of one specimen's table, written only when they are read (a series holds many specimens)."""
+
+    def __init__(self, spec: Zs2Specimen) -> None:
+        self.spec = spec
+        self.first = f"Specimen\t{_cell(spec.name)}"
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(_lines(self.spec))
+
+
+def zs2_sheets(path: str | os.PathLike) -> list[tuple[str, Iterable[str]]]:
     """Each tested specimen of a ``.zs2`` file as ``(name, lines)``: a tab-separated table the reader reads.
 
     The lines are a ``Specimen`` line, a note that values are SI base units, a names row, a units
     row (``s``, ``m``, ``N`` for the channels that can be time, travel or force; ``-`` for the
-    others) and one row per sample, every value written so that it reads back exactly.
+    others) and one row per sample, every value written so that it reads back to the stored value
+    (a single float with its 9 significant digits, a double exactly).  They are
+    written when iterated, so reading one specimen does not write the others.
 
     Examples
     --------
@@ -361,4 +380,4 @@ def zs2_sheets(path: str | os.PathLike) -> list[tuple[str, list[str]]]:
     ...         print(exc.message.startswith("not a"))
     True
     """
-    return [(spec.name, _lines(spec)) for spec in read_zs2(path)]
+    return [(spec.name, _Lines(spec)) for spec in read_zs2(path)]
