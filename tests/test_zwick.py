@@ -93,7 +93,7 @@ def test_inspect_names_format_channels_and_specimens(tmp_path):
 
 def test_read_test_refuses_a_series_of_several_specimens(tmp_path):
     path = _write(tmp_path, _hand_series())
-    with pytest.raises(ReadError, match="2"):
+    with pytest.raises(ReadError, match="holds 2 tests on the specimens of the series 'Probe 1', 'Probe 2'"):
         read_test(path)
 
 

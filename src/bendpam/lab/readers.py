@@ -361,7 +361,8 @@ def _refuse_several(raw: RawTest, **kw: Any) -> None:
     sheets = _other_sheets(raw, **kw)
     if sheets:
         names = ", ".join(repr(s) for s in [raw.metadata.get("sheet"), *[t.metadata.get("sheet") for t in sheets]])
-        raise ReadError(f"holds {len(sheets) + 1} tests on the sheets {names}; read them with read_tests",
+        where = "specimens of the series" if raw.dialect == "zs2" else "sheets"
+        raise ReadError(f"holds {len(sheets) + 1} tests on the {where} {names}; read them with read_tests",
                         raw.path)  # fmt: skip
     parts = _split_blocks(raw)
     if len(parts) > 1:
