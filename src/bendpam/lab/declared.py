@@ -29,6 +29,7 @@ import numpy as np
 import pandas as pd
 
 from bendpam.lab.assemble import check_values
+from bendpam.lab.cblock import c_numbers
 from bendpam.lab.channels import ROLES, canonical_unit, is_unit_token, split_name_unit, unit_cell, unit_factor
 from bendpam.lab.declaration import TEXT_KEYS, Declaration, load_declaration
 from bendpam.lab.layout import is_number, parse_metadata_line, split_cells
@@ -452,7 +453,8 @@ def _names_rows_as_separators(any_num: np.ndarray, status: np.ndarray, n_roles: 
 
 
 def _fast_numbers(texts: list[str], needed: list[int], inp: _Input) -> np.ndarray | None:
-    """The chunk's numbers by pandas' C parser when every line is a regular row of finite numbers, else None.
+    """The chunk's numbers by pandas' C parser (:func:`~bendpam.lab.cblock.c_numbers`, the detected
+    reader's path too) when every line is a regular row of finite numbers, else None.
 
     Only for a one-character delimiter without a thousands separator (whose digit groups the C
     parser would not check); anything irregular (a blank or text line, an empty cell, a line with
@@ -460,23 +462,10 @@ def _fast_numbers(texts: list[str], needed: list[int], inp: _Input) -> np.ndarra
     """
     if inp.delimiter not in ("\t", ";", ",", "whitespace") or inp.thousands or not texts:
         return None
-    sep = r"\s+" if inp.delimiter == "whitespace" else inp.delimiter
-    import io
-    import warnings
-
-    unique = sorted(set(needed))
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            frame = pd.read_csv(io.StringIO("\n".join(texts)), sep=sep, header=None, usecols=unique,
-                                dtype=np.float64, decimal=inp.decimal, quotechar='"', skipinitialspace=True,
-                                skip_blank_lines=False, engine="c", na_filter=True)
-    except (ValueError, IndexError, pd.errors.ParserError, pd.errors.EmptyDataError):
-        return None
-    if len(frame) != len(texts):
-        return None
-    vals = np.ascontiguousarray(frame[needed].to_numpy(dtype=np.float64).T)
-    return vals if np.isfinite(vals).all() else None
+    sep = " " if inp.delimiter == "whitespace" else inp.delimiter
+    arrs = c_numbers("\n".join(texts), sep=sep, decimal=inp.decimal, columns=needed, n_rows=len(texts),
+                     skipinitialspace=True)  # fmt: skip
+    return None if arrs is None else np.ascontiguousarray(np.vstack(arrs))
 
 
 def _groups(cells: list[str], layout: _Layout) -> int:

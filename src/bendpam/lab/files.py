@@ -11,7 +11,7 @@ from bendpam.infra.budgets import check_input_file
 __all__ = ["RAW_SUFFIXES", "collect_raw_files"]
 
 #: File suffixes taken from a folder as raw testing-machine exports.
-RAW_SUFFIXES = frozenset({".csv", ".txt", ".tsv", ".dat", ".asc", ".tra", ".xlsx", ".xls"})
+RAW_SUFFIXES = frozenset({".csv", ".txt", ".tsv", ".dat", ".asc", ".tra", ".xlsx", ".xls", ".zs2", ".zp2"})
 
 
 def collect_raw_files(inputs) -> list[Path]:

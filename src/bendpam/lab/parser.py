@@ -14,7 +14,6 @@ line by line to find the offending line or the end of the block.  :func:`parse_s
 from __future__ import annotations
 
 import dataclasses
-import io
 import math
 import re
 from dataclasses import dataclass, field
@@ -22,16 +21,13 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import pandas as pd
 
+from bendpam.lab.cblock import c_numbers
 from bendpam.lab.channels import (
-    ACCEPTED_NAMES,
     ROLES,
-    UNIT_HINT,
     ChannelChoice,
     ColumnInfo,
     choose_channels,
-    classify_column,
     is_unit_token,
     looks_like_summary,
     normalize_name,
@@ -40,6 +36,7 @@ from bendpam.lab.channels import (
     unit_factor,
 )
 from bendpam.lab.header import find_header, group_period
+from bendpam.lab.header_refusal import no_header_error, role_hits
 from bendpam.lab.layout import (
     DELIMITERS,
     LineReader,
@@ -186,21 +183,9 @@ class ColumnData:
     counter_bad_line: int | None = None
 
 
-def _role_hits(cells: list[str]) -> int:
-    roles = set()
-    for i, cell in enumerate(cells):
-        if not cell or len(cell) > 80:
-            continue
-        name, unit = split_name_unit(cell)
-        for c in classify_column(ColumnInfo(i, cell, name, unit)):
-            if c.role in ROLES:
-                roles.add(c.role)
-    return len(roles)
-
-
 def _is_units_row(cells: list[str], names: list[str]) -> bool:
     nonempty = [c for c in cells if c]
-    if not nonempty or _role_hits(cells) > 0 or _role_hits(names) == 0:
+    if not nonempty or role_hits(cells) > 0 or role_hits(names) == 0:
         return False
     if numeric_cells(cells)[0] > 0:
         return False
@@ -477,7 +462,7 @@ class Parser:
         if self.mts is not None and self.mts.delimiter in order:
             order.remove(self.mts.delimiter)
             order.insert(0, self.mts.delimiter)
-        guess = find_header(pre, line, order, role_hits=_role_hits, is_units_row=_is_units_row)
+        guess = find_header(pre, line, order, role_hits=role_hits, is_units_row=_is_units_row)
         best: tuple[tuple[int, int, int, int], Block] | None = None
         if guess is not None:
             cols = _make_columns(guess.names, guess.units, guess.names_line, guess.units_line)
@@ -497,7 +482,7 @@ class Parser:
                 if len(c2) >= 2 and _is_units_row(c1, c2):
                     names_ln, names, units_ln, units = p2[0], c2, p1[0], c1
             fit = int(len(_trim(names)) >= 2 and abs(len(_trim(names)) - len(_trim(data_cells))) <= 1)
-            score = (_role_hits(names), fit, len(names) >= 2, -k)
+            score = (role_hits(names), fit, len(names) >= 2, -k)
             cols = _make_columns(names, units, names_ln, units_ln)
             blk = Block(len(self.blocks) + 1, names_ln, names, units_ln, units, sep, ln, line, cols)
             if best is None or score > best[0]:
@@ -672,29 +657,10 @@ class Parser:
         Once the optional cycle counter is known to hold a non-number, it is no longer parsed
         (NaN: the counter is left out anyway).
         """
-        if blk.sep == dec:
-            return None
         counter_off = needed[-1][0] == "counter" and data.counter_bad_line is not None
         idx = [col.index for _role, col in (needed[:-1] if counter_off else needed)]
-        try:
-            df = pd.read_csv(
-                io.BytesIO(text.encode("utf-8", "surrogatepass")),
-                sep=r"\s+" if blk.sep == " " else blk.sep,
-                decimal=dec,
-                header=None,
-                usecols=sorted(set(idx)),
-                dtype=np.float64,
-                engine="c",
-                skip_blank_lines=False,
-                quotechar='"',
-                na_filter=False,
-                index_col=False,
-            )
-            arrs = [df[i].to_numpy(dtype=np.float64) for i in idx]  # copied into the sink
-        except Exception:  # any parser trouble -> the slow path finds the line
-            return None
-        del df
-        if any(len(a) != n or not np.isfinite(a).all() for a in arrs):
+        arrs = c_numbers(text, sep=blk.sep, decimal=dec, columns=idx, n_rows=n)
+        if arrs is None:
             return None
         if counter_off:
             arrs.append(np.full(n, np.nan))
@@ -775,7 +741,7 @@ class Parser:
             if not datalike:
                 repeated = [normalize_name(c) for c in cells] == names_norm or any(
                     [normalize_name(c) for c in split_cells(nxt, sep)] == names_norm for nxt in lines[k + 1:k + 3])
-                if blank_run is not None or repeated or _role_hits(cells) >= 2 or blk.n_rows + len(rows) < 2:
+                if blank_run is not None or repeated or role_hits(cells) >= 2 or blk.n_rows + len(rows) < 2:
                     end = blank_run if blank_run is not None else k
                     break
             role, col, cell = problem
@@ -824,78 +790,6 @@ class Parser:
                 end = blank_run if blank_run is not None else k
                 reader.push_back(lines[end:])
                 return
-
-
-def _no_header_error(p: Parser) -> ReadError:
-    label = p.label
-    partial = [b for b in p.blocks if b.choice is not None and b.choice.n_roles >= 2]
-    summaries = [b for b in p.blocks if b.summary and (b.choice is None or b.choice.n_roles < 2)]
-    missing_override = [b for b in p.blocks if b.override_missing is not None]
-    if missing_override and p.overrides:
-        b = missing_override[0]
-        wanted = b.override_missing
-        cols = ", ".join(repr(n) for n in b.names if n)
-        return ReadError(
-            f"column {wanted!r} named in the columns option is not in the file; its columns "
-            f"are {cols}",
-            label,
-            b.header_line,
-        )
-    for b in partial:
-        assert b.choice is not None
-        for role, col in b.choice.bad_unit.items():
-            return ReadError(
-                f"unknown {role} unit {show(col.unit or '')} for column {col.source!r}; expected "
-                f"{UNIT_HINT[role]}",
-                label,
-                col.unit_line or b.header_line,
-                col.source,
-            )
-    if summaries and not partial:
-        b = summaries[0]
-        cols = ", ".join(repr(c) for c in b.summary[:4])
-        return ReadError(
-            f"a per-cycle or per-specimen summary, not a time series: columns such as {cols} "
-            "hold one value per cycle or specimen and no column is a time, stroke or force "
-            "sample; expected the raw data export (time, stroke and force samples)",
-            label,
-            b.header_line,
-        )
-    if partial:
-        b = partial[0]
-        assert b.choice is not None
-        ch = b.choice
-        found = ", ".join(f"{r} {ch.chosen[r].source!r}" for r in ROLES if r in ch.chosen)
-        missing = [r for r in ROLES if r not in ch.chosen]  # stroke or force (time alone is made up)
-        return ReadError(
-            f"header row has no {' or '.join(missing)} column (found {found}); expected a "
-            f"column named after {' and '.join(missing)} (accepted names: {ACCEPTED_NAMES})",
-            label,
-            b.header_line,
-        )
-    # a header without data rows?
-    for ln, line in p.text:
-        for sep in DELIMITERS:
-            if sep in line and _role_hits(split_cells(line, sep)) >= 3:
-                return ReadError(
-                    "header row is followed by no data rows; expected at least 2", label, ln
-                )
-    first_data = p.blocks[0].first_line if p.blocks else p.first_orphan
-    if first_data is not None:
-        return ReadError(
-            "no header row naming time, stroke and force columns before the first data row; "
-            f"expected e.g. 'time_s,stroke_mm,force_n' (accepted names: {ACCEPTED_NAMES})",
-            label,
-            first_data,
-        )
-    # no data row at all: the whole text was searched
-    where = f"lines 1-{p.text[-1][0]}: " if p.text and p.text[-1][0] > 1 else ""
-    return ReadError(
-        f"{where}no header row naming time, stroke and force columns; expected e.g. "
-        f"'time_s,stroke_mm,force_n' (accepted names: {ACCEPTED_NAMES})",
-        label,
-        1 if not where else None,
-    )
 
 
 @dataclass
@@ -962,7 +856,7 @@ def parse_source(source: Source, *, dialect: str | None, overrides: dict[str, st
         if source.close is not None:
             source.close()
     if p.chosen is None:
-        raise _no_header_error(p)
+        raise no_header_error(p)
     return Parsed(p, source, p.chosen)
 
 

@@ -26,7 +26,8 @@ COLUMNS: tuple[str, str, str] = ("time_s", "stroke_mm", "force_n")
 DIALECTS: tuple[str, ...] = ("csv", "testxpert", "bluehill", "mts")
 #: Formats :func:`~bendpam.lab.readers.read_test` reports in :attr:`RawTest.dialect` (alias :attr:`RawTest.format`).
 FORMATS: tuple[str, ...] = (
-    "csv", "testxpert", "bluehill", "mts", "mts793", "wavematrix", "instron", "trapezium", "excel", "declared",
+    "csv", "testxpert", "bluehill", "mts", "mts793", "wavematrix", "instron", "trapezium", "excel", "zs2",
+    "declared",
 )  # fmt: skip
 
 

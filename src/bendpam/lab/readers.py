@@ -9,7 +9,8 @@ The reader is layered, not a list of dialects:
 1. **Bytes to text** (:mod:`bendpam.lab.encoding`): BOM, strict UTF-8, then the legacy code
    pages of these machines (cp1252, cp1250, GB18030, Shift-JIS, latin-1), keeping the one under
    which the header makes sense.  Workbooks (``.xlsx``/``.xls``) are read with
-   ``python-calamine`` (extra ``excel``).  Zwick ``.zs2`` files are refused: export ASCII.
+   ``python-calamine`` (extra ``excel``); native Zwick ``.zs2``/``.zp2`` files with ``zs2decode``
+   (extra ``zwick``), one test per specimen (:mod:`bendpam.lab.zwick`).
 2. **Layout** (:mod:`bendpam.lab.layout`): delimiter (tab, ``;``, ``,``) and decimal mark
    inferred per data block and checked cell by cell; MTS 793's first line
    (``MTS793|MPT|DEU|1|2|,|.|...``) is honoured; quoted or unquoted cells, empty first fields,
@@ -74,6 +75,7 @@ from bendpam.lab.pressure import (
 from bendpam.lab.rawtest import COLUMNS, DIALECTS, FORMATS, RawTest, check_cycle_count
 from bendpam.lab.read_error import ReadError
 from bendpam.lab.source import text_source
+from bendpam.lab.zwick import ZS2_SUFFIXES
 
 __all__ = [
     "COLUMNS",
@@ -172,6 +174,8 @@ _TRAPEZIUM = re.compile(r"試験力|ストローク|trapezium|shimadzu")
 
 def _classify_format(parsed: Parsed) -> str:
     p, blk, source = parsed.parser, parsed.block, parsed.source
+    if source.encoding == "zs2":
+        return "zs2"
     if source.is_excel:
         return "excel"
     if p.mts is not None:
@@ -232,7 +236,8 @@ def _check_options(pressure_kpa: float | None, dialect: str | None, rate_hz: flo
 
 #: Refusals about the file itself, where a format declaration does not help.
 _NOT_LAYOUT = re.compile(r"^(file not found|is a directory|permission denied|cannot read|file is empty|"
-                         r"binary|native Zwick|.*not found$|is a folder|larger than|byte 0|lines? [\d-]+: only)")
+                         r"binary|native Zwick|not a native Zwick|.*not found$|is a folder|larger than|byte 0|"
+                         r"lines? [\d-]+: only)")
 
 
 def with_declaration_hint(exc: ReadError) -> ReadError:
@@ -356,7 +361,8 @@ def _refuse_several(raw: RawTest, **kw: Any) -> None:
     sheets = _other_sheets(raw, **kw)
     if sheets:
         names = ", ".join(repr(s) for s in [raw.metadata.get("sheet"), *[t.metadata.get("sheet") for t in sheets]])
-        raise ReadError(f"holds {len(sheets) + 1} tests on the sheets {names}; read them with read_tests",
+        where = "specimens of the series" if raw.dialect == "zs2" else "sheets"
+        raise ReadError(f"holds {len(sheets) + 1} tests on the {where} {names}; read them with read_tests",
                         raw.path)  # fmt: skip
     parts = _split_blocks(raw)
     if len(parts) > 1:
@@ -379,8 +385,8 @@ def _read_one(path: str | os.PathLike, *, pressure_kpa: float | None, dialect: s
     try:
         parsed = parse_path(p, overrides=overrides, **{k: kw[k] for k in _PARSE_KEYS})
     except ReadError as exc:
-        if exc.column is None:
-            raise with_declaration_hint(exc) from None
+        if exc.column is None:  # a declaration reads text exports and workbooks, not native Zwick files
+            raise (exc if p.suffix.lower() in ZS2_SUFFIXES else with_declaration_hint(exc)) from None
         # a chosen column with cells that are not numbers (an extensometer removed mid-test): another one?
         found = parse_path(p, overrides=overrides, want_data=False, **{k: kw[k] for k in _PARSE_KEYS})
         return _other_column(exc, found, _alternates(found, overrides), p, dialect or _classify_format(found), **kw)
@@ -553,14 +559,19 @@ def _replace_dead(raw: RawTest, role: str, names: list[str], *, path: str | os.P
 
 
 def _other_sheets(raw: RawTest, **kw: Any) -> list[RawTest]:
-    """The tests on the sheets of a workbook after the one read (testXpert writes a 'Values' sheet per specimen)."""
+    """The tests on the sheets of a workbook after the one read (testXpert writes a 'Values' sheet per specimen),
+    or on the specimens of a native Zwick file after the first."""
     sheet = raw.metadata.get("sheet")
     if not sheet:
         return []
     from bendpam.lab.excel import workbook_sheets
+    from bendpam.lab.zwick import read_zs2
 
     try:
-        names = [s.name for s in workbook_sheets(raw.path)]
+        if raw.dialect == "zs2":
+            names = [s.name for s in read_zs2(raw.path)]
+        else:
+            names = [s.name for s in workbook_sheets(raw.path)]
     except Exception:  # the workbook was read a moment ago; a failure now leaves the first test alone
         return []
     later = names[names.index(sheet) + 1:] if sheet in names else []
@@ -653,7 +664,7 @@ def read_tests(
     labels = _specimen_labels(raw)
     if len(labels) <= 1:
         sheets = _other_sheets(raw, **kw)
-        if sheets:
+        if sheets or raw.dialect == "zs2":  # a native Zwick file names its specimens, even a lone one
             return [dataclasses.replace(t, specimen=t.metadata.get("sheet")) for t in [raw, *sheets]]
         return _split_blocks(raw)
     out = [dataclasses.replace(raw, specimen=labels[0])]
@@ -845,10 +856,13 @@ def format_inspection(info: Mapping[str, Any]) -> str:
         return f"{name}\n  error: {info['error']}"
     out = [str(name)]
     delim = _DELIM_NAMES.get(str(info.get("delimiter")), repr(info.get("delimiter")))
-    out.append(
-        f"  format {info.get('format')}, encoding {info.get('encoding')}, delimiter {delim}, "
-        f"decimal {info.get('decimal')!r}, header at line {info.get('header_line')}"
-    )
+    if info.get("format") == "zs2":  # binary: no delimiter or header line of its own
+        out.append(f"  format zs2 (native Zwick testXpert file), specimen {info.get('specimen')!r}")
+    else:
+        out.append(
+            f"  format {info.get('format')}, encoding {info.get('encoding')}, delimiter {delim}, "
+            f"decimal {info.get('decimal')!r}, header at line {info.get('header_line')}"
+        )
     out.append(f"  {info.get('n_samples')} samples")
     tests = info.get("tests") or []
     if tests:

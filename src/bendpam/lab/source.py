@@ -1,9 +1,10 @@
 """The source of a raw test: a file's bytes (or a workbook's sheets, or text) as lines.
 
 :func:`open_source` opens a file: refuses what is not a text export or a workbook (empty
-files, what is not a regular file, files past the size limit, Zwick ``.zs2``, binary data), chooses the encoding
+files, what is not a regular file, files past the size limit, binary data), chooses the encoding
 (:func:`bendpam.lab.encoding.detect_encoding`) and hands out the lines lazily; a workbook gives
-one :class:`Source` per sheet (:mod:`bendpam.lab.excel`).  :func:`text_source` does the same for
+one :class:`Source` per sheet (:mod:`bendpam.lab.excel`), a native Zwick ``.zs2``/``.zp2`` file one
+per tested specimen (:mod:`bendpam.lab.zwick`, encoding ``"zs2"``).  :func:`text_source` does the same for
 text already in memory.
 """
 
@@ -20,6 +21,7 @@ from typing import Any
 from bendpam.infra.budgets import input_file_problem
 from bendpam.lab.encoding import container_kind, detect_encoding
 from bendpam.lab.read_error import ReadError
+from bendpam.lab.zwick import ZS2_SUFFIXES, zs2_sheets
 
 __all__ = ["Source", "open_source", "text_source"]
 
@@ -35,15 +37,16 @@ class Source:
     label : pathlib.Path or str
         The file (``"<text>"`` for text in memory), as named in messages.
     encoding : str
-        Codec the text is decoded with (``"xlsx"``/``"xls"`` for a workbook, ``"str"`` for text).
+        Codec the text is decoded with (``"xlsx"``/``"xls"`` for a workbook, ``"zs2"`` for a
+        specimen of a native Zwick file, ``"str"`` for text).
     lines : iterable of str
         The lines, read lazily from the file.
     first_line : str
         The first non-blank line (an MTS 793 export announces itself there).
     is_excel : bool
-        A workbook sheet.
+        A workbook sheet (or a specimen of a native Zwick file, read the same way).
     sheet : str or None
-        The sheet's name.
+        The sheet's (or the specimen's) name.
     close : callable or None
         Closes the file once the lines are read.
 
@@ -160,6 +163,15 @@ def _open_excel(path: Path, kind: str) -> list[tuple[str, list[str]]]:
     return [(s.name, s.lines) for s in sheets]
 
 
+def _open_zs2(path: Path) -> list[Source]:
+    """One source per tested specimen of a native Zwick file (:mod:`bendpam.lab.zwick`), named like a sheet."""
+    sources = []
+    for name, lines in zs2_sheets(path):
+        first = getattr(lines, "first", "")  # the 'Specimen' line, without writing the table
+        sources.append(Source(path, "zs2", lines, first, is_excel=True, sheet=name))
+    return sources
+
+
 def open_source(path: Path) -> tuple[list[Source], int]:
     """Open an export: its sources (one, or one per workbook sheet) and its size in bytes.
 
@@ -177,7 +189,7 @@ def open_source(path: Path) -> tuple[list[Source], int]:
     ReadError
         For a file that is missing, empty, not a regular file (a directory, a named pipe, a
         device), larger than the limit of a raw test file (2 GiB, :mod:`bendpam.infra.budgets`),
-        unreadable, binary or a native Zwick file.
+        unreadable or binary, or a native Zwick file whose layout is not recognised.
 
     Examples
     --------
@@ -196,12 +208,8 @@ def open_source(path: Path) -> tuple[list[Source], int]:
     if size == 0 or not head:
         raise ReadError("byte 0: the file is empty (0 bytes); expected a header row and data rows", path)
     kind = container_kind(head)
-    if path.suffix.lower() in (".zs2", ".zp2") or (kind == "gzip"):
-        raise ReadError(
-            "native Zwick .zs2 (or gzip) file; export the test as ASCII (TXT/TRA) from "
-            "testXpert and read that",
-            path,
-        )
+    if path.suffix.lower() in ZS2_SUFFIXES or kind == "gzip":
+        return _open_zs2(path), size
     if kind in ("zip", "ole2"):
         sheets = _open_excel(path, kind)
         sources = []
