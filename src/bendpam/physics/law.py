@@ -39,6 +39,7 @@ here and nowhere else.
 
 from __future__ import annotations
 
+import math
 import warnings
 from functools import cached_property, lru_cache
 from typing import Any
@@ -66,11 +67,12 @@ from bendpam.physics.branch import (
     describe_branch,
     solve_free,
 )
+from bendpam.physics.kernel import SplineKernel
 from bendpam.physics.models import energy, force_balance, resolve_model
 from bendpam.physics.roots import bracketed_newton
 from bendpam.physics.sections import MPA_PER_KPA
 from bendpam.physics.stable import StableBranch, stable_branch
-from bendpam.validate import boolean, float_array, instance, integer, number, quadrature_order
+from bendpam.validate import MPA_SUSPECT_KPA, boolean, float_array, instance, integer, number, quadrature_order
 from bendpam.validate import pressure_kpa as _check_pressure
 
 #: ``BRANCH_END``, ``BranchTable``, ``FreeBending``, ``FreeBranch`` (:mod:`bendpam.physics.branch`) and
@@ -562,8 +564,8 @@ class MomentTable:
         self._lo, self._hi, self._n = lo, hi, n
         self._kj = kj
         self._coef = np.ascontiguousarray(np.moveaxis(spl.c, 0, -2))  # (intervals, 4, 2)
-        # the same coefficients as eight contiguous arrays, for the chunked real-valued kernel
-        self._c8 = tuple(np.ascontiguousarray(spl.c[i, :, j]) for j in range(2) for i in range(4))
+        # per interval (a3, a2, a1, a0, g3, g2, g1, g0): the moment kernels (bendpam.physics.kernel)
+        self.kernel = SplineKernel(kj, self._coef.transpose(0, 2, 1).reshape(-1, 8), self.P_start_kpa)
         km = 0.5 * (kj[1:] + kj[:-1])
         Ae, Be = self._exact(km)
         Af, Bf = self.coefficients(km)
@@ -583,15 +585,8 @@ class MomentTable:
         return self._n - 1
 
     def _interval(self, k):
-        kr = np.real(k)
-        n = self._n
-        tl = np.clip(2.0 * kr / self._lo - 1.0, -1.0, 1.0)  # left piece: t = 2k/lo - 1 in [-1, 1]
-        tr = np.clip(1.0 - 2.0 * kr / self._hi, -1.0, 1.0)
-        jl = np.floor(np.arccos(tl) * ((n - 1) / np.pi))
-        jr = (n - 1) + np.floor(np.arccos(tr) * ((n - 1) / np.pi))
-        j = np.where(kr < 0.0, jl, jr).astype(np.intp)
-        np.clip(j, 0, self._kj.size - 2, out=j)
-        return j
+        """The knot interval of each curvature (of its real part): the largest knot ``<= k'``."""
+        return self.kernel.interval(np.real(k))
 
     def _eval(self, k, derivative: bool):
         j = self._interval(k)
@@ -631,58 +626,31 @@ class MomentTable:
     def moment(self, pressure_kpa, curvature_per_mm):
         """``M(P, k')`` in N*mm, broadcasting; the same validation as :meth:`MomentLaw.moment`.
 
-        Evaluated in blocks of 8192 points that stay in cache: one ``arccos`` gives the interval
-        on either side of 0, then eight gathers and two Horner steps, in place.
+        One pass checks the range and finiteness of each input; the moment comes from
+        :class:`~bendpam.physics.kernel.SplineKernel`: NumPy in cache-sized blocks, or the compiled
+        numba loop for large calls when numba is installed (bit-identical results;
+        :func:`~bendpam.physics.kernel.kernel_choice`, environment variable ``BENDPAM_KERNEL``).
         """
-        p = self.law.check_pressure(pressure_kpa)
-        k = self.law.check_curvature(curvature_per_mm)
-        shape = np.broadcast_shapes(p.shape, k.shape)
-        pf = np.ascontiguousarray(np.broadcast_to(p, shape), dtype=float).reshape(-1)
-        kf = np.ascontiguousarray(np.broadcast_to(k, shape), dtype=float).reshape(-1)
-        out = np.empty(kf.size)
-        self._moment_kernel(pf, kf, out)
+        p = float_array("pressure_kpa", pressure_kpa, "kPa")
+        k = float_array("curvature_per_mm", curvature_per_mm, "1/mm")
+        try:
+            shape = np.broadcast_shapes(p.shape, k.shape)
+        except ValueError:
+            raise InputError(f"pressure_kpa of shape {p.shape} and curvature_per_mm of shape {k.shape} "
+                             "do not broadcast to one shape") from None
+        size = math.prod(shape)
+        pf = p.reshape(-1) if p.size == 1 or p.shape == shape else np.broadcast_to(p, shape).reshape(-1)
+        kf = k.reshape(-1) if k.shape == shape else np.broadcast_to(k, shape).reshape(-1)
+        out = np.empty(size)
+        law, lim = self.law, self.limits
+        ok, pmax = self.kernel.evaluate(pf, kf, out, law.max_pressure_kpa, float(lim.k_min), float(lim.k_max))
+        if not ok:  # the full checks name the bad value
+            law.check_pressure(p)
+            law.check_curvature(k)
+            raise InputError("pressure_kpa or curvature_per_mm is not finite or is out of range")
+        if 0.0 < pmax < MPA_SUSPECT_KPA:
+            law.check_pressure(p)  # warns: MPa passed as kPa?
         return out.reshape(shape)
-
-    def _moment_kernel(self, P, k, out, chunk: int = 8192) -> None:
-        """``out = max(P - P_start, 0) A(k) - k G(k)`` for 1-D float arrays, in cache-sized blocks."""
-        n1 = self._n - 1
-        scale = n1 / np.pi
-        inv_lo, inv_hi = 1.0 / self._lo, 1.0 / self._hi
-        kj = self._kj
-        a3, a2, a1, a0, g3, g2, g1, g0 = self._c8
-        last = kj.size - 2
-        for s0 in range(0, k.size, chunk):
-            kk = k[s0:s0 + chunk]
-            r = np.where(kk < 0.0, kk * inv_lo, kk * inv_hi)  # fraction of the way to the lock-up limit
-            np.multiply(r, -2.0, out=r)
-            r += 1.0
-            np.clip(r, -1.0, 1.0, out=r)
-            th = np.arccos(r)
-            th *= scale
-            np.copysign(th, kk, out=th)  # k < 0: n1 - th (left piece), k > 0: n1 + th
-            th += n1
-            j = th.astype(np.intp)
-            np.clip(j, 0, last, out=j)
-            dx = kk - np.take(kj, j)
-            A = np.take(a3, j)
-            A *= dx
-            A += np.take(a2, j)
-            A *= dx
-            A += np.take(a1, j)
-            A *= dx
-            A += np.take(a0, j)
-            G = np.take(g3, j)
-            G *= dx
-            G += np.take(g2, j)
-            G *= dx
-            G += np.take(g1, j)
-            G *= dx
-            G += np.take(g0, j)
-            pa = P[s0:s0 + chunk] - self.P_start_kpa
-            np.maximum(pa, 0.0, out=pa)
-            A *= pa
-            G *= kk
-            np.subtract(A, G, out=out[s0:s0 + chunk])
 
     __call__ = moment
 
