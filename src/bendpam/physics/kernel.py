@@ -141,8 +141,9 @@ class SplineKernel:
         if not (0.0 <= pmin and pmax <= limit_kpa and k_min <= float(k.min()) and float(k.max()) <= k_max):
             return False, pmax
         if (kernel or kernel_choice(k.size)) == "numba":
-            numba_kernel()(P, k, out, self.knots_per_mm, self._next, self.coef, self._inv_lo, self._inv_hi,
-                           self._scale, self._shift, self._last, self.P_start_kpa, self._fine)
+            numba_kernel()(np.ascontiguousarray(P), np.ascontiguousarray(k), out, self.knots_per_mm, self._next,
+                           self.coef, self._inv_lo, self._inv_hi, self._scale, self._shift, self._last,
+                           self.P_start_kpa, self._fine)
         else:
             self._moment_numpy(P, k, out)
         return True, pmax

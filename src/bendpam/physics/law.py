@@ -506,9 +506,12 @@ class MomentTable:
     With the default 513 knots a side and ``tol = 1e-6`` a table takes about 3 ms to build and its
     error is 1-6e-7 (checked against a 128-node reference in ``tests/test_fast.py``).
 
-    Evaluation is a gather of 4 x 2 cubic coefficients per point (the interval index comes from
-    ``arccos`` of the Chebyshev map, no search) and Horner steps; complex curvatures are accepted
-    (the interval comes from the real part), for complex-step derivatives.
+    Evaluation is a gather of 4 x 2 cubic coefficients per point and Horner steps
+    (:class:`~bendpam.physics.kernel.SplineKernel`: NumPy, or a compiled numba loop with bit-identical
+    results); the interval is the knot interval containing the point, found from ``arccos`` of the
+    Chebyshev map and one comparison, no search.  Complex curvatures are accepted by
+    :meth:`coefficients` and :meth:`derivatives` (the interval comes from the real part), for
+    complex-step derivatives.
 
     Examples
     --------
@@ -599,22 +602,30 @@ class MomentTable:
         return v, d
 
     def coefficients(self, curvature_per_mm):
-        """Interpolated ``(A, B)`` (N*mm/kPa, N*mm) at ``curvature_per_mm``; no range check."""
+        """Interpolated ``(A, B)`` (N*mm/kPa, N*mm) at ``curvature_per_mm``, checked like :meth:`moment`."""
         k = self._curvature(curvature_per_mm)
         v, _ = self._eval(k, False)
         return v[..., 0], k * v[..., 1]
 
     def _curvature(self, curvature_per_mm) -> np.ndarray:
-        """Real or complex curvatures whose real part is finite and inside the lock-up limits."""
+        """Real or complex curvatures whose real part is finite and inside the lock-up limits.
+
+        One min and one max decide (NaN fails both); the full check runs only to name a bad value.
+        """
         if isinstance(curvature_per_mm, complex | np.complexfloating) or np.iscomplexobj(curvature_per_mm):
             k = np.asarray(curvature_per_mm)
-            self.limits.check(np.real(k))
+            self._check_real(np.real(k))
             if not np.all(np.isfinite(np.imag(k))):
                 raise InputError("curvature_per_mm has a non-finite imaginary part")
             return k
         k = float_array("curvature_per_mm", curvature_per_mm, "1/mm")
-        self.limits.check(k)
+        self._check_real(k)
         return k
+
+    def _check_real(self, k: np.ndarray) -> None:
+        lim = self.limits
+        if k.size == 0 or not (float(lim.k_min) <= float(k.min()) and float(k.max()) <= float(lim.k_max)):
+            lim.check(k)
 
     def derivatives(self, curvature_per_mm):
         """``(A, B, dA/dk', dB/dk')`` from the splines (complex curvatures allowed)."""
@@ -655,11 +666,13 @@ class MomentTable:
     __call__ = moment
 
     def tangent_stiffness(self, pressure_kpa, curvature_per_mm):
-        """``dM/dk'`` (N*mm^2) from the spline derivatives."""
-        p = self.law.active_pressure_kpa(pressure_kpa)
-        k = self.law.check_curvature(curvature_per_mm)
-        _, _, dA, dB = self.derivatives(k)
-        return p * dA - dB
+        """``dM/dk'`` (N*mm^2) from the spline derivatives, checked like :meth:`moment`."""
+        p = float_array("pressure_kpa", pressure_kpa, "kPa")
+        top = self.law.max_pressure_kpa
+        if p.size == 0 or not (0.0 <= float(p.min()) and MPA_SUSPECT_KPA <= float(p.max()) <= top):
+            p = self.law.check_pressure(p)  # names a bad value, or warns (MPa passed as kPa?)
+        _, _, dA, dB = self.derivatives(curvature_per_mm)
+        return np.maximum(p - self.P_start_kpa, 0.0) * dA - dB
 
     def free_curvature(self, pressure_kpa, *, newton_steps: int = 6) -> FreeBending:
         """Free-bending curvature from the tables: the same branch as :meth:`MomentLaw.free_curvature`.
