@@ -8,7 +8,7 @@ force-balance:
   they were, copied verbatim below as :func:`main_moment`, on this table's spline coefficients):
   ``check_pressure`` and ``check_curvature`` (about eight passes), then 8192-point blocks;
 * ``numpy``: ``MomentTable.moment`` with ``BENDPAM_KERNEL=numpy`` (one min and one max per input,
-  32768-point blocks);
+  8192-point blocks, as before);
 * ``numba``: the same with ``BENDPAM_KERNEL=numba`` (the compiled loop, one core);
 * ``cubicspline``: SciPy's ``CubicSpline`` through the same knots and values (the strongest
   library baseline of issue 24; no input checks), ``M = P_a A - k' G``.

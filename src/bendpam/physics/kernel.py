@@ -48,8 +48,9 @@ __all__ = ["CHUNK", "KERNEL_ENV", "NUMBA_MIN_POINTS", "SplineKernel", "kernel_ch
 KERNEL_ENV = "BENDPAM_KERNEL"
 #: ``auto`` takes the compiled kernel for calls of at least this many points (when numba imports).
 NUMBA_MIN_POINTS = 1 << 18
-#: Points per block of the NumPy kernel (its temporaries stay in the CPU's level-2 cache).
-CHUNK = 1 << 15
+#: Points per block of the NumPy kernel: its temporaries (64 KiB each) stay in cache and below glibc's first mmap
+#: threshold (128 KiB), so a process that has not yet freed a large array does not page-fault them in afresh.
+CHUNK = 8192
 _KERNELS = ("auto", "numpy", "numba")
 # The compiled kernel's first guess of arccos(x), x in [0, 1]: sqrt(1 - x) times a polynomial,
 # Abramowitz & Stegun 4.4.46 (|error| <= 2.2e-8 rad)
@@ -106,15 +107,17 @@ class SplineKernel:
             raise InputError(f"SplineKernel takes at most 10^7 knots, not {kj.size}")
         self._shift = n1 - 0.5  # the guess half an interval low: the true interval is the guess or the next
         self._inv_lo, self._inv_hi = 1.0 / float(kj[0]), 1.0 / float(kj[-1])
+        self._m_lo, self._m_hi = -2.0 * self._inv_lo, -2.0 * self._inv_hi
         self._next = np.append(kj[1:-1], np.inf)  # the knot after each interval's start (none after the last)
         self._cols = tuple(np.ascontiguousarray(c[:, i]) for i in range(8))
 
     def interval(self, k) -> np.ndarray:
         """The knot interval of each real curvature ``k`` (1/mm): the largest knot ``<= k``, within [0, intervals)."""
         k = np.asarray(k, dtype=float)
-        kk = k.reshape(-1)
-        r = np.where(kk < 0.0, kk * self._inv_lo, kk * self._inv_hi)  # fraction of the way to the lock-up limit
-        r *= -2.0
+        return self._interval(k.reshape(-1)).reshape(k.shape)
+
+    def _interval(self, kk: np.ndarray) -> np.ndarray:
+        r = np.where(kk < 0.0, kk * self._m_lo, kk * self._m_hi)  # -2 k / (lock-up limit on k's side)
         r += 1.0
         np.clip(r, -1.0, 1.0, out=r)
         th = np.arccos(r)
@@ -123,7 +126,7 @@ class SplineKernel:
         th += self._shift
         j = th.astype(np.intp)  # in [0, intervals): th is in [-0.5, 2 n1 - 0.5] up to rounding
         j += kk >= np.take(self._next, j)
-        return j.reshape(k.shape)
+        return j
 
     def evaluate(self, P, k, out, limit_kpa: float, k_min: float, k_max: float,
                  kernel: str | None = None) -> tuple[bool, float]:
@@ -154,7 +157,7 @@ class SplineKernel:
         pa_all = max(float(P[0]) - Ps, 0.0) if P.size == 1 else None
         for s0 in range(0, k.size, CHUNK):
             kk = k[s0:s0 + CHUNK]
-            j = self.interval(kk)
+            j = self._interval(kk)
             dx = kk - np.take(kj, j)
             A = np.take(a3, j)
             A *= dx
