@@ -67,7 +67,7 @@ def _main_kernel(table, P, k, out, chunk: int = 8192) -> None:
     scale = n1 / np.pi
     inv_lo, inv_hi = 1.0 / table._lo, 1.0 / table._hi
     kj = table._kj
-    a3, a2, a1, a0, g3, g2, g1, g0 = table.kernel._cols  # the same coefficients as main's table._c8
+    a3, a2, a1, a0, g3, g2, g1, g0 = (np.ascontiguousarray(table.kernel.coef[:, i]) for i in range(8))  # main's _c8
     last = kj.size - 2
     for s0 in range(0, k.size, chunk):
         kk = k[s0:s0 + chunk]
