@@ -14,11 +14,12 @@ force-balance:
   library baseline of issue 24; no input checks), ``M = P_a A - k' G``.
 
 Each is timed by the wall clock (median of the repeats; the machine is shared, so the min is
-shown too) and by the CPU time of the thread (``time.thread_time``, the median: what one core
-spends, whatever else runs).  The results are checked: numba against numpy bit for bit, both
-against ``main`` (which may pick the neighbouring interval at a knot: differences of a few units in
-the last place).  The first use of numba is measured in fresh processes: ``import numba``, the
-first call with an empty cache (compilation), and the first call with the cache written.
+shown too) and by the CPU time of the process (``time.process_time``, the median: what one core
+spends, whatever else runs; every candidate runs on one thread), with ``bench_reader.interleaved``.
+The results are checked: numba against numpy bit for bit, both against ``main`` (which may pick
+the neighbouring interval at a knot: differences of a few units in the last place).  The first use
+of numba is measured in fresh processes: ``import numba``, the first call with an empty cache
+(compilation), and the first call with the cache written.
 
 Run: ``python benchmarks/bench_kernel.py [--quick]``.
 """
@@ -27,11 +28,9 @@ from __future__ import annotations
 
 import json
 import os
-import statistics
 import subprocess
 import sys
 import tempfile
-import time
 import warnings
 from pathlib import Path
 
@@ -39,6 +38,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parent))
 from _timing import Recorder, header, standalone
+from bench_reader import interleaved
 
 import bendpam
 from bendpam.physics.kernel import KERNEL_ENV
@@ -117,23 +117,6 @@ def _with_kernel(name, fn):
     return run
 
 
-def _interleaved(cands: dict, repeats: int) -> dict:
-    """Wall and thread-CPU seconds of each candidate, repeats interleaved in rotated order (after a warm-up)."""
-    names = list(cands)
-    for n in names:
-        cands[n]()
-    wall: dict[str, list[float]] = {n: [] for n in names}
-    cpu: dict[str, list[float]] = {n: [] for n in names}
-    for r in range(repeats):
-        for n in names[r % len(names):] + names[:r % len(names)]:
-            t0, c0 = time.perf_counter(), time.thread_time()
-            cands[n]()
-            cpu[n].append(time.thread_time() - c0)
-            wall[n].append(time.perf_counter() - t0)
-    return {n: {"wall_median_s": statistics.median(wall[n]), "wall_min_s": min(wall[n]),
-                "cpu_median_s": statistics.median(cpu[n]), "cpu_min_s": min(cpu[n])} for n in names}
-
-
 def _case(rec: Recorder, name: str, model: str, n: int, reps: int) -> dict:
     from scipy.interpolate import CubicSpline
 
@@ -161,7 +144,9 @@ def _case(rec: Recorder, name: str, model: str, n: int, reps: int) -> dict:
                  "numpy": _with_kernel("numpy", lambda PP=PP: tab.moment(PP, k)),
                  "numba": _with_kernel("numba", lambda PP=PP: tab.moment(PP, k)),
                  "cubicspline": lambda PP=PP: cubic(PP)}
-        st = _interleaved(cands, reps)
+        wall, cpu = interleaved(cands, reps, n)
+        st = {c: {"wall_median_s": wall[c].median, "wall_min_s": wall[c].min, "cpu_median_s": cpu[c].median,
+                  "cpu_min_s": cpu[c].min} for c in cands}
         m_np, m_nb, m_main = cands["numpy"](), cands["numba"](), cands["main"]()
         scale = np.abs(np.maximum(np.asarray(PP) - Ps, 0.0) * Ak) + np.abs(Bk)
         scale = np.maximum(scale, 1e-3 * np.median(scale))
