@@ -508,7 +508,7 @@ class MomentTable:
 
     Evaluation is a gather of 4 x 2 cubic coefficients per point and Horner steps
     (:class:`~bendpam.physics.kernel.SplineKernel`: NumPy, or a compiled numba loop with bit-identical
-    results; the table's :attr:`kernel`); the interval is the knot interval containing the point, found
+    results; the table's ``kernel``); the interval is the knot interval containing the point, found
     from ``arccos`` of the Chebyshev map and one comparison, no search.  Complex curvatures are accepted by
     :meth:`coefficients` and :meth:`derivatives` (the interval comes from the real part), for
     complex-step derivatives.
