@@ -7,7 +7,11 @@
   the library that parses it costs);
 * what each of those commands leaves in ``sys.modules`` (NumPy, pandas, pyplot, ``scipy.io``...);
 * ``bendpam fit`` on 25 simulated pressures with and without its figure (interleaved, median of 5);
-* ``python -c "import bendpam"`` and the heavy modules it imports.
+* ``python -c "import bendpam"`` and the heavy modules it imports;
+* what reading ``curves.nc`` adds to ``fit``'s imports: ``scipy.io`` (SciPy's NetCDF-3 reader) and
+  ``xarray`` (its lazy backends), each imported after what ``fit`` imports anyway (NumPy,
+  ``scipy.optimize``, ``scipy.special``, ``scipy.spatial``), against ``numpy.load`` of an ``.npz``
+  (nothing to import): the choice of issue 24 item 6, fresh processes, interleaved, median.
 
 Every process runs with bytecode caching on, in a private cache folder (``PYTHONPYCACHEPREFIX``),
 as an installed package would (a checkout run with ``PYTHONDONTWRITEBYTECODE`` recompiles every
@@ -126,6 +130,34 @@ def fit(rec: Recorder, quick: bool, e: dict[str, str], cwd: str) -> None:
             "", "none", not ({m for h in heavy.values() for m in h} & {"matplotlib.pyplot", "scipy.io"}))
 
 
+READER_IMPORT = """
+import time
+import numpy, scipy.optimize, scipy.special, scipy.spatial
+t0 = time.perf_counter()
+{stmt}
+print(time.perf_counter() - t0)
+"""
+
+
+def reader_imports(rec: Recorder, quick: bool, e: dict[str, str], cwd: str) -> None:
+    """Seconds that ``import scipy.io`` / ``import xarray`` add once ``fit``'s other imports are loaded."""
+    reps = 5 if quick else 15
+    stmts = {"scipy.io": "import scipy.io", "xarray": "import xarray", "numpy.load (.npz)": "pass"}
+    runs: dict[str, list[float]] = {n: [] for n in stmts}
+    for _ in range(reps):
+        for name, stmt in stmts.items():
+            out = subprocess.run([sys.executable, "-c", READER_IMPORT.format(stmt=stmt)], env=e, cwd=cwd,
+                                 capture_output=True, text=True, check=True).stdout
+            runs[name].append(float(out.strip().splitlines()[-1]))
+    med = {n: sorted(v)[len(v) // 2] for n, v in runs.items()}
+    header(f"Reading curves.nc in `fit`: the import each reader adds after fit's own imports, median of {reps}")
+    for n, v in med.items():
+        print(f"  {n:18} {v * 1e3:7.1f} ms")
+    rec.record("fit", "reader import after fit's imports (s)", med)
+    rec.row("`fit`: import scipy.io after scipy.optimize", med["scipy.io"], "s", "", None,
+            f"xarray {med['xarray'] * 1e3:.0f} ms; an .npz would save this much, not more")
+
+
 def import_report(e: dict[str, str], cwd: str) -> list[str]:
     code = f"import json, sys, bendpam; print(json.dumps([m for m in {list(HEAVY)!r} if m in sys.modules]))"
     return json.loads(subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
@@ -143,6 +175,7 @@ def run(rec: Recorder, quick: bool) -> None:
         rec.record("startup", "heavy_modules", heavy)
         rec.row("heavy modules imported by `import bendpam`", ", ".join(heavy) or "none", "", "none", not heavy)
         fit(rec, quick, e, cwd)
+        reader_imports(rec, quick, e, cwd)
 
 
 if __name__ == "__main__":

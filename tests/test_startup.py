@@ -127,6 +127,7 @@ def test_fit_with_its_figure_imports_no_pyplot(processed_dir, tmp_path):
     assert (tmp_path / "fit" / "figure7.png").is_file()
     assert "matplotlib" in modules
     assert loaded(modules, "matplotlib.pyplot") == []
+    assert loaded(modules, "bendpam.design") == []  # one figure does not load the design layer (issue 24 item 6)
 
 
 @pytest.mark.parametrize("columns", ["80", "60", "200"])

@@ -13,7 +13,8 @@ layers.
 * :mod:`~bendpam.physics.law`: :class:`~bendpam.physics.law.MomentLaw`, the only sampler of the models,
   and its spline table; the free-bending branch (:mod:`~bendpam.physics.branch`), the law along
   ``u = k'R`` (:mod:`~bendpam.physics.sections`) and the stable branch (:mod:`~bendpam.physics.stable`).
-* :mod:`~bendpam.physics.fast`: the tabulated fast path.
+* :mod:`~bendpam.physics.fast`: the tabulated fast path; :mod:`~bendpam.physics.kernel`: its NumPy and optional
+  numba kernels (bit-identical).
 * :mod:`~bendpam.physics.limits`: frame stress, buckling, lock-up and bladder-stretch margins.
 * :mod:`~bendpam.physics.hysteresis`: loop models around the quasi-static law.
 * :mod:`~bendpam.physics.roots`: the vectorised root finders (bracketed Newton, Illinois) they share.

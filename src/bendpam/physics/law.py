@@ -39,6 +39,7 @@ here and nowhere else.
 
 from __future__ import annotations
 
+import math
 import warnings
 from functools import cached_property, lru_cache
 from typing import Any
@@ -66,11 +67,12 @@ from bendpam.physics.branch import (
     describe_branch,
     solve_free,
 )
+from bendpam.physics.kernel import SplineKernel
 from bendpam.physics.models import energy, force_balance, resolve_model
 from bendpam.physics.roots import bracketed_newton
 from bendpam.physics.sections import MPA_PER_KPA
 from bendpam.physics.stable import StableBranch, stable_branch
-from bendpam.validate import boolean, float_array, instance, integer, number, quadrature_order
+from bendpam.validate import MPA_SUSPECT_KPA, boolean, float_array, instance, integer, number, quadrature_order
 from bendpam.validate import pressure_kpa as _check_pressure
 
 #: ``BRANCH_END``, ``BranchTable``, ``FreeBending``, ``FreeBranch`` (:mod:`bendpam.physics.branch`) and
@@ -504,9 +506,12 @@ class MomentTable:
     With the default 513 knots a side and ``tol = 1e-6`` a table takes about 3 ms to build and its
     error is 1-6e-7 (checked against a 128-node reference in ``tests/test_fast.py``).
 
-    Evaluation is a gather of 4 x 2 cubic coefficients per point (the interval index comes from
-    ``arccos`` of the Chebyshev map, no search) and Horner steps; complex curvatures are accepted
-    (the interval comes from the real part), for complex-step derivatives.
+    Evaluation is a gather of 4 x 2 cubic coefficients per point and Horner steps
+    (:class:`~bendpam.physics.kernel.SplineKernel`: NumPy, or a compiled numba loop with bit-identical
+    results; the table's ``kernel``); the interval is the knot interval containing the point, found
+    from ``arccos`` of the Chebyshev map and one comparison, no search.  Complex curvatures are accepted by
+    :meth:`coefficients` and :meth:`derivatives` (the interval comes from the real part), for
+    complex-step derivatives.
 
     Examples
     --------
@@ -562,8 +567,8 @@ class MomentTable:
         self._lo, self._hi, self._n = lo, hi, n
         self._kj = kj
         self._coef = np.ascontiguousarray(np.moveaxis(spl.c, 0, -2))  # (intervals, 4, 2)
-        # the same coefficients as eight contiguous arrays, for the chunked real-valued kernel
-        self._c8 = tuple(np.ascontiguousarray(spl.c[i, :, j]) for j in range(2) for i in range(4))
+        # per interval (a3, a2, a1, a0, g3, g2, g1, g0): the moment kernels (bendpam.physics.kernel)
+        self.kernel = SplineKernel(kj, self._coef.transpose(0, 2, 1).reshape(-1, 8), self.P_start_kpa)
         km = 0.5 * (kj[1:] + kj[:-1])
         Ae, Be = self._exact(km)
         Af, Bf = self.coefficients(km)
@@ -583,15 +588,8 @@ class MomentTable:
         return self._n - 1
 
     def _interval(self, k):
-        kr = np.real(k)
-        n = self._n
-        tl = np.clip(2.0 * kr / self._lo - 1.0, -1.0, 1.0)  # left piece: t = 2k/lo - 1 in [-1, 1]
-        tr = np.clip(1.0 - 2.0 * kr / self._hi, -1.0, 1.0)
-        jl = np.floor(np.arccos(tl) * ((n - 1) / np.pi))
-        jr = (n - 1) + np.floor(np.arccos(tr) * ((n - 1) / np.pi))
-        j = np.where(kr < 0.0, jl, jr).astype(np.intp)
-        np.clip(j, 0, self._kj.size - 2, out=j)
-        return j
+        """The knot interval of each curvature (of its real part): the largest knot ``<= k'``."""
+        return self.kernel.interval(np.real(k))
 
     def _eval(self, k, derivative: bool):
         j = self._interval(k)
@@ -604,22 +602,30 @@ class MomentTable:
         return v, d
 
     def coefficients(self, curvature_per_mm):
-        """Interpolated ``(A, B)`` (N*mm/kPa, N*mm) at ``curvature_per_mm``; no range check."""
+        """Interpolated ``(A, B)`` (N*mm/kPa, N*mm) at ``curvature_per_mm``, checked like :meth:`moment`."""
         k = self._curvature(curvature_per_mm)
         v, _ = self._eval(k, False)
         return v[..., 0], k * v[..., 1]
 
     def _curvature(self, curvature_per_mm) -> np.ndarray:
-        """Real or complex curvatures whose real part is finite and inside the lock-up limits."""
+        """Real or complex curvatures whose real part is finite and inside the lock-up limits.
+
+        One min and one max decide (NaN fails both); the full check runs only to name a bad value.
+        """
         if isinstance(curvature_per_mm, complex | np.complexfloating) or np.iscomplexobj(curvature_per_mm):
             k = np.asarray(curvature_per_mm)
-            self.limits.check(np.real(k))
+            self._check_real(np.real(k))
             if not np.all(np.isfinite(np.imag(k))):
                 raise InputError("curvature_per_mm has a non-finite imaginary part")
             return k
         k = float_array("curvature_per_mm", curvature_per_mm, "1/mm")
-        self.limits.check(k)
+        self._check_real(k)
         return k
+
+    def _check_real(self, k: np.ndarray) -> None:
+        lim = self.limits
+        if k.size == 0 or not (float(lim.k_min) <= float(k.min()) and float(k.max()) <= float(lim.k_max)):
+            lim.check(k)
 
     def derivatives(self, curvature_per_mm):
         """``(A, B, dA/dk', dB/dk')`` from the splines (complex curvatures allowed)."""
@@ -631,67 +637,42 @@ class MomentTable:
     def moment(self, pressure_kpa, curvature_per_mm):
         """``M(P, k')`` in N*mm, broadcasting; the same validation as :meth:`MomentLaw.moment`.
 
-        Evaluated in blocks of 8192 points that stay in cache: one ``arccos`` gives the interval
-        on either side of 0, then eight gathers and two Horner steps, in place.
+        One pass checks the range and finiteness of each input; the moment comes from
+        :class:`~bendpam.physics.kernel.SplineKernel`: NumPy in cache-sized blocks, or the compiled
+        numba loop for large calls when numba is installed (bit-identical results;
+        :func:`~bendpam.physics.kernel.kernel_choice`, environment variable ``BENDPAM_KERNEL``).
         """
-        p = self.law.check_pressure(pressure_kpa)
-        k = self.law.check_curvature(curvature_per_mm)
-        shape = np.broadcast_shapes(p.shape, k.shape)
-        pf = np.ascontiguousarray(np.broadcast_to(p, shape), dtype=float).reshape(-1)
-        kf = np.ascontiguousarray(np.broadcast_to(k, shape), dtype=float).reshape(-1)
-        out = np.empty(kf.size)
-        self._moment_kernel(pf, kf, out)
+        p = float_array("pressure_kpa", pressure_kpa, "kPa")
+        k = float_array("curvature_per_mm", curvature_per_mm, "1/mm")
+        try:
+            shape = np.broadcast_shapes(p.shape, k.shape)
+        except ValueError:
+            raise InputError(f"pressure_kpa of shape {p.shape} and curvature_per_mm of shape {k.shape} "
+                             "do not broadcast to one shape") from None
+        size = math.prod(shape)
+        pf = p.reshape(-1) if p.size == 1 or p.shape == shape else np.broadcast_to(p, shape).reshape(-1)
+        kf = k.reshape(-1) if k.shape == shape else np.broadcast_to(k, shape).reshape(-1)
+        out = np.empty(size)
+        law, lim = self.law, self.limits
+        ok, pmax = self.kernel.evaluate(pf, kf, out, law.max_pressure_kpa, float(lim.k_min), float(lim.k_max))
+        if not ok:  # the full checks name the bad value
+            law.check_pressure(p)
+            law.check_curvature(k)
+            raise InputError("pressure_kpa or curvature_per_mm is not finite or is out of range")
+        if 0.0 < pmax < MPA_SUSPECT_KPA:
+            law.check_pressure(p)  # warns: MPa passed as kPa?
         return out.reshape(shape)
-
-    def _moment_kernel(self, P, k, out, chunk: int = 8192) -> None:
-        """``out = max(P - P_start, 0) A(k) - k G(k)`` for 1-D float arrays, in cache-sized blocks."""
-        n1 = self._n - 1
-        scale = n1 / np.pi
-        inv_lo, inv_hi = 1.0 / self._lo, 1.0 / self._hi
-        kj = self._kj
-        a3, a2, a1, a0, g3, g2, g1, g0 = self._c8
-        last = kj.size - 2
-        for s0 in range(0, k.size, chunk):
-            kk = k[s0:s0 + chunk]
-            r = np.where(kk < 0.0, kk * inv_lo, kk * inv_hi)  # fraction of the way to the lock-up limit
-            np.multiply(r, -2.0, out=r)
-            r += 1.0
-            np.clip(r, -1.0, 1.0, out=r)
-            th = np.arccos(r)
-            th *= scale
-            np.copysign(th, kk, out=th)  # k < 0: n1 - th (left piece), k > 0: n1 + th
-            th += n1
-            j = th.astype(np.intp)
-            np.clip(j, 0, last, out=j)
-            dx = kk - np.take(kj, j)
-            A = np.take(a3, j)
-            A *= dx
-            A += np.take(a2, j)
-            A *= dx
-            A += np.take(a1, j)
-            A *= dx
-            A += np.take(a0, j)
-            G = np.take(g3, j)
-            G *= dx
-            G += np.take(g2, j)
-            G *= dx
-            G += np.take(g1, j)
-            G *= dx
-            G += np.take(g0, j)
-            pa = P[s0:s0 + chunk] - self.P_start_kpa
-            np.maximum(pa, 0.0, out=pa)
-            A *= pa
-            G *= kk
-            np.subtract(A, G, out=out[s0:s0 + chunk])
 
     __call__ = moment
 
     def tangent_stiffness(self, pressure_kpa, curvature_per_mm):
-        """``dM/dk'`` (N*mm^2) from the spline derivatives."""
-        p = self.law.active_pressure_kpa(pressure_kpa)
-        k = self.law.check_curvature(curvature_per_mm)
-        _, _, dA, dB = self.derivatives(k)
-        return p * dA - dB
+        """``dM/dk'`` (N*mm^2) from the spline derivatives, checked like :meth:`moment`."""
+        p = float_array("pressure_kpa", pressure_kpa, "kPa")
+        top = self.law.max_pressure_kpa
+        if p.size == 0 or not (0.0 <= float(p.min()) and MPA_SUSPECT_KPA <= float(p.max()) <= top):
+            p = self.law.check_pressure(p)  # names a bad value, or warns (MPa passed as kPa?)
+        _, _, dA, dB = self.derivatives(curvature_per_mm)
+        return np.maximum(p - self.P_start_kpa, 0.0) * dA - dB
 
     def free_curvature(self, pressure_kpa, *, newton_steps: int = 6) -> FreeBending:
         """Free-bending curvature from the tables: the same branch as :meth:`MomentLaw.free_curvature`.

@@ -24,8 +24,6 @@ import matplotlib
 import numpy as np
 from matplotlib.colors import LogNorm
 
-from bendpam.design.targets import NAN_MISS, TOL
-from bendpam.design.wrist import wrist_pressures
 from bendpam.errors import InputError
 from bendpam.infra.accessors import register
 from bendpam.present.figures.style import figure_size, figure_style, new_figure, save_figure
@@ -160,11 +158,13 @@ def _wrist_curve_groups(table, positions_deg) -> list[tuple[list[float], np.ndar
                 break
         else:
             groups.append(([float(d)], P, a))
+    from bendpam.design.wrist import wrist_pressures as _wrist_pressures  # the design layer on use only
+
     out = []
     for dirs, P, a in groups:
         names = []
         for d in dirs:
-            on = [p for p, v in zip(positions_deg, wrist_pressures(d, 100.0, positions_deg), strict=True) if v > 0]
+            on = [p for p, v in zip(positions_deg, _wrist_pressures(d, 100.0, positions_deg), strict=True) if v > 0]
             names.append("+".join(f"{p:g}" for p in on) + "°")
         pair = len(names[0].split("+")) > 1
         if len(dirs) == 1:
@@ -255,6 +255,8 @@ def plot_coarse_map(result: DesignResult):
     >>> len(fig.axes)                                     # the map and its colour bar
     2
     """
+    from bendpam.design.targets import NAN_MISS
+
     c = result.coarse
     names = [v.name for v in result.variables]
     fig = new_figure((3.5, 2.9), layout="constrained")
@@ -292,6 +294,8 @@ def plot_pareto(result: DesignResult):
     >>> len(fig.axes)                                     # fig.savefig("pareto.png") to keep it
     1
     """
+    from bendpam.design.targets import TOL
+
     pf = result.pareto
     if pf is None:
         raise InputError("this design has no Pareto front (it needs exactly two targets)")
