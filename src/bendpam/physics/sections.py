@@ -205,9 +205,9 @@ class _TablePath:
         return _assembled(self.law, sub, k, u, R, dR, m)
 
     def to_k(self, u, rows):
-        m = self.tables.means(self.ia[rows], u)
-        sub = self.cs.take(rows)
-        return radius_from_u(u, m["ib"], m["dib"], sub.alpha0, sub.R0_start)[2]
+        ia, u = np.broadcast_arrays(self.ia[rows], np.asarray(u, dtype=float))
+        m = self.tables._eval(ia, u, cols=[self.tables.keys.index("ib"), self.tables.keys.index("dib")])  # Ibar alone
+        return radius_from_u(u, m[..., 0], m[..., 1], self.cs.alpha0[rows], self.cs.R0_start[rows])[2]
 
     def _u_limits(self):
         """The braid limit in u on the bending side, cut where the bladder lumen closes (``R = t_bar``)."""
