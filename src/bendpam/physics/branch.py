@@ -136,7 +136,9 @@ def branch_table(law: MomentLaw, samples: int = BRANCH_SAMPLES) -> BranchTable:
                      np.where(kind == BRANCH_END["unbounded"], np.inf,
                               np.take_along_axis(pk, np.minimum(n_ok, n)[:, None], -1)[:, 0]))
     p_end = np.where(kind == BRANCH_END["neutral"], np.inf, p_end)
-    last = np.where(kind == BRANCH_END["fold"], j, np.minimum(n_ok, n))
+    # a refined fold before sample j ends the branch there: sample j is already past it (on the unstable side)
+    past = use_ref & (np.abs(x_fold) < np.abs(np.take_along_axis(xk, j[:, None], -1)[:, 0]))
+    last = np.where(kind == BRANCH_END["fold"], np.where(past, j - 1, j), np.minimum(n_ok, n))
     pt = np.where(np.arange(n + 1)[None, :] <= last[:, None], pk, np.inf)
     nxt = np.clip(last + 1, 0, n)
     x_after = np.take_along_axis(xk, nxt[:, None], -1)[:, 0]
@@ -298,33 +300,34 @@ def _bracket_index(pt: np.ndarray, pa: np.ndarray) -> np.ndarray:
     return out
 
 
-def _sample_slopes(xt: np.ndarray, pt: np.ndarray, last: np.ndarray, width: int = 5) -> np.ndarray:
-    """``dP_a/du`` at every sample of the branch: the derivative of the polynomial through ``width`` samples.
+def _sample_slopes(xt: np.ndarray, pt: np.ndarray, last: np.ndarray, case: np.ndarray, at: np.ndarray,
+                   width: int = 5) -> np.ndarray:
+    """``dP_a/du`` at samples ``at`` of cases ``case``: the derivative of the polynomial through ``width`` samples.
 
     The stencil is centred where it fits and shifted to stay within samples ``0 .. last`` at the
     branch's start and end (fourth order on the graded samples with the default 5); NaN past the
     last sample, or where the branch has fewer samples than the stencil.
     """
     n = xt.shape[-1]
-    idx = np.arange(n)[None, :]
-    i0 = np.clip(np.minimum(idx - width // 2, last[:, None] - (width - 1)), 0, max(n - width, 0))
-    x = [np.take_along_axis(xt, i0 + d, -1) for d in range(width)]
-    p = [np.take_along_axis(pt, i0 + d, -1) for d in range(width)]
-    d = np.zeros(xt.shape)
+    lc = last[case]
+    i0 = np.clip(np.minimum(at - width // 2, lc - (width - 1)), 0, max(n - width, 0))
+    x = [xt[case, i0 + d] for d in range(width)]
+    p = [pt[case, i0 + d] for d in range(width)]
+    xe = xt[case, np.clip(at, 0, n - 1)]
+    d = np.zeros(np.shape(at))
     with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
         for i in range(width):  # Lagrange: L_i'(x) = sum over m != i of prod over r != i, m of (x - x_r) / ...
-            dl = np.zeros(xt.shape)
+            dl = np.zeros(np.shape(at))
             for m in range(width):
                 if m == i:
                     continue
                 term = 1.0 / (x[i] - x[m])
                 for r in range(width):
                     if r not in (i, m):
-                        term = term * (xt - x[r]) / (x[i] - x[r])
+                        term = term * (xe - x[r]) / (x[i] - x[r])
                 dl += term
             d += p[i] * dl
-    ok = (idx <= last[:, None]) & (last[:, None] >= width - 1)
-    return np.where(ok, d, np.nan)
+    return np.where((at <= lc) & (lc >= width - 1), d, np.nan)
 
 
 def _start(tab: BranchTable, case, j, q):
@@ -339,11 +342,15 @@ def _start(tab: BranchTable, case, j, q):
     beyond = j > last
     fold_end = (tab.kind[case] == BRANCH_END["fold"]) & tab.use_ref[case] & beyond
     unb = (tab.kind[case] == BRANCH_END["unbounded"]) & beyond
-    d = _sample_slopes(tab.xt, tab.pt, tab.last)
     ja = np.where(fold_end | unb, last, j - 1)
     a, b = tab.xt[case, ja], tab.xt[case, j]
     pa_, pb_ = tab.pt[case, ja], tab.pt[case, j]
-    da, db = d[case, ja], d[case, j]
+    if 2 * case.size > tab.xt.size:  # many pressures a case: every sample's slope once, then look them up
+        rows = np.broadcast_to(np.arange(tab.xt.shape[0])[:, None], tab.xt.shape)
+        d = _sample_slopes(tab.xt, tab.pt, tab.last, rows, np.broadcast_to(np.arange(tab.xt.shape[1]), tab.xt.shape))
+        da, db = d[case, ja], d[case, j]
+    else:
+        da, db = (_sample_slopes(tab.xt, tab.pt, tab.last, case, i) for i in (ja, j))
     b = np.where(fold_end, tab.x_fold[case], np.where(unb, tab.x_end[case], b))
     pb_ = np.where(fold_end, tab.p_end[case], np.where(unb, np.inf, pb_))
     db = np.where(fold_end, 0.0, db)

@@ -112,8 +112,9 @@ def _j_closed_form(u, c):
 def _axial_means(u, c):
     """Circle means of ``cot^2 alpha(Phi) = c^2 lambda1^2 / (1 - c^2 lambda1^2)`` and ``lambda1^-2``, closed form.
 
-    With ``lambda1 = (1 + u) - u cos Phi``: ``1 / (1 - c^2 lambda1^2)`` is ``(1/(1 - c lambda1) + 1/(1 + c lambda1)) / 2``
-    and ``mean 1/(alpha + beta cos Phi) = (alpha^2 - beta^2)^(-1/2)``, so
+    With ``lambda1 = (1 + u) - u cos Phi``: ``1 / (1 - c^2 lambda1^2)`` is
+    ``(1/(1 - c lambda1) + 1/(1 + c lambda1)) / 2`` and
+    ``mean 1/(alpha + beta cos Phi) = (alpha^2 - beta^2)^(-1/2)``, so
     ``mean cot^2 = ((1 - c)(1 - c - 2cu))^(-1/2) / 2 + ((1 + c)(1 + c + 2cu))^(-1/2) / 2 - 1`` (``cot^2 alpha0``
     at ``u = 0``; finite below the lock-up ``u = (1/c - 1)/2``) and
     ``mean lambda1^-2 = (1 + u) / (1 + 2u)^(3/2)`` (its derivative in ``alpha``).
