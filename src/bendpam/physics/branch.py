@@ -259,15 +259,23 @@ def solve_free(law: MomentLaw, tab: BranchTable, pa: np.ndarray, xtol: float = 1
     x0, s0, a, b, ga, gb = _start(tab, case, j, q)
     sgn = tab.sgn[case]
     ev = tab.path
+    # the curvature at the last evaluation and its slope: k' at the root by one Taylor step (the root is
+    # within xtol of it, so the step's error is of order xtol^2), without another evaluation of the law
+    x_last, k_last, dk_last = np.full(q.size, np.nan), np.zeros(q.size), np.zeros(q.size)
 
     def G(x, idx):  # P_a(u) - q, increasing along the branch; past A's sign change (unbounded end) beyond the root
-        A, B = ev.coef(x, case[idx])
+        A, B, kx, dk = ev.coef_k(x, case[idx])
+        x_last[idx], k_last[idx], dk_last[idx] = x, kx, dk
         with np.errstate(divide="ignore", invalid="ignore"):
             return np.where(sgn[idx] * A > 0.0, B / A - q[idx], np.inf)
 
     tol = xtol * np.abs(tab.x_end[case]) + 1e-300
     x = table_newton(G, x0, s0, a, b, ga, gb, tol)
-    k[case, col] = ev.to_k(x, case)
+    near = np.isfinite(x_last) & np.isfinite(k_last) & np.isfinite(dk_last) & (np.abs(x - x_last) <= tol)
+    kx = np.where(near, k_last + dk_last * (x - x_last), 0.0)
+    if not np.all(near):  # a root on a bracket's end (never evaluated), or one found by the bracket's width
+        kx[~near] = ev.to_k(x[~near], case[~near])
+    k[case, col] = kx
     u[case, col] = x
     return k, u
 
