@@ -49,7 +49,7 @@ from functools import lru_cache
 
 import numpy as np
 
-__all__ = ["CHUNK", "NODES", "Baseline", "BaselineBranch", "per_point_moment"]
+__all__ = ["CHUNK", "NODES", "Baseline", "BaselineBranch", "BatchedBaseline", "closed_means", "per_point_moment"]
 
 NODES = 24
 CHUNK = 4096
@@ -103,9 +103,10 @@ class Baseline:
     """
 
     def __init__(self, actuator_or_params, model: str = "energy", *, nodes: int = NODES, chunk: int = CHUNK,
-                 eq19_factor: bool = True):
+                 eq19_factor: bool = True, closed_form: bool = False):
         p = actuator_or_params if isinstance(actuator_or_params, Params) else Params.of(actuator_or_params)
         self.p = p
+        self.closed_form = bool(closed_form)
         self.model = model.replace("-", "_")
         if self.model not in ("energy", "force_balance"):
             raise ValueError(f"unknown model {model!r}")
@@ -133,6 +134,8 @@ class Baseline:
 
     def _ibar(self, u):
         """``Ibar, Ibar'`` (and the force-balance ``J``) at ``u`` (1-D), one (n x nodes) pass."""
+        if self.closed_form:
+            return closed_means(u, self.c, self.model == "force_balance")
         lam, cl, g, r = self._buffers(u.size)
         np.multiply(u[:, None], self.omc, out=lam)
         lam += 1.0
@@ -221,43 +224,8 @@ class Baseline:
 
     # ---- the models ----------------------------------------------------------------------
     def _block(self, k):
-        p = self.p
-        c, s, R0 = self.c, self.s, p.R0
-        u, ib, dib, J = self.solve_u(k * R0)
-        xi = 1.0 / (s * ib)
-        R = R0 * xi
-        eta = xi
-        if self.model == "energy":
-            dxi = -xi * dib / ib
-            dR = R0 * dxi * R / (1.0 - R0 * dxi * k)
-            A = np.pi * ((2.0 * R + 3.0 * k * R * R) * dR + R**3)
-            q = 1.0 + 2.0 * u
-            rq = 1.0 / np.sqrt(q)
-            rq3 = rq / q
-            e2 = eta * eta
-            C1, C2 = p.C10, p.C01
-            l1o = 1.0 + 1.5 * u  # mean lam1 omc
-            l3o = (2.0 + u) * rq3 / (2.0 * q)  # mean lam1^-3 omc
-            l2 = 1.0 + u * (2.0 + 1.5 * u)  # mean lam1^2
-            lm2 = (1.0 + u) * rq3  # mean lam1^-2
-            d1 = (R + k * dR) * (2.0 * (C1 + C2 * e2) * l1o - 2.0 * (C1 / e2 + C2) * l3o)
-            e3 = e2 * eta
-            d2 = (dR / R0) * (2.0 * C1 * eta - 2.0 * C1 * lm2 / e3 - 2.0 * C2 / e3 + 2.0 * C2 * eta * l2)
-            fac = p.area * (1.0 + u) if self.eq19 else p.area
-            B = fac * (d1 + d2) + p.EI * k
-            return A, B
-        C1, C2 = p.C10, p.C01
-        le = (1.0 + u) * eta
-        le2 = le * le
-        tb = p.t0 / le
-        q = 1.0 + 2.0 * u
-        var = 2.0 * np.pi * (2.0 * C1 * (1.0 + u * (3.0 + 2.5 * u)) - 2.0 * C2 / (q * np.sqrt(q)))
-        k1 = -2.0 * C1 / le2 + 2.0 * C2 * le2
-        s2 = 2.0 * C1 * (eta * eta - 1.0 / le2) - 2.0 * C2 / (eta * eta) + 2.0 * C2 * le2
-        w = tb * R * R
-        A = R**3 * (np.pi - c * c * J)
-        B = p.EI * k + w * (var + 2.0 * np.pi * k1) - s2 * w * c * c * J
-        return A, B
+        u, ib, dib, J = self.solve_u(k * self.p.R0)
+        return _coefficients(self.model, self.eq19, self.p, self.c, u, k, 1.0 / (self.s * ib), ib, dib, J)
 
     def coefficients(self, k):
         """``(A, B)``: A in N*mm/kPa, B in N*mm; blocks of :attr:`chunk` points."""
@@ -331,6 +299,84 @@ class Baseline:
         return (branch or self.branch()).solve(pressure_kpa, xtol)
 
 
+def _coefficients(model, eq19, p, c, u, k, xi, ib, dib, J):
+    """``(A per MPa, B)`` of either model at the kinematic state ``u, k' = u/R, xi = R/R0`` (eq 5) and its means.
+
+    ``p`` holds the actuator's fields (scalars, or arrays broadcasting against ``u`` for a batch of cases).
+    """
+    R0 = p.R0
+    R = R0 * xi
+    eta = xi
+    C1, C2 = p.C10, p.C01
+    if model == "energy":
+        dxi = -xi * dib / ib
+        dR = R0 * dxi * R / (1.0 - R0 * dxi * k)
+        A = np.pi * ((2.0 * R + 3.0 * k * R * R) * dR + R**3)
+        q = 1.0 + 2.0 * u
+        rq = 1.0 / np.sqrt(q)
+        rq3 = rq / q
+        e2 = eta * eta
+        l1o = 1.0 + 1.5 * u  # mean lam1 omc
+        l3o = (2.0 + u) * rq3 / (2.0 * q)  # mean lam1^-3 omc
+        l2 = 1.0 + u * (2.0 + 1.5 * u)  # mean lam1^2
+        lm2 = (1.0 + u) * rq3  # mean lam1^-2
+        d1 = (R + k * dR) * (2.0 * (C1 + C2 * e2) * l1o - 2.0 * (C1 / e2 + C2) * l3o)
+        e3 = e2 * eta
+        d2 = (dR / R0) * (2.0 * C1 * eta - 2.0 * C1 * lm2 / e3 - 2.0 * C2 / e3 + 2.0 * C2 * eta * l2)
+        fac = p.area * (1.0 + u) if eq19 else p.area
+        return A, fac * (d1 + d2) + p.EI * k
+    le = (1.0 + u) * eta
+    le2 = le * le
+    tb = p.t0 / le
+    q = 1.0 + 2.0 * u
+    var = 2.0 * np.pi * (2.0 * C1 * (1.0 + u * (3.0 + 2.5 * u)) - 2.0 * C2 / (q * np.sqrt(q)))
+    k1 = -2.0 * C1 / le2 + 2.0 * C2 * le2
+    s2 = 2.0 * C1 * (eta * eta - 1.0 / le2) - 2.0 * C2 / (eta * eta) + 2.0 * C2 * le2
+    w = tb * R * R
+    A = R**3 * (np.pi - c * c * J)
+    return A, p.EI * k + w * (var + 2.0 * np.pi * k1) - s2 * w * c * c * J
+
+
+def _rsqrt_m1(y):
+    """``(1 + y)^(-1/2) - 1``, accurate for small ``y``."""
+    return np.expm1(-0.5 * np.log1p(y))
+
+
+def closed_means(u, c, want_j: bool = False):
+    """``Ibar, Ibar'`` (and ``J``) in closed form: what the baseline computes when given bendpam's closed forms.
+
+    Derived here from the means' definitions: ``1 - c^2 lam1^2`` is a quadratic in ``cos Phi``, so
+    ``Ibar(u) = (2/pi) K(m) / sqrt(D)`` with ``D = (1 - c)(1 + c + 2cu)`` (u >= 0) or ``(1 + c)(1 - c - 2cu)``
+    (u < 0) and ``m = 4 c |u| / D``; ``Ibar'`` by the chain rule with ``dK/dm = (E - (1 - m) K) / (2 m (1 - m))``
+    (its series below m = 1e-3).  ``J = 2 pi mean(lam1^2 omc / (1 - c^2 lam1^2))``: partial fractions in
+    ``1 -+ c lam1`` and ``mean 1/(a + b cos) = (a^2 - b^2)^(-1/2)`` give
+    ``J = (2 pi / c^2) ((g(-2cu/(1 - c)) - g(2cu/(1 + c))) / (2cu) - 1)`` with ``g(y) = (1 + y)^(-1/2) - 1``.
+    """
+    from scipy.special import ellipe, ellipk
+
+    u = np.asarray(u, dtype=float)
+    c = np.asarray(c, dtype=float)
+    pos = u >= 0.0
+    cu = c * u
+    D = np.where(pos, (1.0 - c) * (1.0 + c + 2.0 * cu), (1.0 + c) * (1.0 - c - 2.0 * cu))
+    dD = np.where(pos, 2.0 * c * (1.0 - c), -2.0 * c * (1.0 + c))
+    m = 4.0 * np.abs(cu) / D
+    dm = np.where(pos, 4.0 * c, -4.0 * c) / D - m * dD / D
+    K, E = ellipk(m), ellipe(m)
+    small = m < 1e-3
+    ms = np.where(small, 0.5, m)
+    dK = np.where(small, 0.5 * np.pi * (0.25 + m * (9.0 / 32.0 + m * (75.0 / 256.0 + m * (1225.0 / 4096.0)))),
+                  (E - (1.0 - ms) * K) / (2.0 * ms * (1.0 - ms)))
+    rD = 1.0 / np.sqrt(D)
+    ib = (2.0 / np.pi) * K * rD
+    dib = (2.0 / np.pi) * rD * (dK * dm - 0.5 * K * dD / D)
+    J = None
+    if want_j:
+        x = np.where(cu == 0.0, 1e-300, 2.0 * cu)
+        J = (2.0 * np.pi / (c * c)) * ((_rsqrt_m1(-x / (1.0 - c)) - _rsqrt_m1(x / (1.0 + c))) / x - 1.0)
+    return ib, dib, J
+
+
 @dataclass
 class BaselineBranch:
     """Sampled free-bending branch of a :class:`Baseline` (``kt`` from 0, ``pt`` increasing)."""
@@ -364,6 +410,146 @@ class BaselineBranch:
 
         k[idx] = _illinois(F, a, b, xtol * abs(self.kt[-1]))
         return k.reshape(P.shape)
+
+
+class BatchedBaseline:
+    """The competent baseline of a block of actuator cases at once (sweeps): no Python loop over cases.
+
+    Every case's parameters are arrays; the section means are the closed forms of :func:`closed_means`
+    (the strongest baseline: it is given bendpam's closed forms).  The free-bending branch is
+    sampled in ``u = k'R``, where a point needs no solve of eq 5 (``k' = u / R(u)``), for all cases
+    in one array; folds are refined by a vectorised golden section, and the roots at every pressure of
+    every case by one vectorised Illinois iteration on ``M = 0`` in ``u``, bracketed by a vectorised
+    bisection in the sampled branch.  :meth:`sweep` gives the blocked moment and the free curvature.
+    """
+
+    def __init__(self, params: list[Params], model: str = "energy", *, eq19_factor: bool = True):
+        self.model = model.replace("-", "_")
+        self.eq19 = eq19_factor
+        self.f = {name: np.array([getattr(p, name) for p in params], dtype=float)
+                  for name in Params.__dataclass_fields__}
+        a0 = self.f["alpha0"]
+        self.c, self.s = np.cos(a0), np.sin(a0)
+        self.sgn = np.where(a0 > math.atan(math.sqrt(2.0)), 1.0, -1.0)
+        self.u_end = self._u_limits()
+
+    def _take(self, rows):
+        return _Fields({name: v[rows] for name, v in self.f.items()})
+
+    def coef(self, u, rows):
+        """``(A per MPa, B)`` and ``k'`` at ``u`` for the cases ``rows`` (arrays of one shape)."""
+        ib, dib, J = closed_means(u, self.c[rows], self.model == "force_balance")
+        xi = 1.0 / (self.s[rows] * ib)
+        p = self._take(rows)
+        k = u / (p.R0 * xi)
+        A, B = _coefficients(self.model, self.eq19, p, self.c[rows], u, k, xi, ib, dib, J)
+        return A, B, k
+
+    def _u_limits(self):
+        """The end of the admissible range in the bending direction: 99 % of lock-up, or the lumen closing."""
+        n = self.c.size
+        end = np.where(self.sgn > 0, _LOCK_FRACTION * (1.0 / self.c - 1.0) / 2.0, -0.5 * (1.0 - _MIN_FAR_STRETCH))
+        rows = np.arange(n)[:, None]
+
+        def lumen(u, rows):
+            ib, _, _ = closed_means(u, self.c[rows])
+            xi = 1.0 / (self.s[rows] * ib)
+            return self.f["R0"][rows] * xi * xi * (1.0 + u) - self.f["t0"][rows]
+
+        grid = end[:, None] * np.linspace(0.0, 1.0, 201)
+        neg = lumen(grid, rows) <= 0.0
+        has = neg.any(-1)
+        j = np.where(has, np.argmax(neg, -1), 1)
+        a, b = grid[np.arange(n), j - 1], grid[np.arange(n), j]
+        for _ in range(64):
+            mid = 0.5 * (a + b)
+            pos = lumen(mid, np.arange(n)) > 0.0
+            a, b = np.where(pos, mid, a), np.where(pos, b, mid)
+        return np.where(has, 0.5 * (a + b), end)
+
+    def branch(self, samples: int = 256):
+        """``(ut, pt, last)``: the sampled branch in u from 0 (``pt`` rising to index ``last``, inf after)."""
+        n = self.c.size
+        rows = np.arange(n)[:, None]
+        ug = self.u_end[:, None] * np.linspace(0.0, 1.0, samples + 1) ** 1.5
+        A, B, _ = self.coef(ug, rows)
+        ok = self.sgn[:, None] * A > 0.0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            pt = np.where(ok, B / A * 1e3, np.nan)  # kPa
+        pt[:, 0] = 0.0
+        idx = np.arange(samples + 1)[None, :]
+        n_ok = np.where(ok.all(-1), samples + 1, np.argmin(ok, -1))
+        dec = (np.diff(pt, axis=-1) <= 0.0) & (idx[:, 1:] < n_ok[:, None])
+        fold = dec.any(-1)
+        j = np.argmax(dec, -1)
+        last = np.where(fold, j, np.where(n_ok <= samples, n_ok, samples))
+        ut = ug.copy()
+        pt = np.where(~fold[:, None] & (n_ok[:, None] <= samples) & (idx == n_ok[:, None]), np.inf, pt)
+        f = np.flatnonzero(fold & (j > 0))
+        if f.size:  # golden section on [u_{j-1}, u_{j+1}] for the maximum of B/A
+            jf = j[f]
+            lo, hi = ug[f, jf - 1], ug[f, np.minimum(jf + 1, samples)]
+
+            def pf(x):
+                A_, B_, _ = self.coef(x, f)
+                return B_ / A_ * 1e3
+
+            g = (math.sqrt(5.0) - 1.0) / 2.0
+            x1, x2 = hi - g * (hi - lo), lo + g * (hi - lo)
+            f1, f2 = pf(x1), pf(x2)
+            for _ in range(60):
+                left = f1 > f2
+                hi, lo = np.where(left, x2, hi), np.where(left, lo, x1)
+                new = np.where(left, hi - g * (hi - lo), lo + g * (hi - lo))
+                fn = pf(new)
+                x1, f1, x2, f2 = (np.where(left, new, x2), np.where(left, fn, f2),
+                                  np.where(left, x1, new), np.where(left, f1, fn))
+            um = 0.5 * (lo + hi)
+            pm = pf(um)
+            better = pm > pt[f, jf]
+            before = np.abs(um) < np.abs(ug[f, jf])  # the maximum lies before sample j: it replaces it
+            at = np.where(before, jf, jf + 1)
+            ut[f[better], at[better]] = um[better]
+            pt[f[better], at[better]] = pm[better]
+            last[f[better]] = at[better]
+        pt = np.where(idx <= last[:, None], pt, np.inf)
+        return ut, pt, last
+
+    def sweep(self, pressure_kpa, samples: int = 256, xtol: float = 1e-13):
+        """``(blocked moment N*mm, free k' 1/mm)``, arrays (cases, pressures); NaN above the branch's end."""
+        P = np.asarray(pressure_kpa, dtype=float)
+        n = self.c.size
+        rows = np.arange(n)[:, None]
+        pa = np.maximum(P[None, :] - self.f["P_start"][:, None] * 1e3, 0.0)
+        A0, _, _ = self.coef(np.zeros((n, 1)), rows)
+        blocked = pa * A0 * 1e-3
+        ut, pt, last = self.branch(samples)
+        p_end = pt[np.arange(n), last]
+        k = np.where(pa > p_end[:, None], np.nan, 0.0)
+        case, col = np.nonzero((pa > 0.0) & (pa <= p_end[:, None]))
+        q = pa[case, col]
+        lo, hi = np.zeros(q.size, dtype=np.intp), last[case].copy()
+        for _ in range(int(samples + 2).bit_length()):  # bisection: the first sample with pt >= q
+            mid = (lo + hi) // 2
+            below = pt[case, mid] < q
+            lo, hi = np.where(below, mid + 1, lo), np.where(below, hi, mid)
+        j = np.maximum(lo, 1)
+        sg = self.sgn[case]
+
+        def F(x, sel):
+            A, B, _ = self.coef(x, case[sel])
+            return sg[sel] * (q[sel] * 1e-3 * A - B)
+
+        u = _illinois(F, ut[case, j - 1], ut[case, j], xtol * float(np.abs(self.u_end).max()))
+        k[case, col] = self.coef(u, case)[2]
+        return blocked, k
+
+
+class _Fields:
+    """Attribute access to a dict of per-case arrays (what :func:`_coefficients` reads)."""
+
+    def __init__(self, d):
+        self.__dict__.update(d)
 
 
 def _illinois(F, a, b, tol, maxiter: int = 100):

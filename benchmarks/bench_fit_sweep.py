@@ -4,7 +4,9 @@ Sweeps (BE-PAM base, energy model, an ``alpha0_deg x t0_mm`` grid of actuator ca
 
 * ``bendpam.sweep`` cases/s at 16 and at 1000 pressures, against the same cases evaluated one by
   one with the competent baseline of ``baseline.py`` (its blocked moment and its own free-bending
-  solve at every pressure; the per-case parameters are built outside the timing);
+  solve at every pressure; the per-case parameters are built outside the timing), and against the
+  strongest baseline, ``BatchedBaseline`` over the same cases in blocks of 256 (closed forms; it
+  computes no margins, the sweep does);
 * the agreement of the two on the free curvatures;
 * the peak traced memory when the sweep grows 4x;
 * the projected time of a sweep of 10^8 (case, pressure) points from the 1000-pressure rate.
@@ -27,7 +29,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parent))
 from _timing import Recorder, bendpam_cli, compare, fmt, fmt_time, header, peak_mib, standalone, wall
-from baseline import Baseline, Params
+from baseline import Baseline, BatchedBaseline, Params
 
 import bendpam
 
@@ -55,6 +57,11 @@ def _one_by_one(params, P):
     return out
 
 
+def _batched(params, P):
+    """The baseline batched over the cases of each block of 256 (the strongest sweep baseline)."""
+    return [BatchedBaseline(params[i:i + 256], MODEL).sweep(P) for i in range(0, len(params), 256)]
+
+
 def sweeps(rec: Recorder, quick: bool) -> None:
     base = bendpam.physics.presets.be_pam()
     bendpam.sweep(base, pressure_kpa=[100.0, 200.0], alpha0_deg=[65.0, 70.0], t0_mm=[2.0])  # imports, caches
@@ -70,9 +77,11 @@ def sweeps(rec: Recorder, quick: bool) -> None:
         n_cases = a0.size * t0.size
         ba0, bt0 = _grid(max(1, round(na * n_base / n_cases)), nt)
         bparams = _baseline_cases(base, ba0, bt0)
+        allparams = _baseline_cases(base, a0, t0)
         st = compare({
             "sweep": (lambda P=P, a0=a0, t0=t0: bendpam.sweep(base, pressure_kpa=P, alpha0_deg=a0, t0_mm=t0), n_cases),
             "baseline": (lambda P=P, bp=bparams: _one_by_one(bp, P), len(bparams)),
+            "batched": (lambda P=P, ap=allparams: _batched(ap, P), n_cases),
         }, repeats=reps, warmup=0)
         ds = bendpam.sweep(base, pressure_kpa=P, alpha0_deg=ba0, t0_mm=bt0)
         ks = ds["free_curvature_per_mm"].values.reshape(len(bparams), P.size)
@@ -80,17 +89,23 @@ def sweeps(rec: Recorder, quick: bool) -> None:
         same_nan = bool(np.array_equal(np.isnan(ks), np.isnan(kb)))
         dk = float(np.nanmax(np.abs(ks - kb)) / np.nanmax(np.abs(ks)))
         ratio = st["sweep"].rate / st["baseline"].rate
+        strongest = st["sweep"].rate / max(st["baseline"].rate, st["batched"].rate)
         print(f"  {P.size:5} pressures: sweep of {n_cases:5} cases {st['sweep']} -> {st['sweep'].rate:8.3g} cases/s "
               f"({st['sweep'].rate * P.size:.3g} points/s); baseline one by one ({len(bparams)} cases) "
-              f"{st['baseline'].rate:8.3g} cases/s; sweep/baseline = {ratio:.2f}x; max |dk'| {dk:.1e} of the "
+              f"{st['baseline'].rate:8.3g} cases/s; batched over cases {st['batched'].rate:8.3g} cases/s (no margins); "
+              f"sweep/one by one = {ratio:.2f}x, sweep/strongest = {strongest:.2f}x; max |dk'| {dk:.1e} of the "
               f"largest, NaN pattern {'equal' if same_nan else 'DIFFERENT'}")
         rec.record("sweep", f"{P.size}_pressures", {"cases": n_cases, "baseline_cases": len(bparams), "timing": st,
-                                                    "ratio": ratio, "max_dk_rel": dk, "same_nan": same_nan})
+                                                    "ratio": ratio, "ratio_vs_strongest": strongest,
+                                                    "max_dk_rel": dk, "same_nan": same_nan})
         rec.row(f"sweep cases/s at {P.size} pressures", st["sweep"].rate, "/s", ">= 1e4" if P.size == 16 else "",
                 st["sweep"].rate >= TARGET_SWEEP if P.size == 16 else None, f"{n_cases} cases")
-        # the issue's 30x target is set at 16 pressures; at 1000 the ratio is reported, not judged
+        # the issue's 30x target is set at 16 pressures against the baseline one case at a time; every ratio is
+        # also given against the strongest baseline (batched over cases, without the margins the sweep computes)
         rec.row(f"sweep / one-by-one baseline, {P.size} pressures", ratio, "x", ">= 30x" if P.size == 16 else "",
                 ratio >= TARGET_SWEEP_RATIO if P.size == 16 else None, f"baseline {fmt(st['baseline'].rate)} cases/s")
+        rec.row(f"sweep / strongest (batched) baseline, {P.size} pressures", strongest, "x", "", None,
+                f"batched {fmt(st['batched'].rate)} cases/s, without margins")
         rate_points = st["sweep"].rate * P.size
     projected = 1e8 / rate_points
     print(f"  projected time of a 10^8-point sweep at the 1000-pressure rate: {fmt_time(projected)}")

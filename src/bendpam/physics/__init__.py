@@ -17,7 +17,8 @@ layers.
   numba kernels (bit-identical).
 * :mod:`~bendpam.physics.limits`: frame stress, buckling, lock-up and bladder-stretch margins.
 * :mod:`~bendpam.physics.hysteresis`: loop models around the quasi-static law.
-* :mod:`~bendpam.physics.roots`: the vectorised root finders (bracketed Newton, Illinois) they share.
+* :mod:`~bendpam.physics.roots`: the vectorised root finders they share (bracketed Newton, Illinois,
+  Newton from a table).
 """
 
 

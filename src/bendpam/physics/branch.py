@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from bendpam.errors import InputTypeError
-from bendpam.physics.roots import illinois
+from bendpam.physics.roots import table_newton
 from bendpam.physics.sections import branch_path
 from bendpam.validate import float_array, instance, integer
 
@@ -136,7 +136,9 @@ def branch_table(law: MomentLaw, samples: int = BRANCH_SAMPLES) -> BranchTable:
                      np.where(kind == BRANCH_END["unbounded"], np.inf,
                               np.take_along_axis(pk, np.minimum(n_ok, n)[:, None], -1)[:, 0]))
     p_end = np.where(kind == BRANCH_END["neutral"], np.inf, p_end)
-    last = np.where(kind == BRANCH_END["fold"], j, np.minimum(n_ok, n))
+    # a refined fold before sample j ends the branch there: sample j is already past it (on the unstable side)
+    past = use_ref & (np.abs(x_fold) < np.abs(np.take_along_axis(xk, j[:, None], -1)[:, 0]))
+    last = np.where(kind == BRANCH_END["fold"], np.where(past, j - 1, j), np.minimum(n_ok, n))
     pt = np.where(np.arange(n + 1)[None, :] <= last[:, None], pk, np.inf)
     nxt = np.clip(last + 1, 0, n)
     x_after = np.take_along_axis(xk, nxt[:, None], -1)[:, 0]
@@ -223,8 +225,11 @@ def _refine_folds(ev, xk, pk, has_dec, j):
 def solve_free(law: MomentLaw, tab: BranchTable, pa: np.ndarray, xtol: float = 1e-13) -> tuple[np.ndarray, np.ndarray]:
     """Roots ``(k', u = k'R)`` of ``M = 0`` at active pressures ``pa`` (cases, pressures) (kPa); NaN above the end.
 
-    The root is bracketed from the sampled branch ``tab`` and polished by the Illinois iteration
-    (:func:`~bendpam.physics.roots.illinois`) to ``xtol`` relative to the branch's end in ``u``.
+    All pressures of all cases at once: the sampled branch ``tab`` gives each root's bracket (the
+    samples it lies between) and a start, the root of a cubic Hermite interpolant of ``P_a(u)`` on
+    the bracket (slopes from the neighbouring samples); Newton's method on ``P_a(u) - P_a``
+    with the interpolant's slope, then secant slopes (:func:`~bendpam.physics.roots.table_newton`),
+    polishes it to ``xtol`` relative to the branch's end in ``u``, in about two evaluations of the law.
 
     Examples
     --------
@@ -250,32 +255,129 @@ def solve_free(law: MomentLaw, tab: BranchTable, pa: np.ndarray, xtol: float = 1
         return k, u
     case, col = np.nonzero(solve)
     q = pa[case, col]
-    # bracket: first table index with p >= q (the table is increasing up to its end, then inf)
-    if tab.pt.shape[0] == 1:
-        jall = np.searchsorted(tab.pt[0], pa[0], side="left")[None, :]
-    else:
-        jall = (tab.pt[:, None, :] < pa[:, :, None]).sum(-1)  # (cases, pressures): no per-point copies
-    j = np.clip(jall[case, col], 1, tab.xt.shape[-1] - 1)
-    a = tab.xt[case, j - 1]
-    b = tab.xt[case, j]
+    j = np.clip(_bracket_index(tab.pt, pa)[case, col], 1, tab.xt.shape[-1] - 1)
+    x0, s0, a, b, ga, gb = _start(tab, case, j, q)
+    sgn = tab.sgn[case]
+    ev = tab.path
+    # the curvature at the last evaluation and its slope: k' at the root by one Taylor step (the root is
+    # within xtol of it, so the step's error is of order xtol^2), without another evaluation of the law
+    x_last, k_last, dk_last = np.full(q.size, np.nan), np.zeros(q.size), np.zeros(q.size)
+
+    def G(x, idx):  # P_a(u) - q, increasing along the branch; past A's sign change (unbounded end) beyond the root
+        A, B, kx, dk = ev.coef_k(x, case[idx])
+        x_last[idx], k_last[idx], dk_last[idx] = x, kx, dk
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(sgn[idx] * A > 0.0, B / A - q[idx], np.inf)
+
+    tol = xtol * np.abs(tab.x_end[case]) + 1e-300
+    x = table_newton(G, x0, s0, a, b, ga, gb, tol)
+    near = np.isfinite(x_last) & np.isfinite(k_last) & np.isfinite(dk_last) & (np.abs(x - x_last) <= tol)
+    kx = np.where(near, k_last + dk_last * (x - x_last), 0.0)
+    if not np.all(near):  # a root on a bracket's end (never evaluated), or one found by the bracket's width
+        kx[~near] = ev.to_k(x[~near], case[~near])
+    k[case, col] = kx
+    u[case, col] = x
+    return k, u
+
+
+def _bracket_index(pt: np.ndarray, pa: np.ndarray) -> np.ndarray:
+    """``(cases, pressures)``: per case, the first table index with ``pt >= pa`` (``pt`` rises, then is inf).
+
+    A sorted search per case, all cases at once and without (cases, pressures, samples) arrays: the
+    pressures of each case are sorted, a vectorised bisection finds how many lie at or below each
+    sample, and a cumulative count turns that into each pressure's index.
+    """
+    if pt.shape[0] == 1:
+        return np.searchsorted(pt[0], pa[0], side="left")[None, :]
+    n, m = pa.shape
+    order = np.argsort(pa, axis=-1, kind="stable")
+    ps = np.take_along_axis(pa, order, -1)
+    lo = np.zeros(pt.shape, dtype=np.intp)  # the number of sorted pressures <= each sample, by bisection
+    hi = np.full(pt.shape, m, dtype=np.intp)
+    for _ in range(max(m, 1).bit_length()):
+        mid = (lo + hi) >> 1
+        at_or_below = np.take_along_axis(ps, np.minimum(mid, m - 1), -1) <= pt
+        step = lo < hi
+        lo = np.where(step & at_or_below, mid + 1, lo)
+        hi = np.where(step & ~at_or_below, mid, hi)
+    # pt[i] < ps[l] exactly when l >= lo[i]: count the samples below each sorted pressure
+    rows = np.arange(n)[:, None]
+    counts = np.bincount((rows * (m + 1) + lo).ravel(), minlength=n * (m + 1)).reshape(n, m + 1)
+    out = np.empty((n, m), dtype=np.intp)
+    np.put_along_axis(out, order, np.cumsum(counts, axis=-1)[:, :m], -1)
+    return out
+
+
+def _sample_slopes(xt: np.ndarray, pt: np.ndarray, last: np.ndarray, case: np.ndarray, at: np.ndarray,
+                   width: int = 5) -> np.ndarray:
+    """``dP_a/du`` at samples ``at`` of cases ``case``: the derivative of the polynomial through ``width`` samples.
+
+    The stencil is centred where it fits and shifted to stay within samples ``0 .. last`` at the
+    branch's start and end (fourth order on the graded samples with the default 5); NaN past the
+    last sample, or where the branch has fewer samples than the stencil.
+    """
+    n = xt.shape[-1]
+    lc = last[case]
+    i0 = np.clip(np.minimum(at - width // 2, lc - (width - 1)), 0, max(n - width, 0))
+    x = [xt[case, i0 + d] for d in range(width)]
+    p = [pt[case, i0 + d] for d in range(width)]
+    xe = xt[case, np.clip(at, 0, n - 1)]
+    d = np.zeros(np.shape(at))
+    with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
+        for i in range(width):  # Lagrange: L_i'(x) = sum over m != i of prod over r != i, m of (x - x_r) / ...
+            dl = np.zeros(np.shape(at))
+            for m in range(width):
+                if m == i:
+                    continue
+                term = 1.0 / (x[i] - x[m])
+                for r in range(width):
+                    if r not in (i, m):
+                        term = term * (xe - x[r]) / (x[i] - x[r])
+                dl += term
+            d += p[i] * dl
+    return np.where((at <= lc) & (lc >= width - 1), d, np.nan)
+
+
+def _start(tab: BranchTable, case, j, q):
+    """Start, slope and bracket of each root: ``(x0, slope0, a, b, ga, gb)`` with ``g = P_a(u) - q``.
+
+    The bracket is the samples ``j - 1, j`` (past the last sample: the refined fold, or the end of an
+    unbounded branch, where ``g = +inf``); the start is the root of the cubic Hermite interpolant of
+    ``P_a`` on it (slopes :func:`_sample_slopes`; zero at a refined fold, which is a maximum), found by two
+    Newton steps on the cubic; an unbounded end starts at the bracket's midpoint without a slope.
+    """
     last = tab.last[case]
     beyond = j > last
     fold_end = (tab.kind[case] == BRANCH_END["fold"]) & tab.use_ref[case] & beyond
     unb = (tab.kind[case] == BRANCH_END["unbounded"]) & beyond
+    ja = np.where(fold_end | unb, last, j - 1)
+    a, b = tab.xt[case, ja], tab.xt[case, j]
+    pa_, pb_ = tab.pt[case, ja], tab.pt[case, j]
+    if 2 * case.size > tab.xt.size:  # many pressures a case: every sample's slope once, then look them up
+        rows = np.broadcast_to(np.arange(tab.xt.shape[0])[:, None], tab.xt.shape)
+        d = _sample_slopes(tab.xt, tab.pt, tab.last, rows, np.broadcast_to(np.arange(tab.xt.shape[1]), tab.xt.shape))
+        da, db = d[case, ja], d[case, j]
+    else:
+        da, db = (_sample_slopes(tab.xt, tab.pt, tab.last, case, i) for i in (ja, j))
     b = np.where(fold_end, tab.x_fold[case], np.where(unb, tab.x_end[case], b))
-    a = np.where(fold_end | unb, tab.xt[case, last], a)
-    sgn = tab.sgn[case]
-    ev = tab.path
-
-    def F(x, idx):
-        A, B = ev.coef(x, case[idx])
-        return sgn[idx] * (q[idx] * A - B)
-
-    tol = xtol * np.abs(tab.x_end[case]) + 1e-300
-    x = illinois(F, a, b, tol)
-    k[case, col] = ev.to_k(x, case)
-    u[case, col] = x
-    return k, u
+    pb_ = np.where(fold_end, tab.p_end[case], np.where(unb, np.inf, pb_))
+    db = np.where(fold_end, 0.0, db)
+    ga, gb = pa_ - q, pb_ - q
+    h = b - a
+    t = np.clip(np.where(unb, 0.5, ga / np.where(unb, -1.0, ga - gb)), 0.0, 1.0)  # the chord's root
+    with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
+        for _ in range(2):  # Newton on the cubic Hermite interpolant of g over t in [0, 1] (two: as good as four)
+            t2, t3 = t * t, t * t * t
+            g = ((2 * t3 - 3 * t2 + 1) * ga + (t3 - 2 * t2 + t) * h * da + (3 * t2 - 2 * t3) * gb
+                 + (t3 - t2) * h * db)
+            dg = (6 * t2 - 6 * t) * (ga - gb) + (3 * t2 - 4 * t + 1) * h * da + (3 * t2 - 2 * t) * h * db
+            tn = t - g / dg
+            ok = ~unb & np.isfinite(tn)
+            t = np.where(ok, np.clip(tn, 0.0, 1.0), t)
+        t2 = t * t
+        dg = (6 * t2 - 6 * t) * (ga - gb) + (3 * t2 - 4 * t + 1) * h * da + (3 * t2 - 2 * t) * h * db
+        slope0 = np.where(unb, np.nan, dg / h)
+    return a + t * h, slope0, a, b, ga, gb
 
 
 @dataclass(frozen=True)

@@ -376,9 +376,9 @@ class MomentLaw:
 
         Above the fold (or lock-up) pressure there is no equilibrium on the branch: the curvature
         is NaN, the status ``"no-equilibrium"`` and the reason says why.  A root on a
-        disconnected branch beyond a fold is never returned.  The root is bracketed from the
-        sampled branch and polished by a vectorised Illinois iteration to ``xtol`` relative to
-        the branch's curvature range.
+        disconnected branch beyond a fold is never returned.  The root is bracketed and started from
+        the sampled branch and polished by Newton's method on it (:func:`bendpam.physics.branch.solve_free`)
+        to ``xtol`` relative to the branch's range in ``u = k'R``.
         """
         if self.is_cases:
             raise InputError("free_curvature() describes one actuator; use free_curvature_array() for cases")

@@ -3,8 +3,10 @@
 * :func:`bracketed_newton`: Newton's method safeguarded by a bracket, for an increasing function
   (the radius equation eq 5 in :mod:`bendpam.physics.braid`, the free curvature and the inverse of
   the stable branch on the spline table of :mod:`bendpam.physics.law`).
-* :func:`illinois`: the Illinois variant of regula falsi, for the free-bending roots of
-  :class:`~bendpam.physics.law.MomentLaw` (no derivative needed).
+* :func:`illinois`: the Illinois variant of regula falsi (no derivative needed);
+* :func:`table_newton`: Newton's method started from a table of the function and safeguarded by the
+  table's bracket, secant slopes after the first step, for the free-bending roots of
+  :class:`~bendpam.physics.law.MomentLaw` (:func:`bendpam.physics.branch.solve_free`).
 
 Both work on whole arrays of independent problems at once, with no Python loop over the points.
 """
@@ -19,7 +21,7 @@ import numpy as np
 from bendpam.errors import InputTypeError
 from bendpam.validate import float_array, integer
 
-__all__ = ["bracketed_newton", "illinois"]
+__all__ = ["bracketed_newton", "illinois", "table_newton"]
 
 
 def _callable(name: str, f: Any) -> None:
@@ -135,5 +137,61 @@ def illinois(F, a, b, tol, maxiter: int = 100):
         fb[act] = np.where(pos, fb_, fx)
         side[act] = np.where(pos, 1.0, -1.0)
         done = (fx == 0.0) | (np.abs(b[act] - a[act]) <= tol[act]) | (step <= tol[act])
+        act = act[~done]
+    return x.reshape(shape)
+
+
+def table_newton(G, x0, slope0, a, b, ga, gb, tol, maxiter: int = 100):
+    """Roots of ``G(x) = 0`` on brackets ``[a, b]`` (``G(a) <= 0 <= G(b)``), started from a table of ``G``.
+
+    The start ``x0`` and its slope ``slope0`` come from an interpolant of tabulated values (no
+    evaluation of ``G``); the bracket's values ``ga``, ``gb`` are the table's too (``+inf`` is allowed
+    at ``b``).  Each step evaluates ``G`` once, only at unconverged points (``G(x, idx)`` for the flat
+    indices ``idx``), and moves by Newton's step with the last secant slope (the first with
+    ``slope0``, or, where that is not finite, the secant to ``a``).  A step that leaves the bracket
+    (which shrinks with every evaluation) is replaced by the bracket's midpoint.  A point stops when
+    its step or its bracket is below ``tol`` (scalar or per point), or ``G`` is zero there.  With a
+    start from a cubic table a point needs about two evaluations (the regula falsi of
+    :func:`illinois` about five, and two more for the bracket).
+
+    Returns the roots (shape of ``x0``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> q = np.array([2.0, 3.0])
+    >>> x = table_newton(lambda x, idx: x * x - q[idx], np.array([1.4, 1.7]), np.array([2.8, 3.4]),
+    ...                  np.ones(2), np.full(2, 2.0), 1.0 - q, 4.0 - q, 1e-14)
+    >>> bool(np.allclose(x, np.sqrt(q), rtol=1e-15))
+    True
+    """
+    _callable("G", G)
+    maxiter = integer("maxiter", maxiter, 1, 10_000)
+    shape = np.shape(x0)
+    x, s0, a, b, ga, gb = (np.array(float_array(name, v, "1"), dtype=float).ravel() for name, v in
+                           (("x0", x0), ("slope0", slope0), ("a", a), ("b", b), ("ga", ga), ("gb", gb)))
+    tol = np.broadcast_to(np.asarray(float_array("tol", tol, "1"), dtype=float), shape).ravel()
+    x = np.where(ga == 0.0, a, np.where(gb == 0.0, b, x))
+    # the first slope: the table's, else the secant from the bracket's left end
+    xp, gp = a.copy(), ga.copy()
+    first = np.isfinite(s0) & (s0 != 0.0)
+    act = np.flatnonzero((ga != 0.0) & (gb != 0.0))
+    for _ in range(maxiter):
+        if act.size == 0:
+            break
+        xa, lo, hi = x[act], a[act], b[act]
+        g = G(xa, act)
+        neg, pos = g < 0.0, g > 0.0
+        lo, hi = np.where(neg, xa, lo), np.where(pos, xa, hi)
+        a[act], b[act] = lo, hi
+        with np.errstate(divide="ignore", invalid="ignore"):
+            slope = np.where(first[act], s0[act], (g - gp[act]) / (xa - xp[act]))
+            xn = xa - g / slope
+        inside = (xn > np.minimum(lo, hi)) & (xn < np.maximum(lo, hi))
+        xn = np.where(inside, xn, 0.5 * (lo + hi))
+        xp[act], gp[act] = xa, g
+        first[act] = False
+        done = ~(neg | pos) | (np.abs(xn - xa) <= tol[act]) | (np.abs(hi - lo) <= tol[act])
+        x[act] = np.where(neg | pos, xn, xa)
         act = act[~done]
     return x.reshape(shape)

@@ -64,8 +64,12 @@ class _ExactUPath:
         return sub, m, R, dR, k
 
     def coef(self, u, rows):
+        return self.coef_k(u, rows)[:2]
+
+    def coef_k(self, u, rows):
+        """``(A, B, k', dk'/du)`` at ``u``: the coefficients, the curvature and its slope ``1 / (R + k' dR/dk')``."""
         sub, m, R, dR, k = self._state(np.asarray(u, dtype=float), rows)
-        return _assembled(self.law, sub, k, u, R, dR, m)
+        return (*_assembled(self.law, sub, k, u, R, dR, m), k, 1.0 / (R + k * dR))
 
     def to_k(self, u, rows):
         return self._state(np.asarray(u, dtype=float), rows)[4]
@@ -201,13 +205,17 @@ class _TablePath:
         return sub, m, R, dR, k
 
     def coef(self, u, rows):
+        return self.coef_k(u, rows)[:2]
+
+    def coef_k(self, u, rows):
+        """``(A, B, k', dk'/du)`` at ``u``, as :meth:`_ExactUPath.coef_k`."""
         sub, m, R, dR, k = self._state(u, rows)
-        return _assembled(self.law, sub, k, u, R, dR, m)
+        return (*_assembled(self.law, sub, k, u, R, dR, m), k, 1.0 / (R + k * dR))
 
     def to_k(self, u, rows):
-        m = self.tables.means(self.ia[rows], u)
-        sub = self.cs.take(rows)
-        return radius_from_u(u, m["ib"], m["dib"], sub.alpha0, sub.R0_start)[2]
+        ia, u = np.broadcast_arrays(self.ia[rows], np.asarray(u, dtype=float))
+        m = self.tables._eval(ia, u, cols=[self.tables.keys.index("ib"), self.tables.keys.index("dib")])  # Ibar alone
+        return radius_from_u(u, m[..., 0], m[..., 1], self.cs.alpha0[rows], self.cs.R0_start[rows])[2]
 
     def _u_limits(self):
         """The braid limit in u on the bending side, cut where the bladder lumen closes (``R = t_bar``)."""
@@ -246,8 +254,8 @@ def branch_path(law: MomentLaw) -> _ExactUPath | _TablePath:
     Blocks of cases with few distinct braid angles (at least :data:`TABLE_MIN_CASES_PER_ANGLE`
     cases an angle) share :class:`SectionTables`; otherwise the section means are computed
     exactly.  The path's ``coef(u, rows)`` gives ``(A, B)`` (N*mm/kPa, N*mm) of the cases ``rows``
-    at ``u``, ``to_k(u, rows)`` the curvature (1/mm) there; ``x_min``, ``x_max`` (``k_min``,
-    ``k_max``) are the admissible range of ``u`` (of the curvature) of every case.
+    at ``u`` (``coef_k``: also ``k'`` and ``dk'/du``), ``to_k(u, rows)`` the curvature (1/mm) there;
+    ``x_min``, ``x_max`` (``k_min``, ``k_max``) are the admissible range of ``u`` (of the curvature) of every case.
 
     Examples
     --------

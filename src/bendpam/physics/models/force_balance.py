@@ -109,6 +109,22 @@ def _j_closed_form(u, c):
     return 2.0 * np.pi * (t - 1.0) / (c * c)
 
 
+def _axial_means(u, c):
+    """Circle means of ``cot^2 alpha(Phi) = c^2 lambda1^2 / (1 - c^2 lambda1^2)`` and ``lambda1^-2``, closed form.
+
+    With ``lambda1 = (1 + u) - u cos Phi``: ``1 / (1 - c^2 lambda1^2)`` is
+    ``(1/(1 - c lambda1) + 1/(1 + c lambda1)) / 2`` and
+    ``mean 1/(alpha + beta cos Phi) = (alpha^2 - beta^2)^(-1/2)``, so
+    ``mean cot^2 = ((1 - c)(1 - c - 2cu))^(-1/2) / 2 + ((1 + c)(1 + c + 2cu))^(-1/2) / 2 - 1`` (``cot^2 alpha0``
+    at ``u = 0``; finite below the lock-up ``u = (1/c - 1)/2``) and
+    ``mean lambda1^-2 = (1 + u) / (1 + 2u)^(3/2)`` (its derivative in ``alpha``).
+    """
+    cu2 = 2.0 * c * u
+    cot2 = 0.5 / np.sqrt((1.0 - c) * (1.0 - c - cu2)) + 0.5 / np.sqrt((1.0 + c) * (1.0 + c + cu2)) - 1.0
+    q = 1.0 + 2.0 * u
+    return cot2, (1.0 + u) / (q * np.sqrt(q))
+
+
 def section_means(u, alpha0, order: int = DEFAULT_ORDER, ib=None, dib=None) -> dict:
     """The section integrals of the force-balance model that depend on ``u = k'R`` and ``alpha0`` only.
 
@@ -282,7 +298,9 @@ def axial_forces(params, p_active, u, R, *, order: int = DEFAULT_ORDER):
     ``u = k'R`` and ``R`` are the kinematic state of eq 5 (mm) and ``p_active`` the active pressure
     (MPa); the parameter fields broadcast against ``u`` (a block of cases needs a trailing axis,
     :meth:`~bendpam.ModelParams.col`).  Returns a dict of arrays: ``F_p``, ``F_br``, ``F_bl``,
-    ``N_frame`` (N), ``P_e`` (MPa, eq 45), ``t_bar`` (mm, eq 40) and ``eta`` (``R/R0``).
+    ``N_frame`` (N), ``P_e`` (MPa, eq 45), ``t_bar`` (mm, eq 40) and ``eta`` (``R/R0``).  With the
+    default ``order = 0`` the two circle means are in closed form (:func:`_axial_means`), otherwise
+    Gauss-Legendre with ``order`` nodes.
 
     Examples
     --------
@@ -295,15 +313,18 @@ def axial_forces(params, p_active, u, R, *, order: int = DEFAULT_ORDER):
     (30.726, 310.33)
     """
     u, p, R = kernel_args(params, ("u", u, "1"), ("p_active", p_active, "MPa"), ("R", R, "mm"))
-    phi, wbar = gauss_nodes(order)
-    lam1 = 1.0 + u[..., None] * (1.0 - np.cos(phi))
     lbar = 1.0 + u
     eta = R / params.R0_start
     tbar = params.t0_start / (lbar * eta)
     const1, sig2e = _bladder_elastic(params.C10, params.C01, lbar, eta)
-    cl2 = (case_column(np.cos(params.alpha0)) * lam1) ** 2
-    mean_cot2 = (cl2 / (1.0 - cl2)) @ wbar  # circle mean of cot^2 alpha(Phi), eq 46-47
-    mean_lm2 = (1.0 / (lam1 * lam1)) @ wbar
+    if order == CLOSED_FORM:
+        mean_cot2, mean_lm2 = _axial_means(u, np.cos(params.alpha0))
+    else:
+        phi, wbar = gauss_nodes(order)
+        lam1 = 1.0 + u[..., None] * (1.0 - np.cos(phi))
+        cl2 = (case_column(np.cos(params.alpha0)) * lam1) ** 2
+        mean_cot2 = (cl2 / (1.0 - cl2)) @ wbar  # circle mean of cot^2 alpha(Phi), eq 46-47
+        mean_lm2 = (1.0 / (lam1 * lam1)) @ wbar
     mean_l2 = 1.0 + u * (2.0 + 1.5 * u)  # circle mean of lambda1^2: mean((1 - cos)^n) = 1, 3/2
     n2 = p * R - sig2e * tbar  # braid hoop line tension P_e R (eq 31, 45)
     f_p = p * np.pi * R * R
