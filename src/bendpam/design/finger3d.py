@@ -254,8 +254,8 @@ class Finger3DShape:
     >>> import bendpam
     >>> f3 = Finger3D(Finger(bendpam.physics.presets.be_pam()))
     >>> sh = solve_finger3d(f3, 150.0, FingerLoads3D(tip_force_n=(0.0, 0.0, 0.2)))
-    >>> sh.equilibrium, round(sh.tip_z_mm, 2), round(sh.twist_deg, 2)
-    (True, 0, 0)
+    >>> sh.equilibrium, round(sh.tip_z_mm, 2), round(sh.twist_deg, 2)   # the twist moment is below the lock torque
+    (True, 3.59, 0.0)
     """
 
     finger3d: Finger3D
@@ -440,9 +440,9 @@ def solve_finger3d(finger3d: Finger3D, pressure_kpa, loads: FingerLoads3D | None
     --------
     >>> import bendpam
     >>> f3 = Finger3D(Finger(bendpam.physics.presets.be_pam()))
-    >>> sh = solve_finger3d(f3, 150.0, FingerLoads3D(tip_force_n=(0.0, 0.0, 0.5)))
-    >>> round(sh.tip_z_mm, 1), round(sh.twist_deg, 1), sh.equilibrium
-    (0, 0, True)
+    >>> sh = solve_finger3d(f3, 150.0, FingerLoads3D(tip_force_n=(0.0, 0.0, 4.0)))     # 4 N sideways
+    >>> round(sh.tip_z_mm, 1), round(sh.out_of_plane_deg, 1), round(sh.twist_deg, 1), sh.equilibrium
+    (64.4, 34.6, 3.0, True)
     """
     if not isinstance(finger3d, Finger3D):
         raise TypeError(f"finger3d must be a bendpam.design.finger3d.Finger3D, got {type(finger3d).__name__}")

@@ -70,7 +70,7 @@ def segment_maps(w, length):
     the director frame at the end relative to the start, and the end point in the start's frame.
 
     >>> import numpy as np
-    >>> Q, p = segment_maps(np.array([0.0, 0.01, 0.0]), 100.0)     # a quarter... of 1 rad: an arc
+    >>> Q, p = segment_maps(np.array([0.0, 0.01, 0.0]), 100.0)     # a 1 rad arc
     >>> p.round(4).tolist()                                         # (1 - cos 1)/k, 0, sin 1 / k
     [45.9698, 0.0, 84.1471]
     """
@@ -102,7 +102,7 @@ class Rod3D:
     >>> K = np.zeros((rod.n, 3)); K[:, 1] = 0.01                   # k' = 0.01 1/mm: the planar arc
     >>> D, x, xt = rod.geometry(K.reshape(-1))
     >>> xt.round(4).tolist()                                       # 100 sin(1.45), 100 (1 - cos 1.45), 0
-    [99.2713, 87.9204, 0.0]
+    [99.2713, 87.9497, 0.0]
     """
 
     def __init__(self, finger3d: Finger3D, loads: FingerLoads3D):
