@@ -59,6 +59,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -262,7 +263,7 @@ def spatial_stiffness(actuator: Actuator, pressure_kpa, curvature_per_mm=None, *
     law, P, k = _states(actuator, pressure_kpa, curvature_per_mm, model)
     params = actuator.params
     frame = _frame_constants(actuator, frame_shear_modulus_mpa)
-    pa = law.active_pressure_kpa(P) * 1e-3
+    pa = np.maximum(P - law.P_start_kpa, 0.0) * 1e-3  # MPa (P was checked once)
     _u, R_in, _dR, _ib, _dib = radius_state(k, float(params.alpha0), float(params.R0_start))
     _, k_lat = _taylor(params, frame, pa, k, R_in, "kap2")
     lock, gj = _taylor(params, frame, pa, k, R_in, "tau")
@@ -302,7 +303,7 @@ def section_energy_n(actuator: Actuator, pressure_kpa, curvature_per_mm, lateral
     P, k, k2, tw = np.broadcast_arrays(P, k, k2, tw)
     params = actuator.params
     frame = _frame_constants(actuator, frame_shear_modulus_mpa)
-    pa = law.active_pressure_kpa(P) * 1e-3
+    pa = np.maximum(P - law.P_start_kpa, 0.0) * 1e-3  # MPa (P was checked once)
     R_in = radius_state(k, float(params.alpha0), float(params.R0_start))[1]
     return np.real(_energy(params, frame, pa, k, k2.astype(complex), tw.astype(complex), R_in))
 
@@ -338,16 +339,23 @@ class SpatialTable:
         kw = dict(model=model, frame_shear_modulus_mpa=frame_shear_modulus_mpa)
         t = 0.5 * (1.0 - np.cos(np.pi * np.arange(knots) / (knots - 1)))
         self.knots = lo + t * (hi - lo)
-        tm = 0.5 * (t[1:] + t[:-1])
-        k_all = np.concatenate([self.knots, lo + tm * (hi - lo)])
-        st = spatial_stiffness(actuator, float(pressure_kpa), k_all, **kw)
-        Y = np.stack([st.lateral_stiffness_nmm2, st.torsional_stiffness_nmm2_per_rad, st.torsion_lock_torque_nmm], -1)
-        self.coef = CubicSpline(self.knots, Y[:knots]).c  # (4, knots - 1, 3)
-        F = np.stack([np.real(v) for v in self(k_all[knots:])], -1)
-        E = Y[knots:]
-        floor = np.median(np.abs(Y), axis=0)  # a sign change (the lock torque) is judged on the typical size
+        self._check = (actuator, float(pressure_kpa), kw, lo + 0.5 * (t[1:] + t[:-1]) * (hi - lo))
+        st = spatial_stiffness(actuator, float(pressure_kpa), self.knots, **kw)
+        self._values = np.stack([st.lateral_stiffness_nmm2, st.torsional_stiffness_nmm2_per_rad,
+                                 st.torsion_lock_torque_nmm], -1)
+        self.coef = CubicSpline(self.knots, self._values).c  # (4, knots - 1, 3)
+
+    @cached_property
+    def max_rel_error(self) -> float:
+        """The largest relative error at the midpoints between knots, over the inner 90 % of the range."""
+        actuator, P, kw, km = self._check
+        ex = spatial_stiffness(actuator, P, km, **kw)
+        E = np.stack([ex.lateral_stiffness_nmm2, ex.torsional_stiffness_nmm2_per_rad, ex.torsion_lock_torque_nmm], -1)
+        F = np.stack([np.real(v) for v in self(km)], -1)
+        floor = np.median(np.abs(self._values), axis=0)  # a sign change (the lock torque) is judged on the typical size
+        tm = (km - self.knots[0]) / (self.knots[-1] - self.knots[0])
         inner = (tm > 0.05) & (tm < 0.95)
-        self.max_rel_error = float(np.max((np.abs(F - E) / (np.abs(E) + floor))[inner]))
+        return float(np.max((np.abs(F - E) / (np.abs(E) + floor))[inner]))
 
     def __call__(self, curvature_per_mm):
         """``(EI_lat N*mm^2, GJ N*mm^2/rad, T_lock N*mm)`` at the curvatures (any shape, complex allowed)."""
