@@ -133,3 +133,17 @@ def test_bad_input_is_one_line():
         spatial_stiffness(be_pam(), 100.0, 1.0)
     with pytest.raises(InputError, match="frame_shear_modulus_mpa"):
         spatial_stiffness(be_pam(), 100.0, 0.0, frame_shear_modulus_mpa=-1.0)
+
+
+def test_predict_json_gives_the_stiffnesses_at_the_free_curvature(capsys):
+    import json
+
+    from bendpam.cli import main
+
+    assert main(["predict", "--preset", "bc-pam", "--pressure-kpa", "100", "200", "--json"]) == 0
+    res = json.loads(capsys.readouterr().out)["results"]
+    s = spatial_stiffness(bc_pam(), 100.0)
+    assert res[0]["lateral_stiffness_nmm2"] == pytest.approx(float(s.lateral_stiffness_nmm2), rel=1e-12)
+    assert res[0]["torsional_stiffness_nmm2_per_rad"] == pytest.approx(float(s.torsional_stiffness_nmm2_per_rad))
+    assert res[0]["torsion_lock_torque_nmm"] == pytest.approx(float(s.torsion_lock_torque_nmm))
+    assert res[1]["lateral_stiffness_nmm2"] is None  # above the fold: no free curvature

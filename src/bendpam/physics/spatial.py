@@ -202,7 +202,8 @@ class SpatialStiffness:
     inplane_stiffness_nmm2 : ``-dM/dk'`` of the same law (positive on the stable branch), N*mm^2.
     lateral_stiffness_nmm2 : out-of-plane bending stiffness ``EI_lat``, N*mm^2.
     torsional_stiffness_nmm2_per_rad : ``GJ`` of the twisting actuator, N*mm^2/rad.
-    torsion_lock_torque_nmm : the torque the pressurised braid carries without twisting, N*mm.
+    torsion_lock_torque_nmm : the torque the pressurised braid carries without twisting, N*mm (0 without
+        active pressure, and where the energy's slope would be negative: no lock).
     parts : the frame, bladder and air (pressure) parts of the lateral and torsional stiffness and of the
         lock torque (``{"lateral": {...}, "torsion": {...}, "lock": {...}}``, same units).
 
@@ -271,7 +272,8 @@ def spatial_stiffness(actuator: Actuator, pressure_kpa, curvature_per_mm=None, *
     Kin = -law.tangent_stiffness(P, k)
     EIf, EIs, GJf = frame
     parts = {"lateral": {"frame_nmm2": EIs}, "torsion": {"frame_nmm2_per_rad": GJf}}
-    return SpatialStiffness(P, k, M, Kin, k_lat, gj, lock, parts)
+    # a negative lock torque (deep reverse bending: the braid's hoop tension gone) means no lock
+    return SpatialStiffness(P, k, M, Kin, k_lat, gj, np.maximum(lock, 0.0), parts)
 
 
 def lateral_stiffness_nmm2(actuator: Actuator, pressure_kpa, curvature_per_mm=None, **kw) -> np.ndarray:
