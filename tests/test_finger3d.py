@@ -99,3 +99,25 @@ def test_bad_input_is_one_line():
         Finger3D(Finger(be_pam()), rotation=np.diag([1.0, 1.0, -1.0]))
     with pytest.raises(InputError, match="beyond the active length"):
         solve_finger3d(Finger3D(Finger(be_pam())), 100.0, FingerLoads3D(point_forces_n=((500.0, (0, 0, 1)),)))
+
+
+def test_cli_finger_forces_and_moments_in_space(capsys, tmp_path):
+    from bendpam.cli import main
+
+    fig = tmp_path / "f3.png"
+    assert main(["finger", "--preset", "be-pam", "--pressure-kpa", "150", "--tip-force-n", "0,-0.5,1",
+                 "--tip-moment-nmm", "10,0,-3", "--json", "--plot", str(fig)]) == 0
+    res = json.loads(capsys.readouterr().out)["results"][0]
+    sh = solve_finger3d(Finger3D(Finger(be_pam())), 150.0,
+                        FingerLoads3D(tip_force_n=(0.0, -0.5, 1.0), tip_moment_nmm=(10.0, 0.0, -3.0)))
+    for key in ("tip_z_mm", "out_of_plane_deg", "twist_deg"):
+        assert res[key] == pytest.approx(sh.to_dict()[key], rel=1e-9)
+    assert fig.read_bytes()[:4] == b"\x89PNG"
+    # the in-plane forms work as before, and say that the finger stays in its plane
+    assert main(["finger", "--preset", "be-pam", "--pressure-kpa", "150", "--tip-force-n", "0,-0.5",
+                 "--tip-moment-nmm", "-3", "--json"]) == 0
+    res2 = json.loads(capsys.readouterr().out)["results"][0]
+    planar = solve_finger(Finger(be_pam()), 150.0, FingerLoads(tip_force_n=(0.0, -0.5), tip_moment_nmm=-3.0))
+    assert res2["tip_x_mm"] == pytest.approx(planar.tip_xy[0], rel=1e-12) and res2["tip_z_mm"] == 0.0
+    assert main(["finger", "--preset", "be-pam", "--pressure-kpa", "150", "--tip-moment-nmm", "1,2"]) == 2
+    assert "--tip-moment-nmm" in capsys.readouterr().err
