@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
@@ -167,6 +168,8 @@ class FingerLoads3D:
         A further uniform load per length, N/mm.
     point_forces_n : sequence of (s_mm, (Fx, Fy, Fz))
         Forces at arc lengths ``s_mm`` along the active length (contacts of known force), N.
+    point_moments_nmm : sequence of (s_mm, (Mx, My, Mz))
+        Moments at arc lengths ``s_mm`` (a force applied off the frame line, moved onto it), N*mm.
     gravity : (gx, gy, gz)
         Direction of gravity (normalised here); default ``(0, -1, 0)``.
 
@@ -184,6 +187,7 @@ class FingerLoads3D:
     distributed_n_per_mm: tuple[float, float, float] = (0.0, 0.0, 0.0)
     point_forces_n: tuple = ()
     gravity: tuple[float, float, float] = (0.0, -1.0, 0.0)
+    point_moments_nmm: tuple = ()
 
     def __post_init__(self):
         s = object.__setattr__
@@ -193,15 +197,15 @@ class FingerLoads3D:
         s(self, "mass_per_length_g_per_mm",
           number("mass_per_length_g_per_mm", self.mass_per_length_g_per_mm, 0.0, unit="g/mm"))
         s(self, "distributed_n_per_mm", checked_vector("distributed_n_per_mm", self.distributed_n_per_mm, "N/mm"))
-        pts = []
-        for i, item in enumerate(self.point_forces_n):
-            try:
-                sp, Fp = item
-            except (TypeError, ValueError):
-                raise InputError(f"point_forces_n[{i}] must be (s_mm, (Fx, Fy, Fz))") from None
-            pts.append((number(f"point_forces_n[{i}] s_mm", sp, 0.0, unit="mm"),
-                        checked_vector(f"point_forces_n[{i}] force", Fp, "N")))
-        s(self, "point_forces_n", tuple(pts))
+        for key, unit in (("point_forces_n", "N"), ("point_moments_nmm", "N*mm")):
+            pts = []
+            for i, item in enumerate(getattr(self, key)):
+                try:
+                    sp, Fp = item
+                except (TypeError, ValueError):
+                    raise InputError(f"{key}[{i}] must be (s_mm, (X, Y, Z)) ({unit})") from None
+                pts.append((number(f"{key}[{i}] s_mm", sp, 0.0, unit="mm"), checked_vector(f"{key}[{i}]", Fp, unit)))
+            s(self, key, tuple(pts))
         g = np.asarray(checked_vector("gravity", self.gravity, "direction"))
         ng = float(np.linalg.norm(g))
         if ng == 0.0:
@@ -223,7 +227,8 @@ class FingerLoads3D:
     def is_zero(self) -> bool:
         return (not any(self.tip_force_n) and not any(self.tip_moment_nmm) and self.tip_mass_g == 0.0
                 and self.mass_per_length_g_per_mm == 0.0 and not any(self.distributed_n_per_mm)
-                and not any(any(F) for _, F in self.point_forces_n))
+                and not any(any(F) for _, F in self.point_forces_n)
+                and not any(any(M) for _, M in self.point_moments_nmm))
 
     def tip_resultant(self) -> tuple[float, float, float]:
         """Total force at the fingertip point (force + weight of the tip mass), N."""
@@ -453,11 +458,17 @@ def solve_finger3d(finger3d: Finger3D, pressure_kpa, loads: FingerLoads3D | None
         raise TypeError(f"loads must be a FingerLoads3D, got {type(loads).__name__}")
     f = finger3d.finger
     P = checked_pressure_kpa(pressure_kpa, actuator=f.actuator)
-    for sp, _F in loads.point_forces_n:
+    for sp, _F in loads.point_forces_n + loads.point_moments_nmm:
         if sp > f.length:
-            raise InputError(f"point_forces_n: s_mm = {sp:g} mm is beyond the active length {f.length:g} mm")
+            raise InputError(f"point loads: s_mm = {sp:g} mm is beyond the active length {f.length:g} mm")
     with pressures_checked():
         return _solve(finger3d, P, loads)
+
+
+@lru_cache(maxsize=32)
+def _table(actuator, P: float, k_lo: float, k_hi: float, model, shear) -> SpatialTable:
+    """The stiffness table at one pressure and stable branch (shared by repeated solves: load steps, sweeps)."""
+    return SpatialTable(actuator, P, k_lo, k_hi, model=model, frame_shear_modulus_mpa=shear)
 
 
 def _solve(f3: Finger3D, P: float, loads: FingerLoads3D) -> Finger3DShape:
@@ -467,8 +478,7 @@ def _solve(f3: Finger3D, P: float, loads: FingerLoads3D) -> Finger3DShape:
         br = f.branch(P)
     except NoEquilibrium as exc:
         return _failure(f3, rod, None, P, loads, str(exc))
-    table = SpatialTable(f.actuator, P, br.k_lo, br.k_hi, model=f.model,
-                         frame_shear_modulus_mpa=f3.frame_shear_modulus_mpa)
+    table = _table(f.actuator, P, br.k_lo, br.k_hi, f.model, f3.frame_shear_modulus_mpa)
     sys_ = _System(rod, br, table, f3.sleeve_lock)
     lo, hi = _bounds(br, rod.n)
     kf = br.free_curvature

@@ -124,6 +124,7 @@ class Rod3D:
         self.q = np.asarray(loads.distributed(), dtype=float)
         self.Mt = np.asarray(loads.tip_moment_nmm, dtype=float)
         self.points = [(float(sp), np.asarray(Fp, dtype=float)) for sp, Fp in loads.point_forces_n]
+        self.couples = [(float(sp), np.asarray(Mp, dtype=float)) for sp, Mp in loads.point_moments_nmm]
 
     def curvatures(self, U):
         """The Darboux vectors ``(kappa1, c k', tau)`` (..., n, 3) of the states ``U`` (..., 3 n)."""
@@ -159,6 +160,8 @@ class Rod3D:
             xp = self._at(D, x, sp, U)
             beyond = (self.s < sp)[:, None]
             m = m + np.where(beyond, np.cross(xp[..., None, :] - x, Fp), 0.0)
+        for sp, Mp in self.couples:
+            m = m + np.where((self.s < sp)[:, None], Mp, 0.0)
         return lam * m
 
     def _at(self, D, x, sp, U):
@@ -174,6 +177,7 @@ class Rod3D:
         lever = self.L + self.ell + abs(self.off)
         load = (float(np.linalg.norm(self.Mt)) + float(np.linalg.norm(self.F)) * lever
                 + float(np.linalg.norm(self.q)) * self.L ** 2
-                + sum(float(np.linalg.norm(Fp)) * lever for _, Fp in self.points))
+                + sum(float(np.linalg.norm(Fp)) * lever for _, Fp in self.points)
+                + sum(float(np.linalg.norm(Mp)) for _, Mp in self.couples))
         return max(abs(branch_moment_nmm), load, 1.0)
 
