@@ -64,7 +64,7 @@ class GraspTwist:
     >>> gripper = Gripper(bendpam.physics.presets.be_pam().replace(L0_mm=130.0), nodes=21)
     >>> tw = grasp_twist(gripper, 180.0, 150.0, fractions=(1.0,))     # a 180 mm sphere at 150 kPa
     >>> tw.lost_by, round(tw.torque_at_loss_nmm), round(tw.at_loss["object_rotation_deg"], 1)   # N*mm, deg
-    ('friction', 0, 0)
+    ('friction', 58, 3.1)
     """
 
     grasp: Grasp
