@@ -2,7 +2,8 @@
 
 PyElastica's rods are linear-elastic, so the finger is given to it as a **linear-elastic equivalent rod at the
 operating point**: the free shape at the pressure as the rest shape (rest curvature = the free curvature), the
-bending stiffnesses ``diag(EI_lat, -dM/dk', GJ)`` of bendpam's laws there (:func:`bendpam.physics.spatial.spatial_stiffness`),
+bending stiffnesses ``diag(EI_lat, -dM/dk', GJ)`` of bendpam's laws there
+(:func:`bendpam.physics.spatial.spatial_stiffness`),
 stiff in stretch and shear (inextensible and unshearable within 1e-3), and bendpam's finger without the braid's
 lock torque (``sleeve_lock=False``: a kinked law PyElastica cannot take).  A tip force is ramped up and the rod
 is run to rest with PyElastica's analytical linear damper (mass and damping are numerical only: statics).
@@ -93,8 +94,8 @@ def crosscheck(elements: int = 40, pressure_kpa: float = 150.0, tip_force_n=(0.0
 if __name__ == "__main__":
     rows = {n: crosscheck(n) for n in (20, 40, 80)}
     for n, r in rows.items():
-        print(f"{n:3d} elements: elastica tip {np.round(r['elastica_tip_mm'], 3)} mm, bendpam {np.round(r['bendpam_tip_mm'], 3)}"
-              f" mm, difference {100 * r['difference_of_length']:.3f} % of L")
+        print(f"{n:3d} elements: elastica tip {np.round(r['elastica_tip_mm'], 3)} mm, "
+              f"bendpam {np.round(r['bendpam_tip_mm'], 3)} mm, difference {100 * r['difference_of_length']:.3f} % of L")
     e40, e80 = np.asarray(rows[40]["elastica_tip_mm"]), np.asarray(rows[80]["elastica_tip_mm"])
     rich = 2.0 * e80 - e40  # first-order convergence
     print(f"Richardson (40, 80): {np.round(rich, 3)} mm; bendpam (81 nodes) {np.round(rows[80]['bendpam_tip_mm'], 3)}"

@@ -104,7 +104,8 @@ def finger_cmd(
     pressure_kpa: PressureOpt = None,
     l0_mm: L0Opt = None,
     tip_force_n: Annotated[Optional[str], typer.Option(
-        "--tip-force-n", help="Tip force FX,FY in the bending plane, or FX,FY,FZ in space (N; z out of the plane).")] = None,
+        "--tip-force-n", help="Tip force FX,FY in the bending plane, or FX,FY,FZ in space (N; z out of the plane).")
+    ] = None,
     tip_moment_nmm: Annotated[Optional[str], typer.Option(
         "--tip-moment-nmm", help="Tip moment MZ (N*mm, ccw in the plane), or MX,MY,MZ in space.")] = None,
     tip_mass_g: Annotated[float, typer.Option("--tip-mass-g", help="Point mass at the fingertip (g).")] = 0.0,
@@ -147,14 +148,14 @@ def finger_cmd(
                             "--tip-moment-nmm MZ")
         _finger3d(act, mname, finger, P, F, M, (tip_mass_g, mass_per_length, gravity_deg), as_json, plot, fig_format)
         return
-    tip_moment_nmm = M[0]
-    loads = FingerLoads(tip_force_n=F, tip_moment_nmm=tip_moment_nmm, tip_mass_g=tip_mass_g,
+    Mz = M[0]
+    loads = FingerLoads(tip_force_n=(F[0], F[1]), tip_moment_nmm=Mz, tip_mass_g=tip_mass_g,
                         mass_per_length_g_per_mm=mass_per_length, gravity=(math.cos(g), math.sin(g)))
     _, shapes = finger_sweep(finger, P, loads)
     lims = [sh.limits() if sh.equilibrium else None for sh in shapes]  # worst section along the finger
     held = [blocked_tip_force(finger, p, loads=loads) for p in P] if blocked else None
     if plot is not None:  # with a load, the free shapes beside the loaded ones
-        loaded = any(F) or tip_moment_nmm or tip_mass_g or mass_per_length
+        loaded = any(F) or Mz or tip_mass_g or mass_per_length
         free = finger_sweep(finger, P, FingerLoads())[1] if loaded else None
         _save_plot(lambda ax: plot_finger_shapes(shapes, ax=ax, free=free, title=f"{act.name or act.kind}, "
                                                  f"L0 = {act.L0_mm:g} mm"), plot, fig_format, aspect=0.9)
@@ -169,7 +170,7 @@ def finger_cmd(
         rows.append(row)
     if as_json:
         obj = {"model": mname, "actuator": act.name or act.kind, "L0_mm": act.L0_mm,
-               "loads": {"tip_force_n": list(F), "tip_moment_nmm": tip_moment_nmm, "tip_mass_g": tip_mass_g,
+               "loads": {"tip_force_n": list(F), "tip_moment_nmm": Mz, "tip_mass_g": tip_mass_g,
                          "mass_per_length_g_per_mm": mass_per_length, "gravity_deg": gravity_deg},
                "units": {"tip_x_mm": "mm", "tip_angle_deg": "deg (tangent at the tip, from +x)",
                          "bend_angle_deg": "deg (tip rotation in the bending direction)"},

@@ -330,7 +330,7 @@ class Finger3DShape:
         (113.47, 0.0, 0.0)
         """
         ok = self.equilibrium
-        tx, ty, tz = self.tip_xyz
+        tx, ty, _ = self.tip_xyz
         return {"pressure_kpa": float(self.pressure_kpa), "tip_x_mm": json_number(tx), "tip_y_mm": json_number(ty),
                 "tip_z_mm": json_number(self.tip_z_mm if ok else math.nan),
                 "bend_angle_deg": json_number(self.bend_angle_deg if ok else math.nan),

@@ -28,7 +28,6 @@ Units: mm, N, N*mm, rad; curvatures 1/mm, twist rad/mm.
 
 from __future__ import annotations
 
-import math
 from typing import TYPE_CHECKING
 
 import numpy as np

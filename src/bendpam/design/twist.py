@@ -119,6 +119,7 @@ def _contact_loads(gripper: Gripper, grasp: Grasp, T: float) -> tuple[FingerLoad
     if grasp.contact == "tip":
         return FingerLoads3D(tip_force_n=F), p, float(p[0]), None
     sh = grasp.shape
+    assert sh is not None, "a grasp in contact has its finger's shape"
     j = int(np.argmin(np.hypot(sh.x - p[0], sh.y - p[1])))
     arm = np.array([p[0] - sh.x[j], p[1] - sh.y[j], 0.0])
     Mc = np.cross(arm, np.asarray(F))
@@ -131,6 +132,7 @@ def _contact_lateral(shape: Finger3DShape, grasp: Grasp, node: int | None, p) ->
     if node is None:
         return shape.tip_z_mm
     sh = grasp.shape
+    assert sh is not None, "a grasp in contact has its finger's shape"
     arm = np.array([p[0] - sh.x[node], p[1] - sh.y[node], 0.0])
     a = sh.angle[node]
     ref = np.array([[-math.sin(a), 0.0, math.cos(a)], [math.cos(a), 0.0, math.sin(a)], [0.0, 1.0, 0.0]])

@@ -61,8 +61,8 @@ from bendpam.infra.accessors import figure
 from bendpam.physics import presets
 from bendpam.physics.actuator import Actuator
 from bendpam.physics.law import MomentLaw, StableBranch
-from bendpam.physics.spatial import lateral_stiffness_nmm2
 from bendpam.physics.models import normalise_model, resolve_model
+from bendpam.physics.spatial import lateral_stiffness_nmm2
 from bendpam.validate import number
 
 __all__ = [

@@ -161,7 +161,7 @@ def _energy(params, frame, p_mpa, k, kap2, tau, R_start):
     R0 = float(params.R0_start)
     R = _radius(R_start, R0, k, kap2, tau, c, s)
     omc, sn = _circle()
-    lam1, L12, gam, _lam2 = _closure(R, k, kap2, tau, c, s, omc, sn)
+    _lam1, L12, gam, _lam2 = _closure(R, k, kap2, tau, c, s, omc, sn)
     eta = (R / R0)[..., None]
     det = eta * eta * (L12 - gam * gam)
     tr = L12 + eta * eta
@@ -270,7 +270,7 @@ def spatial_stiffness(actuator: Actuator, pressure_kpa, curvature_per_mm=None, *
     lock, gj = _taylor(params, frame, pa, k, R_in, "tau")
     M = law.moment(P, k)
     Kin = -law.tangent_stiffness(P, k)
-    EIf, EIs, GJf = frame
+    _EIf, EIs, GJf = frame
     parts = {"lateral": {"frame_nmm2": EIs}, "torsion": {"frame_nmm2_per_rad": GJf}}
     # a negative lock torque (deep reverse bending: the braid's hoop tension gone) means no lock
     return SpatialStiffness(P, k, M, Kin, k_lat, gj, np.maximum(lock, 0.0), parts)
@@ -338,7 +338,7 @@ class SpatialTable:
             raise InputError(f"k_hi = {k_hi:g} 1/mm must be above k_lo = {k_lo:g} 1/mm")
         pad = 1e-3 * (float(k_hi) - float(k_lo))  # the ends may be the lock-up limits themselves
         lo, hi = float(k_lo) + pad, float(k_hi) - pad
-        kw = dict(model=model, frame_shear_modulus_mpa=frame_shear_modulus_mpa)
+        kw: dict[str, Any] = dict(model=model, frame_shear_modulus_mpa=frame_shear_modulus_mpa)
         t = 0.5 * (1.0 - np.cos(np.pi * np.arange(knots) / (knots - 1)))
         self.knots = lo + t * (hi - lo)
         self._check = (actuator, float(pressure_kpa), kw, lo + 0.5 * (t[1:] + t[:-1]) * (hi - lo))
