@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 
 from bendpam.design.finger import Finger, FingerLoads
-from bendpam.design.parts import G_N_PER_G, checked_pressure_kpa, json_number, pressures_checked
+from bendpam.design.parts import G_N_PER_G, checked_pressure_kpa, checked_vector, json_number, pressures_checked
 from bendpam.design.rod import NEWTON_TOL, continuation, newton
 from bendpam.design.rod3d import Rod3D
 from bendpam.errors import InputError, NoEquilibrium
@@ -49,31 +49,9 @@ __all__ = [
     "Finger3D",
     "Finger3DShape",
     "FingerLoads3D",
-    "checked_vector",
     "plot_finger3d",
     "solve_finger3d",
 ]
-
-
-def checked_vector(name: str, value, unit: str) -> tuple[float, float, float]:
-    """Three finite numbers as a tuple of floats, else a one-line InputError.
-
-    >>> checked_vector("tip_force_n", [0, 0, -1.5], "N")
-    (0.0, 0.0, -1.5)
-    >>> checked_vector("tip_force_n", [0, 1], "N")
-    Traceback (most recent call last):
-    ...
-    bendpam.errors.InputError: tip_force_n = [0, 1] must be three finite numbers (N)
-    """
-    if isinstance(value, str | bytes):
-        raise InputError(f"{name} = {value!r} must be three numbers ({unit})")
-    try:
-        a = np.asarray(value, dtype=float).ravel()
-    except (TypeError, ValueError):
-        raise InputError(f"{name} = {value!r} must be three numbers ({unit})") from None
-    if a.size != 3 or not np.all(np.isfinite(a)):
-        raise InputError(f"{name} = {value!r} must be three finite numbers ({unit})")
-    return float(a[0]), float(a[1]), float(a[2])
 
 
 @dataclass(frozen=True)
