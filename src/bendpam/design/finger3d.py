@@ -18,7 +18,10 @@ identity (default) world and local axes coincide and in-plane loads give the pla
 Solved by continuation in the load fraction from the free shape with the one Newton method of
 :mod:`bendpam.design.rod`; when the loads ask for more than the stable branch of the law supplies
 (snap-through), or the path reaches a limit point, the result has ``equilibrium=False``, NaN arrays,
-a note and the last equilibrium reached in ``limit``, as the planar finger.
+a note and the last equilibrium reached in ``limit``, as the planar finger.  Unlike the planar
+finger there is no separate structural-stability check of the equilibrium (the second variation):
+a limit point on the load path stops the continuation; a bifurcation off it is not detected.
+Contacts are loads of known force (point forces), not unilateral constraints.
 
 Units: mm, N, N*mm, kPa, g; angles in degrees in names ending ``_deg``.
 """
@@ -229,8 +232,10 @@ class Finger3DShape:
     directors : (n, 3, 3) columns ``d1`` (in-plane normal), ``d2`` (bending axis), ``d3`` (tangent).
     curvature : the paper's frame curvature ``k'`` (1/mm).  lateral_curvature : about ``d1`` (1/mm).
     twist : rad/mm.  moment : (n, 3) the loads' moment in the director frame (``m.d1, m.d2, m.d3``), N*mm.
-    tip_xyz : fingertip point, mm.  equilibrium, stable, residual_nmm, load_fraction, note, limit, branch:
-    as :class:`~bendpam.design.finger.FingerShape`.
+    tip_xyz : fingertip point, mm.  equilibrium, residual_nmm, load_fraction, note, limit, branch:
+    as :class:`~bendpam.design.finger.FingerShape`.  stable : every section on the stable branch of its
+    law (the 3-D finger has no separate structural-stability check: a structural limit point shows as
+    the load continuation stopping, ``equilibrium=False``).
 
     Examples
     --------
