@@ -39,6 +39,8 @@ __all__ = ["register"]
 
 #: The most equilibrium solutions one design command may compute (each takes about 10 ms).
 MAX_DESIGN_POINTS = 10_000
+#: grasps that ``bendpam grasp --twist`` twists at most (each a few spatial-finger solves, about a second each)
+MAX_TWIST_GRASPS = 12
 
 JsonOpt = Annotated[bool, typer.Option("--json", help="Print one JSON object instead of a table.")]
 PlotOpt = Annotated[Optional[Path], typer.Option("--plot", help="Write a figure (.png/.pdf/.svg).")]
@@ -63,17 +65,6 @@ def _record(row: dict[str, Any]) -> dict[str, Any]:
             else:
                 out[k] = None if math.isnan(f) else f  # infinity: "inf" in the JSON (print_json)
     return out
-
-
-def _pair(text: str, name: str, unit: str) -> tuple[float, float]:
-    parts = [p for p in str(text).replace(";", ",").split(",") if p.strip()]
-    try:
-        vals = [float(p) for p in parts]
-    except ValueError:
-        raise UserError(f"{name}: {text!r} must be two numbers X,Y ({unit})") from None
-    if len(vals) != 2 or not all(math.isfinite(v) for v in vals):
-        raise UserError(f"{name}: {text!r} must be two finite numbers X,Y ({unit})")
-    return vals[0], vals[1]
 
 
 def _plot_target(plot: Optional[Path], fmt=None):
@@ -114,8 +105,11 @@ def finger_cmd(
     model: ModelOpt = None,
     pressure_kpa: PressureOpt = None,
     l0_mm: L0Opt = None,
-    tip_force_n: Annotated[Optional[str], typer.Option("--tip-force-n", help="Tip force FX,FY (N).")] = None,
-    tip_moment_nmm: Annotated[float, typer.Option("--tip-moment-nmm", help="Tip moment (N*mm, ccw).")] = 0.0,
+    tip_force_n: Annotated[Optional[str], typer.Option(
+        "--tip-force-n", help="Tip force FX,FY in the bending plane, or FX,FY,FZ in space (N; z out of the plane).")
+    ] = None,
+    tip_moment_nmm: Annotated[Optional[str], typer.Option(
+        "--tip-moment-nmm", help="Tip moment MZ (N*mm, ccw in the plane), or MX,MY,MZ in space.")] = None,
     tip_mass_g: Annotated[float, typer.Option("--tip-mass-g", help="Point mass at the fingertip (g).")] = 0.0,
     mass_per_length: Annotated[
         float, typer.Option("--mass-per-length-g-mm", help="Self-weight of the actuator (g/mm).")] = 0.0,
@@ -145,30 +139,32 @@ def finger_cmd(
     bend_key = bend.strip().lower()
     if bend_key not in ("ccw", "cw"):
         raise UserError(f"--bend: {bend!r} is not allowed; choose ccw or cw")
-    F = _pair(tip_force_n, "--tip-force-n", "N") if tip_force_n is not None else (0.0, 0.0)
+    F = _components(tip_force_n, "--tip-force-n", "N", "FX,FY", 2) if tip_force_n is not None else (0.0, 0.0)
+    M = _components(tip_moment_nmm, "--tip-moment-nmm", "N*mm", "MZ", 1) if tip_moment_nmm is not None else (0.0,)
     g = math.radians(gravity_deg)
     finger = Finger(act, mname, base_angle_deg=base_angle_deg, bend=1 if bend_key == "ccw" else -1,
                     fingertip_mm=fingertip_mm, fingertip_offset_mm=fingertip_offset_mm)
-    loads = FingerLoads(tip_force_n=F, tip_moment_nmm=tip_moment_nmm, tip_mass_g=tip_mass_g,
+    if len(F) == 3 or len(M) == 3:  # loads out of the bending plane: the spatial finger
+        if blocked:
+            raise UserError("--blocked-force: the blocked force is for in-plane loads; give --tip-force-n FX,FY and "
+                            "--tip-moment-nmm MZ")
+        _finger3d(act, mname, finger, P, F, M, (tip_mass_g, mass_per_length, gravity_deg), as_json, plot, fig_format)
+        return
+    Mz = M[0]
+    loads = FingerLoads(tip_force_n=(F[0], F[1]), tip_moment_nmm=Mz, tip_mass_g=tip_mass_g,
                         mass_per_length_g_per_mm=mass_per_length, gravity=(math.cos(g), math.sin(g)))
     _, shapes = finger_sweep(finger, P, loads)
     lims = [sh.limits() if sh.equilibrium else None for sh in shapes]  # worst section along the finger
     held = [blocked_tip_force(finger, p, loads=loads) for p in P] if blocked else None
     if plot is not None:  # with a load, the free shapes beside the loaded ones
-        loaded = any(F) or tip_moment_nmm or tip_mass_g or mass_per_length
+        loaded = any(F) or Mz or tip_mass_g or mass_per_length
         free = finger_sweep(finger, P, FingerLoads())[1] if loaded else None
         _save_plot(lambda ax: plot_finger_shapes(shapes, ax=ax, free=free, title=f"{act.name or act.kind}, "
                                                  f"L0 = {act.L0_mm:g} mm"), plot, fig_format, aspect=0.9)
-    rows = []
-    for i, (sh, lm) in enumerate(zip(shapes, lims, strict=True)):
-        row = sh.to_dict()
-        if held is not None:
-            row["blocked_force_n"] = held[i].to_dict()["force_n"]
-        row["limits"] = None if lm is None else lm.to_dict()
-        rows.append(row)
+    rows = _finger_rows(shapes, lims, held)
     if as_json:
         obj = {"model": mname, "actuator": act.name or act.kind, "L0_mm": act.L0_mm,
-               "loads": {"tip_force_n": list(F), "tip_moment_nmm": tip_moment_nmm, "tip_mass_g": tip_mass_g,
+               "loads": {"tip_force_n": list(F), "tip_moment_nmm": Mz, "tip_mass_g": tip_mass_g,
                          "mass_per_length_g_per_mm": mass_per_length, "gravity_deg": gravity_deg},
                "units": {"tip_x_mm": "mm", "tip_angle_deg": "deg (tangent at the tip, from +x)",
                          "bend_angle_deg": "deg (tip rotation in the bending direction)"},
@@ -182,6 +178,72 @@ def finger_cmd(
         for v in (lm.violations if lm is not None else ()):
             typer.echo(f"bendpam: warning: past a limit: {v}", err=True)
     if plot is not None and not as_json:
+        echo_wrote(f"wrote {plot}")
+
+
+def _finger_rows(shapes, lims, held) -> list[dict[str, Any]]:
+    """The JSON rows of the planar ``bendpam finger``: pose, z = 0 (in the plane), blocked force, limits."""
+    rows = []
+    for i, (sh, lm) in enumerate(zip(shapes, lims, strict=True)):
+        row = sh.to_dict()
+        flat = 0.0 if sh.equilibrium else None  # in-plane loads: the finger stays in its plane
+        row |= {"tip_z_mm": flat, "out_of_plane_deg": flat, "twist_deg": flat}
+        if held is not None:
+            row["blocked_force_n"] = held[i].to_dict()["force_n"]
+        row["limits"] = None if lm is None else lm.to_dict()
+        rows.append(row)
+    return rows
+
+
+def _components(text: str, name: str, unit: str, planar: str, n_planar: int) -> tuple[float, ...]:
+    """``n_planar`` numbers (the in-plane form, ``planar``) or three (X,Y,Z in space), else a one-line error."""
+    parts = [p for p in str(text).replace(";", ",").split(",") if p.strip()]
+    try:
+        vals = [float(p) for p in parts]
+    except ValueError:
+        raise UserError(f"{name}: {text!r} must be {planar} or X,Y,Z ({unit})") from None
+    if len(vals) not in (n_planar, 3) or not all(math.isfinite(v) for v in vals):
+        raise UserError(f"{name}: {text!r} must be {n_planar if n_planar > 1 else 'one'} or three finite numbers: "
+                        f"{planar} or X,Y,Z ({unit})")
+    return tuple(vals)
+
+
+def _finger3d(act, mname, finger, P, F, M, weights, as_json: bool, plot, fig_format) -> None:
+    """``bendpam finger`` with loads out of the bending plane (:func:`bendpam.design.finger3d.solve_finger3d`)."""
+    from bendpam.design.finger3d import Finger3D, FingerLoads3D, plot_finger3d, solve_finger3d
+    from bendpam.present.figures import save_figure
+
+    tip_mass_g, mass_per_length, gravity_deg = weights
+    g = math.radians(gravity_deg)
+    F3 = (*F, 0.0) if len(F) == 2 else F
+    M3 = (0.0, 0.0, M[0]) if len(M) == 1 else M
+    loads = FingerLoads3D(tip_force_n=F3, tip_moment_nmm=M3, tip_mass_g=tip_mass_g,
+                          mass_per_length_g_per_mm=mass_per_length, gravity=(math.cos(g), math.sin(g), 0.0))
+    f3 = Finger3D(finger)
+    shapes = [solve_finger3d(f3, p, loads) for p in P]
+    rows = [sh.to_dict() for sh in shapes]
+    if plot is not None:
+        save_figure(plot_finger3d(shapes, title=f"{act.name or act.kind}, L0 = {act.L0_mm:g} mm"), plot,
+                    format=figure_format(plot, fig_format, "--plot"))
+    if as_json:
+        print_json({"model": mname, "actuator": act.name or act.kind, "L0_mm": act.L0_mm,
+                    "loads": {"tip_force_n": list(F3), "tip_moment_nmm": list(M3), "tip_mass_g": tip_mass_g,
+                              "mass_per_length_g_per_mm": mass_per_length, "gravity_deg": gravity_deg},
+                    "units": {"tip_x_mm": "mm (z: out of the bending plane)",
+                              "out_of_plane_deg": "deg (tip tangent out of the bending plane)",
+                              "twist_deg": "deg (tip section about the frame line)",
+                              "base_moment_nmm": "N*mm (along d1 in-plane normal, d2 plane normal, d3 tangent)"},
+                    "results": rows})
+        return
+    typer.echo(f"{act.name or act.kind}, L0 = {act.L0_mm:g} mm — {mname.replace('_', '-')} model, loads in space")
+    typer.echo(f"{'P (kPa)':>8} {'tip x (mm)':>10} {'tip y (mm)':>10} {'tip z (mm)':>10} {'bend (deg)':>10} "
+               f"{'out (deg)':>9} {'twist (deg)':>11} {'residual':>9}  note")
+    for r in rows:
+        typer.echo(f"{r['pressure_kpa']:8.4g} {_fmt(r['tip_x_mm'], '10.2f')} {_fmt(r['tip_y_mm'], '10.2f')} "
+                   f"{_fmt(r['tip_z_mm'], '10.2f')} {_fmt(r['bend_angle_deg'], '10.2f')} "
+                   f"{_fmt(r['out_of_plane_deg'], '9.2f')} {_fmt(r['twist_deg'], '11.2f')} "
+                   f"{_fmt(r['residual_nmm'], '9.1e')}" + ("  " + r["note"] if r["note"] else ""))
+    if plot is not None:
         echo_wrote(f"wrote {plot}")
 
 
@@ -252,6 +314,8 @@ def grasp_cmd(
     splay_deg: Annotated[
         Optional[float], typer.Option("--splay-deg", help="Outward tilt of the open fingers (deg); "
                                       "default 15.")] = None,
+    twist: Annotated[bool, typer.Option("--twist", help="Also twist each grasped sphere about the gripper's axis "
+                                        "until the grip slips (the fingers as 3-D rods; at most 12 grasps).")] = False,
     as_json: JsonOpt = False,
     plot: PlotOpt = None,
     fig_format: FigureFormatOpt = None,
@@ -260,7 +324,8 @@ def grasp_cmd(
 
     Each grasp is pulled out quasi-statically (the base lifted step by step, the fingers'
     statics with their moment law, Coulomb stick/slip at the contacts); the grip force is the
-    peak lifting load before the sphere escapes.
+    peak lifting load before the sphere escapes.  With --twist, each grasp is also twisted about
+    the gripper's axis until the contacts slip: the torque then and the fingers' distortion.
     """
     from bendpam.design.grasp import grasp_dataset, plot_grasp, solve_grasps
     from bendpam.design.gripper import (
@@ -280,6 +345,7 @@ def grasp_cmd(
             raise UserError(f"--diameter-mm: {d:g} mm is not a positive diameter")
     P = pressures_kpa(pressure_kpa, None)
     _budget(len(P) * len(D), "--pressure-kpa x --diameter-mm")
+    _twist_budget(twist, len(P) * len(D))
     mname = model_for(act, model)
     plot = _plot_target(plot, fig_format)
     gr = Gripper(act, mname, fingers=fingers,
@@ -292,10 +358,14 @@ def grasp_cmd(
         ds = grasp_dataset(gr, grasps)
         _save_plot(lambda ax: plot_grasp(ds, ax=ax), plot, fig_format)
     rows = [g.to_dict() for row in grasps for g in row]
+    if twist:
+        _add_twists(gr, grasps, rows)
     if as_json:
         print_json({**gr.to_dict(), "units": _GRASP_UNITS, "results": rows})
         return
     _print_grasps(gr, rows)
+    if twist:
+        _print_twists(rows)
     if plot is not None:
         echo_wrote(f"wrote {plot}")
 
@@ -316,6 +386,32 @@ def _print_grasps(gr, rows: list[dict[str, Any]]) -> None:
                    + (f"  {r['note']}" if r["note"] else ""))
 
 
+def _twist_budget(twist: bool, n: int) -> None:
+    if twist and n > MAX_TWIST_GRASPS:
+        raise UserError(f"--twist: {n} grasps; at most {MAX_TWIST_GRASPS} (each a few 3-D finger solves): give "
+                        "fewer --diameter-mm or --pressure-kpa values")
+
+
+def _add_twists(gr, grasps, rows: list[dict[str, Any]]) -> None:
+    """Each grasp twisted about the gripper's axis until the grip slips (:func:`bendpam.design.twist.twist_grasp`)."""
+    from bendpam.design.twist import twist_grasp
+
+    for r, g in zip(rows, (g for row in grasps for g in row), strict=True):
+        r["twist"] = twist_grasp(gr, g).to_dict()
+
+
+def _print_twists(rows: list[dict[str, Any]]) -> None:
+    """The twist table of ``bendpam grasp --twist``: the torque when the grip slips and the distortion there."""
+    typer.echo("twisted about the gripper's axis until the grip is lost (docs/out-of-plane.md)")
+    typer.echo(f"{'D (mm)':>7} {'P (kPa)':>8} {'torque (N·mm)':>13} {'across (mm)':>11} {'object (deg)':>12} "
+               f"{'twist (deg)':>11} {'mm/N':>6}  lost by")
+    for r in rows:
+        t = r["twist"]
+        typer.echo(f"{r['diameter_mm']:7.4g} {r['pressure_kpa']:8.4g} {_fmt(t['torque_at_loss_nmm'], '13.1f')} "
+                   f"{_fmt(t['contact_lateral_mm'], '11.2f')} {_fmt(t['object_rotation_deg'], '12.2f')} "
+                   f"{_fmt(t['twist_deg'], '11.2f')} {_fmt(t['lateral_compliance_mm_per_n'], '6.1f')}  {t['lost_by']}")
+
+
 # ---- wrist --------------------------------------------------------------------------------------
 _HOLDING = ("pressure_kpa", "angle_deg", "holds_horizontal", "capacity_g", "equilibrium", "note")
 
@@ -334,7 +430,7 @@ def wrist_cmd(
     radius_mm: Annotated[float, typer.Option("--radius-mm", help="Mounting radius around the column (mm).")] = 20.0,
     lateral_stiffness: Annotated[
         Optional[float], typer.Option("--lateral-stiffness-nmm2", help="Out-of-plane stiffness of one actuator "
-                                      "(N*mm^2); default: the frame's strong axis.")] = None,
+                                      "(N*mm^2); default: the actuator's, unpressurised.")] = None,
     column_stiffness: Annotated[
         float, typer.Option("--column-stiffness-nmm2", help="Bending stiffness of the column (N*mm^2).")] = 0.0,
     load_g: Annotated[float, typer.Option("--load-g", help="Mass held horizontally (g).")] = 335.0,
