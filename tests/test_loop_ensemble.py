@@ -110,3 +110,24 @@ def test_unequal_times_and_unknown_laws_are_refused():
         make_law("lugre", 5.0)
     assert isinstance(make_law("bouc-wen", 5.0), BoucWen) and isinstance(make_law("maxwell_slip", 5.0), MaxwellSlip)
     assert isinstance(make_law("dahl", 5.0), DahlLaw)
+
+
+# --------------------------------------------------------------------------------------------
+# breakaway friction (stiction)
+# --------------------------------------------------------------------------------------------
+def test_breakaway_sticks_peaks_at_the_static_level_and_decays_to_the_kinetic():
+    from bendpam.physics.hysteresis import Breakaway
+
+    law = Breakaway(0.05, ratio=1.6, decay=3.0)
+    d = np.linspace(0.0, 1.0, 2001)
+    z = law.z_path(d, -1.0)
+    # stick: slope 1.6 / 0.05 = 32 /rad from -1 to 1.6, i.e. for 2.6 / 32 rad
+    i_peak = int(np.argmax(z))
+    assert z[i_peak] == pytest.approx(1.6, abs=32 * 5e-4) and d[i_peak] == pytest.approx(2.6 / 32, abs=1e-3)
+    assert z[-1] == pytest.approx(1.0 + 0.6 * math.exp(-(1.0 - 2.6 / 32) / 0.15), rel=1e-9)
+    # steady cycle = the path after a few cycles
+    span = 0.4
+    th = triangle(span, 4)
+    zp = law.z_path(th, -1.0)
+    away, back = law.steady_branches(np.linspace(0.0, span, 401), span)
+    assert np.allclose(zp[-801:-400], away, atol=1e-9) and np.allclose(zp[-401:], back, atol=1e-9)

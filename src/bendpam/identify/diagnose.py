@@ -44,7 +44,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from bendpam.identify.result import JointInterval, MaterialFit, parameter_field, parameter_unit
+from bendpam.identify.result import JointInterval, MaterialFit, UncertaintyBudget, parameter_field, parameter_unit
 
 if TYPE_CHECKING:
     from bendpam.identify.uncertainty import Uncertainty
@@ -318,7 +318,7 @@ def shape_identified(se_shape: float, shape_bounds, at_bound: bool, held: str) -
 
 
 def identifiability(mat: MaterialFit | None, free: list[str], unc: Uncertainty, fitted: Actuator,
-                    shift: dict[str, float], alt: str, law: str | None) -> list[str]:
+                    budget: UncertaintyBudget | None = None, law: str | None = None) -> list[str]:
     """Sentences: which of alpha0, the shear modulus and the shape the data determine (``FitResult.identifiability``).
 
     Parameters
@@ -327,23 +327,24 @@ def identifiability(mat: MaterialFit | None, free: list[str], unc: Uncertainty, 
     free : the model parameters varied.
     unc : their :class:`~bendpam.identify.uncertainty.Uncertainty`.
     fitted : the fitted actuator.
-    shift, alt, law : the parameters' shift with the other loop law ``alt`` (the fit's is ``law``).
+    budget, law : the errors' statistical and systematic parts (the ensemble of loop laws), the fit's law.
 
     Examples
     --------
     >>> import bendpam
     >>> from bendpam.identify.uncertainty import Uncertainty
     >>> unc = Uncertainty({}, ["alpha0"], np.array([[0.0004]]), 0.0, 0, {}, 0.0, 40, 0.95)
-    >>> identifiability(None, ["alpha0"], unc, bendpam.physics.presets.be_pam(), {}, "", None)
+    >>> identifiability(None, ["alpha0"], unc, bendpam.physics.presets.be_pam())
     ['alpha0 = 69.7 ± 0.04 deg (2 SE) is determined by the curves.']
     """
     out = []
     if "alpha0" in unc.names:
         i = unc.names.index("alpha0")
         se = float(unc.sd[i])
-        sys_ = abs(shift.get("alpha0", 0.0)) / math.sqrt(3.0)
-        tail = (f"; the loop law alone ({law} vs {alt}, systematic) accounts for ± {2 * sys_:.2g} deg"
-                if law and alt and sys_ > 0 else "")
+        sys_ = 0.0 if budget is None else budget.systematic.get("alpha0_deg", 0.0)
+        n_laws = 0 if budget is None else len(budget.ensemble)
+        tail = (f"; the loop law alone ({law} among {n_laws} laws, systematic) accounts for ± {2 * sys_:.2g} deg"
+                if law and n_laws and sys_ > 0 else "")
         head = f"alpha0 = {fitted.alpha0_deg:.4g} ± {2 * se:.2g} deg (2 SE{tail})"
         if unc.at_bound.get("alpha0", False):
             out.append(f"{head} sits at a bound of its range: the curves do not determine it there.")

@@ -33,6 +33,7 @@ __all__ = [
     "HYST_PARAMETERS",
     "PARAMETERS",
     "Band",
+    "EnsembleMember",
     "ExtrapolationWarning",
     "FitResult",
     "HysteresisFit",
@@ -42,6 +43,7 @@ __all__ = [
     "Metrics",
     "Parameter",
     "Profile",
+    "UncertaintyBudget",
     "parameter_field",
     "parameter_unit",
 ]
@@ -351,6 +353,73 @@ class HysteresisFit:
 
 
 @dataclass
+class EnsembleMember:
+    """One loop law of the ensemble behind the systematic uncertainty: its fit and its weight.
+
+    ``values`` are the model parameters it gives (``{field: value}``, with ``shear_modulus_kpa`` and
+    ``shape`` when the constants vary), ``nrmse`` the square root of its objective (eq 53).
+
+    >>> m = EnsembleMember("bouc_wen", 0.25, 0.012, {"alpha0_deg": 69.8})
+    >>> EnsembleMember.from_dict(m.to_dict()) == m
+    True
+    """
+
+    law: str
+    weight: float
+    nrmse: float
+    values: dict[str, float]
+
+    def to_dict(self) -> dict:
+        """The member as JSON types."""
+        return {"law": self.law, "weight": self.weight, "nrmse": self.nrmse, "values": dict(self.values)}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> EnsembleMember:
+        """The member from :meth:`to_dict`'s dictionary."""
+        return cls(str(d["law"]), _num(d["weight"]), _num(d["nrmse"]), {k: _num(v) for k, v in d["values"].items()})
+
+
+@dataclass
+class UncertaintyBudget:
+    """The standard errors of a fit in their two parts (``{field: SE}``; the total is their root sum of squares).
+
+    ``statistical`` is the noise's part: resampling the cycles of each test (the exact covariance
+    of a block bootstrap over cycles) where a test has two cycles or more, the sandwich with its
+    AR(1) inflation elsewhere (``resampling`` says which, in words).  ``systematic`` is the loop
+    law's part: the weighted spread over the :class:`EnsembleMember` fits (``ensemble``), weighted by
+    ``weighting``.  Both include ``shear_modulus_kpa`` and ``shape`` when the constants vary.
+
+    >>> b = UncertaintyBudget({"alpha0_deg": 0.03}, {"alpha0_deg": 0.04}, "cycles", "Akaike", [])
+    >>> round(b.total["alpha0_deg"], 3), UncertaintyBudget.from_dict(b.to_dict()) == b
+    (0.05, True)
+    """
+
+    statistical: dict[str, float]
+    systematic: dict[str, float]
+    resampling: str
+    weighting: str
+    ensemble: list[EnsembleMember] = field(default_factory=list)
+
+    @property
+    def total(self) -> dict[str, float]:
+        """``sqrt(statistical^2 + systematic^2)`` per quantity."""
+        return {k: math.hypot(v, self.systematic.get(k, 0.0)) for k, v in self.statistical.items()}
+
+    def to_dict(self) -> dict:
+        """The budget as JSON types."""
+        return {"statistical": dict(self.statistical), "systematic": dict(self.systematic), "total": self.total,
+                "resampling": self.resampling, "weighting": self.weighting,
+                "ensemble": [m.to_dict() for m in self.ensemble]}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> UncertaintyBudget:
+        """The budget from :meth:`to_dict`'s dictionary."""
+        return cls({k: _num(v) for k, v in d["statistical"].items()}, {k: _num(v) for k, v in d["systematic"].items()},
+                   str(d.get("resampling", "")), str(d.get("weighting", "")),
+                   [EnsembleMember.from_dict(m) for m in d.get("ensemble", [])])
+
+
+@dataclass
 class FitResult:
     """Result of :func:`fit`: a value you can print, predict with, plot, save and load.
 
@@ -372,6 +441,8 @@ class FitResult:
     covariance : covariance matrix of the varied parameters (``correlation_names`` order; statistical
         plus systematic), in their units.
     pressure_range_kpa : the tested pressures' range (predictions outside it are extrapolations).
+    uncertainty : :class:`UncertaintyBudget`: the standard errors' statistical and systematic parts, and
+        the ensemble of loop laws behind the latter (None without it).
 
     Examples
     --------
@@ -419,6 +490,7 @@ class FitResult:
     joint_intervals: list[JointInterval] = field(default_factory=list)
     covariance: np.ndarray | None = None
     pressure_range_kpa: tuple[float, float] = (math.nan, math.nan)
+    uncertainty: UncertaintyBudget | None = None
 
     @property
     def loop(self):
@@ -525,6 +597,7 @@ class FitResult:
             "residual_autocorrelation": self.autocorrelation,
             "actuator": self.actuator.to_dict(),
             **({"hysteresis": self.hysteresis.to_dict()} if self.hysteresis is not None else {}),
+            "uncertainty": None if self.uncertainty is None else self.uncertainty.to_dict(),
         }
 
     def to_json(self) -> str:
@@ -582,6 +655,7 @@ class FitResult:
             joint_intervals=[JointInterval.from_dict(j) for j in d.get("joint_intervals", [])],
             covariance=None if cov is None else np.array(cov, dtype=float).reshape(n, n),
             pressure_range_kpa=_pair(d.get("pressure_range_kpa", [None, None])),
+            uncertainty=UncertaintyBudget.from_dict(d["uncertainty"]) if d.get("uncertainty") else None,
         )
 
     @classmethod

@@ -30,6 +30,8 @@ Laws for ``z`` (both rate-independent: they depend on the path, not on its speed
     * :class:`MaxwellSlip` (``"maxwell_slip"``): the Maxwell-slip (Iwan) model of ``n`` parallel
       elasto-slip elements of EQUAL slip moment, their slip angles spread as the Prandtl-Ishlinskii
       thresholds: the stiff elements slip first, so the loop has a sharper corner than PI's.
+    * :class:`Breakaway` (``"stiction"``): static friction above the kinetic one: after a reversal
+      the contact sticks, breaks away at the static level and slides as the friction decays.
 
 The loop laws above are rate-independent.  :class:`ViscousLoop` (``"viscous"``, a Maxwell fluid:
 a spring in series with a dashpot, ``tau dz/dt + z = (dtheta/dt) / omega_ref``) depends on the
@@ -61,6 +63,7 @@ __all__ = [
     "ENSEMBLE",
     "LAWS",
     "BoucWen",
+    "Breakaway",
     "Cycle",
     "DahlLaw",
     "LoopModel",
@@ -76,7 +79,7 @@ __all__ = [
 
 LAWS = ("pi", "dahl")
 #: The loop laws whose fits make the identification's systematic (model-form) uncertainty.
-ENSEMBLE = ("pi", "dahl", "bouc_wen", "maxwell_slip", "viscous")
+ENSEMBLE = ("pi", "dahl", "bouc_wen", "maxwell_slip", "stiction", "viscous")
 
 
 def _segments(theta: np.ndarray):
@@ -444,6 +447,79 @@ class ViscousLoop:
         return up, -up
 
 
+@dataclass(frozen=True)
+class Breakaway:
+    """Breakaway friction (stiction): static friction ``ratio`` times the kinetic one, ``z`` in units of the kinetic.
+
+    After a reversal the contact sticks: ``z`` runs linearly with slope ``ratio / theta_s`` (rad^-1)
+    until it reaches the static level ``ratio`` (an elastic stick); then it slides and the friction
+    decays to the kinetic level, ``z = 1 + (ratio - 1) exp(-(slip) / theta_d)`` with the decay angle
+    ``theta_d = decay * theta_s``.  Exact per monotone segment; ``z`` may exceed 1 (by ``ratio - 1``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> law = Breakaway(0.1, ratio=1.5, decay=2.0)   # from z = -1: stick at slope 15 /rad for 1/6 rad, then slide
+    >>> law.z_path(np.array([0.0, 0.1, 0.25, 2.0]), z0=-1.0).round(4).tolist()   # 1 + 0.5 exp(-(0.25 - 1/6) / 0.2)
+    [-1.0, 0.5, 1.3296, 1.0001]
+    """
+
+    theta_s_rad: float = math.radians(2.0)
+    ratio: float = 1.5
+    decay: float = 2.0
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.theta_s_rad) and self.theta_s_rad > 0):
+            raise InputError(f"theta_s_rad = {self.theta_s_rad!r} must be > 0 rad")
+        if not (math.isfinite(self.ratio) and self.ratio >= 1.0 and math.isfinite(self.decay) and self.decay > 0):
+            raise InputError(f"ratio = {self.ratio!r} must be >= 1 and decay = {self.decay!r} > 0")
+
+    name = "stiction"
+
+    @property
+    def angle_rad(self) -> float:
+        return self.theta_s_rad
+
+    def _branch(self, start, dist):
+        """``s z`` at the distances ``dist`` from a reversal where ``s z`` was ``start`` (<= ratio)."""
+        g = self.ratio / self.theta_s_rad
+        d_b = np.maximum(self.ratio - start, 0.0) / g  # the stick ends at the static level
+        stick = start + g * dist
+        slide = 1.0 + (self.ratio - 1.0) * np.exp(-np.maximum(dist - d_b, 0.0) / (self.decay * self.theta_s_rad))
+        return np.where(dist < d_b, stick, slide)
+
+    def z_path(self, theta, z0: float = 0.0) -> np.ndarray:
+        """``z`` along the sampled path ``theta`` (rad) from ``z0``."""
+        th = np.asarray(theta, dtype=float)
+        z = np.empty(th.size)
+        if th.size == 0:
+            return z
+        z[0] = float(z0)
+        starts, ends, sgn = _segments(th)
+        for a, b in zip(starts, ends, strict=True):
+            if b <= a:
+                continue
+            s = sgn[a]
+            if s == 0:
+                z[a + 1: b + 1] = z[a]
+                continue
+            z[a + 1: b + 1] = s * self._branch(min(float(s * z[a]), self.ratio), np.abs(th[a + 1: b + 1] - th[a]))
+        return z
+
+    def steady_branches(self, delta, span):
+        """Periodic cycle between end points ``span`` (rad) apart: ``(z_away, z_back)``, symmetric.
+
+        Each branch starts at minus the value the other one ended at: the turning value ``z_b`` is the
+        fixed point of ``z_b = branch(-z_b, span)`` (a contraction; 30 steps, vectorised).
+        """
+        span = np.asarray(span, dtype=float)
+        zb = np.ones(span.shape)
+        for _ in range(30):
+            zb = self._branch(-zb, span)
+        up = self._branch(-zb, np.minimum(np.asarray(delta, dtype=float), span))
+        return up, -up
+
+
 def make_law(name: str, angle_deg: float):
     """A rate-independent law by name (``"pi"``, ``"dahl"``, ``"bouc_wen"``, ``"maxwell_slip"``), its angle in degrees.
 
@@ -463,8 +539,10 @@ def make_law(name: str, angle_deg: float):
         return BoucWen(math.radians(float(angle_deg)))
     if key in ("maxwell_slip", "maxwell"):
         return MaxwellSlip(math.radians(float(angle_deg)))
+    if key in ("stiction", "breakaway"):
+        return Breakaway(math.radians(float(angle_deg)))
     raise InputError(f"hysteresis law {name!r} is not known; choose 'pi' (Prandtl-Ishlinskii), 'dahl', "
-                     "'bouc_wen' or 'maxwell_slip'")
+                     "'bouc_wen', 'maxwell_slip' or 'stiction'")
 
 
 @dataclass(frozen=True)
