@@ -131,3 +131,111 @@ def test_breakaway_sticks_peaks_at_the_static_level_and_decays_to_the_kinetic():
     zp = law.z_path(th, -1.0)
     away, back = law.steady_branches(np.linspace(0.0, span, 401), span)
     assert np.allclose(zp[-801:-400], away, atol=1e-9) and np.allclose(zp[-401:], back, atol=1e-9)
+
+
+# --------------------------------------------------------------------------------------------
+# the ensemble's weights and systematic part
+# --------------------------------------------------------------------------------------------
+def test_akaike_weights_give_less_weight_to_a_law_that_fits_worse():
+    from bendpam.identify.ensemble import akaike_weights, systematic_covariance
+
+    w = akaike_weights([1.0, 1.05, 1.3, math.nan], 40.0)
+    assert w.sum() == pytest.approx(1.0) and w[0] > w[1] > w[2] > 0 and w[3] == 0
+    # Delta = m_eff ln(SSR_i / SSR_min): hand numbers
+    assert w[1] / w[0] == pytest.approx(math.exp(-0.5 * 40.0 * math.log(1.05)))
+    # the spread is about the reported values (row 0), not the weighted mean
+    cov = systematic_covariance(np.array([0.0]), np.array([[0.0], [1.0], [np.nan]]), np.array([0.5, 0.5, 0.0]))
+    assert cov[0, 0] == pytest.approx(0.5)
+
+
+@pytest.fixture(scope="module")
+def loop_fit():
+    """One fit of a processed set made with an independent Bouc-Wen loop (tests/independent_loops.py)."""
+    from bendpam import presets
+    from bendpam.identify.fitting import fit
+    from independent_loops import BoucWen, make_truth, noisy_set
+
+    base = presets.get("be-pam", "energy")
+    S = base.C10_kpa + base.C01_kpa
+    truth = base.replace(alpha0_deg=base.alpha0_deg + 0.8, C10_kpa=0.4 * S, C01_kpa=0.6 * S)
+    lt = make_truth(truth, [100, 150, 200], "energy", law=BoucWen())
+    return fit(noisy_set(lt, seed=3), base, profile_points=0), truth
+
+
+def test_fit_reports_the_ensemble_and_both_parts(loop_fit, tmp_path):
+    from bendpam.identify.result import FitResult
+    from bendpam.physics.hysteresis import ENSEMBLE
+
+    r, truth = loop_fit
+    b = r.uncertainty
+    assert b.ensemble[0].law == "pi" and sorted(m.law for m in b.ensemble) == sorted(ENSEMBLE)
+    assert sum(m.weight for m in b.ensemble) == pytest.approx(1.0)
+    # a law that fits worse gets less weight
+    by_fit = sorted(b.ensemble, key=lambda m: m.nrmse)
+    assert by_fit[0].weight >= by_fit[-1].weight and by_fit[-1].weight < 0.5
+    # the parameter's stderr is the root sum of squares of the two parts
+    for name, field in (("alpha0", "alpha0_deg"), ("C10", "C10_kpa")):
+        assert r.parameters[name].stderr == pytest.approx(math.hypot(b.statistical[field], b.systematic[field]))
+    assert r.material.se_shear_modulus_kpa == pytest.approx(b.total["shear_modulus_kpa"])
+    # fit.json has both parts, and they come back
+    r.save(tmp_path)
+    import json
+
+    d = json.loads((tmp_path / "fit.json").read_text())["uncertainty"]
+    assert set(d) >= {"statistical", "systematic", "total", "ensemble", "resampling", "weighting"}
+    assert d["statistical"]["alpha0_deg"] > 0 and "alpha0_deg" in d["systematic"]
+    back = FitResult.load(tmp_path)
+    assert back.uncertainty == b and back.to_json() == r.to_json()
+
+
+def test_cycle_resampling_sees_coloured_noise_wider_than_white():
+    """The cycle bootstrap's standard error of a mean: larger for AR(1) noise than for white noise of equal variance."""
+    from hypothesis import given, settings
+    from hypothesis import strategies as st
+    from scipy.signal import lfilter
+
+    from bendpam.identify.uncertainty import sandwich_covariance
+
+    n_cyc, m = 12, 200
+    J = np.ones((m, 1)) / m  # the parameter is the mean of the points
+
+    def se(E):
+        cov, _ = sandwich_covariance(J, np.zeros(m), np.zeros(m, int), [(np.arange(m), E - E.mean(axis=0))])
+        return math.sqrt(cov[0, 0])
+
+    @settings(max_examples=8, deadline=None, derandomize=True)
+    @given(rho=st.floats(0.6, 0.95), seed=st.integers(0, 2**31 - 1))
+    def check(rho, seed):
+        e = np.random.default_rng(seed).standard_normal((n_cyc, m))
+        coloured = lfilter([math.sqrt(1 - rho**2)], [1.0, -rho], e, axis=1)  # unit variance AR(1)
+        assert se(coloured) > 1.5 * se(e)
+
+    check()
+
+
+def test_a_narrow_shape_is_determined_only_where_the_study_covers_it(tmp_path):
+    import json
+
+    from bendpam import presets
+    from bendpam.identify.diagnose import _material_sentences, study_coverage
+    from bendpam.identify.uncertainty import Uncertainty, material_fit
+
+    good, bad = tmp_path / "good.json", tmp_path / "bad.json"
+    good.write_text(json.dumps({"cases": {"none": {"narrow": 10, "covered": 10}, "stiction": {"narrow": 0,
+                                                                                               "covered": 0}}}))
+    bad.write_text(json.dumps({"cases": {"none": {"narrow": 10, "covered": 10}, "drift": {"narrow": 5,
+                                                                                           "covered": 3}}}))
+    assert study_coverage(str(good)) == (True, "")
+    holds, why = study_coverage(str(bad))
+    assert not holds and "13 of 15" in why and "drift: 3 of 5" in why
+    assert study_coverage(str(tmp_path / "missing.json"))[0] is False
+    act = presets.be_pam().replace(C10_kpa=100.0, C01_kpa=300.0)
+    unc = Uncertainty({}, ["C10", "C01"], np.array([[4.0, -5.0], [-5.0, 9.0]]), 0.0, 0, {}, 0.0, 40, 0.95)
+    mat = material_fit(act, unc, (-0.15, 1.07), (0.6, 1.6), False, "", ["C10", "C01"])
+    # the shipped record decides; either way a narrow interval is narrow, and the words follow the decision
+    holds, why = study_coverage()
+    assert mat.shape_narrow and mat.shape_identified == holds and mat.shape_study == why
+    words = " ".join(_material_sentences(mat, True))
+    assert ("is determined too" in words) if holds else ("ridge" in words and "not claimed" in words)
+    # a joint fit with a tension test is judged by its interval alone
+    assert material_fit(act, unc, (-0.15, 1.07), (0.6, 1.6), False, "", ["C10", "C01"], joint=True).shape_identified

@@ -73,7 +73,7 @@ def _periods(d: FitData) -> np.ndarray:
     """Each point's cycle period (s): its test's, or 1 s for every test when any is not known."""
     per = getattr(d, "period_s", None)
     if per is None or d.seg is None or not np.all(np.isfinite(per) & (np.asarray(per) > 0)):
-        return np.ones(np.shape(d.span))
+        return np.ones(np.asarray(d.span).shape)
     return np.asarray(per, dtype=float)[d.seg]
 
 
@@ -188,7 +188,8 @@ def uncertainty_budget(unc: Uncertainty, fitted, fits: dict[str, tuple[dict[str,
             stat[key] = math.sqrt(max(float(g @ unc.cov_stat @ g), 0.0))
             sys_[key] = math.sqrt(max(float(g @ unc.cov_sys @ g), 0.0))
     resampling = (f"the cycles of {n_resampled} test(s) resampled (a block bootstrap over cycles through the "
-                  "linearised fit, its covariance computed exactly)" if n_resampled else
-                  "no test has two cycles to resample")
-    return UncertaintyBudget(stat, sys_, resampling + "; the sandwich with its AR(1) inflation for the curves of "
-                             "single-cycle tests and a tension test", weighting, members)
+                  "linearised fit, its covariance computed exactly); the sandwich with its AR(1) inflation for the "
+                  "curves of single-cycle tests and a tension test" if n_resampled else
+                  "the sandwich with its AR(1) inflation for every curve (no cycles resampled: single-cycle tests, "
+                  "or a shape at an admissibility bound, where the model's misfit is treated as noise)")
+    return UncertaintyBudget(stat, sys_, resampling, weighting, members)

@@ -56,19 +56,18 @@ Folds
     rejected: the shape is scanned over the admissible interval and the best fold-free material
     kept, with a note; if none exists the fit is flagged as unable to describe the data.
 
-Uncertainty
-    1. Statistical: a sandwich covariance ``B^-1 (sum_g s_g^2 f_g J_g^T J_g) B^-1``
-       (:mod:`bendpam.identify.uncertainty`),
-       ``B = J^T J``, with each curve (each branch with a loop) ``g`` its own residual variance
-       ``s_g^2`` and an inflation ``f_g = (1 + rho_g) / (1 - rho_g)`` for the lag-1
-       autocorrelation of its residuals.
+Uncertainty (both parts are reported separately: ``FitResult.uncertainty``)
+    1. Statistical: a sandwich covariance ``B^-1 (sum meat) B^-1`` (:mod:`bendpam.identify.uncertainty`),
+       ``B = J^T J``.  The meat of a test with two cycles or more is the exact covariance of
+       resampling its cycles (a block bootstrap over cycles through the linearised fit, scaled for
+       few cycles); that of a single-cycle test or a tension test is its residual variance ``s_g^2``
+       inflated by ``f_g = (1 + rho_g) / (1 - rho_g)`` for the lag-1 autocorrelation of its
+       residuals; a drift correction adds its own doubt as an offset.
     2. Systematic (the loop law): no law is known to be the actuator's.  The fit is repeated with
-       the other law bendpam offers (Prandtl-Ishlinskii <-> Dahl, warm-started); the shift
-       ``delta`` of the model parameters between the two is a model-form error, taken as
-       uniformly distributed over ``[0, delta]``: ``delta delta^T / 3`` is added to the covariance
-       (standard error ``|delta| / sqrt 3`` per parameter, fully correlated).  On data made with
-       an independent (Bouc-Wen) loop law this makes the 2-SE intervals cover the truth
-       (tests/test_identify_loops.py).
+       every law of :data:`bendpam.physics.hysteresis.ENSEMBLE` (warm-started, the quasi-static
+       parameters free as in the fit); the weighted spread of the parameters about the reported
+       fit, with Akaike weights on the residuals' effective number of points, is added to the
+       covariance (:mod:`bendpam.identify.ensemble`).
     3. The profile of alpha0 (the objective minimised over everything else, against alpha0) is
        kept in ``FitResult.alpha0_profile``.
     Pairs with ``|corr| > corr_flag`` are flagged, with the combination the data determine and
@@ -436,7 +435,8 @@ def fit(processed, actuator: Actuator, model: str | None = None, free=("alpha0",
     hysteresis_law : the law of ``"auto"`` (``"pi"``: Prandtl-Ishlinskii, or ``"dahl"``).  With a
         free P_start the loop's amplitude ``a0 + a1 (P - P_start)`` uses the nominal P_start (the
         amplitude stays linear in a0, a1); the fitted loop is saved with the fitted one.
-    law_uncertainty : with a loop, refit with the other law and add the shift as a systematic error.
+    law_uncertainty : with a loop, refit with every law of the ensemble and add their weighted spread as the
+        systematic part (:mod:`bendpam.identify.ensemble`).
     admissible_range : principal stretches (lo, hi) the material must be physical over besides the
         tested ones (the range it will predict); None: only the tested ones.
     profile_points : points of the profile of alpha0 (0: none).
@@ -561,8 +561,9 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool):
                 run.nfev += n
                 fits[alt] = (values, ssr)
     r = run.prob.residual_full(np.concatenate([[run.nl[p] for p in run.prob.nonlin], run.lin]))
+    shape_bound = unc.at_bound.get("S_lo", False) or unc.at_bound.get("S_hi", False)
     budget = uncertainty_budget(unc, run.prob.actuator(unc.values), fits, r, run.prob.groups, run.law,
-                                len(run.cycles))
+                                0 if shape_bound else len(run.cycles))
     return unc, budget
 
 
@@ -645,8 +646,8 @@ def _start(prob: _Problem, bnd, grid_alpha: int, grid_r0: int):
     return best, nfev
 
 
-def _search(prob: _Problem, bnd, best):
-    """A bounded trust-region search on the projected problem; the final linear solve."""
+def _search(prob: _Problem, bnd, best, tol: float = 1e-10):
+    """A bounded trust-region search on the projected problem (``xtol = tol``); the final linear solve."""
     from scipy.optimize import least_squares
 
     nfev = 0
@@ -662,7 +663,7 @@ def _search(prob: _Problem, bnd, best):
             return prob.project(dict(zip(prob.nonlin, x, strict=True)))[0]
 
         sol = least_squares(fun, x0, bounds=(lo, hi), method="trf", x_scale=np.maximum(hi - lo, 1e-9) * 0.05,
-                            diff_step=1e-6, xtol=1e-10, ftol=1e-12, gtol=1e-12)
+                            diff_step=1e-6, xtol=tol, ftol=1e-2 * tol, gtol=1e-2 * tol)
         nfev += sol.nfev * (1 + len(prob.nonlin))
         converged = bool(sol.status > 0)
         message = "converged" if converged else "the search stopped before converging (iteration limit)"
@@ -752,7 +753,10 @@ def _uncertainty(prob: _Problem, bnd, nl_best, lin, corr_flag: float, cycles=(),
     group (a curve, a branch, the tension test) gets its own variance with its AR(1) inflation, or,
     for the tests in ``cycles`` (:func:`~bendpam.identify.data.cycle_deviations`), the covariance of
     resampling their cycles, and the drift corrections' doubt (``offsets``,
-    :func:`~bendpam.identify.data.drift_offsets`).
+    :func:`~bendpam.identify.data.drift_offsets`).  Where the shape sits on an admissibility bound the
+    model cannot follow the curves; their misfit, the same in every cycle, is then treated as
+    correlated noise (the sandwich with its AR(1) inflation for every curve) instead of resampling
+    the cycles, which would not see it.
     """
     nfev = 0
     x_int = np.concatenate([[nl_best[p] for p in prob.nonlin], lin])
@@ -768,24 +772,29 @@ def _uncertainty(prob: _Problem, bnd, nl_best, lin, corr_flag: float, cycles=(),
         nfev += 2
     _, X = prob.design(nl_best)
     J[:, nn:] = prob.w[:, None] * X
-    weighted = [(rows, prob.w[rows][None, :] * E) for rows, E in cycles]
-    offs = [(rows, sd * prob.w[rows]) for rows, sd in offsets]
-    cov_int, rho = sandwich_covariance(J, r, prob.groups, weighted, offs)
     lo_all = np.concatenate([[bnd[p][0] for p in prob.nonlin], prob.lo])
     hi_all = np.concatenate([[bnd[p][1] for p in prob.nonlin], prob.hi])
     at_bound = at_bounds(x_int, lo_all, hi_all)
+    bound_names = {n: bool(b) for n, b in zip(prob.nonlin + prob.int_names, at_bound, strict=True)}
+    if bound_names.get("S_lo", False) or bound_names.get("S_hi", False):
+        cycles = ()  # the model cannot follow the curves (shape at an admissibility bound): misfit as noise
+    weighted = [(rows, prob.w[rows][None, :] * E) for rows, E in cycles]
+    offs = [(rows, sd * prob.w[rows]) for rows, sd in offsets]
+    cov_int, rho = sandwich_covariance(J, r, prob.groups, weighted, offs)
     G = np.zeros((nn + len(prob.lin), x_int.size))
     G[:nn, :nn] = np.eye(nn)
     G[nn:, nn:] = prob.T
     cov = G @ cov_int @ G.T
     names = prob.nonlin + prob.lin
     values = prob.to_user(nl_best, lin)
-    bound_names = {n: bool(b) for n, b in zip(prob.nonlin + prob.int_names, at_bound, strict=True)}
     return Uncertainty(values, names, cov, rho, nfev, bound_names, float(r @ r), m, corr_flag)
 
 
 def _law_refit(prob: _Problem, bnd, nl, alt: str):
-    """The fit with another loop law ``alt`` (warm start, angle grid): ``(values, ssr, nfev)``."""
+    """The fit with another loop law ``alt`` (warm start, angle grid): ``(values, ssr, nfev)``.
+
+    The search stops at ``xtol = 1e-7``: the ensemble's values need to be good to well within their spread.
+    """
     p2 = copy.copy(prob)  # the same data and kinematics (their cache is shared), another loop law
     p2.law, p2._z_cache = alt, {}
     nfev = 0
@@ -796,7 +805,7 @@ def _law_refit(prob: _Problem, bnd, nl, alt: str):
         nfev += 1
         if float(r @ r) < best[0]:
             best = (float(r @ r), trial)
-    nl2, lin2, _, _, n = _search(p2, bnd, best)
+    nl2, lin2, _, _, n = _search(p2, bnd, best, tol=1e-7)
     return p2.to_user(nl2, lin2), _ssr(p2, nl2, lin2), nfev + n
 
 
@@ -854,7 +863,8 @@ def _result(processed, actuator: Actuator, run: _Run, unc: Uncertainty, tension,
     shape_at_bound = prob.cone and prob.shape_fixed is None and (unc.at_bound.get("S_lo", False)
                                                                  or unc.at_bound.get("S_hi", False))
     free_user = [p for p in prob.free if p in PARAMETERS]
-    mat = material_fit(fitted, unc, prob.shape_bounds, run.stretch, shape_at_bound, run.shape_held, free_user)
+    mat = material_fit(fitted, unc, prob.shape_bounds, run.stretch, shape_at_bound, run.shape_held, free_user,
+                       joint=prob.tension is not None)
     joint, jflags = correlated_pairs(unc.names, unc.values, unc.cov, unc.corr, unc.corr_flag)
     ident = identifiability(mat, free_user, unc, fitted, budget, law)
     hyst = _hysteresis_fit(processed, fitted, model, unc, bnd, law, budget, order, eq19_factor)

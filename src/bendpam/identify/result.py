@@ -176,6 +176,8 @@ class MaterialFit:
     shape_at_bound : True when the shape sits on an admissibility bound (set by the rule, not the data).
     shape_identified : True when the data determine the shape (95 % interval within half the width).
     shape_held : the reason the shape was held fixed (a fold, the free list), or "".
+    shape_study : why a narrow interval of the shape is not called determined (the calibration study's coverage
+        for it does not hold, :func:`bendpam.identify.diagnose.study_coverage`), or "".
 
     Examples
     --------
@@ -193,6 +195,12 @@ class MaterialFit:
     shape_at_bound: bool
     shape_identified: bool
     shape_held: str = ""
+    shape_study: str = ""
+
+    @property
+    def shape_narrow(self) -> bool:
+        """Whether the shape's interval is narrow (determined, or narrow but not claimed for the study's sake)."""
+        return bool(self.shape_identified or self.shape_study)
 
     def to_dict(self) -> dict:
         """The fields as a dictionary."""
@@ -203,7 +211,8 @@ class MaterialFit:
         """The material from :meth:`to_dict`'s dictionary."""
         return cls(_num(d["shear_modulus_kpa"]), _opt(d.get("se_shear_modulus_kpa")), _num(d["shape"]),
                    _opt(d.get("se_shape")), _pair(d["shape_bounds"]), _pair(d["stretch_range"]),
-                   bool(d["shape_at_bound"]), bool(d["shape_identified"]), str(d.get("shape_held", "")))
+                   bool(d["shape_at_bound"]), bool(d["shape_identified"]), str(d.get("shape_held", "")),
+                   str(d.get("shape_study", "")))
 
 
 @dataclass

@@ -16,11 +16,12 @@ it to the bladder's shear modulus and shape.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 
 from bendpam.errors import FitError
-from bendpam.identify.diagnose import shape_identified
+from bendpam.identify.diagnose import shape_identified, study_coverage
 from bendpam.identify.result import MaterialFit
 from bendpam.physics.actuator import Actuator
 
@@ -109,8 +110,8 @@ def lag1_autocorrelation(resid: np.ndarray, seg: np.ndarray) -> float:
 
 
 def sandwich_covariance(J: np.ndarray, r: np.ndarray, groups: np.ndarray,
-                        cycles: list[tuple[np.ndarray, np.ndarray]] = (),
-                        offsets: list[tuple[np.ndarray, np.ndarray]] = ()) -> tuple[np.ndarray, float]:
+                        cycles: Sequence[tuple[np.ndarray, np.ndarray]] = (),
+                        offsets: Sequence[tuple[np.ndarray, np.ndarray]] = ()) -> tuple[np.ndarray, float]:
     """``B^-1 (sum_g meat_g) B^-1`` with ``B = J^T J``, and the mean autocorrelation of the groups.
 
     A residual group ``g`` not covered by ``cycles`` contributes ``s_g^2 f_g J_g^T J_g``: its own
@@ -200,18 +201,21 @@ def sandwich_covariance(J: np.ndarray, r: np.ndarray, groups: np.ndarray,
 
 
 def material_fit(fitted: Actuator, unc: Uncertainty, shape_bounds, stretch, at_bound: bool, held: str,
-                 free: list[str]) -> MaterialFit | None:
+                 free: list[str], *, joint: bool = False) -> MaterialFit | None:
     """The bladder's shear modulus ``2 (C10 + C01)`` and shape ``C01 / (C10 + C01)`` with their standard errors.
 
     By the delta method from ``unc``; None when neither constant is in ``free``.  ``shape_bounds``
     and ``stretch`` are the admissible shapes and the stretches they hold over, ``at_bound`` whether
-    the shape sits on one of them, ``held`` why it was held fixed ("" if not).
+    the shape sits on one of them, ``held`` why it was held fixed ("" if not).  A narrow interval
+    of the shape is called determined only where the calibration study's coverage for it holds
+    (:func:`~bendpam.identify.diagnose.study_coverage`), unless a tension test was fitted with the
+    curves (``joint``), which the study does not cover.
 
     >>> import bendpam
     >>> act = bendpam.physics.presets.be_pam().replace(C10_kpa=100.0, C01_kpa=300.0)
     >>> unc = Uncertainty({}, ["C10", "C01"], np.array([[4.0, -5.0], [-5.0, 9.0]]), 0.0, 0, {}, 0.0, 40, 0.95)
     >>> mat = material_fit(act, unc, (-0.15, 1.07), (0.6, 1.6), False, "", ["C10", "C01"])
-    >>> mat.shear_modulus_kpa, round(mat.se_shear_modulus_kpa, 3), mat.shape, mat.shape_identified
+    >>> mat.shear_modulus_kpa, round(mat.se_shear_modulus_kpa, 3), mat.shape, mat.shape_narrow
     (800.0, 3.464, 0.75, True)
     """
     if "C10" not in free and "C01" not in free:
@@ -222,8 +226,11 @@ def material_fit(fitted: Actuator, unc: Uncertainty, shape_bounds, stretch, at_b
     se_mu = math.sqrt(max(float(g_mu @ unc.cov @ g_mu), 0.0))
     se_b = math.sqrt(max(float(g_b @ unc.cov @ g_b), 0.0))
     identified = shape_identified(se_b, shape_bounds, at_bound, held)
+    why = ""
+    if identified and not joint:
+        identified, why = study_coverage()
     return MaterialFit(2.0 * S, se_mu, c01 / S, se_b, (float(shape_bounds[0]), float(shape_bounds[1])),
-                       (float(stretch[0]), float(stretch[1])), bool(at_bound), identified, held)
+                       (float(stretch[0]), float(stretch[1])), bool(at_bound), identified, held, why)
 
 
 def material_gradients(fitted: Actuator, names: list[str]) -> tuple[np.ndarray, np.ndarray]:
