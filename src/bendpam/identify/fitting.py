@@ -435,8 +435,7 @@ def fit(processed, actuator: Actuator, model: str | None = None, free=("alpha0",
     hysteresis_law : the law of ``"auto"`` (``"pi"``: Prandtl-Ishlinskii, or ``"dahl"``).  With a
         free P_start the loop's amplitude ``a0 + a1 (P - P_start)`` uses the nominal P_start (the
         amplitude stays linear in a0, a1); the fitted loop is saved with the fitted one.
-    law_uncertainty : with a loop, refit with every law of the ensemble and add their weighted spread as the
-        systematic part (:mod:`bendpam.identify.ensemble`).
+    law_uncertainty : with a loop, the ensemble of loop laws' systematic part (:mod:`bendpam.identify.ensemble`).
     admissible_range : principal stretches (lo, hi) the material must be physical over besides the
         tested ones (the range it will predict); None: only the tested ones.
     profile_points : points of the profile of alpha0 (0: none).
@@ -478,8 +477,6 @@ def fit(processed, actuator: Actuator, model: str | None = None, free=("alpha0",
     run = _prepare(processed, actuator, model, free, bounds, tension_data, fit_range, hysteresis, hysteresis_law,
                    admissible_range, order, eq19_factor)
     _search_stages(run, grid_alpha, grid_r0, tension_data)
-    run.cycles = cycle_deviations(processed, run.args[1])
-    run.offsets = drift_offsets(processed, run.args[1])
     unc, budget = _uncertainty_stages(run, corr_flag, law_uncertainty)
     profile, n = _profile(run.prob, run.bnd, run.nl, unc, profile_points)
     run.nfev += n
@@ -524,7 +521,8 @@ def _prepare(processed, actuator: Actuator, model: str, free: list[str], bounds,
     stretch = _stretch_range(actuator, d, admissible_range, tension_data)
     shape_bounds = _shape_bounds(stretch, bounds)
     args = (actuator, d, model, free, bnd, order, eq19_factor, law, shape_bounds)
-    return _Run(args, stretch, _Problem(*args))
+    return _Run(args, stretch, _Problem(*args), cycles=cycle_deviations(processed, d),
+                offsets=drift_offsets(processed, d))
 
 
 def _search_stages(run: _Run, grid_alpha: int, grid_r0: int, tension_data) -> None:

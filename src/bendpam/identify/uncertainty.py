@@ -167,21 +167,8 @@ def sandwich_covariance(J: np.ndarray, r: np.ndarray, groups: np.ndarray,
                        "hold some of them fixed")
     m = r.size
     B = J.T @ J
-    meat = np.zeros_like(B)
     share = 1.0 - J.shape[1] / max(m, 1)
-    covered = np.zeros(m, dtype=bool)
-    boot = np.zeros_like(B)
-    dof = 0
-    for rows, U in cycles:
-        n = U.shape[0]
-        G = U @ J[rows]
-        boot += G.T @ G / (n * (n - 1))
-        covered[rows] = True
-        dof += n - 1
-    if dof:
-        from scipy.stats import t as student
-
-        meat += boot * (float(student.ppf(0.975, dof)) / 1.96) ** 2
+    meat, covered = _cycle_meat(J, cycles)
     for rows, u in offsets:
         g = u @ J[rows]
         meat += np.outer(g, g)
@@ -198,6 +185,24 @@ def sandwich_covariance(J: np.ndarray, r: np.ndarray, groups: np.ndarray,
     rho = float(np.mean(rhos)) if rhos else 0.0
     Binv = np.linalg.pinv(B, rcond=1e-13)
     return Binv @ meat @ Binv, rho
+
+
+def _cycle_meat(J: np.ndarray, cycles) -> tuple[np.ndarray, np.ndarray]:
+    """The cycle bootstrap's meat, t-scaled (:func:`sandwich_covariance`), and which rows it covers."""
+    meat = np.zeros((J.shape[1], J.shape[1]))
+    covered = np.zeros(J.shape[0], dtype=bool)
+    dof = 0
+    for rows, U in cycles:
+        n = U.shape[0]
+        G = U @ J[rows]
+        meat += G.T @ G / (n * (n - 1))
+        covered[rows] = True
+        dof += n - 1
+    if dof:
+        from scipy.stats import t as student
+
+        meat *= (float(student.ppf(0.975, dof)) / 1.96) ** 2
+    return meat, covered
 
 
 def material_fit(fitted: Actuator, unc: Uncertainty, shape_bounds, stretch, at_bound: bool, held: str,
