@@ -20,7 +20,7 @@ from bendpam.physics.actuator import Actuator
 from bendpam.physics.braid import radius_terms
 
 __all__ = ["FitData", "bladder_stretch_range", "branch_data", "cycle_deviations", "cycle_period_s", "developed_range",
-           "drift_offsets", "fit_data"]
+           "drift_offsets", "fit_data", "relative_rate"]
 
 
 @dataclass
@@ -63,12 +63,13 @@ class FitData:
     span: np.ndarray | None = None  # bending angle between the loop's end points (rad)
     grid_index: np.ndarray | None = None  # each point's index on its test's curvature grid
     period_s: np.ndarray | None = None  # (n,) each test's mean cycle period, s (NaN: not known)
+    rate: np.ndarray | None = None  # each point's bending rate at a constant crosshead speed, relative to k' = 0
 
     def thin(self, step: int) -> FitData:
         """Every ``step``-th point (weights scaled so the objective keeps its scale): for the grid stage."""
         keep = np.arange(self.kc.size) % step == 0
         opt = {n: None if getattr(self, n) is None else getattr(self, n)[keep]
-               for n in ("branch", "delta", "span", "grid_index")}
+               for n in ("branch", "delta", "span", "grid_index", "rate")}
         return FitData(self.P, self.k, self.M, self.BM, self.BM_se, self.K, self.K_se,
                      self.w[keep] * math.sqrt(self.kc.size / keep.sum()), self.kc[keep], self.Mc[keep], self.Pc[keep],
                      self.seg[keep], **opt, period_s=self.period_s)
@@ -142,8 +143,24 @@ def branch_data(processed, L0: float) -> FitData:
             span.append(np.full(n, Kf * L0))
     cat = np.concatenate
     gi = cat([np.tile(np.arange(np.asarray(r.curvature_grid).size), 2) for r in res])
+    fixture = getattr(processed, "fixture", None)
     return FitData(d.P, d.k, d.M, d.BM, d.BM_se, d.K, d.K_se, cat(w), cat(k), cat(M), cat(Pc), cat(seg), cat(br),
-                 cat(delta), cat(span), gi, d.period_s)
+                 cat(delta), cat(span), gi, d.period_s, None if fixture is None else relative_rate(fixture, cat(k)))
+
+
+def relative_rate(fixture, curvature_per_mm) -> np.ndarray:
+    """The bending rate at a constant crosshead speed, relative to the straight state (eq 6 and 8).
+
+    ``theta = 2 beta`` and ``ds/dbeta = d sec^2 beta + c sec beta tan beta`` (``c = 2 r + t``), so the rate
+    ``dtheta/dt = 2 v / (ds/dbeta)`` falls as the plates pitch: ``d / (ds/dbeta)`` relative to ``beta = 0``.
+
+    >>> from bendpam.physics.fixture import PAPER_FIXTURE
+    >>> relative_rate(PAPER_FIXTURE, np.array([0.0, 0.01])).round(3).tolist()   # beta = 0.725 rad: 35 / 73.1
+    [1.0, 0.479]
+    """
+    b = np.abs(fixture.curvature_to_beta(np.asarray(curvature_per_mm, dtype=float)))
+    sec = 1.0 / np.cos(b)
+    return fixture.d_mm / (fixture.d_mm * sec**2 + fixture.c * sec * np.tan(b))
 
 
 def fit_data(processed, fit_range: str = "developed") -> FitData:

@@ -22,11 +22,13 @@ Systematic covariance
     moves a parameter, the reported value may be off by as much.
 
 The rate-dependent law
-    :class:`~bendpam.physics.hysteresis.ViscousLoop` needs each test's rate: ``2 span / period``
-    from the cycle period of the test's samples when the processed set kept them
-    (:func:`bendpam.identify.data.cycle_period_s`); a set read back from its folder keeps no time,
-    and then every test is taken to have the same period (the rate grows with the loop's span).
-    Its angle parameter is ``theta_c`` of the fastest test.
+    A viscous loop (a dashpot with a Maxwell element, :class:`~bendpam.physics.hysteresis.ViscousLoop`)
+    needs the bending rate.  Testing machines drive the crosshead at a constant speed, so the rate
+    along a branch follows the fixture's kinematics (eq 6 and 8,
+    :func:`bendpam.identify.data.relative_rate`): the dashpot's moment is that rate profile times
+    a Dahl approach over ``theta_c`` (the Maxwell element's relaxation at that speed), the same for
+    every test.  Without the fixture, the rate comes from each test's cycle period
+    (:func:`bendpam.identify.data.cycle_period_s`; a common period when the samples were not kept).
 """
 
 from __future__ import annotations
@@ -59,6 +61,11 @@ def steady_z(law: str, theta_deg: float, d: FitData) -> np.ndarray:
     from bendpam.physics.hysteresis import ViscousLoop, make_law
 
     assert d.branch is not None and d.delta is not None and d.span is not None, "a loop fit is built on branch data"
+    if law == "viscous" and getattr(d, "rate", None) is not None:
+        # constant crosshead speed: the dashpot's moment follows the fixture's rate profile, and the
+        # Maxwell element relaxes over theta_c (the same for every test: the same speed)
+        z_away, z_back = make_law("dahl", theta_deg).steady_branches(d.delta, d.span)
+        return d.rate * np.where(d.branch < 0, z_away, z_back)
     if law == "viscous":
         period = _periods(d)
         rate = 2.0 * d.span / period
