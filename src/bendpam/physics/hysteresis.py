@@ -94,6 +94,23 @@ def _segments(theta: np.ndarray):
     return starts, ends, sgn
 
 
+def _segment_path(theta, z0: float, branch) -> np.ndarray:
+    """``z`` along a sampled path, law by law: ``branch(s, z_start, dist)`` gives ``z`` at the distances ``dist``
+    from the start of a monotone segment of direction ``s`` where ``z`` was ``z_start``; dwell keeps ``z``."""
+    th = np.asarray(theta, dtype=float)
+    z = np.empty(th.size)
+    if th.size == 0:
+        return z
+    z[0] = z0
+    starts, ends, sgn = _segments(th)
+    for a, b in zip(starts, ends, strict=True):
+        if b <= a:
+            continue
+        s = sgn[a]
+        z[a + 1: b + 1] = z[a] if s == 0 else branch(s, float(z[a]), np.abs(th[a + 1: b + 1] - th[a]))
+    return z
+
+
 def _stops_path(theta, r: np.ndarray, weight: np.ndarray, z0: float) -> np.ndarray:
     """``z = sum_j w_j s_j / sum_j w_j r_j`` of stop operators (thresholds ``r``) along ``theta`` (rad).
 
@@ -119,7 +136,22 @@ def _stops_path(theta, r: np.ndarray, weight: np.ndarray, z0: float) -> np.ndarr
 
 
 @dataclass(frozen=True)
-class DahlLaw:
+class _AngleLaw:
+    """A law with one characteristic angle ``theta_c_rad`` (> 0)."""
+
+    theta_c_rad: float = math.radians(5.0)
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.theta_c_rad) and self.theta_c_rad > 0):
+            raise InputError(f"theta_c_rad = {self.theta_c_rad!r} must be > 0 rad")
+
+    @property
+    def angle_rad(self) -> float:
+        return self.theta_c_rad
+
+
+@dataclass(frozen=True)
+class DahlLaw(_AngleLaw):
     """Rate-independent Dahl law with characteristic angle ``theta_c_rad`` (> 0).
 
     Examples
@@ -130,35 +162,11 @@ class DahlLaw:
     [0.0, 0.632, 0.982, -0.271]
     """
 
-    theta_c_rad: float = math.radians(5.0)
-
-    def __post_init__(self) -> None:
-        if not (math.isfinite(self.theta_c_rad) and self.theta_c_rad > 0):
-            raise InputError(f"theta_c_rad = {self.theta_c_rad!r} must be > 0 rad")
-
     name = "dahl"
-
-    @property
-    def angle_rad(self) -> float:
-        return self.theta_c_rad
 
     def z_path(self, theta, z0: float = 0.0) -> np.ndarray:
         """``z`` along the sampled path ``theta`` (rad), starting from ``z0``: exact per monotone segment."""
-        th = np.asarray(theta, dtype=float)
-        z = np.empty(th.size)
-        if th.size == 0:
-            return z
-        z[0] = z0
-        starts, ends, sgn = _segments(th)
-        zs = z0
-        for a, b in zip(starts, ends, strict=True):
-            if b <= a:
-                continue
-            s = sgn[a]
-            seg = th[a + 1: b + 1]
-            z[a + 1: b + 1] = zs if s == 0 else s + (zs - s) * np.exp(-np.abs(seg - th[a]) / self.theta_c_rad)
-            zs = z[b]
-        return z
+        return _segment_path(theta, z0, lambda s, zs, dist: s + (zs - s) * np.exp(-dist / self.theta_c_rad))
 
     def steady_branches(self, delta, span):
         """Periodic cycle between two end points ``span`` (rad) apart.
@@ -255,7 +263,7 @@ class PrandtlIshlinskii:
 
 
 @dataclass(frozen=True)
-class BoucWen:
+class BoucWen(_AngleLaw):
     """Bouc-Wen law (exponent 2, ``beta = gamma = 1/2``) with characteristic angle ``theta_c_rad`` (> 0).
 
     ``dz/dtheta = (s - |z| z / 2 - s z^2 / 2) / theta_c``: toward ``s`` (``s z >= 0``) this is
@@ -272,17 +280,7 @@ class BoucWen:
     [0.0, 0.7616, 1.0, 0.5]
     """
 
-    theta_c_rad: float = math.radians(5.0)
-
-    def __post_init__(self) -> None:
-        if not (math.isfinite(self.theta_c_rad) and self.theta_c_rad > 0):
-            raise InputError(f"theta_c_rad = {self.theta_c_rad!r} must be > 0 rad")
-
     name = "bouc_wen"
-
-    @property
-    def angle_rad(self) -> float:
-        return self.theta_c_rad
 
     @staticmethod
     def _g(w):
@@ -290,23 +288,11 @@ class BoucWen:
 
     def z_path(self, theta, z0: float = 0.0) -> np.ndarray:
         """``z`` along the sampled path ``theta`` (rad), starting from ``z0``: exact per monotone segment."""
-        th = np.asarray(theta, dtype=float)
-        z = np.empty(th.size)
-        if th.size == 0:
-            return z
-        z[0] = float(np.clip(z0, -1.0, 1.0))
-        starts, ends, sgn = _segments(th)
-        for a, b in zip(starts, ends, strict=True):
-            if b <= a:
-                continue
-            s, u = sgn[a], 0.0
-            if s == 0:
-                z[a + 1: b + 1] = z[a]
-                continue
-            u = min(float(s * z[a]), 1.0 - 1e-16)
-            w0 = math.atanh(u) if u >= 0 else u
-            z[a + 1: b + 1] = s * self._g(w0 + np.abs(th[a + 1: b + 1] - th[a]) / self.theta_c_rad)
-        return z
+        def branch(s, zs, dist):
+            u = min(s * zs, 1.0 - 1e-16)
+            return s * self._g((math.atanh(u) if u >= 0 else u) + dist / self.theta_c_rad)
+
+        return _segment_path(theta, float(np.clip(z0, -1.0, 1.0)), branch)
 
     def steady_branches(self, delta, span):
         """Periodic cycle between two end points ``span`` (rad) apart: ``(z_away, z_back)`` (as :class:`DahlLaw`).
@@ -490,21 +476,7 @@ class Breakaway:
 
     def z_path(self, theta, z0: float = 0.0) -> np.ndarray:
         """``z`` along the sampled path ``theta`` (rad) from ``z0``."""
-        th = np.asarray(theta, dtype=float)
-        z = np.empty(th.size)
-        if th.size == 0:
-            return z
-        z[0] = float(z0)
-        starts, ends, sgn = _segments(th)
-        for a, b in zip(starts, ends, strict=True):
-            if b <= a:
-                continue
-            s = sgn[a]
-            if s == 0:
-                z[a + 1: b + 1] = z[a]
-                continue
-            z[a + 1: b + 1] = s * self._branch(min(float(s * z[a]), self.ratio), np.abs(th[a + 1: b + 1] - th[a]))
-        return z
+        return _segment_path(theta, float(z0), lambda s, zs, dist: s * self._branch(min(s * zs, self.ratio), dist))
 
     def steady_branches(self, delta, span):
         """Periodic cycle between end points ``span`` (rad) apart: ``(z_away, z_back)``, symmetric.
