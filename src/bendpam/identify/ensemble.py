@@ -27,8 +27,11 @@ The rate-dependent law
     along a branch follows the fixture's kinematics (eq 6 and 8,
     :func:`bendpam.identify.data.relative_rate`): the dashpot's moment is that rate profile times
     a Dahl approach over ``theta_c`` (the Maxwell element's relaxation at that speed), the same for
-    every test.  Without the fixture, the rate comes from each test's cycle period
-    (:func:`bendpam.identify.data.cycle_period_s`; a common period when the samples were not kept).
+    every test (``"viscous"``).  Machines may instead cycle at a fixed period (displacement control
+    at a set frequency); the processed set does not say which, so the ensemble also holds
+    ``"viscous_period"``: each test at its own cycle period
+    (:func:`bendpam.identify.data.cycle_period_s`; a common period when the samples were not kept),
+    its rate ``2 span / period``, ``theta_c`` that of the fastest test.
 """
 
 from __future__ import annotations
@@ -66,7 +69,7 @@ def steady_z(law: str, theta_deg: float, d: FitData) -> np.ndarray:
         # Maxwell element relaxes over theta_c (the same for every test: the same speed)
         z_away, z_back = make_law("dahl", theta_deg).steady_branches(d.delta, d.span)
         return d.rate * np.where(d.branch < 0, z_away, z_back)
-    if law == "viscous":
+    if law in ("viscous", "viscous_period"):
         period = _periods(d)
         rate = 2.0 * d.span / period
         w_ref = float(np.max(rate))
