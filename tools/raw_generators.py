@@ -1,0 +1,452 @@
+"""Independent generators of raw four-point-bending cyclic tests (issue 23, the calibration study).
+
+These files are what a testing machine writes (time, crosshead stroke, force, plus the pressure in the
+header), made WITHOUT bendpam's loop laws (``bendpam.physics.hysteresis``) and without its virtual
+machine (``bendpam.lab.simulate``), so that a fit's error bars can be checked on data whose loop and
+instrument faults bendpam does not assume.  Only the quasi-static moment of the true actuator comes
+from bendpam (:class:`bendpam.MomentLaw`): that is the model being identified.
+
+The chain, per pressure ``P``:
+
+1. Fixture (the paper's eq 6-8, written here from the paper, not from ``physics/fixture.py``): the
+   crosshead stroke ``ds`` pitches the plates by ``beta`` with ``d tan(beta) + (sec(beta) - 1)(t + 2r) = ds``
+   (solved by Newton's method), the frame curvature is ``k' = 2 beta / L0`` and the machine force
+   balances the moment: ``F = 2 cos(beta)^2 M / (d + (2r + t) sin(beta))``.
+2. Moment ``M = M_qs(P, k') + H``: ``M_qs`` from :class:`bendpam.MomentLaw` of the true actuator, ``H`` the
+   friction loop of one of the laws below (``H > 0`` while the machine straightens the actuator, toward
+   the blocked state; amplitude ``A = loop_fraction * M_qs(P, 0)``), driven by the bending angle
+   ``theta = 2 beta`` (rad) and the time.
+3. The machine finds the free state as a real one does: from the blocked state it releases the
+   actuator until the force falls to the detection load (0.2 N), then runs triangular cycles
+   blocked -> free -> blocked at a constant crosshead speed.
+4. Instrument faults: coloured force noise (AR(1), standard deviation ``noise_fraction`` of the blocked
+   force, lag-one correlation ``noise_ar1``), a small white stroke noise, and a load-cell offset that
+   drifts linearly by ``drift_fraction`` of the blocked force over the test.
+5. The file, in one of three dialects written here (a plain CSV with a ``#`` header, a Zwick testXpert
+   text export with decimal commas, an Instron Bluehill CSV with quoted cells and a units row).
+
+Loop laws (all written here from their textbook forms):
+
+``maxwell-creep``
+    Maxwell-slip (Iwan) elements: springs with Coulomb sliders of geometrically spaced slip angles and
+    equal break forces; the sliders of the slow half creep (the spring force relaxes with a time
+    constant while stuck), so the loop depends on time and dwells.
+``stiction``
+    One stiff spring and a slider with breakaway friction: it sticks after each reversal until the
+    spring force reaches the static limit, then slides at a friction that decays from the static to
+    the kinetic limit (static = 1.6 x kinetic) over a short slip.
+``viscous``
+    Rate-dependent: a linear dashpot plus a Maxwell (spring-dashpot) branch with a 10 s relaxation
+    time, integrated exactly along the sampled time.
+``backlash``
+    A dead zone in the fixture's stroke (the crosshead travels 0.3 mm at each reversal before the plates
+    follow) in series with an elasto-slip friction loop.
+``bouc-wen``
+    A non-saturating Bouc-Wen loop ``dz/dtheta = (1 - (gamma + beta_bw sgn(dtheta z)) |z|^n) / theta_c`` with
+    ``theta_c`` comparable to the test's bending span, so ``z`` never reaches its bound (a lens-shaped
+    loop, pointed at the reversals).
+``none``
+    No loop (noise and drift only).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from scipy.signal import lfilter
+
+import bendpam
+from bendpam import presets
+from bendpam.infra.atomic import atomic_write_text
+
+__all__ = ["CASES", "HOLDOUT", "LOOPS", "Case", "Truth", "case_truth", "generate_set", "machine_test", "start_actuator"]
+
+LOOPS = ("none", "maxwell-creep", "stiction", "viscous", "backlash", "bouc-wen")
+DIALECTS = ("csv", "testxpert", "bluehill")
+SUFFIX = {"csv": ".csv", "testxpert": ".txt", "bluehill": ".csv"}
+DETECTION_LOAD_N = 0.2
+MAX_BETA_RAD = math.radians(75.0)
+
+
+# ------------------------------------------------------------------------------------------------
+# the fixture, eq 6-8 (written from the paper)
+# ------------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Rig:
+    """The four-point fixture (mm): roller distance ``d``, roller radius ``r``, plate thickness ``t``, ``L0``."""
+
+    d: float = 35.0
+    r: float = 2.5
+    t: float = 4.0
+    L0: float = 145.0
+
+    def stroke(self, beta):
+        """Eq 6: the crosshead stroke (mm) at plate pitch ``beta`` (rad)."""
+        return self.d * np.tan(beta) + (1.0 / np.cos(beta) - 1.0) * (self.t + 2.0 * self.r)
+
+    def beta(self, stroke):
+        """The inverse of eq 6 by Newton's method (monotone, convex on [0, pi/2): converges from atan(ds/d))."""
+        s = np.asarray(stroke, dtype=float)
+        b = np.arctan(np.maximum(s, 0.0) / self.d)
+        c = self.t + 2.0 * self.r
+        for _ in range(30):
+            g = self.stroke(b) - s
+            dg = self.d / np.cos(b) ** 2 + c * np.sin(b) / np.cos(b) ** 2
+            step = g / dg
+            b = np.clip(b - step, -0.5, 1.5)
+            if np.max(np.abs(step)) < 1e-14:
+                break
+        return b
+
+    def force(self, moment, beta):
+        """Eq 7 solved for the machine force (N) from the moment (N*mm)."""
+        return 2.0 * np.cos(beta) ** 2 * moment / (self.d + (self.t + 2.0 * self.r) * np.sin(beta))
+
+
+# ------------------------------------------------------------------------------------------------
+# loop laws: H (N*mm) along a path of bending angle u (rad) sampled at times t (s)
+# ------------------------------------------------------------------------------------------------
+def maxwell_slip(t, u, A, *, creep_tau_s: float | None = 40.0, n: int = 8, u_min=math.radians(0.3),
+                 u_max=math.radians(8.0)):
+    """Maxwell-slip elements (equal break forces ``A / n``, slip angles geometric); the slow half creeps."""
+    r = np.geomspace(u_min, u_max, n)
+    f = np.full(n, A / n)
+    k = f / r
+    x = u[0] + r  # after a loading (u decreasing): every spring stretched to its negative limit
+    creep = np.zeros(n)
+    if creep_tau_s is not None:
+        creep[n // 2:] = 1.0
+    out = np.empty(u.size)
+    dt = np.diff(t, prepend=t[0])
+    for i in range(u.size):
+        x = np.clip(x, u[i] - r, u[i] + r)
+        if creep_tau_s is not None and dt[i] > 0:
+            x = x + creep * (u[i] - x) * (1.0 - math.exp(-dt[i] / creep_tau_s))
+        out[i] = -float(k @ (u[i] - x))
+    return out
+
+
+def stiction(t, u, A, *, ratio: float = 1.6, stick_deg: float = 1.5, decay_deg: float = 3.0):
+    """Breakaway friction: kinetic limit ``A``, static ``ratio * A`` after a stick of ``stick_deg``, decaying breakaway.
+
+    While stuck the slider holds and the spring (stiffness ``ratio * A / stick_deg``) takes the motion; past the
+    static limit it slides at ``A + (ratio - 1) A exp(-slip / decay_deg)``; a reversal sticks it again.
+    """
+    fs, fk = ratio * A, A
+    K = fs / math.radians(stick_deg)
+    delta = math.radians(decay_deg)
+    x = float(u[0]) + fk / K  # after a loading: sliding toward the blocked state at the kinetic force
+    sliding, direction, slip = True, -1.0, 1e3
+    out = np.empty(u.size)
+    for i in range(u.size):
+        F = K * (u[i] - x)
+        if sliding:
+            limit = fk + (fs - fk) * math.exp(-slip / delta)
+            if F * direction >= limit:  # it goes on sliding the same way
+                new_x = u[i] - direction * limit / K
+                slip += abs(new_x - x)
+                x = new_x
+            else:
+                sliding = False  # the motion stopped or reversed: it sticks
+        if not sliding and abs(F) > fs:  # breakaway
+            sliding, direction, slip = True, (1.0 if F > 0 else -1.0), 0.0
+            x = u[i] - direction * fs / K
+        out[i] = -K * (u[i] - x)
+    return out
+
+
+def viscous(t, u, A, *, speed_rad_s: float, tau_s: float = 10.0, dashpot_share: float = 0.5):
+    """A dashpot and a Maxwell branch (time constant ``tau_s``); together ``A`` at ``speed_rad_s`` in steady motion."""
+    c = dashpot_share * A / speed_rad_s
+    km = (1.0 - dashpot_share) * A / (speed_rad_s * tau_s)
+    du = np.diff(u, prepend=u[0])
+    dt = np.diff(t, prepend=t[0])
+    dt_mean = float(np.median(dt[1:])) if t.size > 1 else 1.0
+    a = math.exp(-dt_mean / tau_s)
+    # exact for a velocity constant over each step of the (uniform) sampling: F_n = a F_(n-1) + km tau (1 - a) du/dt
+    maxwell = lfilter([km * tau_s * (1.0 - a) / dt_mean], [1.0, -a], du)
+    rate = np.gradient(u, t) if t.size > 1 else np.zeros_like(u)
+    return -(c * rate + maxwell)
+
+
+def play(c, width):
+    """The play (backlash) operator: the output stays in ``[c - width, c]`` and moves only when pushed."""
+    out = np.empty(c.size)
+    a = float(c[0])
+    for i in range(c.size):
+        a = min(max(a, c[i] - width), c[i])
+        out[i] = a
+    return out
+
+
+def bouc_wen(t, u, A, *, theta_c: float, n: float = 1.0, beta_bw: float = 0.6, gamma_bw: float = 0.4,
+             substeps: int = 4):
+    """A Bouc-Wen loop, ``H = -A z / z_ref`` with ``z_ref`` the value ``z`` reaches over the span ``theta_c``."""
+    z = -0.8
+    out = np.empty(u.size)
+    out[0] = z
+    for i in range(1, u.size):
+        h = (u[i] - u[i - 1]) / theta_c / substeps
+        for _ in range(substeps):
+            s = 1.0 if h * z >= 0 else -1.0
+            k1 = h * (1.0 - (gamma_bw + beta_bw * s) * abs(z) ** n)
+            zm = z + 0.5 * k1
+            s = 1.0 if h * zm >= 0 else -1.0
+            z = z + h * (1.0 - (gamma_bw + beta_bw * s) * abs(zm) ** n)
+        out[i] = z
+    return -A * out / 0.8
+
+
+# ------------------------------------------------------------------------------------------------
+# cases and truths
+# ------------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Case:
+    """One calibration case: the true actuator, its tests, the loop law and the instrument faults.
+
+    preset, model : the paper's actuator (``"be-pam"``/``"bc-pam"``) and the model whose constants start the fit.
+    geometry : replacements of its geometry (mm), the same in the truth and the start of the fit.
+    d_alpha0_deg, mu_factor, shape : the truth: alpha0 moved, shear modulus scaled, shape ``C01/(C10 + C01)``.
+    loop, loop_fraction : the loop law (:data:`LOOPS`) and its amplitude (fraction of the blocked moment).
+    loop_options : the law's own settings (its keywords; ``gap_mm`` for the backlash, ``theta_c_span`` for Bouc-Wen).
+    noise_fraction, noise_ar1 : force noise (fraction of the blocked force) and its lag-one correlation.
+    drift_fraction : load-cell offset drift over each test (fraction of the blocked force).
+    """
+
+    name: str
+    preset: str = "be-pam"
+    model: str = "energy"
+    pressures_kpa: tuple[float, ...] = (100.0, 150.0, 200.0)
+    geometry: dict = field(default_factory=dict)
+    d_alpha0_deg: float = 0.8
+    mu_factor: float = 1.03
+    shape: float = 0.6
+    loop: str = "none"
+    loop_fraction: float = 0.05
+    loop_options: dict = field(default_factory=dict)
+    noise_fraction: float = 0.01
+    noise_ar1: float = 0.9
+    drift_fraction: float = 0.0
+    dialect: str = "csv"
+    cycles: int = 3
+    speed_mm_min: float = 30.0
+    rate_hz: float = 20.0
+    dwell_s: float = 0.0
+
+
+CASES = {c.name: c for c in (
+    Case("none", noise_fraction=0.01, dialect="csv"),
+    Case("maxwell-creep", preset="bc-pam", pressures_kpa=(50.0, 70.0, 90.0, 110.0), d_alpha0_deg=-0.6,
+         loop="maxwell-creep", loop_fraction=0.06, noise_fraction=0.01, dwell_s=5.0, dialect="testxpert"),
+    Case("stiction", pressures_kpa=(100.0, 125.0, 150.0, 175.0, 200.0), loop="stiction", loop_fraction=0.05,
+         noise_fraction=0.005, noise_ar1=0.8, dialect="bluehill"),
+    Case("viscous", preset="bc-pam", geometry={"R0_mm": 9.0, "R0_start_mm": 9.1, "t0_mm": 2.3},
+         pressures_kpa=(50.0, 80.0, 110.0), d_alpha0_deg=-0.6, loop="viscous", loop_fraction=0.05,
+         noise_fraction=0.02, dialect="csv"),
+    Case("backlash", geometry={"R0_mm": 8.0, "L0_mm": 150.0}, pressures_kpa=(90.0, 110.0, 130.0, 150.0, 170.0, 190.0),
+         d_alpha0_deg=-0.7, shape=0.4, loop="backlash", loop_fraction=0.04, noise_fraction=0.01, dialect="testxpert"),
+    Case("bouc-wen", pressures_kpa=(100.0, 140.0, 180.0, 220.0), mu_factor=0.95, loop="bouc-wen", loop_fraction=0.06,
+         noise_fraction=0.03, noise_ar1=0.95, dialect="bluehill"),
+    Case("drift", pressures_kpa=(100.0, 150.0, 200.0), loop="none", noise_fraction=0.005, drift_fraction=0.01,
+         dialect="csv"),
+)}
+
+#: Cases kept out of any tuning: other parameters of the same laws, faults combined, the other model.  A fit tuned
+#: on :data:`CASES` is checked on these (``calibration_study.py --set holdout``).
+HOLDOUT = {c.name: c for c in (
+    Case("stiction+drift", preset="bc-pam", pressures_kpa=(45.0, 65.0, 85.0, 105.0, 125.0), d_alpha0_deg=0.5,
+         shape=0.5, loop="stiction", loop_fraction=0.04, loop_options={"ratio": 1.4, "stick_deg": 1.0},
+         noise_fraction=0.01, noise_ar1=0.85, drift_fraction=0.008, dialect="testxpert"),
+    Case("creep+drift", geometry={"R0_mm": 9.0, "R0_start_mm": 9.1}, pressures_kpa=(110.0, 135.0, 160.0, 185.0),
+         d_alpha0_deg=-0.5, mu_factor=1.06, loop="maxwell-creep", loop_fraction=0.05,
+         loop_options={"creep_tau_s": 20.0, "n": 6}, noise_fraction=0.005, drift_fraction=-0.01, dwell_s=3.0,
+         dialect="bluehill"),
+    Case("viscous-fb", model="force_balance", pressures_kpa=(100.0, 140.0, 180.0), d_alpha0_deg=0.6, shape=0.5,
+         loop="viscous", loop_fraction=0.06, loop_options={"tau_s": 3.0, "dashpot_share": 0.3}, noise_fraction=0.015,
+         noise_ar1=0.9, dialect="csv"),
+    Case("backlash-bc", preset="bc-pam", pressures_kpa=(40.0, 60.0, 80.0, 100.0, 120.0), d_alpha0_deg=0.7,
+         loop="backlash", loop_fraction=0.05, loop_options={"gap_mm": 0.2}, noise_fraction=0.02, noise_ar1=0.8,
+         dialect="csv"),
+    Case("bouc-wen-n2", pressures_kpa=(90.0, 115.0, 140.0, 165.0, 190.0, 215.0), d_alpha0_deg=-0.8, mu_factor=1.08,
+         loop="bouc-wen", loop_fraction=0.05, loop_options={"n": 2.0, "theta_c_span": 0.25}, noise_fraction=0.01,
+         noise_ar1=0.7, dialect="testxpert"),
+)}
+
+
+@dataclass(frozen=True)
+class Truth:
+    """The true actuator of a case and the values a fit should recover (deg, kPa)."""
+
+    actuator: object
+    alpha0_deg: float
+    shear_modulus_kpa: float
+    shape: float
+
+
+def _preset(case: Case):
+    base = presets.get(case.preset, case.model)
+    return base.replace(**case.geometry) if case.geometry else base
+
+
+def start_actuator(case: Case):
+    """The actuator a fit starts from: the case's geometry with the preset's constants."""
+    return _preset(case)
+
+
+def case_truth(case: Case) -> Truth:
+    """The true actuator: the preset's geometry and P_start, alpha0 moved, an admissible material."""
+    base = _preset(case)
+    S = (base.C10_kpa + base.C01_kpa) * case.mu_factor
+    act = base.replace(alpha0_deg=base.alpha0_deg + case.d_alpha0_deg, C10_kpa=S * (1.0 - case.shape),
+                       C01_kpa=S * case.shape)
+    return Truth(act, act.alpha0_deg, 2.0 * S, case.shape)
+
+
+# ------------------------------------------------------------------------------------------------
+# one test
+# ------------------------------------------------------------------------------------------------
+def _loop(case: Case, t, u, A, speed_rad_s: float, span_rad: float):
+    """The loop's moment ``H`` (N*mm) of ``case`` along the path; ``case.loop_options`` are the law's keywords."""
+    opts = dict(case.loop_options)
+    opts.pop("gap_mm", None)
+    if case.loop == "none" or A == 0.0:
+        return np.zeros(u.size)
+    if case.loop == "maxwell-creep":
+        return maxwell_slip(t, u, A, **opts)
+    if case.loop == "stiction":
+        return stiction(t, u, A, **opts)
+    if case.loop == "viscous":
+        return viscous(t, u, A, speed_rad_s=speed_rad_s, **opts)
+    if case.loop == "backlash":
+        return maxwell_slip(t, u, A, **{"creep_tau_s": None, "u_min": math.radians(0.5), "u_max": math.radians(4.0),
+                                        **opts})
+    if case.loop == "bouc-wen":
+        span = opts.pop("theta_c_span", 0.4)
+        return bouc_wen(t, u, A, theta_c=span * span_rad, **opts)
+    raise ValueError(f"unknown loop {case.loop!r}; one of {', '.join(LOOPS)}")
+
+
+def _path(s_free: float, case: Case):
+    """Time (s) and crosshead stroke (mm) of the triangular cycles with their dwells, sampled at ``rate_hz``."""
+    ramp = s_free / (case.speed_mm_min / 60.0)
+    kt, ks = [0.0], [0.0]
+    for _ in range(case.cycles):
+        for target in (s_free, 0.0):
+            kt.append(kt[-1] + ramp)
+            ks.append(target)
+            if case.dwell_s > 0:
+                kt.append(kt[-1] + case.dwell_s)
+                ks.append(target)
+    t = np.arange(0.0, kt[-1] + 0.5 / case.rate_hz, 1.0 / case.rate_hz)
+    return t, np.interp(t, kt, ks)
+
+
+def machine_test(case: Case, truth: Truth, pressure_kpa: float, rng: np.random.Generator, rig: Rig):
+    """One raw test: ``(time s, stroke mm, force N, info)``; ``info`` has the free stroke and the blocked force."""
+    act = truth.actuator
+    sign = act.bend_sign or 1
+    law = bendpam.MomentLaw.of(act, case.model)
+
+    def m_qs(k):
+        return sign * law.moment(pressure_kpa, sign * np.asarray(k, dtype=float))
+
+    Mb = float(m_qs(0.0))
+    A = case.loop_fraction * Mb
+    lim = bendpam.curvature_limits(act)
+    k_lim = 0.98 * abs(lim.k_max if sign > 0 else lim.k_min)
+    beta_hi = min(MAX_BETA_RAD, 0.5 * k_lim * rig.L0)
+    speed_rad_s = 2.0 * (case.speed_mm_min / 60.0) / rig.d  # about, near the blocked state
+    gap = float(case.loop_options.get("gap_mm", 0.3)) if case.loop == "backlash" else 0.0
+
+    def force(t, cross, span_rad):
+        beta = rig.beta(play(cross, gap) if gap else cross)
+        u = 2.0 * beta
+        return rig.force(m_qs(u / rig.L0) + _loop(case, t, u, A, speed_rad_s, span_rad), beta)
+
+    # 1. the machine releases the actuator from the blocked state until the force falls to the detection load
+    s_hi = float(rig.stroke(beta_hi))
+    s = np.linspace(0.0, s_hi, 4000)
+    kk = np.linspace(0.0, 2.0 * beta_hi / rig.L0, 400)
+    mq = m_qs(kk)
+    span = float(kk[np.argmax(mq <= 0.0)] * rig.L0) if np.any(mq <= 0.0) else 2.0 * beta_hi  # quasi-static free angle
+    f = force(s / (case.speed_mm_min / 60.0), s, span)
+    below = np.flatnonzero(f <= DETECTION_LOAD_N)
+    if below.size == 0 or below[0] == 0:
+        raise ValueError(f"{case.name}: at {pressure_kpa:g} kPa the force never falls to the detection load")
+    j = int(below[0])
+    s_free = float(s[j - 1] + (s[j] - s[j - 1]) * (f[j - 1] - DETECTION_LOAD_N) / (f[j - 1] - f[j]))
+    # 2. the cycles
+    t, cross = _path(s_free, case)
+    clean = force(t, cross, span)
+    F_block = float(clean[0])
+    w = rng.normal(0.0, 1.0, t.size)
+    w[1:] *= math.sqrt(1.0 - case.noise_ar1**2)  # e_0 = w_0, e_n = phi e_(n-1) + sqrt(1 - phi^2) w_n: stationary
+    noise = lfilter([1.0], [1.0, -case.noise_ar1], w)
+    drift = case.drift_fraction * F_block * (t - t[0]) / (t[-1] - t[0])
+    force_n = clean + case.noise_fraction * F_block * noise + drift
+    stroke = cross + rng.normal(0.0, 0.002, t.size)
+    info = {"pressure_kpa": pressure_kpa, "free_stroke_mm": s_free, "blocked_force_n": F_block,
+            "blocked_moment_nmm": Mb, "loop_amplitude_nmm": A, "samples": int(t.size),
+            "duration_s": float(t[-1]), "drift_n": float(drift[-1])}
+    return t, stroke, force_n, info
+
+
+# ------------------------------------------------------------------------------------------------
+# files in a machine's dialect
+# ------------------------------------------------------------------------------------------------
+def _num(x: float, comma: bool = False) -> str:
+    text = f"{x:.6g}"
+    return text.replace(".", ",") if comma else text
+
+
+def export_text(dialect: str, t, stroke, force, pressure_kpa: float, specimen: str) -> tuple[str, str]:
+    """The text of a raw export and its encoding: ``csv``, ``testxpert`` (decimal comma) or ``bluehill``."""
+    rows = np.column_stack([t, stroke, force])
+    if dialect == "csv":
+        head = [f"# Pressure: {pressure_kpa:g} kPa", f"# Specimen: {specimen}", "# Test speed: 30 mm/min",
+                "time_s,stroke_mm,force_n"]
+        body = "\n".join(f"{a:.3f},{b:.5f},{c:.5f}" for a, b, c in rows.tolist())
+        return "\n".join(head) + "\n" + body + "\n", "utf-8"
+    if dialect == "testxpert":
+        head = ["$testXpert II ASCII-Export", f"Probe;{specimen}", f"Druck;{_num(pressure_kpa, True)};kPa",
+                "Prüfgeschwindigkeit;30;mm/min", "", "Prüfzeit;Standardweg;Standardkraft", "s;mm;N"]
+        body = "\r\n".join(f"{a:.3f};{b:.5f};{c:.5f}".replace(".", ",") for a, b, c in rows.tolist())
+        return "\r\n".join(head) + "\r\n" + body + "\r\n", "cp1252"
+    if dialect == "bluehill":
+        head = ['"Specimen : ' + specimen + '"', f'"Pressure : {pressure_kpa:g} kPa"', '"Rate 1 : 30 mm/min"', "",
+                '"Time","Extension","Load"', '"(s)","(mm)","(N)"']
+        body = "\r\n".join(f'"{a:.3f}","{b:.5f}","{c:.5f}"' for a, b, c in rows.tolist())
+        return "\r\n".join(head) + "\r\n" + body + "\r\n", "utf-8"
+    raise ValueError(f"unknown dialect {dialect!r}; one of {', '.join(DIALECTS)}")
+
+
+def generate_set(case: Case, seed: int, folder) -> dict:
+    """Write one raw file per pressure of ``case`` into ``folder`` (noise drawn from ``seed``); returns the truth.
+
+    Files are named ``{preset}_{P}kPa{suffix}`` and carry the pressure in their header.
+
+    >>> import dataclasses, tempfile
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     truth = generate_set(dataclasses.replace(CASES["stiction"], pressures_kpa=(150.0,), cycles=2), 1, folder)
+    ...     names = sorted(p.name for p in Path(folder).iterdir())
+    >>> names, round(truth["alpha0_deg"], 2)
+    (['be-pam_150kPa.csv'], 70.5)
+    """
+    truth = case_truth(case)
+    rig = Rig(L0=truth.actuator.L0_mm)
+    rng = np.random.default_rng([seed, sum(map(ord, case.name))])
+    folder = Path(folder)
+    files, tests = [], []
+    for p in case.pressures_kpa:
+        t, stroke, force, info = machine_test(case, truth, float(p), rng, rig)
+        name = f"{case.preset}_{p:g}kPa{SUFFIX[case.dialect]}"
+        text, encoding = export_text(case.dialect, t, stroke, force, float(p), f"{case.name}-{seed}")
+        atomic_write_text(folder / name, text, encoding=encoding)
+        files.append(name)
+        tests.append(info)
+    return {"case": case.name, "seed": seed, "alpha0_deg": truth.alpha0_deg,
+            "shear_modulus_kpa": truth.shear_modulus_kpa, "shape": truth.shape, "files": files, "tests": tests,
+            "fixture_L0_mm": rig.L0}
