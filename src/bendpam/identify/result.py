@@ -732,6 +732,14 @@ class FitResult:
             lines.append("  energy-loss ratio measured/predicted: " + ", ".join(
                 f"{e.pressure_kpa:g} kPa {100 * e.measured:.1f}/{_pct(e.predicted, 1)}"
                 for e in h.energy_loss_ratio))
+        b = self.uncertainty
+        if b is not None:
+            keys = [k for k in b.statistical if k in (*(v[0] for v in PARAMETERS.values()), "shear_modulus_kpa",
+                                                      "shape")]
+            lines.append("  standard errors, statistical / systematic: " + ", ".join(
+                f"{k} {b.statistical[k]:.2g} / {b.systematic.get(k, 0.0):.2g}" for k in keys))
+            if b.ensemble:
+                lines.append("  loop laws (weight): " + ", ".join(f"{m.law} {m.weight:.2f}" for m in b.ensemble))
         lines += [f"  identifiability: {s}" for s in self.identifiability]
         lines += [f"  note: {f}" for f in self.flags]
         return "\n".join(lines)
