@@ -239,3 +239,33 @@ def test_a_narrow_shape_is_determined_only_where_the_study_covers_it(tmp_path):
     assert ("is determined too" in words) if holds else ("ridge" in words and "not claimed" in words)
     # a joint fit with a tension test is judged by its interval alone
     assert material_fit(act, unc, (-0.15, 1.07), (0.6, 1.6), False, "", ["C10", "C01"], joint=True).shape_identified
+
+
+def test_the_shipped_coverage_record_is_read_and_the_tool_writes_it(tmp_path):
+    import json
+    import sys
+    from pathlib import Path
+
+    from bendpam.identify.diagnose import SHAPE_COVERAGE_FILE, study_coverage
+
+    assert "missing" not in study_coverage()[1]  # the package ships the record
+    assert "cases" in json.loads(SHAPE_COVERAGE_FILE.read_text())
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tools"))
+    try:
+        from shape_coverage import coverage_record, main
+    finally:
+        sys.path.pop(0)
+    study = {"meta": {"commit": "c"}, "runs": [
+        {"case": "drift", "variant": "linear", "shape_narrow": True, "shape": 0.60, "se_shape": 0.01,
+         "truth": {"shape": 0.61}},
+        {"case": "drift", "variant": "linear", "shape_narrow": True, "shape": 0.60, "se_shape": 0.01,
+         "truth": {"shape": 0.65}},
+        {"case": "none", "variant": "none", "shape_narrow": False, "truth": {"shape": 0.6}},
+        {"case": "none", "variant": "none", "failed": "fit: no"}]}
+    assert coverage_record(study)["cases"] == {"drift (linear)": {"narrow": 2, "covered": 1},
+                                               "none": {"narrow": 0, "covered": 0}}
+    src, out = tmp_path / "study.json", tmp_path / "rec.json"
+    src.write_text(json.dumps(study))
+    assert main([str(src), "--out", str(out)]) == 0
+    assert study_coverage(str(out)) == (False, "in the calibration study such narrow intervals covered the truth in "
+                                               "1 of 2 runs (drift (linear): 1 of 2)")
