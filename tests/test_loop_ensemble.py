@@ -131,6 +131,9 @@ def test_breakaway_sticks_peaks_at_the_static_level_and_decays_to_the_kinetic():
     zp = law.z_path(th, -1.0)
     away, back = law.steady_branches(np.linspace(0.0, span, 401), span)
     assert np.allclose(zp[-801:-400], away, atol=1e-9) and np.allclose(zp[-401:], back, atol=1e-9)
+    # a loop too narrow to break away stays elastic: turning value 1.6 span / (2 x 0.05)
+    small = law.steady_branches(np.array([0.0, 0.02]), 0.02)[0]
+    assert small.tolist() == pytest.approx([-0.32, 0.32], abs=1e-12)
 
 
 # --------------------------------------------------------------------------------------------

@@ -553,11 +553,13 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool):
     fits: dict[str, tuple[dict[str, float], float]] = {}
     if run.law and law_uncertainty:
         fits[run.law] = (unc.values, _ssr(run.prob, run.nl, run.lin))
-        for alt in ENSEMBLE:
-            if alt != run.law:
+        for alt in (a for a in ENSEMBLE if a != run.law):
+            try:
                 values, ssr, n = _law_refit(run.prob, run.bnd, run.nl, alt)
-                run.nfev += n
-                fits[alt] = (values, ssr)
+            except FitError:  # this law cannot describe the curves at all: it has no weight
+                continue
+            run.nfev += n
+            fits[alt] = (values, ssr)
     r = run.prob.residual_full(np.concatenate([[run.nl[p] for p in run.prob.nonlin], run.lin]))
     shape_bound = unc.at_bound.get("S_lo", False) or unc.at_bound.get("S_hi", False)
     budget = uncertainty_budget(unc, run.prob.actuator(unc.values), fits, r, run.prob.groups, run.law,
