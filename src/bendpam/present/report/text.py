@@ -41,6 +41,7 @@ __all__ = [
 #: The models and loop laws by name, as the page writes them.
 MODEL_LABEL = {"energy": "energy", "force_balance": "force-balance"}
 LAW_LABEL = {"pi": "Prandtl-Ishlinskii", "dahl": "Dahl", "bouc_wen": "Bouc-Wen", "maxwell_slip": "Maxwell-slip",
+             "stiction": "breakaway (stiction)",
              "viscous": "viscous (constant crosshead speed)", "viscous_period": "viscous (constant cycle period)"}
 
 
