@@ -74,6 +74,7 @@ def _fit_record(result) -> dict:
             "mu_kpa": m.shear_modulus_kpa if m else None, "se_mu_kpa": m.se_shear_modulus_kpa if m else None,
             "shape": m.shape if m else None, "se_shape": m.se_shape if m else None,
             "shape_determined": bool(m.shape_identified) if m else False,
+            "shape_narrow": bool(getattr(m, "shape_narrow", m.shape_identified)) if m else False,
             "converged": bool(result.converged), "loop": result.metrics.curves}
 
 

@@ -19,7 +19,8 @@ from bendpam.errors import InputError
 from bendpam.physics.actuator import Actuator
 from bendpam.physics.braid import radius_terms
 
-__all__ = ["FitData", "bladder_stretch_range", "branch_data", "developed_range", "fit_data"]
+__all__ = ["FitData", "bladder_stretch_range", "branch_data", "cycle_deviations", "cycle_period_s", "developed_range",
+           "drift_offsets", "fit_data", "relative_rate"]
 
 
 @dataclass
@@ -60,14 +61,18 @@ class FitData:
     branch: np.ndarray | None = None  # +1 loading (free -> blocked), -1 unloading (hysteresis fits)
     delta: np.ndarray | None = None  # bending angle from the branch's starting end point (rad)
     span: np.ndarray | None = None  # bending angle between the loop's end points (rad)
+    grid_index: np.ndarray | None = None  # each point's index on its test's curvature grid
+    period_s: np.ndarray | None = None  # (n,) each test's mean cycle period, s (NaN: not known)
+    rate: np.ndarray | None = None  # each point's bending rate at a constant crosshead speed, relative to k' = 0
 
     def thin(self, step: int) -> FitData:
         """Every ``step``-th point (weights scaled so the objective keeps its scale): for the grid stage."""
         keep = np.arange(self.kc.size) % step == 0
-        opt = {n: None if getattr(self, n) is None else getattr(self, n)[keep] for n in ("branch", "delta", "span")}
+        opt = {n: None if getattr(self, n) is None else getattr(self, n)[keep]
+               for n in ("branch", "delta", "span", "grid_index", "rate")}
         return FitData(self.P, self.k, self.M, self.BM, self.BM_se, self.K, self.K_se,
                      self.w[keep] * math.sqrt(self.kc.size / keep.sum()), self.kc[keep], self.Mc[keep], self.Pc[keep],
-                     self.seg[keep], **opt)
+                     self.seg[keep], **opt, period_s=self.period_s)
 
     @property
     def group(self) -> np.ndarray:
@@ -137,8 +142,25 @@ def branch_data(processed, L0: float) -> FitData:
             delta.append(np.maximum(dist, 0.0))
             span.append(np.full(n, Kf * L0))
     cat = np.concatenate
+    gi = cat([np.tile(np.arange(np.asarray(r.curvature_grid).size), 2) for r in res])
+    fixture = getattr(processed, "fixture", None)
     return FitData(d.P, d.k, d.M, d.BM, d.BM_se, d.K, d.K_se, cat(w), cat(k), cat(M), cat(Pc), cat(seg), cat(br),
-                 cat(delta), cat(span))
+                 cat(delta), cat(span), gi, d.period_s, None if fixture is None else relative_rate(fixture, cat(k)))
+
+
+def relative_rate(fixture, curvature_per_mm) -> np.ndarray:
+    """The bending rate at a constant crosshead speed, relative to the straight state (eq 6 and 8).
+
+    ``theta = 2 beta`` and ``ds/dbeta = d sec^2 beta + c sec beta tan beta`` (``c = 2 r + t``), so the rate
+    ``dtheta/dt = 2 v / (ds/dbeta)`` falls as the plates pitch: ``d / (ds/dbeta)`` relative to ``beta = 0``.
+
+    >>> from bendpam.physics.fixture import PAPER_FIXTURE
+    >>> relative_rate(PAPER_FIXTURE, np.array([0.0, 0.01])).round(3).tolist()   # beta = 0.725 rad: 35 / 73.1
+    [1.0, 0.479]
+    """
+    b = np.abs(fixture.curvature_to_beta(np.asarray(curvature_per_mm, dtype=float)))
+    sec = 1.0 / np.cos(b)
+    return fixture.d_mm / (fixture.d_mm * sec**2 + fixture.c * sec * np.tan(b))
 
 
 def fit_data(processed, fit_range: str = "developed") -> FitData:
@@ -172,8 +194,66 @@ def fit_data(processed, fit_range: str = "developed") -> FitData:
     wK = K / K.sum()
     w = np.concatenate([np.full(kk.size, math.sqrt(wK[i]) / (BM[i] * math.sqrt(kk.size))) for i, kk in enumerate(k)])
     seg = np.concatenate([np.full(kk.size, i) for i, kk in enumerate(k)])
+    gi = np.concatenate([np.flatnonzero(m) for m in masks])
     return FitData(P, k, M, BM, BMse, K, Kse, w, np.concatenate(k), np.concatenate(M),
-                 np.concatenate([np.full(kk.size, P[i]) for i, kk in enumerate(k)]), seg)
+                 np.concatenate([np.full(kk.size, P[i]) for i, kk in enumerate(k)]), seg,
+                 grid_index=gi, period_s=np.array([cycle_period_s(r) for r in res]))
+
+
+def cycle_period_s(result) -> float:
+    """A test's mean cycle period (s) from its kept samples (their ``time_s`` and ``cycle`` labels); NaN without.
+
+    >>> import pandas as pd
+    >>> from types import SimpleNamespace as NS
+    >>> series = pd.DataFrame({"time_s": np.arange(9.0), "cycle": [0, 1, 1, 1, 1, 2, 2, 2, 2]})
+    >>> cycle_period_s(NS(series=series)), cycle_period_s(NS(series=None))
+    (3.0, nan)
+    """
+    series = getattr(result, "series", None)
+    if series is None or "cycle" not in series or "time_s" not in series:
+        return math.nan
+    t = series["time_s"].to_numpy(dtype=float)
+    c = series["cycle"].to_numpy()
+    ids = np.unique(c[c > 0])
+    if ids.size == 0:
+        return math.nan
+    first = np.array([t[c == i][0] for i in ids])
+    last = np.array([t[c == i][-1] for i in ids])
+    return float(np.mean(last - first))
+
+
+def cycle_deviations(processed, d: FitData) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Each cycle's deviation from the mean of its test at the fit's points: ``[(rows, E)]``.
+
+    One entry per test with two cycles or more: ``rows`` index ``d``'s points of that test and
+    ``E`` (cycles x rows, N*mm) is each cycle's branch (loading, unloading, or their average for the
+    mean curves) minus the mean over the cycles, at those points.  This is what resampling the cycles
+    (a block bootstrap over cycles) perturbs the fitted data by.
+
+    >>> from types import SimpleNamespace as NS
+    >>> k = np.linspace(0.0, 0.008, 3)
+    >>> br = np.array([[[3.0, 2.0, 1.0], [1.0, 0.0, -1.0]], [[5.0, 4.0, 3.0], [3.0, 2.0, 1.0]]])
+    >>> d = FitData(np.array([150.0]), [k], [br.mean(axis=(0, 1))], np.ones(1), np.zeros(1), np.ones(1), np.zeros(1),
+    ...             np.ones(3), k, br.mean(axis=(0, 1)), np.full(3, 150.0), np.zeros(3, int), grid_index=np.arange(3))
+    >>> [(rows.tolist(), E.tolist()) for rows, E in cycle_deviations(NS(results=[NS(branches=br)]), d)]
+    [([0, 1, 2], [[-1.0, -1.0, -1.0], [1.0, 1.0, 1.0]])]
+    """
+    out: list[tuple[np.ndarray, np.ndarray]] = []
+    if d.grid_index is None:
+        return out
+    for i, r in enumerate(processed.results):
+        br = getattr(r, "branches", None)
+        if br is None or np.asarray(br).ndim != 3 or np.asarray(br).shape[0] < 2:
+            continue
+        br = np.asarray(br, dtype=float)
+        rows = np.flatnonzero(d.seg == i)
+        gi = d.grid_index[rows]
+        if d.branch is None:
+            Y = 0.5 * (br[:, 0, gi] + br[:, 1, gi])
+        else:
+            Y = np.where(d.branch[rows] > 0, br[:, 0, gi], br[:, 1, gi])
+        out.append((rows, Y - Y.mean(axis=0)))
+    return out
 
 
 def bladder_stretch_range(actuator: Actuator, curvature_per_mm) -> tuple[float, float]:
@@ -207,3 +287,34 @@ def bladder_stretch_range(actuator: Actuator, curvature_per_mm) -> tuple[float, 
     return float(np.min(allv)), float(np.max(allv))
 
 
+
+
+def drift_offsets(processed, d: FitData) -> list[tuple[np.ndarray, float]]:
+    """The load-cell drift's doubt as a moment offset per test: ``[(rows, sd_nmm)]``.
+
+    A test whose drift was corrected keeps the error of the estimated rate: an offset growing
+    from the test's start, ``rate_se (t - t0)``, common to its cycles on average (``rate_se x
+    duration / 2``; resampling the cycles sees only its growth), converted to moment by the
+    blocked state's lever ``M_b / F_b``.  A flagged drift left uncorrected is an offset of the size
+    correcting it would have moved the blocked moment.  Tests without a drift estimate add nothing.
+
+    >>> from types import SimpleNamespace as NS
+    >>> drift = NS(corrected=True, flagged=True, rate_se_n_per_s=1e-4, duration_s=200.0, blocked_moment_nmm=300.0,
+    ...            blocked_force_n=10.0, blocked_moment_shift_nmm=-3.0)
+    >>> d = NS(seg=np.array([0, 0, 0]))
+    >>> [(rows.tolist(), round(sd, 6)) for rows, sd in drift_offsets(NS(results=[NS(drift=drift)]), d)]  # N*mm
+    [([0, 1, 2], 0.3)]
+    """
+    out: list[tuple[np.ndarray, float]] = []
+    for i, r in enumerate(processed.results):
+        e = getattr(r, "drift", None)
+        if e is None:
+            continue
+        if e.corrected:
+            lever = e.blocked_moment_nmm / e.blocked_force_n if e.blocked_force_n else math.nan
+            sd = abs(e.rate_se_n_per_s * e.duration_s / 2.0 * lever)
+        else:
+            sd = abs(e.blocked_moment_shift_nmm) if e.flagged else 0.0
+        if math.isfinite(sd) and sd > 0:
+            out.append((np.flatnonzero(d.seg == i), float(sd)))
+    return out

@@ -36,15 +36,17 @@ Examples
 
 from __future__ import annotations
 
+import functools
 import math
 import re
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from bendpam.identify.result import JointInterval, MaterialFit, parameter_field, parameter_unit
+from bendpam.identify.result import JointInterval, MaterialFit, UncertaintyBudget, parameter_field, parameter_unit
 
 if TYPE_CHECKING:
     from bendpam.identify.uncertainty import Uncertainty
@@ -71,6 +73,7 @@ __all__ = [
     "needs_type_check",
     "search_state",
     "shape_identified",
+    "study_coverage",
     "tension_identifiability",
 ]
 
@@ -307,8 +310,9 @@ def correlated_pairs(names, values, cov, corr, limit: float = LIMITS.correlation
 
 
 def shape_identified(se_shape: float, shape_bounds, at_bound: bool, held: str) -> bool:
-    """Whether the data determine the shape C01/(C10 + C01): its 95 % interval within ``LIMITS.shape_resolved``
-    of the admissible width, neither at a bound nor held fixed.
+    """Whether the shape C01/(C10 + C01)'s interval is narrow: its 95 % interval within ``LIMITS.shape_resolved``
+    of the admissible width, neither at a bound nor held fixed.  Whether that is enough to call it
+    determined is :func:`study_coverage`'s to say (for fits of bending curves alone).
 
     >>> shape_identified(0.05, (-0.15, 1.07), False, ""), shape_identified(0.5, (-0.15, 1.07), False, "")
     (True, False)
@@ -317,8 +321,49 @@ def shape_identified(se_shape: float, shape_bounds, at_bound: bool, held: str) -
     return bool(not at_bound and not held and width > 0 and 2 * _Z95 * se_shape <= LIMITS.shape_resolved * width)
 
 
+#: The calibration study's record of the shape's coverage (written by tools/shape_coverage.py).
+SHAPE_COVERAGE_FILE = Path(__file__).with_name("shape_coverage.json")
+
+
+@functools.lru_cache(maxsize=4)
+def study_coverage(path: str | None = None, target: float = 0.85) -> tuple[bool, str]:
+    """Whether the calibration study's 2-SE coverage of the shape, where its interval was narrow, holds.
+
+    The record (``path``, default :data:`SHAPE_COVERAGE_FILE`) lists per case of the study the runs
+    whose shape interval was narrow and how many of those covered the truth.  The coverage holds
+    when it reaches ``target`` in every case that had such runs (and overall); then a narrow
+    interval of a fit of bending curves alone may be called determined.  Returns ``(holds, why)``,
+    ``why`` the words when it does not (no record: it does not).
+
+    >>> import json, tempfile, os
+    >>> rec = {"cases": {"none": {"narrow": 10, "covered": 10}, "drift": {"narrow": 10, "covered": 6}}}
+    >>> with tempfile.NamedTemporaryFile("w", suffix=".json", delete=False) as f:
+    ...     json.dump(rec, f)
+    >>> study_coverage(f.name)
+    (False, 'in the calibration study such narrow intervals covered the truth in 16 of 20 runs (drift: 6 of 10)')
+    >>> os.remove(f.name)
+    """
+    import json
+
+    p = Path(path) if path else SHAPE_COVERAGE_FILE
+    try:
+        cases = json.loads(p.read_text(encoding="utf-8"))["cases"]
+        counts = {str(k): (int(v["narrow"]), int(v["covered"])) for k, v in cases.items()}
+    except (OSError, ValueError, KeyError, TypeError):
+        return False, "the calibration study's record of its coverage is missing"
+    n = sum(a for a, _ in counts.values())
+    k = sum(b for _, b in counts.values())
+    bad = [f"{c}: {b} of {a}" for c, (a, b) in counts.items() if a and b < target * a]
+    if n and not bad and k >= target * n:
+        return True, ""
+    if not n:
+        return False, "the calibration study had no run with so narrow an interval to check it on"
+    return False, (f"in the calibration study such narrow intervals covered the truth in {k} of {n} runs"
+                   + (f" ({'; '.join(bad)})" if bad else ""))
+
+
 def identifiability(mat: MaterialFit | None, free: list[str], unc: Uncertainty, fitted: Actuator,
-                    shift: dict[str, float], alt: str, law: str | None) -> list[str]:
+                    budget: UncertaintyBudget | None = None, law: str | None = None) -> list[str]:
     """Sentences: which of alpha0, the shear modulus and the shape the data determine (``FitResult.identifiability``).
 
     Parameters
@@ -327,23 +372,24 @@ def identifiability(mat: MaterialFit | None, free: list[str], unc: Uncertainty, 
     free : the model parameters varied.
     unc : their :class:`~bendpam.identify.uncertainty.Uncertainty`.
     fitted : the fitted actuator.
-    shift, alt, law : the parameters' shift with the other loop law ``alt`` (the fit's is ``law``).
+    budget, law : the errors' statistical and systematic parts (the ensemble of loop laws), the fit's law.
 
     Examples
     --------
     >>> import bendpam
     >>> from bendpam.identify.uncertainty import Uncertainty
     >>> unc = Uncertainty({}, ["alpha0"], np.array([[0.0004]]), 0.0, 0, {}, 0.0, 40, 0.95)
-    >>> identifiability(None, ["alpha0"], unc, bendpam.physics.presets.be_pam(), {}, "", None)
+    >>> identifiability(None, ["alpha0"], unc, bendpam.physics.presets.be_pam())
     ['alpha0 = 69.7 ± 0.04 deg (2 SE) is determined by the curves.']
     """
     out = []
     if "alpha0" in unc.names:
         i = unc.names.index("alpha0")
         se = float(unc.sd[i])
-        sys_ = abs(shift.get("alpha0", 0.0)) / math.sqrt(3.0)
-        tail = (f"; the loop law alone ({law} vs {alt}, systematic) accounts for ± {2 * sys_:.2g} deg"
-                if law and alt and sys_ > 0 else "")
+        sys_ = 0.0 if budget is None else budget.systematic.get("alpha0_deg", 0.0)
+        n_laws = 0 if budget is None else len(budget.ensemble)
+        tail = (f"; the loop law alone ({law} among {n_laws} laws, systematic) accounts for ± {2 * sys_:.2g} deg"
+                if law and n_laws and sys_ > 0 else "")
         head = f"alpha0 = {fitted.alpha0_deg:.4g} ± {2 * se:.2g} deg (2 SE{tail})"
         if unc.at_bound.get("alpha0", False):
             out.append(f"{head} sits at a bound of its range: the curves do not determine it there.")
@@ -353,7 +399,21 @@ def identifiability(mat: MaterialFit | None, free: list[str], unc: Uncertainty, 
             out.append(f"{head} is determined by the curves.")
     if mat is not None:
         out += _material_sentences(mat, "C10" in free and "C01" in free)
+    if budget is not None and law and budget.ensemble:
+        out += _better_law(budget, law)
     return out
+
+
+def _better_law(budget: UncertaintyBudget, law: str) -> list[str]:
+    """A sentence when another loop law of the ensemble fits clearly better (most of the weight) than the fit's."""
+    own = next((m for m in budget.ensemble if m.law == law), None)
+    best = max(budget.ensemble, key=lambda m: m.weight)
+    if own is None or best.law == law or best.weight < 0.5:
+        return []
+    vals = ", ".join(f"{k} = {v:.4g}" for k, v in best.values.items() if k in ("alpha0_deg", "shear_modulus_kpa"))
+    return [f"The {best.law.replace('_', '-')} loop law fits the branches better than the {law} law (NRMSE "
+            f"{100 * best.nrmse:.3g} % against {100 * own.nrmse:.3g} %, weight {best.weight:.2f}) and gives {vals}; "
+            "the systematic part of the standard errors spans the difference."]
 
 
 def _material_sentences(mat: MaterialFit, both: bool) -> list[str]:
@@ -379,6 +439,11 @@ def _material_sentences(mat: MaterialFit, both: bool) -> list[str]:
     elif mat.shape_identified:
         out.append(f"The shape C01/(C10 + C01) = {mat.shape:.3g} ± {2 * (mat.se_shape or 0):.2g} (2 SE) is "
                    f"determined too: its 95 % interval covers at most half of {adm}.")
+    elif mat.shape_study:
+        out.append(f"The shape C01/(C10 + C01) = {mat.shape:.3g} ± {2 * (mat.se_shape or 0):.2g} (2 SE) is not "
+                   f"claimed although its interval is narrow: {mat.shape_study}.  The curves lie on a ridge: they fix "
+                   "mu = 2(C10 + C01) and leave the shape free along it; a tension test of the bladder determines "
+                   "it.")
     else:
         frac = 2 * _Z95 * (mat.se_shape or 0) / (hi - lo) if hi > lo else math.inf
         out.append(f"The shape C01/(C10 + C01) = {mat.shape:.3g} ± {2 * (mat.se_shape or 0):.2g} (2 SE) is not "

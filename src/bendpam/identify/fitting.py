@@ -56,19 +56,18 @@ Folds
     rejected: the shape is scanned over the admissible interval and the best fold-free material
     kept, with a note; if none exists the fit is flagged as unable to describe the data.
 
-Uncertainty
-    1. Statistical: a sandwich covariance ``B^-1 (sum_g s_g^2 f_g J_g^T J_g) B^-1``
-       (:mod:`bendpam.identify.uncertainty`),
-       ``B = J^T J``, with each curve (each branch with a loop) ``g`` its own residual variance
-       ``s_g^2`` and an inflation ``f_g = (1 + rho_g) / (1 - rho_g)`` for the lag-1
-       autocorrelation of its residuals.
+Uncertainty (both parts are reported separately: ``FitResult.uncertainty``)
+    1. Statistical: a sandwich covariance ``B^-1 (sum meat) B^-1`` (:mod:`bendpam.identify.uncertainty`),
+       ``B = J^T J``.  The meat of a test with two cycles or more is the exact covariance of
+       resampling its cycles (a block bootstrap over cycles through the linearised fit, scaled for
+       few cycles); that of a single-cycle test or a tension test is its residual variance ``s_g^2``
+       inflated by ``f_g = (1 + rho_g) / (1 - rho_g)`` for the lag-1 autocorrelation of its
+       residuals; a drift correction adds its own doubt as an offset.
     2. Systematic (the loop law): no law is known to be the actuator's.  The fit is repeated with
-       the other law bendpam offers (Prandtl-Ishlinskii <-> Dahl, warm-started); the shift
-       ``delta`` of the model parameters between the two is a model-form error, taken as
-       uniformly distributed over ``[0, delta]``: ``delta delta^T / 3`` is added to the covariance
-       (standard error ``|delta| / sqrt 3`` per parameter, fully correlated).  On data made with
-       an independent (Bouc-Wen) loop law this makes the 2-SE intervals cover the truth
-       (tests/test_identify_loops.py).
+       every law of :data:`bendpam.physics.hysteresis.ENSEMBLE` (warm-started, the quasi-static
+       parameters free as in the fit); the weighted spread of the parameters about the reported
+       fit, with Akaike weights on the residuals' effective number of points, is added to the
+       covariance (:mod:`bendpam.identify.ensemble`).
     3. The profile of alpha0 (the objective minimised over everything else, against alpha0) is
        kept in ``FitResult.alpha0_profile``.
     Pairs with ``|corr| > corr_flag`` are flagged, with the combination the data determine and
@@ -92,6 +91,7 @@ bound can be overridden (``bounds={"shape": (lo, hi)}`` narrows the admissible s
 
 from __future__ import annotations
 
+import copy
 import math
 import time
 from dataclasses import dataclass, field
@@ -100,7 +100,14 @@ from datetime import UTC, datetime
 import numpy as np
 
 from bendpam.errors import FitError, InputError
-from bendpam.identify.data import FitData, bladder_stretch_range, branch_data, fit_data
+from bendpam.identify.data import (
+    FitData,
+    bladder_stretch_range,
+    branch_data,
+    cycle_deviations,
+    drift_offsets,
+    fit_data,
+)
 from bendpam.identify.diagnose import (
     LIMITS,
     at_bounds,
@@ -110,6 +117,7 @@ from bendpam.identify.diagnose import (
     has_loop,
     identifiability,
 )
+from bendpam.identify.ensemble import steady_z, uncertainty_budget
 from bendpam.identify.metrics import score
 from bendpam.identify.numerics import bounded_lstsq, chebyshev_interpolation, halfline
 from bendpam.identify.result import (
@@ -120,6 +128,7 @@ from bendpam.identify.result import (
     LossRatio,
     Parameter,
     Profile,
+    UncertaintyBudget,
 )
 from bendpam.identify.uncertainty import Uncertainty, material_fit, sandwich_covariance
 from bendpam.lab.processed import as_processed
@@ -319,13 +328,10 @@ class _Problem:
     def _z(self, theta_deg: float) -> np.ndarray:
         z = self._z_cache.get(theta_deg)
         if z is None:
-            from bendpam.physics.hysteresis import make_law
-
             if len(self._z_cache) > 256:
                 self._z_cache.clear()
-            assert self.law is not None and self.d.branch is not None, "a loop fit is built on branch data"
-            z_away, z_back = make_law(self.law, theta_deg).steady_branches(self.d.delta, self.d.span)
-            z = np.where(self.d.branch < 0, z_away, z_back)  # unloading leaves the blocked state
+            assert self.law is not None, "a loop fit has a law"
+            z = steady_z(self.law, theta_deg, self.d)
             self._z_cache[theta_deg] = z
         return z
 
@@ -429,7 +435,7 @@ def fit(processed, actuator: Actuator, model: str | None = None, free=("alpha0",
     hysteresis_law : the law of ``"auto"`` (``"pi"``: Prandtl-Ishlinskii, or ``"dahl"``).  With a
         free P_start the loop's amplitude ``a0 + a1 (P - P_start)`` uses the nominal P_start (the
         amplitude stays linear in a0, a1); the fitted loop is saved with the fitted one.
-    law_uncertainty : with a loop, refit with the other law and add the shift as a systematic error.
+    law_uncertainty : with a loop, the ensemble of loop laws' systematic part (:mod:`bendpam.identify.ensemble`).
     admissible_range : principal stretches (lo, hi) the material must be physical over besides the
         tested ones (the range it will predict); None: only the tested ones.
     profile_points : points of the profile of alpha0 (0: none).
@@ -471,10 +477,10 @@ def fit(processed, actuator: Actuator, model: str | None = None, free=("alpha0",
     run = _prepare(processed, actuator, model, free, bounds, tension_data, fit_range, hysteresis, hysteresis_law,
                    admissible_range, order, eq19_factor)
     _search_stages(run, grid_alpha, grid_r0, tension_data)
-    unc, shift, alt = _uncertainty_stages(run, corr_flag, law_uncertainty)
+    unc, budget = _uncertainty_stages(run, corr_flag, law_uncertainty)
     profile, n = _profile(run.prob, run.bnd, run.nl, unc, profile_points)
     run.nfev += n
-    return _result(processed, actuator, run, unc, tension, t0, shift, alt, profile, hysteresis)
+    return _result(processed, actuator, run, unc, tension, t0, budget, profile, hysteresis)
 
 
 @dataclass
@@ -491,6 +497,8 @@ class _Run:
     nfev: int = 0
     notes: list[str] = field(default_factory=list)
     shape_held: str = ""
+    cycles: list = field(default_factory=list)  # the tests whose cycles are resampled (data.cycle_deviations)
+    offsets: list = field(default_factory=list)  # the drift corrections' doubt (data.drift_offsets)
 
     @property
     def bnd(self) -> dict[str, tuple[float, float]]:
@@ -513,7 +521,8 @@ def _prepare(processed, actuator: Actuator, model: str, free: list[str], bounds,
     stretch = _stretch_range(actuator, d, admissible_range, tension_data)
     shape_bounds = _shape_bounds(stretch, bounds)
     args = (actuator, d, model, free, bnd, order, eq19_factor, law, shape_bounds)
-    return _Run(args, stretch, _Problem(*args))
+    return _Run(args, stretch, _Problem(*args), cycles=cycle_deviations(processed, d),
+                offsets=drift_offsets(processed, d))
 
 
 def _search_stages(run: _Run, grid_alpha: int, grid_r0: int, tension_data) -> None:
@@ -536,17 +545,26 @@ def _search_stages(run: _Run, grid_alpha: int, grid_r0: int, tension_data) -> No
 
 
 def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool):
-    """The statistical covariance, and the loop law's systematic part: ``(unc, shift, alt)``."""
-    unc = _uncertainty(run.prob, run.bnd, run.nl, run.lin, corr_flag)
+    """The statistical covariance, and the loop laws' systematic part: ``(unc, budget)``."""
+    from bendpam.physics.hysteresis import ENSEMBLE
+
+    unc = _uncertainty(run.prob, run.bnd, run.nl, run.lin, corr_flag, run.cycles, run.offsets)
     run.nfev += unc.nfev
-    shift: dict[str, float] = {}
-    alt = ""
+    fits: dict[str, tuple[dict[str, float], float]] = {}
     if run.law and law_uncertainty:
-        alt = "dahl" if run.law == "pi" else "pi"
-        shift, n = _law_shift(run.prob, run.args, run.bnd, run.nl, run.lin, alt)
-        run.nfev += n
-        unc.add_systematic(shift)
-    return unc, shift, alt
+        fits[run.law] = (unc.values, _ssr(run.prob, run.nl, run.lin))
+        for alt in (a for a in ENSEMBLE if a != run.law):
+            try:
+                values, ssr, n = _law_refit(run.prob, run.bnd, run.nl, alt)
+            except FitError:  # this law cannot describe the curves at all: it has no weight
+                continue
+            run.nfev += n
+            fits[alt] = (values, ssr)
+    r = run.prob.residual_full(np.concatenate([[run.nl[p] for p in run.prob.nonlin], run.lin]))
+    shape_bound = unc.at_bound.get("S_lo", False) or unc.at_bound.get("S_hi", False)
+    budget = uncertainty_budget(unc, run.prob.actuator(unc.values), fits, r, run.prob.groups, run.law,
+                                0 if shape_bound else len(run.cycles))
+    return unc, budget
 
 
 def _bounds(actuator: Actuator, d: FitData, bounds) -> dict[str, tuple[float, float]]:
@@ -628,8 +646,8 @@ def _start(prob: _Problem, bnd, grid_alpha: int, grid_r0: int):
     return best, nfev
 
 
-def _search(prob: _Problem, bnd, best):
-    """A bounded trust-region search on the projected problem; the final linear solve."""
+def _search(prob: _Problem, bnd, best, tol: float = 1e-10):
+    """A bounded trust-region search on the projected problem (``xtol = tol``); the final linear solve."""
     from scipy.optimize import least_squares
 
     nfev = 0
@@ -645,7 +663,7 @@ def _search(prob: _Problem, bnd, best):
             return prob.project(dict(zip(prob.nonlin, x, strict=True)))[0]
 
         sol = least_squares(fun, x0, bounds=(lo, hi), method="trf", x_scale=np.maximum(hi - lo, 1e-9) * 0.05,
-                            diff_step=1e-6, xtol=1e-10, ftol=1e-12, gtol=1e-12)
+                            diff_step=1e-6, xtol=tol, ftol=1e-2 * tol, gtol=1e-2 * tol)
         nfev += sol.nfev * (1 + len(prob.nonlin))
         converged = bool(sol.status > 0)
         message = "converged" if converged else "the search stopped before converging (iteration limit)"
@@ -728,11 +746,17 @@ def _joint_tension(prob: _Problem, args, bnd, nl, lin, tension_data):
     return p2, nl2, lin2, n, note
 
 
-def _uncertainty(prob: _Problem, bnd, nl_best, lin, corr_flag: float) -> Uncertainty:
+def _uncertainty(prob: _Problem, bnd, nl_best, lin, corr_flag: float, cycles=(), offsets=()) -> Uncertainty:
     """Sandwich covariance from the joint Jacobian (nonlinear columns by central differences).
 
     The weights normalise each curve (eq 53), they are not inverse noise variances, so each residual
-    group (a curve, a branch, the tension test) gets its own variance with its AR(1) inflation.
+    group (a curve, a branch, the tension test) gets its own variance with its AR(1) inflation, or,
+    for the tests in ``cycles`` (:func:`~bendpam.identify.data.cycle_deviations`), the covariance of
+    resampling their cycles, and the drift corrections' doubt (``offsets``,
+    :func:`~bendpam.identify.data.drift_offsets`).  Where the shape sits on an admissibility bound the
+    model cannot follow the curves; their misfit, the same in every cycle, is then treated as
+    correlated noise (the sandwich with its AR(1) inflation for every curve) instead of resampling
+    the cycles, which would not see it.
     """
     nfev = 0
     x_int = np.concatenate([[nl_best[p] for p in prob.nonlin], lin])
@@ -748,25 +772,31 @@ def _uncertainty(prob: _Problem, bnd, nl_best, lin, corr_flag: float) -> Uncerta
         nfev += 2
     _, X = prob.design(nl_best)
     J[:, nn:] = prob.w[:, None] * X
-    cov_int, rho = sandwich_covariance(J, r, prob.groups)
     lo_all = np.concatenate([[bnd[p][0] for p in prob.nonlin], prob.lo])
     hi_all = np.concatenate([[bnd[p][1] for p in prob.nonlin], prob.hi])
     at_bound = at_bounds(x_int, lo_all, hi_all)
+    bound_names = {n: bool(b) for n, b in zip(prob.nonlin + prob.int_names, at_bound, strict=True)}
+    if bound_names.get("S_lo", False) or bound_names.get("S_hi", False):
+        cycles = ()  # the model cannot follow the curves (shape at an admissibility bound): misfit as noise
+    weighted = [(rows, prob.w[rows][None, :] * E) for rows, E in cycles]
+    offs = [(rows, sd * prob.w[rows]) for rows, sd in offsets]
+    cov_int, rho = sandwich_covariance(J, r, prob.groups, weighted, offs)
     G = np.zeros((nn + len(prob.lin), x_int.size))
     G[:nn, :nn] = np.eye(nn)
     G[nn:, nn:] = prob.T
     cov = G @ cov_int @ G.T
     names = prob.nonlin + prob.lin
     values = prob.to_user(nl_best, lin)
-    bound_names = {n: bool(b) for n, b in zip(prob.nonlin + prob.int_names, at_bound, strict=True)}
     return Uncertainty(values, names, cov, rho, nfev, bound_names, float(r @ r), m, corr_flag)
 
 
-def _law_shift(prob: _Problem, args, bnd, nl, lin, alt: str):
-    """Shift of the model parameters when the other loop law is fitted (warm start, angle grid)."""
-    a2 = list(args)
-    a2[7] = alt
-    p2 = _Problem(*a2, shape_fixed=prob.shape_fixed, tension=prob.tension)
+def _law_refit(prob: _Problem, bnd, nl, alt: str):
+    """The fit with another loop law ``alt`` (warm start, angle grid): ``(values, ssr, nfev)``.
+
+    The search stops at ``xtol = 1e-7``: the ensemble's values need to be good to well within their spread.
+    """
+    p2 = copy.copy(prob)  # the same data and kinematics (their cache is shared), another loop law
+    p2.law, p2._z_cache = alt, {}
     nfev = 0
     best = (math.inf, dict(nl))
     for th in _THETA_GRID:
@@ -775,11 +805,8 @@ def _law_shift(prob: _Problem, args, bnd, nl, lin, alt: str):
         nfev += 1
         if float(r @ r) < best[0]:
             best = (float(r @ r), trial)
-    nl2, lin2, _, _, n = _search(p2, bnd, best)
-    nfev += n
-    v1 = prob.to_user(nl, lin)
-    v2 = p2.to_user(nl2, lin2)
-    return {p: v2[p] - v1[p] for p in v1 if p in PARAMETERS}, nfev
+    nl2, lin2, _, _, n = _search(p2, bnd, best, tol=1e-7)
+    return p2.to_user(nl2, lin2), _ssr(p2, nl2, lin2), nfev + n
 
 
 def _profile(prob: _Problem, bnd, nl, unc: Uncertainty, n_points: int):
@@ -824,8 +851,8 @@ def _profile(prob: _Problem, bnd, nl, unc: Uncertainty, n_points: int):
     return Profile([float(x) for x in alphas], [float(x) for x in obj], (a_hat - 2 * sd, a_hat + 2 * sd)), nfev
 
 
-def _result(processed, actuator: Actuator, run: _Run, unc: Uncertainty, tension, t0: float, shift: dict[str, float],
-            alt: str, profile: Profile | None, hysteresis) -> FitResult:
+def _result(processed, actuator: Actuator, run: _Run, unc: Uncertainty, tension, t0: float,
+            budget: UncertaintyBudget, profile: Profile | None, hysteresis) -> FitResult:
     """The fitted actuator, its parameters, material, metrics, loop and notes."""
     prob, bnd, model, law = run.prob, run.bnd, run.args[2], run.law
     order, eq19_factor = run.args[5], run.args[6]
@@ -836,10 +863,11 @@ def _result(processed, actuator: Actuator, run: _Run, unc: Uncertainty, tension,
     shape_at_bound = prob.cone and prob.shape_fixed is None and (unc.at_bound.get("S_lo", False)
                                                                  or unc.at_bound.get("S_hi", False))
     free_user = [p for p in prob.free if p in PARAMETERS]
-    mat = material_fit(fitted, unc, prob.shape_bounds, run.stretch, shape_at_bound, run.shape_held, free_user)
+    mat = material_fit(fitted, unc, prob.shape_bounds, run.stretch, shape_at_bound, run.shape_held, free_user,
+                       joint=prob.tension is not None)
     joint, jflags = correlated_pairs(unc.names, unc.values, unc.cov, unc.corr, unc.corr_flag)
-    ident = identifiability(mat, free_user, unc, fitted, shift, alt, law)
-    hyst = _hysteresis_fit(processed, fitted, model, unc, bnd, law, alt, shift, order, eq19_factor)
+    ident = identifiability(mat, free_user, unc, fitted, budget, law)
+    hyst = _hysteresis_fit(processed, fitted, model, unc, bnd, law, budget, order, eq19_factor)
     loop = None if hyst is None else hyst.loop()
     metrics = score(processed, fitted, model, loop=loop, order=order, eq19_factor=eq19_factor)
     if hyst is not None:
@@ -859,7 +887,7 @@ def _result(processed, actuator: Actuator, run: _Run, unc: Uncertainty, tension,
         metrics=metrics, converged=run.converged, message=message, nfev=run.nfev, time_s=time.perf_counter() - t0,
         flags=flags, autocorrelation=unc.rho, hysteresis=hyst, material=mat, identifiability=ident,
         alpha0_profile=profile, joint_intervals=joint, covariance=unc.cov,
-        pressure_range_kpa=(float(P.min()), float(P.max())),
+        pressure_range_kpa=(float(P.min()), float(P.max())), uncertainty=budget,
     )
 
 
@@ -885,8 +913,8 @@ def _parameters(prob: _Problem, bnd, unc: Uncertainty, fitted: Actuator, actuato
     return params
 
 
-def _hysteresis_fit(processed, fitted: Actuator, model: str, unc: Uncertainty, bnd, law: str | None, alt: str,
-                    shift: dict[str, float], order: int, eq19_factor: bool) -> HysteresisFit | None:
+def _hysteresis_fit(processed, fitted: Actuator, model: str, unc: Uncertainty, bnd, law: str | None,
+                    budget: UncertaintyBudget, order: int, eq19_factor: bool) -> HysteresisFit | None:
     """The fitted loop with its parameters and the energy-loss ratio it predicts per test (None without a loop)."""
     if law is None:
         return None
@@ -899,7 +927,11 @@ def _hysteresis_fit(processed, fitted: Actuator, model: str, unc: Uncertainty, b
         field_, unit = HYST_PARAMETERS[n]
         hp[n] = Parameter(n, field_, unit, float(unc.values[n]), float(sd[i]) if np.isfinite(sd[i]) else None,
                           bnd[n][0], bnd[n][1], True, math.nan)
-    hyst = HysteresisFit(law, "linear", hp, [], math.nan, alt, {PARAMETERS[k][0]: float(v) for k, v in shift.items()})
+    alt = {"pi": "dahl", "dahl": "pi"}.get(law, "")
+    other = next((m for m in budget.ensemble if m.law == alt), None)  # the shift of 0.3's systematic term
+    shift = {} if other is None else {f: v - float(getattr(fitted, f)) for f, v in other.values.items()
+                                      if f in {PARAMETERS[p][0] for p in PARAMETERS}}
+    hyst = HysteresisFit(law, "linear", hp, [], math.nan, alt if shift else "", shift)
     cycles = predict_cycles(fitted, hyst.loop(), [r.pressure_kpa for r in processed.results], model,
                             order=order, eq19_factor=eq19_factor)
     hyst.energy_loss_ratio = [LossRatio(float(r.pressure_kpa), float(r.energy_loss_ratio), c.energy_loss_ratio)

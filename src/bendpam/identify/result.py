@@ -33,6 +33,7 @@ __all__ = [
     "HYST_PARAMETERS",
     "PARAMETERS",
     "Band",
+    "EnsembleMember",
     "ExtrapolationWarning",
     "FitResult",
     "HysteresisFit",
@@ -42,6 +43,7 @@ __all__ = [
     "Metrics",
     "Parameter",
     "Profile",
+    "UncertaintyBudget",
     "parameter_field",
     "parameter_unit",
 ]
@@ -174,6 +176,8 @@ class MaterialFit:
     shape_at_bound : True when the shape sits on an admissibility bound (set by the rule, not the data).
     shape_identified : True when the data determine the shape (95 % interval within half the width).
     shape_held : the reason the shape was held fixed (a fold, the free list), or "".
+    shape_study : why a narrow interval of the shape is not called determined (the calibration study's coverage
+        for it does not hold, :func:`bendpam.identify.diagnose.study_coverage`), or "".
 
     Examples
     --------
@@ -191,6 +195,12 @@ class MaterialFit:
     shape_at_bound: bool
     shape_identified: bool
     shape_held: str = ""
+    shape_study: str = ""
+
+    @property
+    def shape_narrow(self) -> bool:
+        """Whether the shape's interval is narrow (determined, or narrow but not claimed for the study's sake)."""
+        return bool(self.shape_identified or self.shape_study)
 
     def to_dict(self) -> dict:
         """The fields as a dictionary."""
@@ -201,7 +211,8 @@ class MaterialFit:
         """The material from :meth:`to_dict`'s dictionary."""
         return cls(_num(d["shear_modulus_kpa"]), _opt(d.get("se_shear_modulus_kpa")), _num(d["shape"]),
                    _opt(d.get("se_shape")), _pair(d["shape_bounds"]), _pair(d["stretch_range"]),
-                   bool(d["shape_at_bound"]), bool(d["shape_identified"]), str(d.get("shape_held", "")))
+                   bool(d["shape_at_bound"]), bool(d["shape_identified"]), str(d.get("shape_held", "")),
+                   str(d.get("shape_study", "")))
 
 
 @dataclass
@@ -351,6 +362,73 @@ class HysteresisFit:
 
 
 @dataclass
+class EnsembleMember:
+    """One loop law of the ensemble behind the systematic uncertainty: its fit and its weight.
+
+    ``values`` are the model parameters it gives (``{field: value}``, with ``shear_modulus_kpa`` and
+    ``shape`` when the constants vary), ``nrmse`` the square root of its objective (eq 53).
+
+    >>> m = EnsembleMember("bouc_wen", 0.25, 0.012, {"alpha0_deg": 69.8})
+    >>> EnsembleMember.from_dict(m.to_dict()) == m
+    True
+    """
+
+    law: str
+    weight: float
+    nrmse: float
+    values: dict[str, float]
+
+    def to_dict(self) -> dict:
+        """The member as JSON types."""
+        return {"law": self.law, "weight": self.weight, "nrmse": self.nrmse, "values": dict(self.values)}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> EnsembleMember:
+        """The member from :meth:`to_dict`'s dictionary."""
+        return cls(str(d["law"]), _num(d["weight"]), _num(d["nrmse"]), {k: _num(v) for k, v in d["values"].items()})
+
+
+@dataclass
+class UncertaintyBudget:
+    """The standard errors of a fit in their two parts (``{field: SE}``; the total is their root sum of squares).
+
+    ``statistical`` is the noise's part: resampling the cycles of each test (the exact covariance
+    of a block bootstrap over cycles) where a test has two cycles or more, the sandwich with its
+    AR(1) inflation elsewhere (``resampling`` says which, in words).  ``systematic`` is the loop
+    law's part: the weighted spread over the :class:`EnsembleMember` fits (``ensemble``), weighted by
+    ``weighting``.  Both include ``shear_modulus_kpa`` and ``shape`` when the constants vary.
+
+    >>> b = UncertaintyBudget({"alpha0_deg": 0.03}, {"alpha0_deg": 0.04}, "cycles", "Akaike", [])
+    >>> round(b.total["alpha0_deg"], 3), UncertaintyBudget.from_dict(b.to_dict()) == b
+    (0.05, True)
+    """
+
+    statistical: dict[str, float]
+    systematic: dict[str, float]
+    resampling: str
+    weighting: str
+    ensemble: list[EnsembleMember] = field(default_factory=list)
+
+    @property
+    def total(self) -> dict[str, float]:
+        """``sqrt(statistical^2 + systematic^2)`` per quantity."""
+        return {k: math.hypot(v, self.systematic.get(k, 0.0)) for k, v in self.statistical.items()}
+
+    def to_dict(self) -> dict:
+        """The budget as JSON types."""
+        return {"statistical": dict(self.statistical), "systematic": dict(self.systematic), "total": self.total,
+                "resampling": self.resampling, "weighting": self.weighting,
+                "ensemble": [m.to_dict() for m in self.ensemble]}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> UncertaintyBudget:
+        """The budget from :meth:`to_dict`'s dictionary."""
+        return cls({k: _num(v) for k, v in d["statistical"].items()}, {k: _num(v) for k, v in d["systematic"].items()},
+                   str(d.get("resampling", "")), str(d.get("weighting", "")),
+                   [EnsembleMember.from_dict(m) for m in d.get("ensemble", [])])
+
+
+@dataclass
 class FitResult:
     """Result of :func:`fit`: a value you can print, predict with, plot, save and load.
 
@@ -372,6 +450,8 @@ class FitResult:
     covariance : covariance matrix of the varied parameters (``correlation_names`` order; statistical
         plus systematic), in their units.
     pressure_range_kpa : the tested pressures' range (predictions outside it are extrapolations).
+    uncertainty : :class:`UncertaintyBudget`: the standard errors' statistical and systematic parts, and
+        the ensemble of loop laws behind the latter (None without it).
 
     Examples
     --------
@@ -419,6 +499,7 @@ class FitResult:
     joint_intervals: list[JointInterval] = field(default_factory=list)
     covariance: np.ndarray | None = None
     pressure_range_kpa: tuple[float, float] = (math.nan, math.nan)
+    uncertainty: UncertaintyBudget | None = None
 
     @property
     def loop(self):
@@ -525,6 +606,7 @@ class FitResult:
             "residual_autocorrelation": self.autocorrelation,
             "actuator": self.actuator.to_dict(),
             **({"hysteresis": self.hysteresis.to_dict()} if self.hysteresis is not None else {}),
+            "uncertainty": None if self.uncertainty is None else self.uncertainty.to_dict(),
         }
 
     def to_json(self) -> str:
@@ -582,6 +664,7 @@ class FitResult:
             joint_intervals=[JointInterval.from_dict(j) for j in d.get("joint_intervals", [])],
             covariance=None if cov is None else np.array(cov, dtype=float).reshape(n, n),
             pressure_range_kpa=_pair(d.get("pressure_range_kpa", [None, None])),
+            uncertainty=UncertaintyBudget.from_dict(d["uncertainty"]) if d.get("uncertainty") else None,
         )
 
     @classmethod
@@ -649,6 +732,14 @@ class FitResult:
             lines.append("  energy-loss ratio measured/predicted: " + ", ".join(
                 f"{e.pressure_kpa:g} kPa {100 * e.measured:.1f}/{_pct(e.predicted, 1)}"
                 for e in h.energy_loss_ratio))
+        b = self.uncertainty
+        if b is not None:
+            keys = [k for k in b.statistical if k in (*(v[0] for v in PARAMETERS.values()), "shear_modulus_kpa",
+                                                      "shape")]
+            lines.append("  standard errors, statistical / systematic: " + ", ".join(
+                f"{k} {b.statistical[k]:.2g} / {b.systematic.get(k, 0.0):.2g}" for k in keys))
+            if b.ensemble:
+                lines.append("  loop laws (weight): " + ", ".join(f"{m.law} {m.weight:.2f}" for m in b.ensemble))
         lines += [f"  identifiability: {s}" for s in self.identifiability]
         lines += [f"  note: {f}" for f in self.flags]
         return "\n".join(lines)

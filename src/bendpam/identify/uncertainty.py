@@ -3,23 +3,29 @@
 The weights of the fit normalise each curve (eq 53); they are not inverse noise variances.  So
 :func:`sandwich_covariance` gives each residual group (a curve, a branch, the tension test) its own
 variance, inflated for the lag-1 autocorrelation of its residuals
-(:func:`lag1_autocorrelation`).  :class:`Uncertainty` holds the covariance of the varied
-parameters in their units, to which the loop law's systematic part is added; :func:`material_fit`
-propagates it to the bladder's shear modulus and shape.
+(:func:`lag1_autocorrelation`).  Where a test has two cycles or more, its groups' part comes from
+resampling its cycles instead (a block bootstrap over cycles, through the linearised fit; its
+covariance is computed exactly rather than from random resamples): noise that is not white,
+slow drifts and creep from cycle to cycle widen it as they widen the seed-to-seed spread, while
+the model's own misfit, the same in every cycle, does not (the ensemble of loop laws,
+:mod:`bendpam.identify.ensemble`, answers for that).  :class:`Uncertainty` holds the covariance of
+the varied parameters in their units, statistical and systematic; :func:`material_fit` propagates
+it to the bladder's shear modulus and shape.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 
 from bendpam.errors import FitError
-from bendpam.identify.diagnose import shape_identified
+from bendpam.identify.diagnose import shape_identified, study_coverage
 from bendpam.identify.result import MaterialFit
 from bendpam.physics.actuator import Actuator
 
-__all__ = ["Uncertainty", "lag1_autocorrelation", "material_fit", "sandwich_covariance"]
+__all__ = ["Uncertainty", "lag1_autocorrelation", "material_fit", "material_gradients", "sandwich_covariance"]
 
 
 class Uncertainty:
@@ -42,9 +48,9 @@ class Uncertainty:
     ...                   0.1, 0, {}, 1e-3, 40, 0.95)
     >>> unc.sd.tolist(), round(float(unc.corr[0, 1]), 3)
     ([2.0, 3.0], -0.833)
-    >>> unc.add_systematic({"C10": 6.0})   # a shift of 6 kPa: 6^2 / 3 kPa^2 more variance
-    >>> unc.sd.tolist()
-    [4.0, 3.0]
+    >>> unc.set_systematic(np.diag([12.0, 0.0]))   # 12 kPa^2 more variance of C10
+    >>> unc.sd.tolist(), unc.sd_stat.tolist()
+    ([4.0, 3.0], [2.0, 3.0])
     """
 
     def __init__(self, values, names, cov, rho, nfev, at_bound, ssr, m, corr_flag):
@@ -52,6 +58,7 @@ class Uncertainty:
         self.values = values
         self.names = names
         self.cov_stat = cov
+        self.cov_sys = np.zeros_like(cov)
         self.cov = cov.copy()
         self.rho = rho
         self.nfev = nfev
@@ -65,16 +72,26 @@ class Uncertainty:
         return np.sqrt(np.clip(np.diag(self.cov), 0.0, None))
 
     @property
+    def sd_stat(self) -> np.ndarray:
+        """The statistical part of the standard errors."""
+        return np.sqrt(np.clip(np.diag(self.cov_stat), 0.0, None))
+
+    @property
+    def sd_sys(self) -> np.ndarray:
+        """The systematic part of the standard errors."""
+        return np.sqrt(np.clip(np.diag(self.cov_sys), 0.0, None))
+
+    @property
     def corr(self) -> np.ndarray:
         """Their correlation matrix."""
         sd = self.sd
         with np.errstate(invalid="ignore", divide="ignore"):
             return self.cov / np.outer(sd, sd)
 
-    def add_systematic(self, shift: dict[str, float]) -> None:
-        """Add ``delta delta^T / 3`` for the parameter shifts (:mod:`bendpam.identify.fitting` notes)."""
-        dv = np.array([shift.get(n, 0.0) for n in self.names])
-        self.cov = self.cov_stat + np.outer(dv, dv) / 3.0
+    def set_systematic(self, cov_sys: np.ndarray) -> None:
+        """The systematic covariance (the loop laws' spread, :mod:`bendpam.identify.ensemble`); ``cov`` is the sum."""
+        self.cov_sys = np.asarray(cov_sys, dtype=float)
+        self.cov = self.cov_stat + self.cov_sys
 
 
 def lag1_autocorrelation(resid: np.ndarray, seg: np.ndarray) -> float:
@@ -92,18 +109,32 @@ def lag1_autocorrelation(resid: np.ndarray, seg: np.ndarray) -> float:
     return num / den if den > 0 else 0.0
 
 
-def sandwich_covariance(J: np.ndarray, r: np.ndarray, groups: np.ndarray) -> tuple[np.ndarray, float]:
-    """``B^-1 (sum_g s_g^2 f_g J_g^T J_g) B^-1`` with ``B = J^T J``, and the mean autocorrelation.
+def sandwich_covariance(J: np.ndarray, r: np.ndarray, groups: np.ndarray,
+                        cycles: Sequence[tuple[np.ndarray, np.ndarray]] = (),
+                        offsets: Sequence[tuple[np.ndarray, np.ndarray]] = ()) -> tuple[np.ndarray, float]:
+    """``B^-1 (sum_g meat_g) B^-1`` with ``B = J^T J``, and the mean autocorrelation of the groups.
 
-    Each residual group ``g`` has its own variance ``s_g^2`` (its residuals' mean square, for the
-    degrees of freedom left) and the inflation ``f_g = (1 + rho_g) / (1 - rho_g)`` for the lag-1
-    autocorrelation ``rho_g`` of its residuals (clipped to [0, 0.95]).
+    A residual group ``g`` not covered by ``cycles`` contributes ``s_g^2 f_g J_g^T J_g``: its own
+    variance ``s_g^2`` (its residuals' mean square, for the degrees of freedom left) and the inflation
+    ``f_g = (1 + rho_g) / (1 - rho_g)`` for the lag-1 autocorrelation ``rho_g`` of its residuals
+    (clipped to [0, 0.95]).  Each entry ``(rows, U)`` of ``cycles`` is one test: ``U`` (cycles x rows)
+    the weighted deviation of each of its ``n`` cycles from their mean at the residual rows ``rows``.
+    Resampling its cycles with replacement moves the weighted data by the mean of ``n`` resampled
+    rows of ``U``, whose covariance (times ``n / (n - 1)`` for the resampling's bias) is
+    ``U^T U / (n (n - 1))``: its meat is ``G^T G / (n (n - 1))``, ``G = U J_rows``, the exact
+    covariance of the cycle bootstrap through the linearised fit, and it replaces the sandwich's
+    meat for the groups it covers.  With few cycles that estimate is itself uncertain: it is scaled
+    by ``(t_0.975(nu) / 1.96)^2``, ``nu = sum (n - 1)``, so that +-2 SE keep about 95 %.  Each entry
+    ``(rows, u)`` of ``offsets`` is an offset common to the rows ``rows`` with weighted standard
+    deviations ``u`` (the drift correction's doubt): meat ``g^T g``, ``g = u J_rows``.
 
     Parameters
     ----------
     J : Jacobian of the weighted residuals (rows: residuals, columns: parameters).
     r : the weighted residuals at the optimum.
     groups : the residual group of each row.
+    cycles : the tests whose cycles are resampled (:func:`bendpam.identify.data.cycle_deviations`, weighted).
+    offsets : offsets common to a test's rows (:func:`bendpam.identify.data.drift_offsets`, weighted).
 
     Returns
     -------
@@ -122,47 +153,101 @@ def sandwich_covariance(J: np.ndarray, r: np.ndarray, groups: np.ndarray) -> tup
     >>> cov, rho = sandwich_covariance(J, np.array([0.1, -0.1, -0.1, 0.1]), np.zeros(4, int))
     >>> cov.shape, rho
     ((2, 2), 0.0)
+
+    A mean of two cycles that differ by +-1 at one point: the bootstrap's variance of the mean, 1, times
+    ``(t_0.975(1) / 1.96)^2 = (12.71 / 1.96)^2 = 42.0`` for a single degree of freedom
+
+    >>> one = np.ones((1, 1))
+    >>> cov, _ = sandwich_covariance(one, np.zeros(1), np.zeros(1, int), [(np.array([0]), np.array([[-1.0], [1.0]]))])
+    >>> cov.round(2)
+    array([[42.03]])
     """
+    if not np.all(np.isfinite(J)):
+        raise FitError("the data do not determine the parameters (the Jacobian is not finite at the optimum); "
+                       "hold some of them fixed")
     m = r.size
     B = J.T @ J
-    meat = np.zeros_like(B)
     share = 1.0 - J.shape[1] / max(m, 1)
+    meat, covered = _cycle_meat(J, cycles)
+    for rows, u in offsets:
+        g = u @ J[rows]
+        meat += np.outer(g, g)
     rhos = []
     for g in np.unique(groups):
         sel = groups == g
         ri = r[sel]
-        var_i = float(ri @ ri) / max(share * ri.size, 1.0)
         rho_i = min(max(lag1_autocorrelation(ri, np.zeros(ri.size, int)), 0.0), 0.95)
         rhos.append(rho_i)
+        if covered[sel].all():
+            continue
+        var_i = float(ri @ ri) / max(share * ri.size, 1.0)
         meat += (J[sel].T @ J[sel]) * var_i * (1.0 + rho_i) / (1.0 - rho_i)
     rho = float(np.mean(rhos)) if rhos else 0.0
-    if not np.all(np.isfinite(B)):
-        raise FitError("the data do not determine the parameters (the Jacobian is not finite at the optimum); "
-                       "hold some of them fixed")
     Binv = np.linalg.pinv(B, rcond=1e-13)
     return Binv @ meat @ Binv, rho
 
 
+def _cycle_meat(J: np.ndarray, cycles) -> tuple[np.ndarray, np.ndarray]:
+    """The cycle bootstrap's meat, t-scaled (:func:`sandwich_covariance`), and which rows it covers."""
+    meat = np.zeros((J.shape[1], J.shape[1]))
+    covered = np.zeros(J.shape[0], dtype=bool)
+    dof = 0
+    for rows, U in cycles:
+        n = U.shape[0]
+        G = U @ J[rows]
+        meat += G.T @ G / (n * (n - 1))
+        covered[rows] = True
+        dof += n - 1
+    if dof:
+        from scipy.stats import t as student
+
+        meat *= (float(student.ppf(0.975, dof)) / 1.96) ** 2
+    return meat, covered
+
+
 def material_fit(fitted: Actuator, unc: Uncertainty, shape_bounds, stretch, at_bound: bool, held: str,
-                 free: list[str]) -> MaterialFit | None:
+                 free: list[str], *, joint: bool = False) -> MaterialFit | None:
     """The bladder's shear modulus ``2 (C10 + C01)`` and shape ``C01 / (C10 + C01)`` with their standard errors.
 
     By the delta method from ``unc``; None when neither constant is in ``free``.  ``shape_bounds``
     and ``stretch`` are the admissible shapes and the stretches they hold over, ``at_bound`` whether
-    the shape sits on one of them, ``held`` why it was held fixed ("" if not).
+    the shape sits on one of them, ``held`` why it was held fixed ("" if not).  A narrow interval
+    of the shape is called determined only where the calibration study's coverage for it holds
+    (:func:`~bendpam.identify.diagnose.study_coverage`), unless a tension test was fitted with the
+    curves (``joint``), which the study does not cover.
 
     >>> import bendpam
     >>> act = bendpam.physics.presets.be_pam().replace(C10_kpa=100.0, C01_kpa=300.0)
     >>> unc = Uncertainty({}, ["C10", "C01"], np.array([[4.0, -5.0], [-5.0, 9.0]]), 0.0, 0, {}, 0.0, 40, 0.95)
     >>> mat = material_fit(act, unc, (-0.15, 1.07), (0.6, 1.6), False, "", ["C10", "C01"])
-    >>> mat.shear_modulus_kpa, round(mat.se_shear_modulus_kpa, 3), mat.shape, mat.shape_identified
+    >>> mat.shear_modulus_kpa, round(mat.se_shear_modulus_kpa, 3), mat.shape, mat.shape_narrow
     (800.0, 3.464, 0.75, True)
     """
     if "C10" not in free and "C01" not in free:
         return None
     c10, c01 = fitted.C10_kpa, fitted.C01_kpa
     S = c10 + c01
-    names = unc.names
+    g_mu, g_b = material_gradients(fitted, unc.names)
+    se_mu = math.sqrt(max(float(g_mu @ unc.cov @ g_mu), 0.0))
+    se_b = math.sqrt(max(float(g_b @ unc.cov @ g_b), 0.0))
+    identified = shape_identified(se_b, shape_bounds, at_bound, held)
+    why = ""
+    if identified and not joint:
+        identified, why = study_coverage()
+    return MaterialFit(2.0 * S, se_mu, c01 / S, se_b, (float(shape_bounds[0]), float(shape_bounds[1])),
+                       (float(stretch[0]), float(stretch[1])), bool(at_bound), identified, held, why)
+
+
+def material_gradients(fitted: Actuator, names: list[str]) -> tuple[np.ndarray, np.ndarray]:
+    """Gradients of the shear modulus ``2 (C10 + C01)`` and the shape ``C01 / (C10 + C01)`` in the varied ``names``.
+
+    >>> import bendpam
+    >>> act = bendpam.physics.presets.be_pam().replace(C10_kpa=100.0, C01_kpa=300.0)
+    >>> [g.tolist() for g in material_gradients(act, ["alpha0", "C10", "C01"])]
+    [[0.0, 2.0, 2.0], [0.0, -0.001875, 0.000625]]
+    """
+    c10, c01 = fitted.C10_kpa, fitted.C01_kpa
+    S = c10 + c01
     g_mu = np.zeros(len(names))
     g_b = np.zeros(len(names))
     if "C10" in names:
@@ -171,8 +256,4 @@ def material_fit(fitted: Actuator, unc: Uncertainty, shape_bounds, stretch, at_b
     if "C01" in names:
         g_mu[names.index("C01")] = 2.0
         g_b[names.index("C01")] = c10 / S**2
-    se_mu = math.sqrt(max(float(g_mu @ unc.cov @ g_mu), 0.0))
-    se_b = math.sqrt(max(float(g_b @ unc.cov @ g_b), 0.0))
-    identified = shape_identified(se_b, shape_bounds, at_bound, held)
-    return MaterialFit(2.0 * S, se_mu, c01 / S, se_b, (float(shape_bounds[0]), float(shape_bounds[1])),
-                       (float(stretch[0]), float(stretch[1])), bool(at_bound), identified, held)
+    return g_mu, g_b

@@ -303,10 +303,34 @@ def _fit_detail(m: str, res) -> dict:
          Markup("M<sub>b</sub>, model (N·mm)"), Markup("k′<sub>free</sub>, data (1/mm)"),
          Markup("k′<sub>free</sub>, model (1/mm)")], rows)
     return {"model": m, "title": f"{label.capitalize()} model", "diagnosis": diagnosis(m, res),
+            "uncertainty": _uncertainty_tables(m, label, res),
             "notes": fit_notes(res), "params": _params_table(f"params-{m}", f"Parameters of the {label} model fit",
                                                               res.parameters),
             "correlation": correlation, "metrics": metrics,
             "figures": (f"fig-alpha0-{m}", f"fig-band-{m}", f"fig-figure7-{m}")}
+
+
+def _uncertainty_tables(m: str, label: str, res) -> list[_Table]:
+    """The standard errors in their statistical and systematic parts, and the loop laws behind the latter."""
+    b = getattr(res, "uncertainty", None)
+    if b is None:
+        return []
+    rows = []
+    for f, se in b.statistical.items():
+        sys_, tot = b.systematic.get(f, 0.0), b.total[f]
+        rows.append(_Row([_td(fmt_value(se), se), _td(fmt_value(sys_), sys_), _td(fmt_value(tot), tot)],
+                         Markup(symbol(f).heading())))
+    out = [_Table(f"uncertainty-{m}", f"Standard errors of the {label} model fit: statistical ({b.resampling}) and "
+                  "systematic (the loop law)", ["", "Statistical", "Systematic", "Total"], rows)]
+    if b.ensemble:
+        keys = list(b.ensemble[0].values)
+        rows = [_Row([_td(fmt_value(e.weight), e.weight), _td(fmt_pct(e.nrmse), e.nrmse)]
+                     + [_td(fmt_value(e.values.get(k)), e.values.get(k)) for k in keys],
+                     LAW_LABEL.get(e.law, e.law)) for e in b.ensemble]
+        out.append(_Table(f"ensemble-{m}", f"The loop laws fitted to the same data ({b.weighting})",
+                          ["Loop law", "Weight", "NRMSE of both branches (%)",
+                           *(Markup(symbol(k).heading()) for k in keys)], rows))
+    return out
 
 
 def _hysteresis_context(hyst: Mapping, hyst_error: str | None, separate, mean_ratio: float) -> dict:

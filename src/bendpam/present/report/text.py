@@ -40,7 +40,9 @@ __all__ = [
 
 #: The models and loop laws by name, as the page writes them.
 MODEL_LABEL = {"energy": "energy", "force_balance": "force-balance"}
-LAW_LABEL = {"pi": "Prandtl-Ishlinskii", "dahl": "Dahl"}
+LAW_LABEL = {"pi": "Prandtl-Ishlinskii", "dahl": "Dahl", "bouc_wen": "Bouc-Wen", "maxwell_slip": "Maxwell-slip",
+             "stiction": "breakaway (stiction)",
+             "viscous": "viscous (constant crosshead speed)", "viscous_period": "viscous (constant cycle period)"}
 
 
 def escape(x) -> str:
@@ -245,6 +247,8 @@ SYMBOLS: dict[str, Symbol] = {
     "P_tested": Symbol("P_tested", "P<sub>tested</sub>", "kPa", "pressures of the tests the actuator was fitted "
                        "on (lowest, highest)"),
     "fit": Symbol("fit", "fit", "", "the fit the actuator comes from (fit.json hash, processed set, date, version)"),
+    "shape": Symbol("C₀₁/(C₁₀ + C₀₁)", "C<sub>01</sub>/(C<sub>10</sub> + C<sub>01</sub>)", "",
+                    "shape of the bladder's strain energy"),
 }
 _FIELD_KEY = {
     "alpha0_deg": "alpha0", "R0_mm": "R0", "t0_mm": "t0", "L0_mm": "L0", "frame_thickness_mm": "h_f",
@@ -253,7 +257,7 @@ _FIELD_KEY = {
     "bladder_area_mm2": "A_bl", "frame_inertia_mm4": "I_f", "frame_stiffness_nmm2": "EI_f",
     "shear_modulus_kpa": "mu", "theta_h_deg": "theta_h", "a0_nmm": "a0", "a1_nmm_per_kpa": "a1",
     "frame_strength_mpa": "sigma_f", "bladder_stretch_limit": "lambda_max", "max_pressure_kpa": "P_max",
-    "tested_pressure_kpa": "P_tested", "fit_identity": "fit",
+    "tested_pressure_kpa": "P_tested", "fit_identity": "fit", "shape": "shape",
 }
 #: Unit suffixes of field names (longest first) -> the unit as shown.
 _UNIT_SUFFIX = (("_nmm_per_kpa", "N·mm/kPa"), ("_per_mm", "1/mm"), ("_nmm2", "N·mm²"), ("_nmm", "N·mm"),

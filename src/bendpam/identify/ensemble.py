@@ -1,0 +1,205 @@
+"""The model's own doubt: an ensemble of loop laws, weighted by how well each fits (issue 23 item 2).
+
+No loop law is known to be the actuator's.  With a loop model the fit is repeated with every law
+of :data:`bendpam.physics.hysteresis.ENSEMBLE` (Prandtl-Ishlinskii, Dahl, Bouc-Wen, Maxwell-slip
+and a rate-dependent viscous loop), each warm-started from the fit and with the quasi-static
+parameters free as in it; the spread of the parameters across the laws is the systematic part of
+their uncertainty.
+
+Weights (Akaike weights on an effective number of points)
+    Each law has the same parameters (the loop's angle and its two amplitudes), so Akaike's
+    criterion compares the sums of squares alone: ``AIC_i = m_eff ln(SSR_i) + const``.  The
+    residuals of a curve are strongly correlated (the processing's low-pass filter, and the
+    model's own misfit), so ``m`` points carry the information of fewer independent ones:
+    ``m_eff = sum_g n_g (1 - rho_g) / (1 + rho_g)`` over the residual groups (curves or branches)
+    with their lag-1 autocorrelation ``rho_g`` (clipped to [0, 0.95]) at the reported fit.
+    ``w_i = exp(-Delta_i / 2) / sum_j exp(-Delta_j / 2)`` with ``Delta_i = m_eff ln(SSR_i / SSR_min)``:
+    a law that fits worse gets less weight, one that fits much worse none.
+
+Systematic covariance
+    The reported values are the default law's; the systematic covariance is the weighted spread
+    of the laws' values ABOUT them, ``sum_i w_i (v_i - v_0)(v_i - v_0)^T``: if a better-fitting law
+    moves a parameter, the reported value may be off by as much.
+
+The rate-dependent law
+    A viscous loop (a dashpot with a Maxwell element, :class:`~bendpam.physics.hysteresis.ViscousLoop`)
+    needs the bending rate.  Testing machines drive the crosshead at a constant speed, so the rate
+    along a branch follows the fixture's kinematics (eq 6 and 8,
+    :func:`bendpam.identify.data.relative_rate`): the dashpot's moment is that rate profile times
+    a Dahl approach over ``theta_c`` (the Maxwell element's relaxation at that speed), the same for
+    every test (``"viscous"``).  Machines may instead cycle at a fixed period (displacement control
+    at a set frequency); the processed set does not say which, so the ensemble also holds
+    ``"viscous_period"``: each test at its own cycle period
+    (:func:`bendpam.identify.data.cycle_period_s`; a common period when the samples were not kept),
+    its rate ``2 span / period``, ``theta_c`` that of the fastest test.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from bendpam.identify.data import FitData
+from bendpam.identify.result import PARAMETERS, EnsembleMember, UncertaintyBudget, parameter_field
+from bendpam.identify.uncertainty import Uncertainty, lag1_autocorrelation, material_gradients
+
+__all__ = ["akaike_weights", "effective_points", "steady_z", "systematic_covariance", "uncertainty_budget"]
+
+
+def steady_z(law: str, theta_deg: float, d: FitData) -> np.ndarray:
+    """The loop variable ``z`` of every point of ``d`` on the steady cycle of ``law`` (angle in degrees).
+
+    ``d`` holds both branches (:func:`bendpam.identify.data.branch_data`); the unloading branch
+    (``branch < 0``) leaves the blocked state.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from types import SimpleNamespace as NS
+    >>> d = NS(branch=np.array([1, -1]), delta=np.array([0.0, 0.0]), span=np.array([0.2, 0.2]), period_s=None, seg=None)
+    >>> steady_z("dahl", 5.0, d).round(3).tolist()   # turning points +-(1 - E)/(1 + E), E = exp(-0.2 rad / 5 deg)
+    [0.816, -0.816]
+    """
+    from bendpam.physics.hysteresis import ViscousLoop, make_law
+
+    assert d.branch is not None and d.delta is not None and d.span is not None, "a loop fit is built on branch data"
+    if law == "viscous" and getattr(d, "rate", None) is not None:
+        # constant crosshead speed: the dashpot's moment follows the fixture's rate profile, and the
+        # Maxwell element relaxes over theta_c (the same for every test: the same speed)
+        z_away, z_back = make_law("dahl", theta_deg).steady_branches(d.delta, d.span)
+        return d.rate * np.where(d.branch < 0, z_away, z_back)
+    if law in ("viscous", "viscous_period"):
+        period = _periods(d)
+        rate = 2.0 * d.span / period
+        w_ref = float(np.max(rate))
+        z_away, z_back = ViscousLoop(math.radians(theta_deg) / w_ref, w_ref).steady_branches(d.delta, d.span, period)
+    else:
+        z_away, z_back = make_law(law, theta_deg).steady_branches(d.delta, d.span)
+    return np.where(d.branch < 0, z_away, z_back)
+
+
+def _periods(d: FitData) -> np.ndarray:
+    """Each point's cycle period (s): its test's, or 1 s for every test when any is not known."""
+    per = getattr(d, "period_s", None)
+    if per is None or d.seg is None or not np.all(np.isfinite(per) & (np.asarray(per) > 0)):
+        return np.ones(np.asarray(d.span).shape)
+    return np.asarray(per, dtype=float)[d.seg]
+
+
+def effective_points(r: np.ndarray, groups: np.ndarray) -> float:
+    """``sum_g n_g (1 - rho_g) / (1 + rho_g)``: the independent points worth the correlated residuals ``r``.
+
+    >>> effective_points(np.array([1.0, -1.0, 1.0, -1.0]), np.zeros(4, int))   # rho < 0 counts as 0
+    4.0
+    """
+    total = 0.0
+    for g in np.unique(groups):
+        rg = r[groups == g]
+        rho = min(max(lag1_autocorrelation(rg, np.zeros(rg.size, int)), 0.0), 0.95)
+        total += rg.size * (1.0 - rho) / (1.0 + rho)
+    return max(total, 1.0)
+
+
+def akaike_weights(ssr, m_eff: float) -> np.ndarray:
+    """Akaike weights of models with equal parameter counts from their sums of squares.
+
+    >>> akaike_weights([1.0, 1.0], 50.0).tolist()
+    [0.5, 0.5]
+    >>> w = akaike_weights([1.0, 1.1], 50.0)   # 10 % more SSR on 50 effective points: Delta = 4.77
+    >>> round(float(w[1]), 3)
+    0.084
+    """
+    s = np.asarray(ssr, dtype=float)
+    ok = np.isfinite(s) & (s > 0)
+    w = np.zeros(s.size)
+    if not ok.any():
+        return w
+    delta = m_eff * np.log(s[ok] / s[ok].min())
+    e = np.exp(-0.5 * delta)
+    w[ok] = e / e.sum()
+    return w
+
+
+def systematic_covariance(reference: np.ndarray, values: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    """``sum_i w_i (v_i - v_0)(v_i - v_0)^T``: the weighted spread of the laws' values about the reported ones.
+
+    ``values`` has one row per law (NaN rows, failed refits, are left out), ``reference`` is ``v_0``.
+
+    >>> systematic_covariance(np.array([1.0]), np.array([[1.0], [3.0]]), np.array([0.5, 0.5])).tolist()
+    [[2.0]]
+    """
+    v = np.asarray(values, dtype=float) - np.asarray(reference, dtype=float)[None, :]
+    ok = np.all(np.isfinite(v), axis=1)
+    w = np.asarray(weights, dtype=float)[ok]
+    v = v[ok]
+    if w.sum() <= 0:
+        return np.zeros((v.shape[1], v.shape[1]))
+    w = w / w.sum()
+    return (v * w[:, None]).T @ v
+
+
+def _material(values: dict[str, float], fitted) -> tuple[float, float]:
+    c10 = values.get("C10", fitted.C10_kpa)
+    c01 = values.get("C01", fitted.C01_kpa)
+    S = c10 + c01
+    return 2.0 * S, (c01 / S if S else math.nan)
+
+
+def uncertainty_budget(unc: Uncertainty, fitted, fits: dict[str, tuple[dict[str, float], float]], r: np.ndarray,
+                       groups: np.ndarray, law: str | None, n_resampled: int) -> UncertaintyBudget:
+    """Set ``unc``'s systematic covariance from the loop laws' fits and return the two parts of the errors.
+
+    Parameters
+    ----------
+    unc : the fit's :class:`~bendpam.identify.uncertainty.Uncertainty` (statistical); its systematic
+        covariance is set here.
+    fitted : the fitted actuator (for the shear modulus and shape of the ensemble's members).
+    fits : ``{law: (values by short name, weighted sum of squares)}``, the reported law first; empty:
+        no ensemble (no loop model, or switched off).
+    r, groups : the reported fit's weighted residuals and their groups (for the effective points).
+    law : the reported law (None: mean curves).
+    n_resampled : how many tests had their cycles resampled.
+
+    Examples
+    --------
+    >>> import numpy as np, bendpam
+    >>> from bendpam.identify.uncertainty import Uncertainty
+    >>> unc = Uncertainty({"alpha0": 70.0}, ["alpha0"], np.array([[0.0009]]), 0.0, 0, {}, 0.0, 40, 0.95)
+    >>> fits = {"pi": ({"alpha0": 70.0}, 1.0), "dahl": ({"alpha0": 70.4}, 1.0)}
+    >>> b = uncertainty_budget(unc, bendpam.physics.presets.be_pam(), fits, np.ones(40), np.zeros(40, int), "pi", 0)
+    >>> b.statistical, b.systematic, [m.weight for m in b.ensemble]     # equal fits: half the weight each
+    ({'alpha0_deg': 0.03}, {'alpha0_deg': 0.2}, [0.5, 0.5])
+    """
+    names = unc.names
+    members: list[EnsembleMember] = []
+    weighting = ""
+    if fits:
+        m_eff = effective_points(r, groups)
+        laws = list(fits)
+        w = akaike_weights([fits[k][1] for k in laws], m_eff)
+        ref = np.array([unc.values[n] for n in names])
+        V = np.array([[fits[k][0].get(n, math.nan) if n in PARAMETERS else ref[j] for j, n in enumerate(names)]
+                      for k in laws])
+        unc.set_systematic(systematic_covariance(ref, V, w))
+        for k, wk in zip(laws, w, strict=True):
+            vals = {parameter_field(n): float(fits[k][0][n]) for n in names if n in PARAMETERS}
+            if "C10" in names or "C01" in names:
+                vals["shear_modulus_kpa"], vals["shape"] = _material(fits[k][0], fitted)
+            members.append(EnsembleMember(k, float(wk), math.sqrt(max(fits[k][1], 0.0)), vals))
+        weighting = (f"Akaike weights on {m_eff:.0f} effective points (the {r.size} residuals discounted for their "
+                     "lag-1 autocorrelation); systematic part: the weighted spread of the laws' values about the "
+                     f"reported ({law}) fit")
+    stat = {parameter_field(n): float(v) for n, v in zip(names, unc.sd_stat, strict=True)}
+    sys_ = {parameter_field(n): float(v) for n, v in zip(names, unc.sd_sys, strict=True)}
+    if "C10" in names or "C01" in names:
+        g_mu, g_b = material_gradients(fitted, names)
+        for key, g in (("shear_modulus_kpa", g_mu), ("shape", g_b)):
+            stat[key] = math.sqrt(max(float(g @ unc.cov_stat @ g), 0.0))
+            sys_[key] = math.sqrt(max(float(g @ unc.cov_sys @ g), 0.0))
+    resampling = (f"the cycles of {n_resampled} test(s) resampled (a block bootstrap over cycles through the "
+                  "linearised fit, its covariance computed exactly); the sandwich with its AR(1) inflation for the "
+                  "curves of single-cycle tests and a tension test" if n_resampled else
+                  "the sandwich with its AR(1) inflation for every curve (no cycles resampled: single-cycle tests, "
+                  "or a shape at an admissibility bound, where the model's misfit is treated as noise)")
+    return UncertaintyBudget(stat, sys_, resampling, weighting, members)

@@ -1,0 +1,274 @@
+"""The ensemble of loop laws behind the fit's systematic uncertainty (issue 23 item 2).
+
+Each new law alone, against hand-derived numbers; then the ensemble's weights, the cycle bootstrap
+and how both parts reach fit.json.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+from bendpam.physics.hysteresis import BoucWen, DahlLaw, MaxwellSlip, PrandtlIshlinskii, ViscousLoop, make_law
+
+
+def triangle(span, cycles, n=400, start=0.0):
+    """A path blocked -> free -> blocked: ``cycles`` triangles of amplitude ``span`` from ``start``."""
+    up = np.linspace(0.0, span, n + 1)
+    one = np.concatenate([up, span - up[1:]])
+    return start + np.concatenate([one] + [one[1:]] * (cycles - 1))
+
+
+def loop_area(theta, z):
+    """The enclosed area of the last cycle of a closed path (shoelace formula)."""
+    return 0.5 * abs(float(np.sum(theta[:-1] * z[1:] - theta[1:] * z[:-1])))
+
+
+# --------------------------------------------------------------------------------------------
+# Bouc-Wen (exponent 2, beta = gamma = 1/2)
+# --------------------------------------------------------------------------------------------
+def test_bouc_wen_saturates_at_one_and_returns_linearly():
+    law = BoucWen(0.1)
+    th = np.array([0.0, 0.1, 0.2, 5.0, 4.95, 4.9, 4.85])
+    z = law.z_path(th)
+    assert z[1] == pytest.approx(math.tanh(1.0)) and z[2] == pytest.approx(math.tanh(2.0))
+    assert z[3] == pytest.approx(1.0, abs=1e-15)  # saturated: tanh(50)
+    # back from z = 1 the slope is -1/theta_c until z = 0, then tanh: 0.5, 0, -tanh(0.5)
+    assert z[4:].tolist() == pytest.approx([0.5, 0.0, -math.tanh(0.5)], abs=1e-12)
+
+
+def test_bouc_wen_steady_cycle_is_the_path_after_many_cycles():
+    law, span = BoucWen(0.08), 0.3
+    th = triangle(span, 6)
+    z = law.z_path(th, -1.0)
+    n = 400
+    away, back = law.steady_branches(np.linspace(0.0, span, n + 1), span)
+    last_up, last_down = z[-2 * n - 1: -n], z[-n - 1:]
+    assert np.allclose(last_up, away, atol=1e-9) and np.allclose(last_down, back, atol=1e-9)
+    # turning value z_b = tanh(span / theta_c - z_b)
+    zb = away[-1]
+    assert zb == pytest.approx(math.tanh(span / 0.08 - zb), abs=1e-12)
+
+
+# --------------------------------------------------------------------------------------------
+# Maxwell-slip (equal slip moments)
+# --------------------------------------------------------------------------------------------
+def test_maxwell_slip_energy_loss_per_cycle_is_the_sum_of_the_parallelograms():
+    law = MaxwellSlip(4.0, n=2)  # slip angles r = 0.5 and 1.5 rad
+    span = 4.0
+    th = triangle(span, 3, n=4000)
+    z = law.z_path(th, -1.0)
+    last = th[-8001:], z[-8001:]
+    # element j dissipates 2 span - 4 r_j: (8 - 2 + 8 - 6) / 2 = 4
+    assert loop_area(*last) == pytest.approx(4.0, rel=1e-6)
+    # a loop narrower than both elements' 2 r_j dissipates nothing
+    small = triangle(0.9, 2, n=100)
+    assert loop_area(small[-201:], law.z_path(small, -1.0)[-201:]) == pytest.approx(0.0, abs=1e-12)
+
+
+def test_maxwell_slip_steady_branches_match_the_path_and_differ_from_pi():
+    law, span = MaxwellSlip(0.2, n=16), 0.15
+    th = triangle(span, 3)
+    z = law.z_path(th, -1.0)
+    away, back = law.steady_branches(np.linspace(0.0, span, 401), span)
+    assert np.allclose(z[-801:-400], away, atol=1e-12) and np.allclose(z[-401:], back, atol=1e-12)
+    # the stiff elements slip first: steeper than PI right after the reversal
+    pi_away, _ = PrandtlIshlinskii(0.2, 16).steady_branches(np.array([0.01]), span)
+    assert law.steady_branches(np.array([0.01]), span)[0][0] > pi_away[0] + 0.05
+
+
+# --------------------------------------------------------------------------------------------
+# the rate-dependent viscous loop (Maxwell fluid)
+# --------------------------------------------------------------------------------------------
+def test_viscous_loop_relaxes_to_the_rate_and_its_steady_cycle_matches_the_path():
+    law = ViscousLoop(tau_s=2.0, omega_ref_rad_s=0.05)
+    t = np.linspace(0.0, 10.0, 1001)
+    z = law.z_path(0.02 * t, t)
+    assert np.allclose(z, 0.4 * (1.0 - np.exp(-t / 2.0)), atol=1e-12)  # exact for a constant rate
+    span, period = 0.3, 20.0
+    th = triangle(span, 5, n=500)
+    tt = np.arange(th.size) * (period / 1000.0)
+    zp = law.z_path(th, tt)
+    away, back = law.steady_branches(np.linspace(0.0, span, 501), span, period)
+    assert np.allclose(zp[-1001:-500], away, atol=1e-6) and np.allclose(zp[-501:], back, atol=1e-6)
+
+
+def test_viscous_loop_widens_with_the_rate():
+    law = ViscousLoop(tau_s=1.0, omega_ref_rad_s=0.1)
+    d = np.linspace(0.0, 0.2, 201)
+    slow = law.steady_branches(d, 0.2, 40.0)[0]
+    fast = law.steady_branches(d, 0.2, 4.0)[0]
+    assert fast[-1] > 5 * slow[-1]  # ten times the rate: a loop ~ten times as high, a little rounder
+
+
+def test_unequal_times_and_unknown_laws_are_refused():
+    from bendpam.errors import InputError
+
+    with pytest.raises(InputError, match="equally spaced"):
+        ViscousLoop().z_path(np.array([0.0, 0.1, 0.2]), np.array([0.0, 1.0, 3.0]))
+    with pytest.raises(InputError, match="bouc_wen"):
+        make_law("lugre", 5.0)
+    assert isinstance(make_law("bouc-wen", 5.0), BoucWen) and isinstance(make_law("maxwell_slip", 5.0), MaxwellSlip)
+    assert isinstance(make_law("dahl", 5.0), DahlLaw)
+
+
+# --------------------------------------------------------------------------------------------
+# breakaway friction (stiction)
+# --------------------------------------------------------------------------------------------
+def test_breakaway_sticks_peaks_at_the_static_level_and_decays_to_the_kinetic():
+    from bendpam.physics.hysteresis import Breakaway
+
+    law = Breakaway(0.05, ratio=1.6, decay=3.0)
+    d = np.linspace(0.0, 1.0, 2001)
+    z = law.z_path(d, -1.0)
+    # stick: slope 1.6 / 0.05 = 32 /rad from -1 to 1.6, i.e. for 2.6 / 32 rad
+    i_peak = int(np.argmax(z))
+    assert z[i_peak] == pytest.approx(1.6, abs=32 * 5e-4) and d[i_peak] == pytest.approx(2.6 / 32, abs=1e-3)
+    assert z[-1] == pytest.approx(1.0 + 0.6 * math.exp(-(1.0 - 2.6 / 32) / 0.15), rel=1e-9)
+    # steady cycle = the path after a few cycles
+    span = 0.4
+    th = triangle(span, 4)
+    zp = law.z_path(th, -1.0)
+    away, back = law.steady_branches(np.linspace(0.0, span, 401), span)
+    assert np.allclose(zp[-801:-400], away, atol=1e-9) and np.allclose(zp[-401:], back, atol=1e-9)
+    # a loop too narrow to break away stays elastic: turning value 1.6 span / (2 x 0.05)
+    small = law.steady_branches(np.array([0.0, 0.02]), 0.02)[0]
+    assert small.tolist() == pytest.approx([-0.32, 0.32], abs=1e-12)
+
+
+# --------------------------------------------------------------------------------------------
+# the ensemble's weights and systematic part
+# --------------------------------------------------------------------------------------------
+def test_akaike_weights_give_less_weight_to_a_law_that_fits_worse():
+    from bendpam.identify.ensemble import akaike_weights, systematic_covariance
+
+    w = akaike_weights([1.0, 1.05, 1.3, math.nan], 40.0)
+    assert w.sum() == pytest.approx(1.0) and w[0] > w[1] > w[2] > 0 and w[3] == 0
+    # Delta = m_eff ln(SSR_i / SSR_min): hand numbers
+    assert w[1] / w[0] == pytest.approx(math.exp(-0.5 * 40.0 * math.log(1.05)))
+    # the spread is about the reported values (row 0), not the weighted mean
+    cov = systematic_covariance(np.array([0.0]), np.array([[0.0], [1.0], [np.nan]]), np.array([0.5, 0.5, 0.0]))
+    assert cov[0, 0] == pytest.approx(0.5)
+
+
+@pytest.fixture(scope="module")
+def loop_fit():
+    """One fit of a processed set made with an independent Bouc-Wen loop (tests/independent_loops.py)."""
+    from bendpam import presets
+    from bendpam.identify.fitting import fit
+    from independent_loops import BoucWen, make_truth, noisy_set
+
+    base = presets.get("be-pam", "energy")
+    S = base.C10_kpa + base.C01_kpa
+    truth = base.replace(alpha0_deg=base.alpha0_deg + 0.8, C10_kpa=0.4 * S, C01_kpa=0.6 * S)
+    lt = make_truth(truth, [100, 150, 200], "energy", law=BoucWen())
+    return fit(noisy_set(lt, seed=3), base, profile_points=0), truth
+
+
+def test_fit_reports_the_ensemble_and_both_parts(loop_fit, tmp_path):
+    from bendpam.identify.result import FitResult
+    from bendpam.physics.hysteresis import ENSEMBLE
+
+    r, truth = loop_fit
+    b = r.uncertainty
+    assert b.ensemble[0].law == "pi" and sorted(m.law for m in b.ensemble) == sorted(ENSEMBLE)
+    assert sum(m.weight for m in b.ensemble) == pytest.approx(1.0)
+    # a law that fits worse gets less weight
+    by_fit = sorted(b.ensemble, key=lambda m: m.nrmse)
+    assert by_fit[0].weight >= by_fit[-1].weight and by_fit[-1].weight < 0.5
+    # the parameter's stderr is the root sum of squares of the two parts
+    for name, field in (("alpha0", "alpha0_deg"), ("C10", "C10_kpa")):
+        assert r.parameters[name].stderr == pytest.approx(math.hypot(b.statistical[field], b.systematic[field]))
+    assert r.material.se_shear_modulus_kpa == pytest.approx(b.total["shear_modulus_kpa"])
+    # fit.json has both parts, and they come back
+    r.save(tmp_path)
+    import json
+
+    d = json.loads((tmp_path / "fit.json").read_text())["uncertainty"]
+    assert set(d) >= {"statistical", "systematic", "total", "ensemble", "resampling", "weighting"}
+    assert d["statistical"]["alpha0_deg"] > 0 and "alpha0_deg" in d["systematic"]
+    back = FitResult.load(tmp_path)
+    assert back.uncertainty == b and back.to_json() == r.to_json()
+
+
+def test_cycle_resampling_sees_coloured_noise_wider_than_white():
+    """The cycle bootstrap's standard error of a mean: larger for AR(1) noise than for white noise of equal variance."""
+    from hypothesis import given, settings
+    from hypothesis import strategies as st
+    from scipy.signal import lfilter
+
+    from bendpam.identify.uncertainty import sandwich_covariance
+
+    n_cyc, m = 12, 200
+    J = np.ones((m, 1)) / m  # the parameter is the mean of the points
+
+    def se(E):
+        cov, _ = sandwich_covariance(J, np.zeros(m), np.zeros(m, int), [(np.arange(m), E - E.mean(axis=0))])
+        return math.sqrt(cov[0, 0])
+
+    @settings(max_examples=8, deadline=None, derandomize=True)
+    @given(rho=st.floats(0.6, 0.95), seed=st.integers(0, 2**31 - 1))
+    def check(rho, seed):
+        e = np.random.default_rng(seed).standard_normal((n_cyc, m))
+        coloured = lfilter([math.sqrt(1 - rho**2)], [1.0, -rho], e, axis=1)  # unit variance AR(1)
+        assert se(coloured) > 1.5 * se(e)
+
+    check()
+
+
+def test_a_narrow_shape_is_determined_only_where_the_study_covers_it(tmp_path):
+    import json
+
+    from bendpam import presets
+    from bendpam.identify.diagnose import _material_sentences, study_coverage
+    from bendpam.identify.uncertainty import Uncertainty, material_fit
+
+    good, bad = tmp_path / "good.json", tmp_path / "bad.json"
+    good.write_text(json.dumps({"cases": {"none": {"narrow": 10, "covered": 10}, "stiction": {"narrow": 0,
+                                                                                               "covered": 0}}}))
+    bad.write_text(json.dumps({"cases": {"none": {"narrow": 10, "covered": 10}, "drift": {"narrow": 5,
+                                                                                           "covered": 3}}}))
+    assert study_coverage(str(good)) == (True, "")
+    holds, why = study_coverage(str(bad))
+    assert not holds and "13 of 15" in why and "drift: 3 of 5" in why
+    assert study_coverage(str(tmp_path / "missing.json"))[0] is False
+    act = presets.be_pam().replace(C10_kpa=100.0, C01_kpa=300.0)
+    unc = Uncertainty({}, ["C10", "C01"], np.array([[4.0, -5.0], [-5.0, 9.0]]), 0.0, 0, {}, 0.0, 40, 0.95)
+    mat = material_fit(act, unc, (-0.15, 1.07), (0.6, 1.6), False, "", ["C10", "C01"])
+    # the shipped record decides; either way a narrow interval is narrow, and the words follow the decision
+    holds, why = study_coverage()
+    assert mat.shape_narrow and mat.shape_identified == holds and mat.shape_study == why
+    words = " ".join(_material_sentences(mat, True))
+    assert ("is determined too" in words) if holds else ("ridge" in words and "not claimed" in words)
+    # a joint fit with a tension test is judged by its interval alone
+    assert material_fit(act, unc, (-0.15, 1.07), (0.6, 1.6), False, "", ["C10", "C01"], joint=True).shape_identified
+
+
+def test_the_shipped_coverage_record_is_read_and_the_tool_writes_it(tmp_path):
+    import json
+    import sys
+    from pathlib import Path
+
+    from bendpam.identify.diagnose import SHAPE_COVERAGE_FILE, study_coverage
+
+    assert "missing" not in study_coverage()[1]  # the package ships the record
+    assert "cases" in json.loads(SHAPE_COVERAGE_FILE.read_text())
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tools"))
+    try:
+        from shape_coverage import coverage_record, main
+    finally:
+        sys.path.pop(0)
+    study = {"meta": {"commit": "c"}, "runs": [
+        {"case": "drift", "variant": "linear", "shape_narrow": True, "shape": 0.60, "se_shape": 0.01,
+         "truth": {"shape": 0.61}},
+        {"case": "drift", "variant": "linear", "shape_narrow": True, "shape": 0.60, "se_shape": 0.01,
+         "truth": {"shape": 0.65}},
+        {"case": "none", "variant": "none", "shape_narrow": False, "truth": {"shape": 0.6}},
+        {"case": "none", "variant": "none", "failed": "fit: no"}]}
+    assert coverage_record(study)["cases"] == {"drift (linear)": {"narrow": 2, "covered": 1},
+                                               "none": {"narrow": 0, "covered": 0}}
+    src, out = tmp_path / "study.json", tmp_path / "rec.json"
+    src.write_text(json.dumps(study))
+    assert main([str(src), "--out", str(out)]) == 0
+    assert study_coverage(str(out)) == (False, "in the calibration study such narrow intervals covered the truth in "
+                                               "1 of 2 runs (drift (linear): 1 of 2)")
