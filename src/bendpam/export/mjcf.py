@@ -54,6 +54,7 @@ DEVICES = ("finger", "gripper")
 _PAPER_RANGE_KPA = {1: (100.0, 200.0), -1: (40.0, 140.0)}
 _MM = 1e-3  # mm -> m
 _SEGMENTS_MAX = 200
+_WELD_TIMECONST_S = 0.005  # the arm-palm weld (MuJoCo solref time constant, s)
 
 
 @dataclass(frozen=True)
@@ -472,7 +473,15 @@ def _write_device(root: ET.Element, chain: _Chain, f: Finger, gr: Gripper | None
         palm_z = depth + R
         ET.SubElement(world, "geom", name="floor", type="plane", size="1 1 0.01", contype="2", conaffinity="1",
                       rgba="0.8 0.8 0.8 1")
-        palm = ET.SubElement(world, "body", name="palm", mocap="true", pos=_fmt(0.0, 0.0, palm_z * _MM))
+        # the arm is a mocap body; the palm a free body welded to it, so that moving the arm moves the
+        # fingers with a velocity (a mocap body is moved kinematically, with no velocity: its children's
+        # contacts would slide past the sphere without any friction)
+        ET.SubElement(world, "body", name="arm", mocap="true", pos=_fmt(0.0, 0.0, palm_z * _MM))
+        palm = ET.SubElement(world, "body", name="palm", pos=_fmt(0.0, 0.0, palm_z * _MM))
+        ET.SubElement(palm, "freejoint", name="palm_free")
+        equality = ET.SubElement(root, "equality")
+        ET.SubElement(equality, "weld", name="arm_palm", body1="palm", body2="arm",
+                      solref=_fmt(_WELD_TIMECONST_S, 1.0))
         ET.SubElement(palm, "geom", name="palm_geom", type="cylinder", size=_fmt(gr.base_radius_mm * 1.1 * _MM, 0.005),
                       pos="0 0 0.005", contype="0", conaffinity="0", rgba="0.4 0.4 0.45 1")
         names = tuple(f"pam{i}" for i in range(gr.fingers))

@@ -46,6 +46,7 @@ QVEL_TOL = 1e-6
 _DT = 1e-3
 _RAMP = 100
 _CREEP = 4000
+_LIFT_MM = 0.01  # lift per step of the pull-out, mm
 
 
 @dataclass(frozen=True)
@@ -104,6 +105,7 @@ class _Run:
         m.opt.cone = mj.mjtCone.mjCONE_ELLIPTIC
         m.opt.impratio = 10.0
         m.opt.noslip_iterations = 10
+        m.opt.tolerance = 1e-12  # (the default 1e-8 leaves the weld-held palm creeping at 1e-5 rad/s)
         m.geom_solref[:] = [5 * _DT, 1.0]
         mj.mj_forward(m, self.d)
         full = np.zeros((m.nv, m.nv))
@@ -112,7 +114,8 @@ class _Run:
         f = exported.finger
         h = f.length / exported.segments
         k_stiff = abs(float(f.law.tabulated().tangent_stiffness(float(max(exported.pressures_kpa)), 0.0))) / h * 1e-3
-        m.dof_damping[:] = np.maximum(3.0 * np.sqrt(k_stiff * np.diag(full)), 2.0 * _DT * k_stiff)
+        hinges = self.ctl._dof_ix
+        m.dof_damping[hinges] = np.maximum(3.0 * np.sqrt(k_stiff * np.diag(full)[hinges]), 2.0 * _DT * k_stiff)
         self.P = 0.0
 
     def step(self) -> None:
@@ -262,14 +265,16 @@ def _pullout(exported: MujocoModel, gr, diameter_mm: float, P: float) -> dict[st
     sphere = mj.mj_name2id(run.m, mj.mjtObj.mjOBJ_GEOM, "sphere")
     mu = run.m.geom_friction[:, 0].copy()
     run.m.geom_friction[:, 0] = 0.0  # frictionless closing, as bendpam's grasp statics
+    noslip, run.m.opt.noslip_iterations = run.m.opt.noslip_iterations, 0  # (nothing to stick: it only adds noise)
     settled = run.ramp_to(P, 3 * _RAMP)
     closed = _sphere_force_n(run, sphere)
     run.m.geom_friction[:, 0] = mu
+    run.m.opt.noslip_iterations = noslip
     z0 = float(run.d.mocap_pos[0, 2])
     peak, lift_at_peak, lift = closed, 0.0, 0.0
     for i in range(8000):
-        lift = (i + 1) * 0.01
-        run.d.mocap_pos[0, 2] = z0 + lift * 1e-3
+        lift = (i + 1) * _LIFT_MM
+        run.d.mocap_pos[0, 2] = z0 + lift * 1e-3  # the arm; the palm follows it through the weld
         run.step()
         fz = _sphere_force_n(run, sphere)
         if fz > peak:
