@@ -47,6 +47,7 @@ _DT = 1e-3
 _RAMP = 100
 _CREEP = 4000
 _LIFT_MM = 0.01  # lift per step of the pull-out, mm
+_SMOOTH_MM = 0.2  # the pull-out force is averaged over this much lift, mm
 
 
 @dataclass(frozen=True)
@@ -236,6 +237,41 @@ def _sphere_force_n(run: _Run, sphere: int) -> float:
     return fz
 
 
+def _pull(run: _Run, sphere: int, closed: float) -> tuple[float, float]:
+    """Lift the arm :data:`_LIFT_MM` per step; returns the peak upward force on the sphere (N) and its lift (mm).
+
+    The force is averaged over the last :data:`_SMOOTH_MM` of lift (a tip that slides on the sphere
+    under a light load chatters: its force jumps between steps).  The fingers may close just short
+    of the sphere (the chain's free shape is within 0.5 % of L0 of bendpam's): the pull goes on
+    until they touch it; it ends when they have let it go for 1 mm of lift, when the averaged
+    force has fallen below half its peak (after 1 mm), or after 80 mm.
+    """
+    z0 = float(run.d.mocap_pos[0, 2])
+    w = max(1, round(_SMOOTH_MM / _LIFT_MM))
+    recent = np.full(w, closed)
+    peak, lift_at_peak = closed, 0.0
+    touched, apart = _touching(run, sphere), 0
+    for i in range(int(80.0 / _LIFT_MM)):
+        lift = (i + 1) * _LIFT_MM
+        run.d.mocap_pos[0, 2] = z0 + lift * 1e-3  # the arm; the palm follows it through the weld
+        run.step()
+        recent[i % w] = _sphere_force_n(run, sphere)
+        fz = float(np.mean(recent))
+        if fz > peak:
+            peak, lift_at_peak = fz, lift - 0.5 * w * _LIFT_MM
+        touching = _touching(run, sphere)
+        apart = 0 if touching else apart + 1
+        if (touched and apart * _LIFT_MM > 1.0) or (fz < 0.5 * peak and lift > 1.0):
+            break
+        touched |= touching
+    return peak, max(lift_at_peak, 0.0)
+
+
+def _touching(run: _Run, sphere: int) -> bool:
+    """Whether any geom touches the sphere."""
+    return any(sphere in (run.d.contact[i].geom1, run.d.contact[i].geom2) for i in range(run.d.ncon))
+
+
 def pullout(exported: MujocoModel, diameter_mm: float, pressure_kpa: float) -> dict[str, Any]:
     """The pull-out of a sphere (mm) at a pressure (kPa) in MuJoCo, beside :func:`bendpam.design.grasp.solve_grasp`.
 
@@ -263,6 +299,8 @@ def _pullout(exported: MujocoModel, gr, diameter_mm: float, P: float) -> dict[st
     run = _Run(ex)
     mj = run.mj
     sphere = mj.mj_name2id(run.m, mj.mjtObj.mjOBJ_GEOM, "sphere")
+    floor = mj.mj_name2id(run.m, mj.mjtObj.mjOBJ_GEOM, "floor")
+    run.m.geom_contype[floor] = run.m.geom_conaffinity[floor] = 0  # bendpam's grasp has no table after landing
     mu = run.m.geom_friction[:, 0].copy()
     run.m.geom_friction[:, 0] = 0.0  # frictionless closing, as bendpam's grasp statics
     noslip, run.m.opt.noslip_iterations = run.m.opt.noslip_iterations, 0  # (nothing to stick: it only adds noise)
@@ -270,17 +308,7 @@ def _pullout(exported: MujocoModel, gr, diameter_mm: float, P: float) -> dict[st
     closed = _sphere_force_n(run, sphere)
     run.m.geom_friction[:, 0] = mu
     run.m.opt.noslip_iterations = noslip
-    z0 = float(run.d.mocap_pos[0, 2])
-    peak, lift_at_peak, lift = closed, 0.0, 0.0
-    for i in range(8000):
-        lift = (i + 1) * _LIFT_MM
-        run.d.mocap_pos[0, 2] = z0 + lift * 1e-3  # the arm; the palm follows it through the weld
-        run.step()
-        fz = _sphere_force_n(run, sphere)
-        if fz > peak:
-            peak, lift_at_peak = fz, lift
-        if run.d.ncon == 0 or (fz < 0.5 * peak and lift > 1.0):
-            break
+    peak, lift_at_peak = _pull(run, sphere, closed)
     want = float(ref.grip_force_n)
     err = (peak - want) / want * 100.0 if want > 0 else math.nan
     return {"diameter_mm": diameter_mm, "pressure_kpa": P, "mujoco_grip_force_n": _r(peak),
