@@ -27,6 +27,11 @@ frame line (the gripper's contact surface, :class:`bendpam.design.Gripper`) and 
 tube diameter to the other side; the pad is the same box over the fingertip, its corner the
 fingertip point.  Fingers touch spheres (and the floor), never each other.
 
+The gripper's palm is a free body that a weld holds to the mocap body ``arm``: moving the arm moves
+the fingers with a velocity.  (A mocap body is moved by setting its position, without a velocity;
+MuJoCo's friction is a velocity-level constraint, so fingers on a mocap palm would slide past a
+sphere as if frictionless while the palm is lifted.)
+
 MuJoCo's units are SI: lengths in m, masses in kg, torques in N*m, time in s.
 """
 
@@ -355,7 +360,8 @@ def mujoco_model(actuator: Actuator, device: str = "finger", *, law_model: str |
     device : {"finger", "gripper"}
         ``"finger"``: one finger as :class:`bendpam.design.Finger` (base at the origin, pointing along
         +x, curling counterclockwise in the x-z plane, no fingertip unless ``finger`` says so);
-        ``"gripper"``: :class:`bendpam.design.Gripper` (three fingers on a palm that is a mocap body).
+        ``"gripper"``: :class:`bendpam.design.Gripper` (three fingers on a palm, a free body welded
+        to the mocap body ``arm``: move ``data.mocap_pos`` to move the gripper).
     law_model : the moment law's model (None: the actuator's own).
     segments : hinges per actuator; default: :func:`segments_for` with ``tip_error_pct``.
     tip_error_pct : the tip-error target, % of L0 (default 1).
