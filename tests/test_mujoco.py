@@ -1,5 +1,6 @@
 """MuJoCo export (issue 27): the hinge torques, the MJCF, and the quasi-static validation against bendpam."""
 
+import importlib.util
 import json
 import math
 import re
@@ -157,6 +158,22 @@ def test_the_arm_moves_the_palm_with_a_velocity():
     assert d.qvel[m.jnt_dofadr[palm] + 2] == pytest.approx(speed, rel=0.02)
     lag = float(d.mocap_pos[0, 2]) - float(d.qpos[m.jnt_qposadr[palm] + 2])  # m: about 2 tau speed for the weld
     assert 0.0 < lag < 3 * 0.005 * speed
+
+
+def test_pullout_sweep_tool_prints_one_row_per_case(capsys):
+    """tools/mujoco_pullout_sweep.py on one case (the full sweep, 42 cases, is in docs/mujoco.md)."""
+    spec = importlib.util.spec_from_file_location("mujoco_pullout_sweep", DOCS.parents[1] / "tools" /
+                                                  "mujoco_pullout_sweep.py")
+    tool = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(tool)
+    assert tool.main(["be-pam", "--diameters", "200", "--pressures", "160"]) == 0
+    rows = [r for r in capsys.readouterr().out.splitlines() if r.startswith("| be-pam")]
+    assert len(rows) == 1
+    cells = [c.strip() for c in rows[0].strip("|").split("|")]
+    assert cells[:4] == ["be-pam", "200", "160", "tip"]
+    mj, bp = float(cells[4]), float(cells[5])
+    assert float(cells[6].split()[0]) == pytest.approx((mj - bp) / bp * 100.0, abs=0.2)  # rounded forces
+    assert abs(float(cells[6].split()[0])) <= 5.0
 
 
 def test_sphere_models_and_refusals(tmp_path, capsys):
