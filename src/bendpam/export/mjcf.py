@@ -27,6 +27,11 @@ frame line (the gripper's contact surface, :class:`bendpam.design.Gripper`) and 
 tube diameter to the other side; the pad is the same box over the fingertip, its corner the
 fingertip point.  Fingers touch spheres (and the floor), never each other.
 
+The gripper's palm is a free body that a weld holds to the mocap body ``arm``: moving the arm moves
+the fingers with a velocity.  (A mocap body is moved by setting its position, without a velocity;
+MuJoCo's friction is a velocity-level constraint, so fingers on a mocap palm would slide past a
+sphere as if frictionless while the palm is lifted.)
+
 MuJoCo's units are SI: lengths in m, masses in kg, torques in N*m, time in s.
 """
 
@@ -54,6 +59,7 @@ DEVICES = ("finger", "gripper")
 _PAPER_RANGE_KPA = {1: (100.0, 200.0), -1: (40.0, 140.0)}
 _MM = 1e-3  # mm -> m
 _SEGMENTS_MAX = 200
+_WELD_TIMECONST_S = 0.005  # the arm-palm weld (MuJoCo solref time constant, s)
 
 
 @dataclass(frozen=True)
@@ -354,7 +360,8 @@ def mujoco_model(actuator: Actuator, device: str = "finger", *, law_model: str |
     device : {"finger", "gripper"}
         ``"finger"``: one finger as :class:`bendpam.design.Finger` (base at the origin, pointing along
         +x, curling counterclockwise in the x-z plane, no fingertip unless ``finger`` says so);
-        ``"gripper"``: :class:`bendpam.design.Gripper` (three fingers on a palm that is a mocap body).
+        ``"gripper"``: :class:`bendpam.design.Gripper` (three fingers on a palm, a free body welded
+        to the mocap body ``arm``: move ``data.mocap_pos`` to move the gripper).
     law_model : the moment law's model (None: the actuator's own).
     segments : hinges per actuator; default: :func:`segments_for` with ``tip_error_pct``.
     tip_error_pct : the tip-error target, % of L0 (default 1).
@@ -472,7 +479,15 @@ def _write_device(root: ET.Element, chain: _Chain, f: Finger, gr: Gripper | None
         palm_z = depth + R
         ET.SubElement(world, "geom", name="floor", type="plane", size="1 1 0.01", contype="2", conaffinity="1",
                       rgba="0.8 0.8 0.8 1")
-        palm = ET.SubElement(world, "body", name="palm", mocap="true", pos=_fmt(0.0, 0.0, palm_z * _MM))
+        # the arm is a mocap body; the palm a free body welded to it, so that moving the arm moves the
+        # fingers with a velocity (a mocap body is moved kinematically, with no velocity: its children's
+        # contacts would slide past the sphere without any friction)
+        ET.SubElement(world, "body", name="arm", mocap="true", pos=_fmt(0.0, 0.0, palm_z * _MM))
+        palm = ET.SubElement(world, "body", name="palm", pos=_fmt(0.0, 0.0, palm_z * _MM))
+        ET.SubElement(palm, "freejoint", name="palm_free")
+        equality = ET.SubElement(root, "equality")
+        ET.SubElement(equality, "weld", name="arm_palm", body1="palm", body2="arm",
+                      solref=_fmt(_WELD_TIMECONST_S, 1.0))
         ET.SubElement(palm, "geom", name="palm_geom", type="cylinder", size=_fmt(gr.base_radius_mm * 1.1 * _MM, 0.005),
                       pos="0 0 0.005", contype="0", conaffinity="0", rgba="0.4 0.4 0.45 1")
         names = tuple(f"pam{i}" for i in range(gr.fingers))
