@@ -23,15 +23,19 @@ Systematic covariance
 
 The rate-dependent law
     A viscous loop (a dashpot with a Maxwell element, :class:`~bendpam.physics.hysteresis.ViscousLoop`)
-    needs the bending rate.  Testing machines drive the crosshead at a constant speed, so the rate
-    along a branch follows the fixture's kinematics (eq 6 and 8,
-    :func:`bendpam.identify.data.relative_rate`): the dashpot's moment is that rate profile times
-    a Dahl approach over ``theta_c`` (the Maxwell element's relaxation at that speed), the same for
-    every test (``"viscous"``).  Machines may instead cycle at a fixed period (displacement control
-    at a set frequency); the processed set does not say which, so the ensemble also holds
-    ``"viscous_period"``: each test at its own cycle period
-    (:func:`bendpam.identify.data.cycle_period_s`; a common period when the samples were not kept),
-    its rate ``2 span / period``, ``theta_c`` that of the fastest test.
+    needs the bending rate.  A processed set keeps each branch point's time (the cycle mean of
+    :attr:`~bendpam.lab.processed.PressureResult.branch_times_s`), so ``"viscous"`` is the Maxwell fluid
+    driven by the bending angle at the test's own times, on its steady cycle (``omega_ref`` the
+    fastest rate of the set, ``tau = theta_c / omega_ref``).  A set saved before 0.4 keeps no time; the
+    rate is then approximated twice and the fit says so: at a constant crosshead speed the rate
+    follows the fixture's kinematics (eq 6 and 8, :func:`bendpam.identify.data.relative_rate`) and the
+    dashpot's moment is that rate profile times a Dahl approach over ``theta_c`` (``"viscous"``); at a
+    fixed cycle period each test has its own period (:func:`bendpam.identify.data.cycle_period_s`, a
+    common one when the samples were not kept), its rate ``2 span / period`` (``"viscous_period"``).
+
+The backlash of a fixture is not a member: its loop is the quasi-static curve shifted along the
+curvature by the dead zone (a moment that scales with the local stiffness ``dM/dk'``, not with the
+friction amplitude ``A(P)`` every member shares), so it cannot be refitted as a law for ``z``.
 """
 
 from __future__ import annotations
