@@ -117,18 +117,18 @@ def _viscous_in_time(theta_c: float, d: FitData) -> np.ndarray:
     ok = dt > 0
     w_ref = float(np.max(dd[ok] / dt[ok])) if ok.any() and np.any(dd[ok] > 0) else 1.0
     tau = max(theta_c / w_ref, 1e-9)
-    z = np.empty(d.kc.size)
+    z = np.zeros(d.kc.size)  # a test with one branch only keeps no loop
     for i in np.unique(d.seg):
-        parts = []
+        parts: list[tuple | None] = []
         for key in (2 * int(i), 2 * int(i) + 1):  # loading (toward the blocked state), then unloading
             r = order.get(key)
             if r is None:
                 parts.append(None)
                 continue
             parts.append((r, *_branch_response(d.time_s[r], d.delta[r], float(d.span[r][0]), tau, w_ref)))
-        if any(p is None for p in parts):
+        if parts[0] is None or parts[1] is None:
             continue
-        (r1, t1, z1, e1), (r2, t2, z2, e2) = parts
+        (r1, t1, z1, e1), (r2, t2, z2, e2) = parts[0], parts[1]
         a1, a2 = math.exp(-t1[-1] / tau), math.exp(-t2[-1] / tau)
         # s z (the sign of the motion) starts at y1 on one branch, y2 = -(a1 y1 + e1) on the other, and back
         y1 = (a2 * e1 - e2) / (1.0 - a1 * a2) if a1 * a2 < 1.0 else 0.0
