@@ -26,12 +26,14 @@ The rate-dependent law
     needs the bending rate.  A processed set keeps each branch point's time (the cycle mean of
     :attr:`~bendpam.lab.processed.PressureResult.branch_times_s`), so ``"viscous"`` is the Maxwell fluid
     driven by the bending angle at the test's own times, on its steady cycle (``omega_ref`` the
-    fastest rate of the set, ``tau = theta_c / omega_ref``).  A set saved before 0.4 keeps no time; the
-    rate is then approximated twice and the fit says so: at a constant crosshead speed the rate
-    follows the fixture's kinematics (eq 6 and 8, :func:`bendpam.identify.data.relative_rate`) and the
-    dashpot's moment is that rate profile times a Dahl approach over ``theta_c`` (``"viscous"``); at a
-    fixed cycle period each test has its own period (:func:`bendpam.identify.data.cycle_period_s`, a
-    common one when the samples were not kept), its rate ``2 span / period`` (``"viscous_period"``).
+    fastest rate of the set, ``tau = theta_c / omega_ref``).  A set saved before 0.4 keeps no time;
+    the rate then follows the fixture's kinematics at a constant crosshead speed (eq 6 and 8,
+    :func:`bendpam.identify.data.relative_rate`): the dashpot's moment is that rate profile times a
+    Dahl approach over ``theta_c``, and the fit says so.  The ensemble also holds ``"viscous_period"``,
+    the loop of a machine that cycles at a fixed period (displacement control at a set frequency):
+    each test at its own constant rate ``2 span / period``
+    (:func:`bendpam.identify.data.cycle_period_s`; a common period when the samples were not kept),
+    ``theta_c`` that of the fastest test.
 
 The backlash of a fixture is not a member: its loop is the quasi-static curve shifted along the
 curvature by the dead zone (a moment that scales with the local stiffness ``dM/dk'``, not with the

@@ -553,8 +553,7 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool):
     fits: dict[str, tuple[dict[str, float], float]] = {}
     if run.law and law_uncertainty:
         fits[run.law] = (unc.values, _ssr(run.prob, run.nl, run.lin))
-        timed = getattr(run.prob.d, "time_s", None) is not None
-        for alt in (a for a in ENSEMBLE if a != run.law and not (timed and a == "viscous_period")):
+        for alt in (a for a in ENSEMBLE if a != run.law):
             try:
                 values, ssr, n = _law_refit(run.prob, run.bnd, run.nl, alt)
             except FitError:  # this law cannot describe the curves at all: it has no weight
@@ -566,9 +565,10 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool):
     budget = uncertainty_budget(unc, run.prob.actuator(unc.values), fits, r, run.prob.groups, run.law,
                                 0 if shape_bound else len(run.cycles))
     if "viscous" in fits:
+        timed = getattr(run.prob.d, "time_s", None) is not None
         budget.weighting += ("; the viscous loop driven at the test's own times" if timed else
-                             "; the viscous loop's rate approximated (the processed set keeps no time: saved before "
-                             "0.4), once at a constant crosshead speed and once at a constant cycle period")
+                             "; the viscous loop's rate approximated at a constant crosshead speed (the processed "
+                             "set keeps no time: saved before 0.4)")
     return unc, budget
 
 
