@@ -272,3 +272,19 @@ def test_the_shipped_coverage_record_is_read_and_the_tool_writes_it(tmp_path):
     assert main([str(src), "--out", str(out)]) == 0
     assert study_coverage(str(out)) == (False, "in the calibration study such narrow intervals covered the truth in "
                                                "1 of 2 runs (drift (linear): 1 of 2)")
+
+
+def test_the_viscous_member_driven_at_the_tests_times_is_the_steady_cycle():
+    from types import SimpleNamespace as NS
+
+    from bendpam.identify.ensemble import steady_z
+
+    span, period, n = 0.3, 20.0, 61  # a triangle at a constant rate of 0.03 rad/s, sampled on 61 points a branch
+    delta = np.linspace(0.0, span, n)
+    d = NS(seg=np.zeros(2 * n, int), branch=np.repeat([1, -1], n), delta=np.tile(delta, 2),
+           span=np.full(2 * n, span), time_s=np.tile(delta / (2.0 * span / period), 2), kc=np.zeros(2 * n),
+           period_s=None, rate=None)
+    theta_deg = 8.0
+    away, back = ViscousLoop(math.radians(theta_deg) / 0.03, 0.03).steady_branches(delta, span, period)
+    z = steady_z("viscous", theta_deg, d)
+    assert np.allclose(z[n:], away, atol=1e-4) and np.allclose(z[:n], back, atol=1e-4)

@@ -257,3 +257,31 @@ def test_cli_errors(capsys, tmp_path, monkeypatch, args, words):
         assert "t.csv" in lines[0] and "u.csv" in lines[1] and "2 of 2 file(s)" in lines[2]
     for w in words:
         assert w in err
+
+
+def test_branch_times_are_kept_and_an_old_set_loads_without_them(simulated, tmp_path):
+    import xarray as xr
+
+    d, truth = simulated[("be-pam", "csv")]
+    ps = process_tests([read_test(d / f) for f in truth["files"]], keep_series=True)
+    r = ps.results[0]
+    s = r.series
+    # the loading branch of cycle 1 begins at its free reversal: its times on the grid rise to the blocked end
+    first = s[s["cycle"] == 1]
+    start = float(first.loc[first["branch"] == "loading", "time_s"].iloc[0])
+    t_load = r.branch_times_s[0, 0]
+    k_load = first.loc[first["branch"] == "loading"]
+    expect = np.interp(r.curvature_grid[50], k_load["curvature_per_mm"].to_numpy()[::-1],
+                       k_load["time_s"].to_numpy()[::-1]) - start
+    assert t_load[50] == pytest.approx(expect, rel=1e-6)
+    assert np.all(np.diff(t_load) <= 0) and np.all(np.diff(r.branch_times_s[0, 1]) >= 0)
+    write_processed(ps, tmp_path / "out", figure=False)
+    with xr.open_dataset(tmp_path / "out" / "curves.nc") as ds:
+        assert ds["time_s"].attrs["units"] == "s"
+    back = load_processed(tmp_path / "out")
+    for r0, r1 in zip(ps.results, back.results):
+        assert_allclose(r1.branch_times_s, r0.branch_times_s)
+    old = tmp_path / "old.nc"  # a set saved before 0.4 had no times: it loads, the fit approximates the rate
+    with xr.open_dataset(tmp_path / "out" / "curves.nc") as ds:
+        ds.drop_vars("time_s").load().to_netcdf(old, format="NETCDF3_64BIT")
+    assert all(r.branch_times_s is None for r in load_processed(old).results)

@@ -64,12 +64,13 @@ class FitData:
     grid_index: np.ndarray | None = None  # each point's index on its test's curvature grid
     period_s: np.ndarray | None = None  # (n,) each test's mean cycle period, s (NaN: not known)
     rate: np.ndarray | None = None  # each point's bending rate at a constant crosshead speed, relative to k' = 0
+    time_s: np.ndarray | None = None  # each point's time since its branch began (cycle mean, s); None: not kept
 
     def thin(self, step: int) -> FitData:
         """Every ``step``-th point (weights scaled so the objective keeps its scale): for the grid stage."""
         keep = np.arange(self.kc.size) % step == 0
         opt = {n: None if getattr(self, n) is None else getattr(self, n)[keep]
-               for n in ("branch", "delta", "span", "grid_index", "rate")}
+               for n in ("branch", "delta", "span", "grid_index", "rate", "time_s")}
         return FitData(self.P, self.k, self.M, self.BM, self.BM_se, self.K, self.K_se,
                      self.w[keep] * math.sqrt(self.kc.size / keep.sum()), self.kc[keep], self.Mc[keep], self.Pc[keep],
                      self.seg[keep], **opt, period_s=self.period_s)
@@ -126,13 +127,16 @@ def branch_data(processed, L0: float) -> FitData:
     if not res:
         raise InputError("no processed pressures to fit")
     d = fit_data(processed, "all")
-    k, M, w, Pc, seg, br, delta, span = [], [], [], [], [], [], [], []
+    k, M, w, Pc, seg, br, delta, span, times = [], [], [], [], [], [], [], [], []
     wK = d.K / d.K.sum()
     for i, r in enumerate(res):
         g = np.asarray(r.curvature_grid, float)
         n = g.size
         Kf = d.K[i]
-        for sign, curve, dist in ((1, r.mean_loading, (Kf - g) * L0), (-1, r.mean_unloading, g * L0)):
+        tb = getattr(r, "branch_times_s", None)
+        for bi, (sign, curve, dist) in enumerate(((1, r.mean_loading, (Kf - g) * L0),
+                                                   (-1, r.mean_unloading, g * L0))):
+            times.append(np.full(n, np.nan) if tb is None else np.nanmean(np.asarray(tb, float)[:, bi], axis=0))
             k.append(g)
             M.append(np.asarray(curve, float))
             w.append(np.full(n, math.sqrt(wK[i]) / (d.BM[i] * math.sqrt(2 * n))))
@@ -144,8 +148,10 @@ def branch_data(processed, L0: float) -> FitData:
     cat = np.concatenate
     gi = cat([np.tile(np.arange(np.asarray(r.curvature_grid).size), 2) for r in res])
     fixture = getattr(processed, "fixture", None)
+    t = cat(times)
     return FitData(d.P, d.k, d.M, d.BM, d.BM_se, d.K, d.K_se, cat(w), cat(k), cat(M), cat(Pc), cat(seg), cat(br),
-                 cat(delta), cat(span), gi, d.period_s, None if fixture is None else relative_rate(fixture, cat(k)))
+                 cat(delta), cat(span), gi, d.period_s, None if fixture is None else relative_rate(fixture, cat(k)),
+                 t if np.all(np.isfinite(t)) else None)
 
 
 def relative_rate(fixture, curvature_per_mm) -> np.ndarray:

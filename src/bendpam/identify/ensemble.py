@@ -23,15 +23,21 @@ Systematic covariance
 
 The rate-dependent law
     A viscous loop (a dashpot with a Maxwell element, :class:`~bendpam.physics.hysteresis.ViscousLoop`)
-    needs the bending rate.  Testing machines drive the crosshead at a constant speed, so the rate
-    along a branch follows the fixture's kinematics (eq 6 and 8,
-    :func:`bendpam.identify.data.relative_rate`): the dashpot's moment is that rate profile times
-    a Dahl approach over ``theta_c`` (the Maxwell element's relaxation at that speed), the same for
-    every test (``"viscous"``).  Machines may instead cycle at a fixed period (displacement control
-    at a set frequency); the processed set does not say which, so the ensemble also holds
-    ``"viscous_period"``: each test at its own cycle period
+    needs the bending rate.  A processed set keeps each branch point's time (the cycle mean of
+    :attr:`~bendpam.lab.processed.PressureResult.branch_times_s`), so ``"viscous"`` is the Maxwell fluid
+    driven by the bending angle at the test's own times, on its steady cycle (``omega_ref`` the
+    fastest rate of the set, ``tau = theta_c / omega_ref``).  A set saved before 0.4 keeps no time;
+    the rate then follows the fixture's kinematics at a constant crosshead speed (eq 6 and 8,
+    :func:`bendpam.identify.data.relative_rate`): the dashpot's moment is that rate profile times a
+    Dahl approach over ``theta_c``, and the fit says so.  The ensemble also holds ``"viscous_period"``,
+    the loop of a machine that cycles at a fixed period (displacement control at a set frequency):
+    each test at its own constant rate ``2 span / period``
     (:func:`bendpam.identify.data.cycle_period_s`; a common period when the samples were not kept),
-    its rate ``2 span / period``, ``theta_c`` that of the fastest test.
+    ``theta_c`` that of the fastest test.
+
+The backlash of a fixture is not a member: its loop is the quasi-static curve shifted along the
+curvature by the dead zone (a moment that scales with the local stiffness ``dM/dk'``, not with the
+friction amplitude ``A(P)`` every member shares), so it cannot be refitted as a law for ``z``.
 """
 
 from __future__ import annotations
@@ -64,6 +70,8 @@ def steady_z(law: str, theta_deg: float, d: FitData) -> np.ndarray:
     from bendpam.physics.hysteresis import ViscousLoop, make_law
 
     assert d.branch is not None and d.delta is not None and d.span is not None, "a loop fit is built on branch data"
+    if law == "viscous" and getattr(d, "time_s", None) is not None:
+        return _viscous_in_time(math.radians(theta_deg), d)
     if law == "viscous" and getattr(d, "rate", None) is not None:
         # constant crosshead speed: the dashpot's moment follows the fixture's rate profile, and the
         # Maxwell element relaxes over theta_c (the same for every test: the same speed)
@@ -77,6 +85,59 @@ def steady_z(law: str, theta_deg: float, d: FitData) -> np.ndarray:
     else:
         z_away, z_back = make_law(law, theta_deg).steady_branches(d.delta, d.span)
     return np.where(d.branch < 0, z_away, z_back)
+
+
+def _branch_response(t: np.ndarray, delta: np.ndarray, end: float, tau: float, w_ref: float, n: int = 400):
+    """A Maxwell fluid's response from ``z = 0`` along one branch, the angle ``delta`` (rad) reached at the times
+    ``t`` (s, increasing, from the reversal) and ``end`` (rad) at its far end: ``(times, z, z at the end)``."""
+    from bendpam.physics.hysteresis import ViscousLoop
+
+    tt, dd = np.concatenate([[0.0], t]), np.concatenate([[0.0], delta])
+    v_end = (dd[-1] - dd[-2]) / max(tt[-1] - tt[-2], 1e-9) if tt.size > 2 else 0.0
+    t_end = tt[-1] + max(end - dd[-1], 0.0) / v_end if v_end > 0 else tt[-1]
+    tu = np.linspace(0.0, max(t_end, tt[-1] + 1e-9), n)
+    z = ViscousLoop(tau, w_ref).z_path(np.interp(tu, np.append(tt, t_end), np.append(dd, end)), tu)
+    return tu, z, float(z[-1])
+
+
+def _viscous_in_time(theta_c: float, d: FitData) -> np.ndarray:
+    """``z`` of a Maxwell fluid (``tau dz/dt + z = (dtheta/dt) / omega_ref``) on the steady cycle of each test,
+    driven by the bending angle at the test's own times (the cycle-mean time of each branch point).
+
+    ``omega_ref`` is the fastest bending rate of the set and ``tau = theta_c / omega_ref``.  Each branch is
+    filtered exactly from ``z = 0`` (the angle linear in time between the points; before the first and after
+    the last point at the branch's end rate); the linear response then gives the periodic start of both
+    branches in closed form (``z`` is continuous at the reversals).
+    """
+    assert d.time_s is not None and d.branch is not None and d.delta is not None and d.span is not None
+    order = {}
+    for key in np.unique(2 * d.seg + (d.branch < 0)):
+        rows = np.flatnonzero(2 * d.seg + (d.branch < 0) == key)
+        order[int(key)] = rows[np.argsort(d.time_s[rows], kind="stable")]
+    dt = np.concatenate([np.diff(d.time_s[r]) for r in order.values()])
+    dd = np.concatenate([np.diff(d.delta[r]) for r in order.values()])
+    ok = dt > 0
+    w_ref = float(np.max(dd[ok] / dt[ok])) if ok.any() and np.any(dd[ok] > 0) else 1.0
+    tau = max(theta_c / w_ref, 1e-9)
+    z = np.zeros(d.kc.size)  # a test with one branch only keeps no loop
+    for i in np.unique(d.seg):
+        parts: list[tuple | None] = []
+        for key in (2 * int(i), 2 * int(i) + 1):  # loading (toward the blocked state), then unloading
+            r = order.get(key)
+            if r is None:
+                parts.append(None)
+                continue
+            parts.append((r, *_branch_response(d.time_s[r], d.delta[r], float(d.span[r][0]), tau, w_ref)))
+        if parts[0] is None or parts[1] is None:
+            continue
+        (r1, t1, z1, e1), (r2, t2, z2, e2) = parts[0], parts[1]
+        a1, a2 = math.exp(-t1[-1] / tau), math.exp(-t2[-1] / tau)
+        # s z (the sign of the motion) starts at y1 on one branch, y2 = -(a1 y1 + e1) on the other, and back
+        y1 = (a2 * e1 - e2) / (1.0 - a1 * a2) if a1 * a2 < 1.0 else 0.0
+        y2 = -(a1 * y1 + e1)
+        z[r1] = -(np.interp(d.time_s[r1], t1, z1) + y1 * np.exp(-d.time_s[r1] / tau))
+        z[r2] = np.interp(d.time_s[r2], t2, z2) + y2 * np.exp(-d.time_s[r2] / tau)
+    return z
 
 
 def _periods(d: FitData) -> np.ndarray:

@@ -564,6 +564,11 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool):
     shape_bound = unc.at_bound.get("S_lo", False) or unc.at_bound.get("S_hi", False)
     budget = uncertainty_budget(unc, run.prob.actuator(unc.values), fits, r, run.prob.groups, run.law,
                                 0 if shape_bound else len(run.cycles))
+    if "viscous" in fits:
+        timed = getattr(run.prob.d, "time_s", None) is not None
+        budget.weighting += ("; the viscous loop driven at the test's own times" if timed else
+                             "; the viscous loop's rate approximated at a constant crosshead speed (the processed "
+                             "set keeps no time: saved before 0.4)")
     return unc, budget
 
 

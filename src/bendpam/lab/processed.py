@@ -132,6 +132,8 @@ class PressureResult:
     replicate: int = 1  # 1, 2, ... among the tests at this pressure
     findings: list[dict] = field(default_factory=list)  # plausibility findings (bendpam.lab.plausibility)
     drift: DriftEstimate | None = None  # the load-cell offset drift (bendpam.lab.drift)
+    #: (n_cycles, 2, n_grid) s: each branch point's time since its branch began (None: a set saved before 0.4)
+    branch_times_s: np.ndarray | None = None
 
     @property
     def mean_loading(self) -> np.ndarray:
@@ -438,6 +440,12 @@ class ProcessedSet:
                               {"long_name": "replicate number among the tests at this pressure"}),
             },
         )
+        if all(r.branch_times_s is not None for r in self.results):
+            tb = np.full((npres, ncyc, 2, npt), np.nan)
+            for i, r in enumerate(self.results):
+                tb[i, : r.n_cycles] = r.branch_times_s
+            ds["time_s"] = (("pressure_kpa", "cycle", "branch", "point"), tb,
+                            {"units": "s", "long_name": "time of each branch point since its branch began (reversal)"})
         ds["mean_curve_nmm"] = 0.5 * (ds["mean_loading_nmm"] + ds["mean_unloading_nmm"])
         ds["mean_curve_nmm"].attrs.update(units="N*mm", long_name="hysteresis-free mean curve (average of branches)")
         p0, se = self.deadband()
@@ -600,8 +608,10 @@ def as_processed(processed) -> ProcessedSet:
 def load_processed(path) -> ProcessedSet:
     """Read the output of :func:`write_processed` (a folder or its ``curves.nc``) back.
 
-    The curves, per-cycle values, fixture and sources come back; the options are the defaults
-    and the samples (:attr:`PressureResult.series`) are not stored.
+    The curves, per-cycle values, branch times, fixture and sources come back; the options are the
+    defaults and the samples (:attr:`PressureResult.series`) are not stored.  A set saved before
+    0.4 has no branch times (:attr:`PressureResult.branch_times_s` is None): a fit then
+    approximates the bending rate (see :mod:`bendpam.identify.ensemble`) and says so.
 
     Examples
     --------
@@ -664,6 +674,7 @@ def load_processed(path) -> ProcessedSet:
             replicate=int(replicate[i]) if replicate is not None else 1,
             findings=findings[i] if i < len(findings) else [],
             drift=drifts[i] if i < len(drifts) else None,
+            branch_times_s=ds["time_s"].values[i, :n] if "time_s" in ds.data_vars else None,
         ))
     return ProcessedSet(results=results, fixture=fx, options=ProcessingOptions())
 

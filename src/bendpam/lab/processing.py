@@ -319,10 +319,12 @@ def _common_grid(cycles: list[tuple[int, int, int]], k: np.ndarray, grid_n: int,
 
 
 def _cycle_results(cycles: list[tuple[int, int, int]], k: np.ndarray, M: np.ndarray, grid: np.ndarray,
-                   L0_mm: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Steps 5-6 per cycle: ``(branches, blocked moments, free curvatures, loop energies, stored energies)``."""
+                   L0_mm: float, t: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Steps 5-6 per cycle: ``(branches, blocked moments, free curvatures, loop energies, stored energies,
+    branch times)``; the branch times (s) are each grid point's time since its branch began (its reversal)."""
     n, grid_n = len(cycles), grid.size
     branches = np.empty((n, 2, grid_n))
+    times = np.empty((n, 2, grid_n))
     bm = np.empty(n)
     kf = np.empty(n)
     loss = np.empty(n)
@@ -332,6 +334,7 @@ def _cycle_results(cycles: list[tuple[int, int, int]], k: np.ndarray, M: np.ndar
             kk, mm = k[i0:i1 + 1], M[i0:i1 + 1]
             order = np.argsort(kk, kind="stable")
             branches[ci, bi] = np.interp(grid, kk[order], mm[order])
+            times[ci, bi] = np.interp(grid, kk[order], t[i0:i1 + 1][order] - t[i0])
         bm[ci] = float(M[a:c + 1].max())
         kf[ci] = float(k[b])
         # energy loss in M-theta over this cycle's own range
@@ -341,7 +344,7 @@ def _cycle_results(cycles: list[tuple[int, int, int]], k: np.ndarray, M: np.ndar
         th = own * L0_mm
         loss[ci] = float(np.trapezoid(up - down, th))
         stored[ci] = float(np.trapezoid(0.5 * (up + down), th))
-    return branches, bm, kf, loss, stored
+    return branches, bm, kf, loss, stored, times
 
 
 def _labelled_series(t: np.ndarray, s_z: np.ndarray, f_f: np.ndarray, beta: np.ndarray, k: np.ndarray,
@@ -431,7 +434,7 @@ def process_series(
 
     beta, k, M = _convert(fixture, s_z, f_f, opt.tare_n)
     grid = _common_grid(cycles, k, int(opt.grid_points), source)
-    branches, bm, kf, loss, stored = _cycle_results(cycles, k, M, grid, fixture.L0_mm)
+    branches, bm, kf, loss, stored, times = _cycle_results(cycles, k, M, grid, fixture.L0_mm, t)
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(stored > 0, loss / stored, np.nan)
     if np.any(~np.isfinite(ratio)):
@@ -442,6 +445,7 @@ def process_series(
         pressure_kpa=float(pressure_kpa), source=source, n_cycles=len(cycles), curvature_grid=grid,
         branches=branches, blocked_moments=bm, free_curvatures=kf, energy_loss_ratios=ratio, loop_energy=loss,
         stored_energy=stored, sample_rate_hz=fs, cutoff_hz=cutoff, notes=notes, series=series, drift=drift,
+        branch_times_s=times,
     )
     _judge(result, fixture, cycles, k, (t, s_z, f_f, M), opt.tare_n)
     return result

@@ -42,7 +42,8 @@ __all__ = [
 MODEL_LABEL = {"energy": "energy", "force_balance": "force-balance"}
 LAW_LABEL = {"pi": "Prandtl-Ishlinskii", "dahl": "Dahl", "bouc_wen": "Bouc-Wen", "maxwell_slip": "Maxwell-slip",
              "stiction": "breakaway (stiction)",
-             "viscous": "viscous (constant crosshead speed)", "viscous_period": "viscous (constant cycle period)"}
+             "viscous": "viscous (the test's time; else a constant crosshead speed)",
+             "viscous_period": "viscous (constant cycle period)"}
 
 
 def escape(x) -> str:
