@@ -7,18 +7,20 @@
 * :mod:`.identify`: ``fit``, ``fit-material``;
 * :mod:`.sweep`: ``sweep``;
 * :mod:`.design`: ``finger``, ``grasp``, ``wrist``;
+* :mod:`.hand`: ``hand`` (the soft humanoid hand, Kapandji test);
 * :mod:`.inverse`: ``design`` (inverse design from targets);
 * :mod:`.report`: ``report``.
 """
 
 from __future__ import annotations
 
-from bendpam.cli import design, identify, inverse, lab, predict, report, sweep  # noqa: F401  (registers the commands)
+from bendpam.cli import design, hand, identify, inverse, lab, predict, report, sweep  # noqa: F401  (registers the commands)
 from bendpam.cli.app import app, main
 from bendpam.cli.options import use_bendpam_commands
 
 report.register(app)
 design.register(app)
+hand.register(app)
 use_bendpam_commands(app)  # one grammar for lists, --force where a command writes, readable help
 
 __all__ = ["app", "main"]
