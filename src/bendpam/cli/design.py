@@ -318,6 +318,17 @@ def _print_grasps(gr, rows: list[dict[str, Any]]) -> None:
 
 # ---- wrist --------------------------------------------------------------------------------------
 _HOLDING = ("pressure_kpa", "angle_deg", "holds_horizontal", "capacity_g", "equilibrium", "note")
+_HandMassOpt = Annotated[Optional[float], typer.Option(
+    "--hand-mass-g", help="Mass of the hand (g); default 0 in the holding table, 300 in the tilt of --payload-g.")]
+_HandLeverOpt = Annotated[Optional[float], typer.Option(
+    "--hand-lever-mm", help="Lever of the hand's mass (mm); default 50 in the holding table, 80 in the tilt of "
+    "--payload-g.")]
+_PayloadOpt = Annotated[Optional[float], typer.Option(
+    "--payload-g", help="Tilt in each direction carrying the hand and this payload at --lever-mm (g), with the "
+    "pressures for --tilt-deg and the frame-buckling margins.")]
+_ForearmOpt = Annotated[str, typer.Option(
+    "--forearm", help="With --payload-g: horizontal (actuator at 90 deg on top), up (hand above the wrist) or down.")]
+_TiltOpt = Annotated[float, typer.Option("--tilt-deg", help="With --payload-g: the target tilt (deg).")]
 
 
 def wrist_cmd(
@@ -339,19 +350,11 @@ def wrist_cmd(
         float, typer.Option("--column-stiffness-nmm2", help="Bending stiffness of the column (N*mm^2).")] = 0.0,
     load_g: Annotated[float, typer.Option("--load-g", help="Mass held horizontally (g).")] = 335.0,
     lever_mm: Annotated[float, typer.Option("--lever-mm", help="Lever of the mass beyond the wrist (mm).")] = 100.0,
-    hand_mass_g: Annotated[
-        Optional[float], typer.Option("--hand-mass-g", help="Mass of the hand (g); default 0 in the holding "
-                                      "table, 300 in the tilt of --payload-g.")] = None,
-    hand_lever_mm: Annotated[
-        Optional[float], typer.Option("--hand-lever-mm", help="Lever of the hand's mass (mm); default 50 in the "
-                                      "holding table, 80 in the tilt of --payload-g.")] = None,
-    payload_g: Annotated[
-        Optional[float], typer.Option("--payload-g", help="Tilt in each direction carrying the hand and this "
-                                      "payload at --lever-mm (g), with the pressures for --tilt-deg and the "
-                                      "frame-buckling margins.")] = None,
-    forearm: Annotated[str, typer.Option("--forearm", help="With --payload-g: horizontal (actuator at 90 deg on "
-                                         "top), up (hand above the wrist) or down.")] = "horizontal",
-    tilt_deg: Annotated[float, typer.Option("--tilt-deg", help="With --payload-g: the target tilt (deg).")] = 30.0,
+    hand_mass_g: _HandMassOpt = None,
+    hand_lever_mm: _HandLeverOpt = None,
+    payload_g: _PayloadOpt = None,
+    forearm: _ForearmOpt = "horizontal",
+    tilt_deg: _TiltOpt = 30.0,
     as_json: JsonOpt = False,
     plot: PlotOpt = None,
     fig_format: FigureFormatOpt = None,

@@ -79,14 +79,16 @@ __all__ = [
     "HandPose",
     "arc_frames",
     "default_hand",
+    "finger_frame",
     "hand_pose",
+    "save_result",
     "thumb_chain",
 ]
 
 #: the four fingers, radial to ulnar
 FINGERS = ("index", "middle", "ring", "little")
 #: every actuated part of the hand (the order of :attr:`Hand.parts`)
-PARTS = FINGERS + ("thumb_proximal", "thumb_distal", "palm_roll")
+PARTS = (*FINGERS, "thumb_proximal", "thumb_distal", "palm_roll")
 
 #: default finger bases (x, y) and lengths, mm (see the module docstring)
 _FINGER_DEFAULTS = {"index": (30.0, 105.0, 95.0), "middle": (10.0, 108.0, 105.0),
@@ -331,7 +333,7 @@ def _rot(axis: np.ndarray, angle) -> np.ndarray:
     """Rotation matrices (..., 3, 3) about the unit vectors ``axis`` (..., 3) by ``angle`` (rad) (Rodrigues)."""
     a = np.asarray(axis, dtype=float)
     th = np.asarray(angle, dtype=float)[..., None, None]
-    K = np.zeros(a.shape[:-1] + (3, 3))
+    K = np.zeros((*a.shape[:-1], 3, 3))
     K[..., 0, 1], K[..., 0, 2], K[..., 1, 2] = -a[..., 2], a[..., 1], -a[..., 0]
     K = K - np.swapaxes(K, -1, -2)
     eye = np.broadcast_to(np.eye(3), K.shape)
@@ -379,7 +381,7 @@ def arc_frames(R, p, angle_rad, length_mm, s_mm=None):
         u, v = local(s)
         return p[..., None, :] + u[..., None] * R[..., None, :, 0] + v[..., None] * R[..., None, :, 1]
 
-    p_end = place(np.full(th.shape + (1,), float(length_mm)))[..., 0, :]
+    p_end = place(np.full((*th.shape, 1), float(length_mm)))[..., 0, :]
     R_end = _rot(R[..., :, 2], th) @ R
     pts = None
     if s_mm is not None:  # (m,) for every arc, or one row per arc (..., m)
@@ -388,8 +390,13 @@ def arc_frames(R, p, angle_rad, length_mm, s_mm=None):
     return pts, R_end, p_end
 
 
-def _finger_base(hand: Hand, name: str) -> tuple[np.ndarray, np.ndarray]:
-    """A finger's base frame (columns t = +y, n = +z, b = +x) and base position (mm)."""
+def finger_frame(hand: Hand, name: str) -> tuple[np.ndarray, np.ndarray]:
+    """A finger's base frame (columns t = +y, n = +z, b = +x) and base position (mm).
+
+    >>> R, p = finger_frame(default_hand(), "ring")
+    >>> R[:, 0].tolist(), p.tolist()                      # along +y, from the knuckle line
+    ([0.0, 1.0, 0.0], [-10.0, 105.0, 0.0])
+    """
     x, y = hand.finger_bases_mm[name]
     return np.column_stack([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]]), np.array([x, y, 0.0])
 
@@ -406,7 +413,7 @@ def thumb_chain(hand: Hand, proximal_rad, distal_rad, roll_rad, s_mm=None):
     """
     th1, th2, phi = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (proximal_rad, distal_rad, roll_rad)))
     L1, L2 = hand.part("thumb_proximal").length_mm, hand.part("thumb_distal").length_mm
-    roll = _rot(np.broadcast_to([0.0, -1.0, 0.0], phi.shape + (3,)), phi)  # about the index axis: +x -> +z
+    roll = _rot(np.broadcast_to([0.0, -1.0, 0.0], (*phi.shape, 3)), phi)  # about the index axis: +x -> +z
     axis = np.array([hand.finger_bases_mm["index"][0], 0.0, 0.0])
     pbase = axis + roll @ (np.array([*hand.thumb_base_mm, 0.0]) - axis)
     d = math.radians(hand.thumb_direction_deg)
@@ -483,10 +490,18 @@ class HandPose:
 
         For a whole set use :class:`bendpam.infra.outputs.OutputSet`, as ``bendpam hand --out`` does.
         """
-        return _save(out_dir, "pose", self.to_dict(), lambda: self.plot(), figure_format)
+        return save_result(out_dir, "pose", self.to_dict(), lambda: self.plot(), figure_format)
 
 
-def _save(out_dir, stem: str, record: dict, draw, figure_format: str) -> dict[str, str]:
+def save_result(out_dir, stem: str, record: dict, draw, figure_format: str) -> dict[str, str]:
+    """Write ``<stem>.json`` (``record``) and the figure ``draw()`` as ``<stem>.<figure_format>`` into ``out_dir``,
+    each atomically; returns ``{file name: path}`` (the ``save()`` of the hand's results).
+
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     sorted(hand_pose(default_hand()).save(d))
+    ['pose.json', 'pose.png']
+    """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     atomic_write_text(out / f"{stem}.json", to_json(record))
@@ -519,7 +534,7 @@ def hand_pose(hand: Hand, pressures_kpa: dict | None = None, *, samples: int = 2
     ang = {n: float(a) for n, a in _angles_rad(hand, {n: np.asarray(P[n]) for n in PARTS}).items()}
     lines, tips = {}, {}
     for f in FINGERS:
-        R, p = _finger_base(hand, f)
+        R, p = finger_frame(hand, f)
         L = hand.part(f).length_mm
         pts, _, tip = arc_frames(R, p, ang[f], L, np.linspace(0.0, L, samples))
         lines[f], tips[f] = pts, tip

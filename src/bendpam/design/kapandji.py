@@ -40,7 +40,7 @@ from typing import Any
 
 import numpy as np
 
-from bendpam.design.hand import FINGERS, Hand, _finger_base, _save, arc_frames, hand_pose, thumb_chain
+from bendpam.design.hand import FINGERS, Hand, arc_frames, finger_frame, hand_pose, save_result, thumb_chain
 from bendpam.design.parts import json_number
 from bendpam.errors import InputError
 from bendpam.infra.accessors import figure
@@ -74,11 +74,11 @@ _THUMB = ("thumb_proximal", "thumb_distal", "palm_roll")
 def _targets(hand: Hand, number: int, finger_rad) -> np.ndarray:
     """Point ``number`` (mm, (..., 3)) with its finger bent by ``finger_rad`` (rad, array)."""
     _n, _d, f, frac, side = KAPANDJI_POINTS[number - 1]
-    R, p = _finger_base(hand, f)
+    R, p = finger_frame(hand, f)
     a = np.asarray(finger_rad, dtype=float)
     if side == "palm":
-        return np.broadcast_to(p + np.array([0.0, frac, hand.radius_mm]), a.shape + (3,))
-    _, Re, pe = arc_frames(np.broadcast_to(R, a.shape + (3, 3)), p, a * frac, frac * hand.part(f).length_mm)
+        return np.broadcast_to(p + np.array([0.0, frac, hand.radius_mm]), (*a.shape, 3))
+    _, Re, pe = arc_frames(np.broadcast_to(R, (*a.shape, 3, 3)), p, a * frac, frac * hand.part(f).length_mm)
     return pe + hand.radius_mm * (Re[..., :, 2] if side == "radial" else Re[..., :, 1])
 
 
@@ -161,6 +161,13 @@ class KapandjiPoint:
     roll_deg : the palm roll there, deg.
     thumb_distance_mm : the closest distance of any point of the thumb, mm (the tip's when it touches).
     tip_mm : the tip position at the closest pose, mm.
+
+    Examples
+    --------
+    >>> from bendpam.design.hand import default_hand
+    >>> p = kapandji(default_hand(), points=(5,), grid=5, starts=1).points[0]
+    >>> p.description, p.touched, sorted(p.to_dict())[:4]
+    ('ring fingertip', True, ['description', 'distance_mm', 'number', 'pressures_kpa'])
     """
 
     number: int
@@ -222,7 +229,7 @@ class KapandjiResult:
                 "points": [p.to_dict() for p in self.points]}
 
     def plot(self, ax=None, title: str | None = None):
-        """A 3-D figure of the thumb's closest pose for every point (:func:`bendpam.present.figures.hand.plot_kapandji`).
+        """A 3-D figure of the thumb's closest pose for every point (:func:`~bendpam.present.figures.hand.plot_kapandji`).
 
         >>> from bendpam.design.hand import default_hand
         >>> fig = kapandji(default_hand(), points=(3,)).plot()
@@ -233,7 +240,7 @@ class KapandjiResult:
 
     def save(self, out_dir, *, figure_format: str = "png") -> dict[str, str]:
         """Write ``kapandji.json`` and ``kapandji.<format>`` into ``out_dir`` (each atomically); ``{name: path}``."""
-        return _save(out_dir, "kapandji", self.to_dict(), lambda: self.plot(), figure_format)
+        return save_result(out_dir, "kapandji", self.to_dict(), lambda: self.plot(), figure_format)
 
 
 def _pressures(hand: Hand, names: tuple, x: np.ndarray) -> dict[str, float]:
@@ -350,7 +357,7 @@ class HandWorkspace:
         return {"pressures_kpa": [float(p) for p in self.pressures_kpa],
                 "fingers": {f: box(t) for f, t in self.finger_tips_mm.items()},
                 "thumb": {**box(self.thumb_tips_mm), "hull_volume_cm3": float(vol),
-                          "points": int(len(self.thumb_tips_mm))}}
+                          "points": len(self.thumb_tips_mm)}}
 
     def plot(self, ax=None, title: str | None = None):
         """A 3-D scatter of the tips (:func:`bendpam.present.figures.hand.plot_hand_workspace`)."""
@@ -373,8 +380,8 @@ def hand_workspace(hand: Hand, n: int = 15) -> HandWorkspace:
     for f in FINGERS:
         part = hand.part(f)
         a = np.radians(part.angle_deg(P))
-        R, p = _finger_base(hand, f)
-        fingers[f] = arc_frames(np.broadcast_to(R, a.shape + (3, 3)), p, a, part.length_mm)[2]
+        R, p = finger_frame(hand, f)
+        fingers[f] = arc_frames(np.broadcast_to(R, (*a.shape, 3, 3)), p, a, part.length_mm)[2]
     ang = [np.radians(hand.part(nm).angle_deg(P)) for nm in _THUMB]
     A = np.meshgrid(*ang, indexing="ij")
     _, tips, _ = thumb_chain(hand, *(a.ravel() for a in A))

@@ -56,7 +56,6 @@ from bendpam.design.parts import G_N_PER_G, checked_pressure_kpa, checked_pressu
 from bendpam.design.rod import newton_batch
 from bendpam.design.wrist import DEFAULT_LEVER_MM, Wrist
 from bendpam.errors import InputError
-from bendpam.physics.law import STABLE_BRANCH_TOL
 from bendpam.physics.limits import section_limits
 from bendpam.validate import integer, number
 
@@ -80,6 +79,7 @@ DEFAULT_HAND_LEVER_MM = 80.0
 FOREARM = ("horizontal", "up", "down")
 _TERMS = 30  # terms of the even power series (exact to round-off for |b| L < 10 rad)
 _STEPS = 8   # continuation steps in pressure from the straight wrist
+_TABLE_TOL = 1e-8  # the moment table's tolerance: the one of MomentLaw.stable_branch (the planar wrist's)
 
 
 def _series(kind: int, y: np.ndarray, d: int) -> np.ndarray:
@@ -152,7 +152,7 @@ class WristLoad:
         s = np.einsum("ij,ij->i", b, b)
         y = s * L * L
         m = np.zeros_like(b)
-        J = np.zeros(b.shape + (2,))
+        J = np.zeros((*b.shape, 2))
         eye = np.eye(2)
         for mass, lev in ((self.hand_mass_g, self.hand_lever_mm), (self.payload_g, self.payload_lever_mm)):
             if mass == 0.0:
@@ -181,7 +181,7 @@ class _Wrist4:
     def __init__(self, wrist: Wrist, load: WristLoad | None):
         law = wrist.law
         self.w, self.load, self.L = wrist, load, wrist._length_mm
-        self.table = law.tabulated(STABLE_BRANCH_TOL)
+        self.table = law.tabulated(_TABLE_TOL)
         self.k_lo, self.k_hi = float(law.limits.k_min), float(law.limits.k_max)
         self.P_start = float(law.P_start_kpa)
         self.s = wrist._actuator.bend_sign
@@ -230,19 +230,20 @@ def _continue(model: _Wrist4, P: np.ndarray, steps: int) -> tuple[np.ndarray, np
     for t in np.linspace(1.0 / steps, 1.0, steps):
         Pt = t * P
 
-        def fun(rows, U, Pt=Pt, t=t):
-            return np.stack([model.moment(Pt[rows], U[:, j], t)[0] for j in range(U.shape[1])], axis=1) / scale
-
-        def jac(rows, u, Pt=Pt, t=t):
-            return model.moment(Pt[rows], u, t)[1] / scale
-
-        def adm(rows, u, Pt=Pt):
-            return model.admissible(Pt[rows], u)
-
         live = np.flatnonzero(ok)
+        Pl = Pt[live]
+
+        def fun(rows, U, Pl=Pl, t=t):
+            return np.stack([model.moment(Pl[rows], U[:, j], t)[0] for j in range(U.shape[1])], axis=1) / scale
+
+        def jac(rows, u, Pl=Pl, t=t):
+            return model.moment(Pl[rows], u, t)[1] / scale
+
+        def adm(rows, u, Pl=Pl):
+            return model.admissible(Pl[rows], u)
+
         if live.size:
-            u, conv, _ = newton_batch(lambda r, U: fun(live[r], U), b[live], -np.inf, np.inf, maxit=50,
-                                      jac=lambda r, u: jac(live[r], u), admissible=lambda r, u: adm(live[r], u))
+            u, conv, _ = newton_batch(fun, b[live], -np.inf, np.inf, maxit=50, jac=jac, admissible=adm)
             good = conv & model.stable(Pt[live], u, t)
             b[live] = u
             ok[live] = good
@@ -331,11 +332,12 @@ def wrist_map(wrist: Wrist, pressures_kpa, load: WristLoad | None = None, *, ste
 
     Examples
     --------
-    The hand (300 g at 80 mm) and a 550 g bottle, forearm horizontal, top actuator inflated:
+    The hand (300 g at 80 mm) and a 550 g bottle, forearm horizontal, top actuator inflated: the hand droops
+    by 27.8 deg (toward 270 deg, down):
 
     >>> m = wrist_map(Wrist(), [[0.0, 140.0, 0.0, 0.0]], WristLoad(payload_g=550.0))
     >>> bool(m.equilibrium[0]), round(float(m.tilt_deg[0]), 1), round(float(m.direction_deg[0]), 1)
-    (True, 5.1, 270.0)
+    (True, 27.8, 270.0)
     """
     if not isinstance(wrist, Wrist):
         raise TypeError(f"wrist must be a bendpam.design.Wrist, got {type(wrist).__name__}")
@@ -364,6 +366,12 @@ class WristTarget:
     tilt_reached_deg, direction_reached_deg : where the forward solve ends, deg.
     min_buckling_margin : per actuator, the smallest frame-buckling margin along the pressure ramp.
     note : why not, else empty.
+
+    Examples
+    --------
+    >>> t = wrist_target(Wrist(), 20.0, 45.0)              # between two actuators: both inflated
+    >>> [round(p) for p in t.pressures_kpa], t.reached
+    ([97, 97, 0, 0], True)
     """
 
     tilt_deg: float
@@ -422,7 +430,7 @@ def wrist_target(wrist: Wrist, tilt_deg: float, direction_deg: float, load: Wris
     --------
     >>> t = wrist_target(Wrist(), 30.0, 90.0)                 # unloaded: the actuator at 90 deg alone
     >>> [round(p) for p in t.pressures_kpa], t.reached, round(t.tilt_reached_deg, 2)
-    ([0, 167, 0, 0], True, 30.0)
+    ([0, 181, 0, 0], True, 30.0)
     """
     if not isinstance(wrist, Wrist):
         raise TypeError(f"wrist must be a bendpam.design.Wrist, got {type(wrist).__name__}")
@@ -510,6 +518,7 @@ def _direction_row(d, P0, ok, tilt, psi, along, reached, mins, tgt: WristTarget,
             note += f" (it tilts {tilt:.1f} deg toward {psi:.0f} deg under the load)"
         note += f"; {target:g} deg needs {need}"
     return {"direction_deg": float(d) % 360.0, "pressure_kpa": P0, "tilt_deg": json_number(tilt) if ok else None,
-            "tilt_direction_deg": json_number(psi) if ok else None, "tilt_along_deg": json_number(along) if ok else None,
+            "tilt_direction_deg": json_number(psi) if ok else None,
+            "tilt_along_deg": json_number(along) if ok else None,
             "equilibrium": bool(ok), "reaches_target": reached,
             "min_buckling_margin": [json_number(m) for m in mins], "target": tgt.to_dict(), "note": note or None}
