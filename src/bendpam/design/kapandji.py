@@ -229,7 +229,8 @@ class KapandjiResult:
                 "points": [p.to_dict() for p in self.points]}
 
     def plot(self, ax=None, title: str | None = None):
-        """A 3-D figure of the thumb's closest pose for every point (:func:`~bendpam.present.figures.hand.plot_kapandji`).
+        """A 3-D figure of the thumb's closest pose for every point
+        (:func:`~bendpam.present.figures.hand.plot_kapandji`).
 
         >>> from bendpam.design.hand import default_hand
         >>> fig = kapandji(default_hand(), points=(3,)).plot()
