@@ -126,6 +126,7 @@ class HandPart:
         if self.actuator.bend_sign == 0:
             raise InputError(f"{self.name}: the actuator has the neutral braid angle (54.74 deg): it does not bend")
         s(self, "actuator", self.actuator.replace(L0_mm=self.length_mm))
+        s(self, "_tables", {})  # angle tables by maximum pressure (not a field: no part of eq or repr)
 
     @property
     def law(self) -> MomentLaw:
@@ -140,13 +141,16 @@ class HandPart:
     def angle_table(self, max_pressure_kpa: float) -> tuple[np.ndarray, np.ndarray]:
         """Pressures (kPa) from 0 to ``max_pressure_kpa`` and the free bending angles there (deg), up to the
         first pressure without an equilibrium (the angle rises with the pressure beyond ``P_start``)."""
-        P = np.linspace(0.0, max_pressure_kpa, _TABLE_POINTS)
-        a = self.angle_deg(P)
-        bad = ~np.isfinite(a)
-        if bad.any():
-            n = int(np.argmax(bad))
-            P, a = P[:n], a[:n]
-        return P, a
+        key = float(max_pressure_kpa)
+        if key not in self._tables:  # type: ignore[attr-defined]
+            P = np.linspace(0.0, key, _TABLE_POINTS)
+            a = self.angle_deg(P)
+            bad = ~np.isfinite(a)
+            if bad.any():
+                n = int(np.argmax(bad))
+                P, a = P[:n], a[:n]
+            self._tables[key] = (P, a)  # type: ignore[attr-defined]
+        return self._tables[key]  # type: ignore[attr-defined]
 
     def pressure_for_angle(self, angle_deg, max_pressure_kpa: float) -> np.ndarray:
         """The pressure (kPa) at which the part bends ``angle_deg`` freely (interpolated in :meth:`angle_table`);
@@ -222,7 +226,9 @@ class Hand:
         >>> {k: round(v) for k, v in default_hand().reach_deg().items()}["thumb_distal"]
         96
         """
-        return {p.name: float(p.angle_deg(self.max_pressure_kpa)) for p in self.parts}
+        if "_reach" not in self.__dict__:
+            object.__setattr__(self, "_reach", {p.name: float(p.angle_deg(self.max_pressure_kpa)) for p in self.parts})
+        return dict(self.__dict__["_reach"])
 
     def to_dict(self) -> dict[str, Any]:
         """The hand's description as a JSON-ready dict (units in the key names).
@@ -296,6 +302,17 @@ def _hand_from_dict(data: dict, path: Path) -> Hand:
     def num(table: dict, where: str, key: str, default: float) -> float:
         return number(f"{path}: [{where}] {key}", table.get(key, default))
 
+    try:
+        return _build_hand(data, path, model, actuator, num)
+    except InputError as exc:
+        if str(path) in str(exc):
+            raise
+        raise InputError(f"{path}: {exc}") from None
+
+
+def _build_hand(data: dict, path: Path, model: str, actuator, num) -> Hand:
+    """The :class:`Hand` of a checked hand file (``actuator`` and ``num`` read its values)."""
+    h, th, pa = data.get("hand", {}), data.get("thumb", {}), data.get("palm", {})
     base = actuator(h, "hand", None)
     parts, bases = [], {}
     for f in FINGERS:

@@ -133,8 +133,15 @@ def _minimise(fun, grid: np.ndarray, bounds: np.ndarray, starts: int) -> tuple[n
     best = np.argsort(values)[:starts]
     x_best, f_best = grid[best[0]], float(values[best[0]])
     box = [(float(lo), float(hi)) for lo, hi in bounds]
+    k = grid.shape[1]
+    steps = np.vstack([np.zeros(k), 1e-6 * np.eye(k), -1e-6 * np.eye(k)])
+
+    def value_and_gradient(z):  # one vectorised call: the value and central differences
+        v = fun(z[None, :] + steps)
+        return float(v[0]), (v[1:k + 1] - v[k + 1:]) / 2e-6
+
     for i in best:
-        res = minimize(lambda z: float(fun(z[None, :])[0]), grid[i], method="L-BFGS-B", bounds=box)
+        res = minimize(value_and_gradient, grid[i], jac=True, method="L-BFGS-B", bounds=box)
         if float(res.fun) < f_best:
             x_best, f_best = np.clip(res.x, bounds[:, 0], bounds[:, 1]), float(res.fun)
     return x_best, f_best

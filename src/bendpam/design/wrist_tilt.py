@@ -77,18 +77,37 @@ DEFAULT_HAND_MASS_G = 300.0
 DEFAULT_HAND_LEVER_MM = 80.0
 #: forearm orientations: horizontal (the actuator at ``up_deg`` on top), vertical with the hand up or down
 FOREARM = ("horizontal", "up", "down")
-_TERMS = 30  # terms of the even power series (exact to round-off for |b| L < 10 rad)
+_TERMS = 14  # terms of the even power series, used for |b| L < 1 rad (closed forms above)
 _STEPS = 8   # continuation steps in pressure from the straight wrist
 _TABLE_TOL = 1e-8  # the moment table's tolerance: the one of MomentLaw.stable_branch (the planar wrist's)
 
 
-def _series(kind: int, y: np.ndarray, d: int) -> np.ndarray:
-    """``d``-th derivative in ``y = x^2`` of c0 = cos x, c1 = (1 - cos x)/x^2 or c2 = sin(x)/x (``kind`` 0, 1, 2)."""
-    shift = {0: 0, 1: 2, 2: 1}[kind]
-    c = np.array([(-1.0) ** i / math.factorial(2 * i + shift) for i in range(_TERMS)])
-    for _ in range(d):
-        c = c[1:] * np.arange(1, len(c))
-    return np.polynomial.polynomial.polyval(y, c)
+def _even_series_coefficients() -> np.ndarray:
+    """Taylor coefficients in ``y = x^2`` of c0 = cos x, c1 = (1 - cos x)/x^2, c2 = sin(x)/x (rows), ``_TERMS`` each."""
+    return np.array([[(-1.0) ** i / math.factorial(2 * i + shift) for i in range(_TERMS)] for shift in (0, 2, 1)])
+
+
+_COEF = _even_series_coefficients()
+_DCOEF = [_COEF, _COEF[:, 1:] * np.arange(1, _TERMS), _COEF[:, 2:] * (np.arange(2, _TERMS) * np.arange(1, _TERMS - 1))]
+
+
+def _c012(y: np.ndarray) -> list[np.ndarray]:
+    """c0, c1, c2 (module docstring: cos x, (1 - cos x)/x^2, sin(x)/x) and their first two derivatives in
+    ``y = x^2 >= 0``: ``[values, first, second]``, each (3, N).  Closed forms for ``y >= 1``, the series below."""
+    y = np.asarray(y, dtype=float)
+    small = [np.stack([np.polynomial.polynomial.polyval(y, c) for c in D]) for D in _DCOEF]
+    ys = np.maximum(y, 1.0)
+    x = np.sqrt(ys)
+    c0, c2 = np.cos(x), np.sin(x) / x
+    c1 = (1.0 - c0) / ys
+    d2 = (c0 - c2) / (2.0 * ys)
+    d0 = -c2 / 2.0
+    d1 = (-d0 - c1) / ys
+    e2 = (d0 - d2) / (2.0 * ys) - d2 / ys
+    e0 = -d2 / 2.0
+    e1 = (-e0 - 2.0 * d1) / ys
+    big = [np.stack([c0, c1, c2]), np.stack([d0, d1, d2]), np.stack([e0, e1, e2])]
+    return [np.where(y < 1.0, a, b) for a, b in zip(small, big, strict=True)]
 
 
 @dataclass(frozen=True)
@@ -154,12 +173,13 @@ class WristLoad:
         m = np.zeros_like(b)
         J = np.zeros((*b.shape, 2))
         eye = np.eye(2)
+        c = _c012(y)
         for mass, lev in ((self.hand_mass_g, self.hand_lever_mm), (self.payload_g, self.payload_lever_mm)):
             if mass == 0.0:
                 continue
             W = mass * G_N_PER_G / L
-            G = [L * L * _series(1, y, d) * L ** (2 * d) + lev * L * _series(2, y, d) * L ** (2 * d) for d in range(3)]
-            A = [L * _series(2, y, d) * L ** (2 * d) + lev * _series(0, y, d) * L ** (2 * d) for d in range(3)]
+            G = [(L * L * c[d][1] + lev * L * c[d][2]) * L ** (2 * d) for d in range(3)]
+            A = [(L * c[d][2] + lev * c[d][0]) * L ** (2 * d) for d in range(3)]
             gb = b @ gxy
             m += W * (gxy[None, :] * G[0][:, None] + 2.0 * (gb * G[1] + gz * A[1])[:, None] * b)
             bb = np.einsum("ni,nj->nij", b, b)
@@ -193,13 +213,16 @@ class _Wrist4:
     def kprime(self, b: np.ndarray) -> np.ndarray:
         return self.s * (b @ self.e.T)
 
-    def moment(self, P: np.ndarray, b: np.ndarray, t: float = 1.0):
-        """Total moment (N*mm, (N, 2)), Jacobian (N, 2, 2) and the actuators' ``dM/dk'`` (N, 4), load scaled by t."""
-        kp = self.kprime(b)
-        kc = np.clip(kp, 0.999 * self.k_lo, 0.999 * self.k_hi)  # evaluated inside; admissible() refuses outside
+    def actuators(self, P: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Each actuator's moment ``M`` (N*mm) and ``dM/dk'`` (N*mm^2), (N, 4), at its frame curvature."""
+        kc = np.clip(self.kprime(b), 0.999 * self.k_lo, 0.999 * self.k_hi)  # inside; admissible() refuses outside
         A, B, dA, dB = self.table.derivatives(kc)
         pa = np.maximum(P - self.P_start, 0.0)
-        M, dM = pa * A - B, pa * dA - dB
+        return pa * A - B, pa * dA - dB
+
+    def moment(self, P: np.ndarray, b: np.ndarray, t: float = 1.0):
+        """Total moment (N*mm, (N, 2)), Jacobian (N, 2, 2) and the actuators' ``dM/dk'`` (N, 4), load scaled by t."""
+        M, dM = self.actuators(P, b)
         m = self.s * (M @ self.e) - b @ self.fixed
         J = np.einsum("ni,ij,ik->njk", dM, self.e, self.e) - self.fixed
         if self.load is not None and self.load.total_g > 0:
@@ -210,7 +233,7 @@ class _Wrist4:
     def admissible(self, P: np.ndarray, b: np.ndarray) -> np.ndarray:
         kp = self.kprime(b)
         inside = np.all((kp > self.k_lo) & (kp < self.k_hi), axis=1)
-        _, _, dM = self.moment(P, b)
+        _, dM = self.actuators(P, b)
         return inside & np.all(dM < 0.0, axis=1)
 
     def stable(self, P: np.ndarray, b: np.ndarray, t: float) -> np.ndarray:
