@@ -122,7 +122,7 @@ def test_hand_file_round_trip_and_one_line_errors(tmp_path):
 
 
 def test_pose_refuses_pressures_outside_the_hand_range():
-    with pytest.raises(InputError, match="index.*300"):
+    with pytest.raises(InputError, match=r"index.*300"):
         hand_pose(default_hand(), {"index": 350.0})
     with pytest.raises(InputError, match="thumb_distal"):
         hand_pose(default_hand(), {"thumb_dist": 100.0})

@@ -286,7 +286,7 @@ def _hand_from_dict(data: dict, path: Path) -> Hand:
             if key not in _TABLES[table]:
                 raise InputError(f"{path}: [{table}] has an unknown key {key!r}{did_you_mean(key, _TABLES[table])}; "
                                  f"allowed: {', '.join(sorted(_TABLES[table]))}")
-    h, th, pa = data.get("hand", {}), data.get("thumb", {}), data.get("palm", {})
+    h, _th, _pa = data.get("hand", {}), data.get("thumb", {}), data.get("palm", {})
     model = h.get("model", "energy")
     if not isinstance(model, str):
         raise InputError(f"{path}: [hand] model = {model!r} must be 'energy' or 'force_balance'")
