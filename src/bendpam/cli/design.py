@@ -387,12 +387,7 @@ def wrist_cmd(
                    plot, fig_format, aspect=1.15)
     results = [_record(r) for r in table.to_dict("records")]
     holding = [{k: d[k] for k in _HOLDING} for d in (h.to_dict() for h in holds)]
-    tilt = None
-    if tilt_load is not None:
-        from bendpam.design.wrist_tilt import wrist_directions
-
-        tilt = {"load": tilt_load.to_dict(), "target_tilt_deg": tilt_deg,
-                "directions": wrist_directions(w, max(P), tilt_load, target_tilt_deg=tilt_deg)}
+    tilt = _tilt(w, max(P), tilt_load, tilt_deg)
     if as_json:
         obj = {"model": mname, "actuator": act.name or act.kind, "length_mm": w.length_mm, "radius_mm": w.radius_mm,
                "lateral_stiffness_nmm2": w.lateral_stiffness_nmm2, "column_stiffness_nmm2": w.column_stiffness_nmm2,
@@ -469,6 +464,16 @@ def _tilt_load(payload_g, forearm: str, tilt_deg: float, hand_mass_g, hand_lever
     return WristLoad(hand_mass_g=DEFAULT_HAND_MASS_G if hand_mass_g is None else hand_mass_g,
                      hand_lever_mm=DEFAULT_HAND_LEVER_MM if hand_lever_mm is None else hand_lever_mm,
                      payload_g=payload_g, payload_lever_mm=lever_mm, forearm=forearm)
+
+
+def _tilt(w, pressure_kpa: float, load, tilt_deg: float) -> dict[str, Any] | None:
+    """The --payload-g section: per direction, the tilt at ``pressure_kpa`` with ``load`` (None: no section)."""
+    if load is None:
+        return None
+    from bendpam.design.wrist_tilt import wrist_directions
+
+    return {"load": load.to_dict(), "target_tilt_deg": tilt_deg,
+            "directions": wrist_directions(w, pressure_kpa, load, target_tilt_deg=tilt_deg)}
 
 
 def _print_tilt(tilt: dict[str, Any]) -> None:
