@@ -60,10 +60,10 @@ from typing import Any
 import numpy as np
 
 from bendpam.design.parts import json_number
-from bendpam.errors import FileFormatError, InputError
+from bendpam.errors import InputError
 from bendpam.infra.accessors import figure
 from bendpam.infra.atomic import atomic_write_text
-from bendpam.infra.budgets import loads_toml, read_input_bytes
+from bendpam.infra.budgets import read_toml_file
 from bendpam.infra.outputs import to_json
 from bendpam.physics import presets
 from bendpam.physics.actuator import Actuator
@@ -266,12 +266,7 @@ class Hand:
         45.0
         """
         p = Path(path)
-        raw = read_input_bytes(p, "actuator file")
-        try:
-            text = raw.decode("utf-8")
-        except UnicodeDecodeError as exc:
-            raise FileFormatError(f"{p}: not UTF-8 text (byte {exc.start})") from None
-        return _hand_from_dict(loads_toml(text, str(p), kind="actuator file"), p)
+        return _hand_from_dict(read_toml_file(p, "hand file"), p)
 
 
 def _hand_from_dict(data: dict, path: Path) -> Hand:
