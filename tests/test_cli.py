@@ -40,7 +40,8 @@ def test_predict_json(capsys):
     assert set(res[0]) == {"pressure_kpa", "blocked_moment_nmm", "free_curvature_per_mm", "free_angle_deg", "note",
                            "frame_axial_force_n", "frame_stress_mpa", "frame_strength_margin", "buckling_margin",
                            "lockup_margin", "bladder_stretch_max", "bladder_stretch_margin", "min_margin",
-                           "limit_note"}
+                           "limit_note", "lateral_stiffness_nmm2", "torsional_stiffness_nmm2_per_rad",
+                           "torsion_lock_torque_nmm"}
     assert res[0]["blocked_moment_nmm"] < 0 and res[0]["free_curvature_per_mm"] < 0 and res[0]["note"] is None
     assert res[2]["free_curvature_per_mm"] is None and res[2]["free_angle_deg"] is None
     assert "fold" in res[2]["note"]

@@ -65,17 +65,6 @@ def _record(row: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
-def _pair(text: str, name: str, unit: str) -> tuple[float, float]:
-    parts = [p for p in str(text).replace(";", ",").split(",") if p.strip()]
-    try:
-        vals = [float(p) for p in parts]
-    except ValueError:
-        raise UserError(f"{name}: {text!r} must be two numbers X,Y ({unit})") from None
-    if len(vals) != 2 or not all(math.isfinite(v) for v in vals):
-        raise UserError(f"{name}: {text!r} must be two finite numbers X,Y ({unit})")
-    return vals[0], vals[1]
-
-
 def _plot_target(plot: Optional[Path], fmt=None):
     """Check --plot and --format (png, pdf or svg; from the suffix if --format is not given); returns --plot."""
     if plot is None:
@@ -114,8 +103,11 @@ def finger_cmd(
     model: ModelOpt = None,
     pressure_kpa: PressureOpt = None,
     l0_mm: L0Opt = None,
-    tip_force_n: Annotated[Optional[str], typer.Option("--tip-force-n", help="Tip force FX,FY (N).")] = None,
-    tip_moment_nmm: Annotated[float, typer.Option("--tip-moment-nmm", help="Tip moment (N*mm, ccw).")] = 0.0,
+    tip_force_n: Annotated[Optional[str], typer.Option(
+        "--tip-force-n", help="Tip force FX,FY in the bending plane, or FX,FY,FZ in space (N; z out of the plane).")
+    ] = None,
+    tip_moment_nmm: Annotated[Optional[str], typer.Option(
+        "--tip-moment-nmm", help="Tip moment MZ (N*mm, ccw in the plane), or MX,MY,MZ in space.")] = None,
     tip_mass_g: Annotated[float, typer.Option("--tip-mass-g", help="Point mass at the fingertip (g).")] = 0.0,
     mass_per_length: Annotated[
         float, typer.Option("--mass-per-length-g-mm", help="Self-weight of the actuator (g/mm).")] = 0.0,
@@ -145,30 +137,40 @@ def finger_cmd(
     bend_key = bend.strip().lower()
     if bend_key not in ("ccw", "cw"):
         raise UserError(f"--bend: {bend!r} is not allowed; choose ccw or cw")
-    F = _pair(tip_force_n, "--tip-force-n", "N") if tip_force_n is not None else (0.0, 0.0)
+    F = _components(tip_force_n, "--tip-force-n", "N", "FX,FY", 2) if tip_force_n is not None else (0.0, 0.0)
+    M = _components(tip_moment_nmm, "--tip-moment-nmm", "N*mm", "MZ", 1) if tip_moment_nmm is not None else (0.0,)
     g = math.radians(gravity_deg)
     finger = Finger(act, mname, base_angle_deg=base_angle_deg, bend=1 if bend_key == "ccw" else -1,
                     fingertip_mm=fingertip_mm, fingertip_offset_mm=fingertip_offset_mm)
-    loads = FingerLoads(tip_force_n=F, tip_moment_nmm=tip_moment_nmm, tip_mass_g=tip_mass_g,
+    if len(F) == 3 or len(M) == 3:  # loads out of the bending plane: the spatial finger
+        if blocked:
+            raise UserError("--blocked-force: the blocked force is for in-plane loads; give --tip-force-n FX,FY and "
+                            "--tip-moment-nmm MZ")
+        _finger3d(act, mname, finger, P, F, M, (tip_mass_g, mass_per_length, gravity_deg), as_json, plot, fig_format)
+        return
+    Mz = M[0]
+    loads = FingerLoads(tip_force_n=(F[0], F[1]), tip_moment_nmm=Mz, tip_mass_g=tip_mass_g,
                         mass_per_length_g_per_mm=mass_per_length, gravity=(math.cos(g), math.sin(g)))
     _, shapes = finger_sweep(finger, P, loads)
     lims = [sh.limits() if sh.equilibrium else None for sh in shapes]  # worst section along the finger
     held = [blocked_tip_force(finger, p, loads=loads) for p in P] if blocked else None
     if plot is not None:  # with a load, the free shapes beside the loaded ones
-        loaded = any(F) or tip_moment_nmm or tip_mass_g or mass_per_length
+        loaded = any(F) or Mz or tip_mass_g or mass_per_length
         free = finger_sweep(finger, P, FingerLoads())[1] if loaded else None
         _save_plot(lambda ax: plot_finger_shapes(shapes, ax=ax, free=free, title=f"{act.name or act.kind}, "
                                                  f"L0 = {act.L0_mm:g} mm"), plot, fig_format, aspect=0.9)
     rows = []
     for i, (sh, lm) in enumerate(zip(shapes, lims, strict=True)):
         row = sh.to_dict()
+        flat = 0.0 if sh.equilibrium else None  # in-plane loads: the finger stays in its plane
+        row |= {"tip_z_mm": flat, "out_of_plane_deg": flat, "twist_deg": flat}
         if held is not None:
             row["blocked_force_n"] = held[i].to_dict()["force_n"]
         row["limits"] = None if lm is None else lm.to_dict()
         rows.append(row)
     if as_json:
         obj = {"model": mname, "actuator": act.name or act.kind, "L0_mm": act.L0_mm,
-               "loads": {"tip_force_n": list(F), "tip_moment_nmm": tip_moment_nmm, "tip_mass_g": tip_mass_g,
+               "loads": {"tip_force_n": list(F), "tip_moment_nmm": Mz, "tip_mass_g": tip_mass_g,
                          "mass_per_length_g_per_mm": mass_per_length, "gravity_deg": gravity_deg},
                "units": {"tip_x_mm": "mm", "tip_angle_deg": "deg (tangent at the tip, from +x)",
                          "bend_angle_deg": "deg (tip rotation in the bending direction)"},
@@ -182,6 +184,58 @@ def finger_cmd(
         for v in (lm.violations if lm is not None else ()):
             typer.echo(f"bendpam: warning: past a limit: {v}", err=True)
     if plot is not None and not as_json:
+        echo_wrote(f"wrote {plot}")
+
+
+def _components(text: str, name: str, unit: str, planar: str, n_planar: int) -> tuple[float, ...]:
+    """``n_planar`` numbers (the in-plane form, ``planar``) or three (X,Y,Z in space), else a one-line error."""
+    parts = [p for p in str(text).replace(";", ",").split(",") if p.strip()]
+    try:
+        vals = [float(p) for p in parts]
+    except ValueError:
+        raise UserError(f"{name}: {text!r} must be {planar} or X,Y,Z ({unit})") from None
+    if len(vals) not in (n_planar, 3) or not all(math.isfinite(v) for v in vals):
+        raise UserError(f"{name}: {text!r} must be {n_planar if n_planar > 1 else 'one'} or three finite numbers: "
+                        f"{planar} or X,Y,Z ({unit})")
+    return tuple(vals)
+
+
+def _finger3d(act, mname, finger, P, F, M, weights, as_json: bool, plot, fig_format) -> None:
+    """``bendpam finger`` with loads out of the bending plane (:func:`bendpam.design.finger3d.solve_finger3d`)."""
+    from bendpam.design.finger3d import Finger3D, FingerLoads3D, plot_finger3d, solve_finger3d
+    from bendpam.present.figures import save_figure
+
+    tip_mass_g, mass_per_length, gravity_deg = weights
+    g = math.radians(gravity_deg)
+    F3 = (*F, 0.0) if len(F) == 2 else F
+    M3 = (0.0, 0.0, M[0]) if len(M) == 1 else M
+    loads = FingerLoads3D(tip_force_n=F3, tip_moment_nmm=M3, tip_mass_g=tip_mass_g,
+                          mass_per_length_g_per_mm=mass_per_length, gravity=(math.cos(g), math.sin(g), 0.0))
+    f3 = Finger3D(finger)
+    shapes = [solve_finger3d(f3, p, loads) for p in P]
+    rows = [sh.to_dict() for sh in shapes]
+    if plot is not None:
+        save_figure(plot_finger3d(shapes, title=f"{act.name or act.kind}, L0 = {act.L0_mm:g} mm"), plot,
+                    format=figure_format(plot, fig_format, "--plot"))
+    if as_json:
+        print_json({"model": mname, "actuator": act.name or act.kind, "L0_mm": act.L0_mm,
+                    "loads": {"tip_force_n": list(F3), "tip_moment_nmm": list(M3), "tip_mass_g": tip_mass_g,
+                              "mass_per_length_g_per_mm": mass_per_length, "gravity_deg": gravity_deg},
+                    "units": {"tip_x_mm": "mm (z: out of the bending plane)",
+                              "out_of_plane_deg": "deg (tip tangent out of the bending plane)",
+                              "twist_deg": "deg (tip section about the frame line)",
+                              "base_moment_nmm": "N*mm (along d1 in-plane normal, d2 plane normal, d3 tangent)"},
+                    "results": rows})
+        return
+    typer.echo(f"{act.name or act.kind}, L0 = {act.L0_mm:g} mm — {mname.replace('_', '-')} model, loads in space")
+    typer.echo(f"{'P (kPa)':>8} {'tip x (mm)':>10} {'tip y (mm)':>10} {'tip z (mm)':>10} {'bend (deg)':>10} "
+               f"{'out (deg)':>9} {'twist (deg)':>11} {'residual':>9}  note")
+    for r in rows:
+        typer.echo(f"{r['pressure_kpa']:8.4g} {_fmt(r['tip_x_mm'], '10.2f')} {_fmt(r['tip_y_mm'], '10.2f')} "
+                   f"{_fmt(r['tip_z_mm'], '10.2f')} {_fmt(r['bend_angle_deg'], '10.2f')} "
+                   f"{_fmt(r['out_of_plane_deg'], '9.2f')} {_fmt(r['twist_deg'], '11.2f')} "
+                   f"{_fmt(r['residual_nmm'], '9.1e')}" + ("  " + r["note"] if r["note"] else ""))
+    if plot is not None:
         echo_wrote(f"wrote {plot}")
 
 

@@ -79,13 +79,16 @@ def predict(
         # the same computation as the loss ratios and loop metrics of `bendpam fit` (one function)
         cycles = predict_cycles(act, loop, P, mname)
     if as_json:
+        oop = _out_of_plane(act, P, df["free_curvature_per_mm"], mname)
         obj = {
             "model": mname,
             "actuator": act.to_dict() | act.derived(),
             "max_equilibrium_pressure_kpa": br.max_pressure_kpa,
             "branch_end": br.kind,
             "units": {"pressure_kpa": "kPa", "blocked_moment_nmm": "N*mm", "free_curvature_per_mm": "1/mm",
-                      "free_angle_deg": "deg", **{k: u for k, (u, _) in LIMIT_OUTPUTS.items()}},
+                      "free_angle_deg": "deg", **{k: u for k, (u, _) in LIMIT_OUTPUTS.items()},
+                      "lateral_stiffness_nmm2": "N*mm^2", "torsional_stiffness_nmm2_per_rad": "N*mm^2/rad",
+                      "torsion_lock_torque_nmm": "N*mm"},
             "results": [
                 {
                     "pressure_kpa": r.pressure_kpa,
@@ -93,6 +96,7 @@ def predict(
                     "free_curvature_per_mm": r.free_curvature_per_mm,
                     "free_angle_deg": r.free_angle_deg,
                     **{k: getattr(r, k) for k in LIMIT_OUTPUTS},
+                    **{k: v[i] for k, v in oop.items()},
                     "note": r.note or None,
                     "limit_note": r.limit_note or None,
                     **({"cycle": _cycle_json(cycles[i])} if cycles is not None else {}),
@@ -116,6 +120,24 @@ def predict(
         for c in cycles:
             typer.echo(f"{c.pressure_kpa:8.4g}  {fmt_num(c.free_curvature_per_mm, '24.5f')}  "
                        f"{fmt_num(100 * c.energy_loss_ratio, '17.2f')}%  {c.note}")
+
+
+def _out_of_plane(act, P, k_free, mname) -> dict[str, list]:
+    """Lateral and torsional stiffness and the braid's lock torque at each free curvature (None without one)."""
+    import numpy as np
+
+    from bendpam.physics.spatial import spatial_stiffness
+
+    keys = ("lateral_stiffness_nmm2", "torsional_stiffness_nmm2_per_rad", "torsion_lock_torque_nmm")
+    out: dict[str, list] = {k: [None] * len(P) for k in keys}
+    k_free = np.asarray(k_free, dtype=float)
+    ok = np.flatnonzero(np.isfinite(k_free))
+    if ok.size:
+        st = spatial_stiffness(act, np.asarray(P, dtype=float)[ok], k_free[ok], model=mname)
+        for k in keys:
+            for j, v in zip(ok, np.atleast_1d(getattr(st, k)), strict=True):
+                out[k][j] = float(v)
+    return out
 
 
 def _loop_model(actuator_file, law, a0, a1_per_kpa, angle):

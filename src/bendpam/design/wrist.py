@@ -17,9 +17,12 @@ Model and assumptions
 
   with ``M`` the paper's moment law (:class:`bendpam.MomentLaw`; an inactive actuator gives its
   passive moment at ``P = 0``), ``EI_lat`` the out-of-plane (lateral) bending stiffness of one
-  actuator and ``EI_col`` that of the column.  The default ``EI_lat`` is the frame strip bent about
-  its strong axis, ``E_f t w^3 / 12`` (35 400 N*mm^2 for the paper's frame); bendpam has no model
-  of the bladder's lateral stiffness, so this is a lower bound, and ``lateral_stiffness_nmm2=0``
+  actuator and ``EI_col`` that of the column.  The default ``EI_lat`` is the actuator's lateral
+  stiffness unpressurised and straight, :func:`bendpam.physics.spatial.lateral_stiffness_nmm2` at
+  ``P = 0, k' = 0``: the frame strip about its strong axis plus the bladder tube (45 100 N*mm^2 for
+  the paper's BC-PAM, of which the frame's ``E_f t w^3 / 12`` is 35 400).  The actuators that bend
+  out of their plane are the passive ones beside the inflated actuator, hence ``P = 0``; the
+  pressure raises it by a few per cent (docs/out-of-plane.md).  ``lateral_stiffness_nmm2=0``
   gives the brief's simplest model (only in-plane moments).  The default column is a free joint
   (``EI_col = 0``).
 * The radius does not enter the moment balance: the actuators are taken to slide axially at the
@@ -59,6 +62,7 @@ from bendpam.physics import presets
 from bendpam.physics.actuator import Actuator
 from bendpam.physics.law import MomentLaw, StableBranch
 from bendpam.physics.models import normalise_model, resolve_model
+from bendpam.physics.spatial import lateral_stiffness_nmm2
 from bendpam.validate import number
 
 __all__ = [
@@ -100,8 +104,8 @@ class Wrist:
     length_mm : float, optional
         Active length of the wrist, mm (default: the actuator's ``L0_mm``, 145 mm for the presets).
     lateral_stiffness_nmm2 : float, optional
-        Out-of-plane bending stiffness of one actuator, N*mm^2 (default: its frame about the strong
-        axis, ``E_f t w^3 / 12``).
+        Out-of-plane bending stiffness of one actuator, N*mm^2 (default: the actuator's, unpressurised
+        and straight: :func:`bendpam.physics.spatial.lateral_stiffness_nmm2`).
     column_stiffness_nmm2 : float
         Bending stiffness of the column, N*mm^2 (default 0: a free joint).
     positions_deg : tuple of 4 floats
@@ -135,8 +139,8 @@ class Wrist:
         L = self.actuator.L0_mm if self.length_mm is None else self.length_mm
         s(self, "length_mm", number("length_mm", L, 0.0, 1e4, lo_open=True, unit="mm"))
         if self.lateral_stiffness_nmm2 is None:
-            a = self.actuator
-            s(self, "lateral_stiffness_nmm2", a.frame_modulus_mpa * a.frame_thickness_mm * a.frame_width_mm ** 3 / 12.0)
+            s(self, "lateral_stiffness_nmm2",
+              float(lateral_stiffness_nmm2(self.actuator, 0.0, 0.0, model=self.model)))
         else:
             s(self, "lateral_stiffness_nmm2",
               number("lateral_stiffness_nmm2", self.lateral_stiffness_nmm2, 0.0, unit="N*mm^2"))
@@ -189,7 +193,7 @@ class WristState:
     --------
     >>> state = wrist_bend(Wrist(), (0.0, 150.0, 0.0, 0.0))
     >>> round(state.angle_deg, 1), state.direction_deg, state.equilibrium
-    (24.4, 90.0, True)
+    (22.3, 90.0, True)
     """
 
     pressures_kpa: tuple
@@ -206,7 +210,7 @@ class WristState:
 
         >>> d = wrist_bend(Wrist(), (0.0, 150.0, 0.0, 0.0)).to_dict()
         >>> round(d["angle_deg"], 1), d["direction_deg"], d["pressures_kpa"]
-        (24.4, 90.0, [0.0, 150.0, 0.0, 0.0])
+        (22.3, 90.0, [0.0, 150.0, 0.0, 0.0])
         """
         return {"pressures_kpa": [float(p) for p in self.pressures_kpa],
                 "curvature_per_mm": json_number(self.curvature), "direction_deg": json_number(self.direction_deg),
@@ -375,7 +379,7 @@ def wrist_bend(wrist: Wrist, pressures_kpa=None, *, direction_deg=None, pressure
     --------
     >>> state = wrist_bend(Wrist(), direction_deg=90.0, pressure_kpa=150.0)
     >>> state.pressures_kpa, round(state.angle_deg, 1)    # kPa, deg
-    ((0.0, 150.0, 0.0, 0.0), 24.4)
+    ((0.0, 150.0, 0.0, 0.0), 22.3)
     """
     _check_wrist(wrist)
     if pressures_kpa is None:
@@ -405,11 +409,11 @@ def wrist_moment(wrist: Wrist, pressures_kpa, angle_deg, direction_deg):
 
     Examples
     --------
-    Held at 10 deg, short of its free 24.4 deg, the wrist pushes on toward 90 deg:
+    Held at 10 deg, short of its free 22.3 deg, the wrist pushes on toward 90 deg:
 
     >>> m, on_branch, note = wrist_moment(Wrist(), (0.0, 150.0, 0.0, 0.0), 10.0, 90.0)
     >>> bool(abs(m[0]) < 1e-9), round(float(m[1]), 1), on_branch    # N*mm
-    (True, 363.4, True)
+    (True, 340.0, True)
     """
     _check_wrist(wrist)
     P = _four_pressures_kpa(pressures_kpa)
@@ -463,7 +467,7 @@ class WristHold:
 
         >>> d = wrist_hold(Wrist(), 150.0).to_dict()
         >>> d["holds_horizontal"], round(d["angle_deg"], 1), round(d["capacity_g"])
-        (True, 2.1, 367)
+        (True, 1.9, 367)
         """
         return {"pressure_kpa": float(self.pressure_kpa), "angle_deg": json_number(self.angle_deg),
                 "holds_horizontal": bool(self.holds_horizontal), "capacity_g": json_number(self.capacity_g),
@@ -552,7 +556,7 @@ def wrist_sweep(wrist: Wrist, pressures_kpa, directions_deg=(0.0, 90.0, 180.0, 2
     --------
     >>> table = wrist_sweep(Wrist(), [100.0, 150.0], directions_deg=(0.0, 90.0))
     >>> table[["direction_deg", "pressure_kpa", "angle_deg"]].round(1).values.tolist()
-    [[0.0, 100.0, 14.7], [0.0, 150.0, 24.4], [90.0, 100.0, 14.7], [90.0, 150.0, 24.4]]
+    [[0.0, 100.0, 13.4], [0.0, 150.0, 22.3], [90.0, 100.0, 13.4], [90.0, 150.0, 22.3]]
     """
     import pandas as pd
 

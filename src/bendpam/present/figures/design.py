@@ -35,6 +35,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "plot_coarse_map",
+    "plot_finger3d",
     "plot_finger_shapes",
     "plot_grasp",
     "plot_pareto",
@@ -93,6 +94,58 @@ def plot_finger_shapes(shapes, ax=None, title: str | None = None, free=None):
     ax.set_xlabel("x (mm)")
     ax.set_ylabel("y (mm)")
     ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    if title:
+        ax.set_title(title)
+    return fig
+
+
+@register("finger3d")
+def plot_finger3d(shapes, ax=None, title: str | None = None):
+    """Draw spatial finger shapes in 3-D (frame line, tip point, the bending plane's base); returns the figure.
+
+    Shapes without equilibrium are drawn dashed from their last equilibrium (``limit``) if any.
+
+    Examples
+    --------
+    >>> from bendpam.physics.presets import be_pam
+    >>> from bendpam.design import Finger
+    >>> from bendpam.design.finger3d import Finger3D, FingerLoads3D, solve_finger3d
+    >>> sh = solve_finger3d(Finger3D(Finger(be_pam())), 150.0, FingerLoads3D(tip_force_n=(0.0, 0.0, 0.5)))
+    >>> fig = plot_finger3d([sh])
+    >>> fig.axes[0].name
+    '3d'
+    """
+    if ax is None:
+        fig = new_figure((6.0, 5.0))
+        ax = fig.add_subplot(projection="3d")
+    else:
+        fig = ax.figure
+    shapes = list(shapes)
+    colors = matplotlib.colormaps["viridis"](np.linspace(0.0, 0.9, max(len(shapes), 1)))
+    pts = []
+    for sh, col in zip(shapes, colors, strict=False):
+        draw, style = (sh, "-") if sh.equilibrium else (sh.limit, "--")
+        label = f"{sh.pressure_kpa:g} kPa" + ("" if sh.equilibrium else " (no equilibrium)")
+        if draw is None:
+            ax.plot([], [], [], style, color=col, label=label)
+            continue
+        xyz, tip = draw.xyz, np.asarray(draw.tip_xyz)
+        ax.plot(xyz[:, 0], xyz[:, 1], xyz[:, 2], style, color=col, label=label)
+        ax.plot([xyz[-1, 0], tip[0]], [xyz[-1, 1], tip[1]], [xyz[-1, 2], tip[2]], style, color=col, lw=3, alpha=0.6)
+        ax.scatter([tip[0]], [tip[1]], [tip[2]], color=col, s=12)
+        pts.append(np.vstack([xyz, tip]))
+    if pts:
+        P = np.vstack(pts)
+        mid, half = 0.5 * (P.max(0) + P.min(0)), 0.5 * float(np.max(P.max(0) - P.min(0))) + 1.0
+        ax.set_xlim(mid[0] - half, mid[0] + half)
+        ax.set_ylim(mid[1] - half, mid[1] + half)
+        ax.set_zlim(mid[2] - half, mid[2] + half)
+        b = shapes[0].finger3d.base_xyz_mm
+        ax.scatter([b[0]], [b[1]], [b[2]], color="k", marker="s", s=20)
+    ax.set_xlabel("x (mm)")
+    ax.set_ylabel("y (mm)")
+    ax.set_zlabel("z (mm)")
     ax.legend(fontsize=8)
     if title:
         ax.set_title(title)
