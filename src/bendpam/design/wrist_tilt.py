@@ -310,8 +310,8 @@ class WristMap:
     Examples
     --------
     >>> m = wrist_map(Wrist(), [[0.0, 150.0, 0.0, 0.0], [150.0, 0.0, 0.0, 0.0]])
-    >>> m.tilt_deg.round(1).tolist(), m.direction_deg.round(1).tolist()     # as wrist_bend: 24.4 deg
-    ([24.4, 24.4], [90.0, 0.0])
+    >>> m.tilt_deg.round(1).tolist(), m.direction_deg.round(1).tolist()     # as wrist_bend: 22.3 deg
+    ([22.3, 22.3], [90.0, 0.0])
     """
 
     pressures_kpa: np.ndarray
@@ -356,11 +356,11 @@ def wrist_map(wrist: Wrist, pressures_kpa, load: WristLoad | None = None, *, ste
     Examples
     --------
     The hand (300 g at 80 mm) and a 550 g bottle, forearm horizontal, top actuator inflated: the hand droops
-    by 27.8 deg (toward 270 deg, down):
+    by 25.9 deg (toward 270 deg, down):
 
     >>> m = wrist_map(Wrist(), [[0.0, 140.0, 0.0, 0.0]], WristLoad(payload_g=550.0))
     >>> bool(m.equilibrium[0]), round(float(m.tilt_deg[0]), 1), round(float(m.direction_deg[0]), 1)
-    (True, 27.8, 270.0)
+    (True, 25.9, 270.0)
     """
     if not isinstance(wrist, Wrist):
         raise TypeError(f"wrist must be a bendpam.design.Wrist, got {type(wrist).__name__}")
@@ -394,7 +394,7 @@ class WristTarget:
     --------
     >>> t = wrist_target(Wrist(), 20.0, 45.0)              # between two actuators: both inflated
     >>> [round(p) for p in t.pressures_kpa], t.reached
-    ([97, 97, 0, 0], True)
+    ([104, 104, 0, 0], True)
     """
 
     tilt_deg: float
@@ -453,7 +453,7 @@ def wrist_target(wrist: Wrist, tilt_deg: float, direction_deg: float, load: Wris
     --------
     >>> t = wrist_target(Wrist(), 30.0, 90.0)                 # unloaded: the actuator at 90 deg alone
     >>> [round(p) for p in t.pressures_kpa], t.reached, round(t.tilt_reached_deg, 2)
-    ([0, 181, 0, 0], True, 30.0)
+    ([0, 197, 0, 0], True, 30.0)
     """
     if not isinstance(wrist, Wrist):
         raise TypeError(f"wrist must be a bendpam.design.Wrist, got {type(wrist).__name__}")
@@ -500,7 +500,7 @@ def wrist_directions(wrist: Wrist, pressure_kpa: float, load: WristLoad | None =
     --------
     >>> rows = wrist_directions(Wrist(), 200.0)               # unloaded: the four directions alike
     >>> [round(r["tilt_deg"], 1) for r in rows], [r["reaches_target"] for r in rows]
-    ([33.2, 33.2, 33.2, 33.2], [True, True, True, True])
+    ([30.4, 30.4, 30.4, 30.4], [True, True, True, True])
     """
     from bendpam.design.wrist import wrist_pressures
 
