@@ -82,6 +82,7 @@ __all__ = [
     "finger_frame",
     "hand_pose",
     "save_result",
+    "thumb_base",
     "thumb_chain",
 ]
 
@@ -413,6 +414,23 @@ def finger_frame(hand: Hand, name: str) -> tuple[np.ndarray, np.ndarray]:
     return np.column_stack([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]]), np.array([x, y, 0.0])
 
 
+def thumb_base(hand: Hand, roll_rad) -> tuple[np.ndarray, np.ndarray]:
+    """The thumb's base position (..., 3), mm, and frame (..., 3, 3; columns t, n, b) at palm rolls ``roll_rad``.
+
+    >>> p, R = thumb_base(default_hand(), np.pi / 2)                 # rolled in front of the index
+    >>> np.round(p, 6).tolist(), np.round(R[:, 1], 6).tolist()       # it bends toward -x (the little finger)
+    ([30.0, 45.0, 22.0], [-1.0, 0.0, 0.0])
+    """
+    phi = np.asarray(roll_rad, dtype=float)
+    roll = _rot(np.broadcast_to([0.0, -1.0, 0.0], (*phi.shape, 3)), phi)  # about the index axis: +x -> +z
+    axis = np.array([hand.finger_bases_mm["index"][0], 0.0, 0.0])
+    pbase = axis + roll @ (np.array([*hand.thumb_base_mm, 0.0]) - axis)
+    d = math.radians(hand.thumb_direction_deg)
+    t0 = np.array([math.sin(d), math.cos(d), 0.0])
+    n0 = np.array([0.0, 0.0, 1.0])
+    return pbase, roll @ np.column_stack([t0, n0, np.cross(t0, n0)])
+
+
 def thumb_chain(hand: Hand, proximal_rad, distal_rad, roll_rad, s_mm=None):
     """The thumb for bend angles (rad, arrays of one shape): points at arc lengths ``s_mm`` from its base
     (mm, 0 to ``L1 + L2``; (m,) or one row (..., m) per pose; None: none), tip positions (..., 3) and
@@ -425,13 +443,7 @@ def thumb_chain(hand: Hand, proximal_rad, distal_rad, roll_rad, s_mm=None):
     """
     th1, th2, phi = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (proximal_rad, distal_rad, roll_rad)))
     L1, L2 = hand.part("thumb_proximal").length_mm, hand.part("thumb_distal").length_mm
-    roll = _rot(np.broadcast_to([0.0, -1.0, 0.0], (*phi.shape, 3)), phi)  # about the index axis: +x -> +z
-    axis = np.array([hand.finger_bases_mm["index"][0], 0.0, 0.0])
-    pbase = axis + roll @ (np.array([*hand.thumb_base_mm, 0.0]) - axis)
-    d = math.radians(hand.thumb_direction_deg)
-    t0 = np.array([math.sin(d), math.cos(d), 0.0])
-    n0 = np.array([0.0, 0.0, 1.0])
-    R0 = roll @ np.column_stack([t0, n0, np.cross(t0, n0)])
+    pbase, R0 = thumb_base(hand, phi)
     s = None if s_mm is None else np.asarray(s_mm, dtype=float)
     pts1, R1, p1 = arc_frames(R0, pbase, th1, L1, None if s is None else np.clip(s, 0.0, L1))
     R1 = R1 @ _rot(np.array([1.0, 0.0, 0.0]), -math.radians(hand.thumb_plane_deg))  # distal plane, toward the palm

@@ -6,6 +6,7 @@ name                function
 ``hand_pose``       :func:`plot_hand_pose` (the hand's centrelines at one set of pressures)
 ``kapandji``        :func:`plot_kapandji` (the thumb's closest pose for each Kapandji point)
 ``hand_workspace``  :func:`plot_hand_workspace` (the tips reachable over a pressure grid)
+``hand_statics``    :func:`plot_hand_statics` (the hand under its weight and tip loads)
 ==================  ====================================================================
 
 The hand frame is the one of :mod:`bendpam.design.hand` (x radial, y distal, z palmar; mm), drawn
@@ -19,7 +20,7 @@ import numpy as np
 from bendpam.infra.accessors import register
 from bendpam.present.figures.style import figure_size, figure_style, new_figure
 
-__all__ = ["plot_hand_pose", "plot_hand_workspace", "plot_kapandji"]
+__all__ = ["plot_hand_pose", "plot_hand_statics", "plot_hand_workspace", "plot_kapandji"]
 
 _TOUCH_COLOURS = {"tip": "tab:green", "thumb": "tab:orange", "none": "tab:red"}
 
@@ -158,6 +159,35 @@ def plot_hand_workspace(ws, ax=None, title: str | None = None):
         pts.append(t)
         ax.legend(fontsize="x-small", loc="upper left")
         _finish(ax, np.vstack(pts), title or "reachable tips")
+        if own:
+            fig.tight_layout()
+    return fig
+
+
+@register("hand_statics")
+def plot_hand_statics(statics, ax=None, title: str | None = None):
+    """Draw the loaded hand (a :class:`~bendpam.design.hand_statics.HandStatics`): each rod's loaded centreline
+    (fingers dark, thumb blue) over the unloaded pose (light grey).
+
+    Examples
+    --------
+    >>> from bendpam.design.hand import default_hand
+    >>> from bendpam.design.hand_statics import hand_statics
+    >>> fig = plot_hand_statics(hand_statics(default_hand(), mass_per_length_g_per_mm=0.0, nodes=11))
+    >>> fig.axes[0].name
+    '3d'
+    """
+    with figure_style():
+        fig, ax, own = _axes3d(ax)
+        pts = [_draw_pose(ax, statics.pose, colour="0.8", alpha=0.7)]
+        for name, sh in statics.shapes.items():
+            xyz = np.asarray(sh.xyz, dtype=float)
+            ax.plot(*xyz.T, color="tab:blue" if name.startswith("thumb") else "0.2", lw=2.0)
+            pts.append(xyz)
+        g = np.asarray(statics.gravity)
+        ax.quiver(0.0, 0.0, 0.0, *(40.0 * g), color="tab:red", arrow_length_ratio=0.2)
+        ax.text(*(45.0 * g), "g", color="tab:red", fontsize=8)
+        _finish(ax, np.vstack(pts), title or "hand under load (grey: unloaded)")
         if own:
             fig.tight_layout()
     return fig
