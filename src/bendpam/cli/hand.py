@@ -8,6 +8,7 @@ through one :class:`~bendpam.infra.outputs.OutputSet`.
 """
 
 # no ``from __future__ import annotations``: Typer reads the annotations of the command functions.
+import math
 from pathlib import Path
 from typing import Annotated, Any, Optional
 
@@ -50,6 +51,13 @@ def hand_cmd(
     kapandji_test: Annotated[bool, typer.Option("--kapandji", help="Run the Kapandji test (8 points).")] = False,
     workspace: Annotated[
         Optional[int], typer.Option("--workspace", help="Reachable tips over N pressures per part (2-30).")] = None,
+    gravity: Annotated[
+        Optional[str], typer.Option("--gravity", metavar="GX,GY,GZ", help="Solve the hand under its weight with "
+                                    "gravity along this direction (hand frame: x radial, y distal, z palmar); "
+                                    "each part a spatial rod.")] = None,
+    mass_per_length: Annotated[
+        float, typer.Option("--mass-per-length-g-mm", help="With --gravity: mass of the BE-PAMs per length "
+                            "(g/mm).")] = 0.24,
     out: Annotated[Optional[Path], typer.Option("--out", help="Output folder: hand.json and the 3-D "
                                                 "figures.")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object instead of a table.")] = False,
@@ -58,7 +66,7 @@ def hand_cmd(
     """Pose, reachable workspace and Kapandji test of the soft humanoid hand (BE-PAM fingers, two-segment thumb).
 
     --pressure-kpa takes one pressure for every part or seven, in the order index, middle, ring,
-    little, thumb_proximal, thumb_distal, palm_roll.
+    little, thumb_proximal, thumb_distal, palm_roll.  --gravity adds the hand under its weight.
     """
     from bendpam.design.hand import PARTS, Hand, default_hand, hand_pose
     from bendpam.design.kapandji import hand_workspace, kapandji
@@ -70,11 +78,14 @@ def hand_cmd(
     hand = Hand.from_toml(hand_file) if hand_file is not None else default_hand()
     P = _part_pressures(pressures_kpa(pressure_kpa, None) if pressure_kpa else [], PARTS, hand.max_pressure_kpa)
     pose = hand_pose(hand, P)
+    statics = _statics(hand, P, gravity, mass_per_length)
     kap = kapandji(hand) if kapandji_test else None
     ws = hand_workspace(hand, workspace) if workspace is not None else None
     record: dict[str, Any] = {"hand": hand.to_dict(), "pose": pose.to_dict(),
                               "units": {"x_mm": "radial (toward the thumb)", "y_mm": "distal (along the fingers)",
                                         "z_mm": "palmar (the side the fingers curl to)"}}
+    if statics is not None:
+        record["statics"] = statics.to_dict()
     if kap is not None:
         record["kapandji"] = kap.to_dict()
     if ws is not None:
@@ -83,16 +94,48 @@ def hand_cmd(
     if out is not None:
         fmt = fig_format.value if fig_format is not None else "png"
         with output_set(out, [hand_file]) as o:
-            files = _write(o, record, pose, kap, ws, fmt)
+            files = _write(o, record, {"pose": pose, "statics": statics, "kapandji": kap, "workspace": ws}, fmt)
     if as_json:
         print_json(record)
         return
     _print(hand, pose, kap, ws)
+    if statics is not None:
+        _print_statics(statics)
     if out is not None:
         echo_wrote(f"wrote {out}/ ({', '.join(files)})")
 
 
-def _write(o, record: dict, pose, kap, ws, fmt: str) -> list[str]:
+def _statics(hand, P: dict, gravity: Optional[str], mass_per_length: float):
+    """The loaded hand of --gravity (None without it)."""
+    if gravity is None:
+        if mass_per_length != 0.24:
+            raise UserError("--mass-per-length-g-mm goes with --gravity GX,GY,GZ")
+        return None
+    from bendpam.design.hand_statics import hand_statics
+
+    parts = [p for p in gravity.replace(";", ",").split(",") if p.strip()]
+    try:
+        g = [float(p) for p in parts]
+    except ValueError:
+        raise UserError(f"--gravity: {gravity!r} must be three numbers GX,GY,GZ (a direction)") from None
+    if len(g) != 3 or not all(math.isfinite(v) for v in g) or not any(g):
+        raise UserError(f"--gravity: {gravity!r} must be three finite numbers GX,GY,GZ, not all 0 (a direction)")
+    if not (math.isfinite(mass_per_length) and 0.0 <= mass_per_length <= 10.0):
+        raise UserError(f"--mass-per-length-g-mm: {mass_per_length:g} g/mm must be in [0, 10]")
+    return hand_statics(hand, P, gravity=tuple(g), mass_per_length_g_per_mm=mass_per_length)
+
+
+def _print_statics(st) -> None:
+    """The loaded tips of --gravity."""
+    g = ", ".join(f"{v:.3g}" for v in st.gravity)
+    typer.echo(f"\nunder its weight ({st.mass_per_length_g_per_mm:g} g/mm, gravity along ({g})): "
+               + ("" if st.equilibrium else f"NO EQUILIBRIUM: {st.note}"))
+    for k, t in st.tips_mm.items():
+        xyz = ", ".join(_fmt(v, ".1f") for v in t)
+        typer.echo(f"{k:>8} tip ({xyz}) mm, moved {_fmt(st.deflection_mm[k], '.2f')} mm")
+
+
+def _write(o, record: dict, results: dict, fmt: str) -> list[str]:
     """hand.json and the figures into the output set's staging folder; returns the file names."""
     from bendpam.infra.accessors import figure
     from bendpam.infra.outputs import to_json
@@ -100,7 +143,7 @@ def _write(o, record: dict, pose, kap, ws, fmt: str) -> list[str]:
     o.write_text("hand.json", to_json(record))
     save = figure("save_figure")
     names = ["hand.json"]
-    for stem, res in (("pose", pose), ("kapandji", kap), ("workspace", ws)):
+    for stem, res in results.items():
         if res is not None:
             save(res.plot(), Path(o.staging) / f"{stem}.{fmt}", format=fmt)
             names.append(f"{stem}.{fmt}")
