@@ -10,7 +10,10 @@ from hypothesis import strategies as st
 
 import bendpam.design.kapandji as kapandji_module
 from bendpam.cli import main
-from bendpam.design.hand import PARTS, Hand, arc_frames, default_hand, hand_pose, thumb_chain
+from bendpam.design.finger import Finger
+from bendpam.design.finger3d import Finger3D, FingerLoads3D, solve_finger3d
+from bendpam.design.hand import PARTS, Hand, arc_frames, default_hand, hand_pose, thumb_base, thumb_chain
+from bendpam.design.hand_statics import hand_statics
 from bendpam.design.kapandji import KAPANDJI_POINTS, hand_workspace, kapandji, kapandji_targets
 from bendpam.design.wrist import Wrist, wrist_bend, wrist_hold
 from bendpam.design.wrist_tilt import WristLoad, wrist_directions, wrist_map, wrist_target
@@ -161,6 +164,26 @@ def test_workspace_contains_the_poses():
     pose = hand_pose(hand, {"thumb_proximal": P[1], "thumb_distal": P[3], "palm_roll": P[2]})
     assert ws.thumb_tips_mm[1 * 16 + 3 * 4 + 2] == pytest.approx(pose.tips_mm["thumb"], abs=1e-9)
     assert ws.to_dict()["thumb"]["hull_volume_cm3"] > 0
+
+
+# ---- the hand under load (spatial rods) ---------------------------------------------------------
+def test_statics_chain_the_thumb_like_one_rod_and_reduce_to_the_free_pose():
+    import dataclasses
+
+    # thumb planes at 0 deg and equal pressures: the two chained 70 mm rods are one 140 mm rod
+    hand = dataclasses.replace(default_hand(), thumb_plane_deg=0.0)
+    P = {"thumb_proximal": 200.0, "thumb_distal": 200.0, "palm_roll": 100.0}
+    F = (0.0, 0.0, -0.3)
+    st = hand_statics(hand, P, gravity=(0, 0, -1), tip_forces_n={"thumb": F}, nodes=21)
+    assert st.equilibrium and st.deflection_mm["thumb"] > 5.0
+    base, R0 = thumb_base(hand, math.radians(st.pose.angles_deg["palm_roll"]))
+    one = Finger3D(Finger(presets.be_pam().replace(L0_mm=140.0), "energy", nodes=41), origin_mm=tuple(base),
+                   rotation=R0)
+    sh = solve_finger3d(one, 200.0, FingerLoads3D(tip_force_n=F, gravity=(0, 0, -1), mass_per_length_g_per_mm=0.24))
+    assert np.asarray(sh.tip_xyz) == pytest.approx(st.tips_mm["thumb"], abs=2e-3)   # mm
+    # no load: every rod is the free arc of the kinematics
+    free = hand_statics(default_hand(), P, mass_per_length_g_per_mm=0.0, nodes=21)
+    assert free.equilibrium and max(free.deflection_mm.values()) < 1e-9
 
 
 # ---- the wrist in 3-D -------------------------------------------------------------------------
