@@ -32,7 +32,7 @@ import numpy as np
 
 from bendpam.design.finger import Finger
 from bendpam.design.finger3d import Finger3D, FingerLoads3D, checked_vector, solve_finger3d
-from bendpam.design.hand import FINGERS, PARTS, Hand, finger_frame, hand_pose, thumb_base
+from bendpam.design.hand import FINGERS, PARTS, Hand, finger_frame, hand_pose, save_result, thumb_base
 from bendpam.design.parts import G_N_PER_G, json_number
 from bendpam.errors import InputError
 from bendpam.infra.accessors import figure
@@ -96,6 +96,10 @@ class HandStatics:
         1
         """
         return figure("hand_statics")(self, ax=ax, title=title)
+
+    def save(self, out_dir, *, figure_format: str = "png") -> dict[str, str]:
+        """Write ``statics.json`` (:meth:`to_dict`) and ``statics.<format>`` into ``out_dir``; ``{name: path}``."""
+        return save_result(out_dir, "statics", self.to_dict(), lambda: self.plot(), figure_format)
 
 
 def _vec(v) -> tuple[float, float, float]:

@@ -371,6 +371,10 @@ class HandWorkspace:
         """A 3-D scatter of the tips (:func:`bendpam.present.figures.hand.plot_hand_workspace`)."""
         return figure("hand_workspace")(self, ax=ax, title=title)
 
+    def save(self, out_dir, *, figure_format: str = "png") -> dict[str, str]:
+        """Write ``workspace.json`` (:meth:`to_dict`) and ``workspace.<format>`` into ``out_dir``; ``{name: path}``."""
+        return save_result(out_dir, "workspace", self.to_dict(), lambda: self.plot(), figure_format)
+
 
 def hand_workspace(hand: Hand, n: int = 15) -> HandWorkspace:
     """The reachable tip positions over ``n`` pressures per part from 0 to ``max_pressure_kpa`` (vectorised).
