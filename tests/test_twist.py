@@ -47,3 +47,16 @@ def test_no_grasp_and_bad_fractions():
     assert tw.lost_by == "no grasp" and tw.steps == () and "too small" in tw.note
     with pytest.raises(InputError, match="fractions"):
         grasp_twist(_gripper(be_pam()), 180.0, 150.0, fractions=(0.5, 0.2))
+
+
+def test_cli_grasp_twist(capsys):
+    from bendpam.cli import main
+
+    # a sphere too small for the fingers: the twist says there is no grasp (cheap); the numbers: the API tests
+    assert main(["grasp", "--preset", "be-pam", "--l0-mm", "130", "--diameter-mm", "120", "--pressure-kpa", "150",
+                 "--twist", "--json"]) == 0
+    res = json.loads(capsys.readouterr().out)["results"][0]
+    assert res["twist"]["lost_by"] == "no grasp" and res["twist"]["torque_at_loss_nmm"] == 0.0
+    assert main(["grasp", "--preset", "be-pam", "--diameter-mm", "80:280:7", "--pressure-kpa", "100", "150",
+                 "--twist"]) == 2
+    assert "--twist" in capsys.readouterr().err

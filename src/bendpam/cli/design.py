@@ -39,6 +39,8 @@ __all__ = ["register"]
 
 #: The most equilibrium solutions one design command may compute (each takes about 10 ms).
 MAX_DESIGN_POINTS = 10_000
+#: grasps that ``bendpam grasp --twist`` twists at most (each a few spatial-finger solves, about a second each)
+MAX_TWIST_GRASPS = 12
 
 JsonOpt = Annotated[bool, typer.Option("--json", help="Print one JSON object instead of a table.")]
 PlotOpt = Annotated[Optional[Path], typer.Option("--plot", help="Write a figure (.png/.pdf/.svg).")]
@@ -159,15 +161,7 @@ def finger_cmd(
         free = finger_sweep(finger, P, FingerLoads())[1] if loaded else None
         _save_plot(lambda ax: plot_finger_shapes(shapes, ax=ax, free=free, title=f"{act.name or act.kind}, "
                                                  f"L0 = {act.L0_mm:g} mm"), plot, fig_format, aspect=0.9)
-    rows = []
-    for i, (sh, lm) in enumerate(zip(shapes, lims, strict=True)):
-        row = sh.to_dict()
-        flat = 0.0 if sh.equilibrium else None  # in-plane loads: the finger stays in its plane
-        row |= {"tip_z_mm": flat, "out_of_plane_deg": flat, "twist_deg": flat}
-        if held is not None:
-            row["blocked_force_n"] = held[i].to_dict()["force_n"]
-        row["limits"] = None if lm is None else lm.to_dict()
-        rows.append(row)
+    rows = _finger_rows(shapes, lims, held)
     if as_json:
         obj = {"model": mname, "actuator": act.name or act.kind, "L0_mm": act.L0_mm,
                "loads": {"tip_force_n": list(F), "tip_moment_nmm": Mz, "tip_mass_g": tip_mass_g,
@@ -185,6 +179,20 @@ def finger_cmd(
             typer.echo(f"bendpam: warning: past a limit: {v}", err=True)
     if plot is not None and not as_json:
         echo_wrote(f"wrote {plot}")
+
+
+def _finger_rows(shapes, lims, held) -> list[dict[str, Any]]:
+    """The JSON rows of the planar ``bendpam finger``: pose, z = 0 (in the plane), blocked force, limits."""
+    rows = []
+    for i, (sh, lm) in enumerate(zip(shapes, lims, strict=True)):
+        row = sh.to_dict()
+        flat = 0.0 if sh.equilibrium else None  # in-plane loads: the finger stays in its plane
+        row |= {"tip_z_mm": flat, "out_of_plane_deg": flat, "twist_deg": flat}
+        if held is not None:
+            row["blocked_force_n"] = held[i].to_dict()["force_n"]
+        row["limits"] = None if lm is None else lm.to_dict()
+        rows.append(row)
+    return rows
 
 
 def _components(text: str, name: str, unit: str, planar: str, n_planar: int) -> tuple[float, ...]:
@@ -306,6 +314,8 @@ def grasp_cmd(
     splay_deg: Annotated[
         Optional[float], typer.Option("--splay-deg", help="Outward tilt of the open fingers (deg); "
                                       "default 15.")] = None,
+    twist: Annotated[bool, typer.Option("--twist", help="Also twist each grasped sphere about the gripper's axis "
+                                        "until the grip slips (the fingers as 3-D rods; at most 12 grasps).")] = False,
     as_json: JsonOpt = False,
     plot: PlotOpt = None,
     fig_format: FigureFormatOpt = None,
@@ -314,7 +324,8 @@ def grasp_cmd(
 
     Each grasp is pulled out quasi-statically (the base lifted step by step, the fingers'
     statics with their moment law, Coulomb stick/slip at the contacts); the grip force is the
-    peak lifting load before the sphere escapes.
+    peak lifting load before the sphere escapes.  With --twist, each grasp is also twisted about
+    the gripper's axis until the contacts slip: the torque then and the fingers' distortion.
     """
     from bendpam.design.grasp import grasp_dataset, plot_grasp, solve_grasps
     from bendpam.design.gripper import (
@@ -334,6 +345,9 @@ def grasp_cmd(
             raise UserError(f"--diameter-mm: {d:g} mm is not a positive diameter")
     P = pressures_kpa(pressure_kpa, None)
     _budget(len(P) * len(D), "--pressure-kpa x --diameter-mm")
+    if twist and len(P) * len(D) > MAX_TWIST_GRASPS:
+        raise UserError(f"--twist: {len(P) * len(D)} grasps; at most {MAX_TWIST_GRASPS} (each a few 3-D finger "
+                        "solves): give fewer --diameter-mm or --pressure-kpa values")
     mname = model_for(act, model)
     plot = _plot_target(plot, fig_format)
     gr = Gripper(act, mname, fingers=fingers,
@@ -346,10 +360,17 @@ def grasp_cmd(
         ds = grasp_dataset(gr, grasps)
         _save_plot(lambda ax: plot_grasp(ds, ax=ax), plot, fig_format)
     rows = [g.to_dict() for row in grasps for g in row]
+    if twist:
+        from bendpam.design.twist import twist_grasp
+
+        for r, g in zip(rows, (g for row in grasps for g in row), strict=True):
+            r["twist"] = twist_grasp(gr, g).to_dict()
     if as_json:
         print_json({**gr.to_dict(), "units": _GRASP_UNITS, "results": rows})
         return
     _print_grasps(gr, rows)
+    if twist:
+        _print_twists(rows)
     if plot is not None:
         echo_wrote(f"wrote {plot}")
 
@@ -368,6 +389,18 @@ def _print_grasps(gr, rows: list[dict[str, Any]]) -> None:
                    f"{_fmt(r['peak_lift_mm'], '9.2f')} {_fmt(r['frozen_grip_force_n'], '10.2f')} "
                    f"{_fmt(r['contact_force_n'], '9.2f')} {r['contact']:>8} {_fmt(r['contact_angle_deg'], '8.1f')}"
                    + (f"  {r['note']}" if r["note"] else ""))
+
+
+def _print_twists(rows: list[dict[str, Any]]) -> None:
+    """The twist table of ``bendpam grasp --twist``: the torque when the grip slips and the distortion there."""
+    typer.echo("twisted about the gripper's axis until the grip is lost (docs/out-of-plane.md)")
+    typer.echo(f"{'D (mm)':>7} {'P (kPa)':>8} {'torque (N·mm)':>13} {'across (mm)':>11} {'object (deg)':>12} "
+               f"{'twist (deg)':>11} {'mm/N':>6}  lost by")
+    for r in rows:
+        t = r["twist"]
+        typer.echo(f"{r['diameter_mm']:7.4g} {r['pressure_kpa']:8.4g} {_fmt(t['torque_at_loss_nmm'], '13.1f')} "
+                   f"{_fmt(t['contact_lateral_mm'], '11.2f')} {_fmt(t['object_rotation_deg'], '12.2f')} "
+                   f"{_fmt(t['twist_deg'], '11.2f')} {_fmt(t['lateral_compliance_mm_per_n'], '6.1f')}  {t['lost_by']}")
 
 
 # ---- wrist --------------------------------------------------------------------------------------
@@ -399,7 +432,7 @@ def wrist_cmd(
     radius_mm: Annotated[float, typer.Option("--radius-mm", help="Mounting radius around the column (mm).")] = 20.0,
     lateral_stiffness: Annotated[
         Optional[float], typer.Option("--lateral-stiffness-nmm2", help="Out-of-plane stiffness of one actuator "
-                                      "(N*mm^2); default: the frame's strong axis.")] = None,
+                                      "(N*mm^2); default: the actuator's, unpressurised.")] = None,
     column_stiffness: Annotated[
         float, typer.Option("--column-stiffness-nmm2", help="Bending stiffness of the column (N*mm^2).")] = 0.0,
     load_g: Annotated[float, typer.Option("--load-g", help="Mass held horizontally (g).")] = 335.0,

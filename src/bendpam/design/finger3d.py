@@ -18,7 +18,10 @@ identity (default) world and local axes coincide and in-plane loads give the pla
 Solved by continuation in the load fraction from the free shape with the one Newton method of
 :mod:`bendpam.design.rod`; when the loads ask for more than the stable branch of the law supplies
 (snap-through), or the path reaches a limit point, the result has ``equilibrium=False``, NaN arrays,
-a note and the last equilibrium reached in ``limit``, as the planar finger.
+a note and the last equilibrium reached in ``limit``, as the planar finger.  Unlike the planar
+finger there is no separate structural-stability check of the equilibrium (the second variation):
+a limit point on the load path stops the continuation; a bifurcation off it is not detected.
+Contacts are loads of known force (point forces), not unilateral constraints.
 
 Units: mm, N, N*mm, kPa, g; angles in degrees in names ending ``_deg``.
 """
@@ -34,7 +37,7 @@ from typing import Any
 import numpy as np
 
 from bendpam.design.finger import Finger, FingerLoads
-from bendpam.design.parts import G_N_PER_G, checked_pressure_kpa, json_number, pressures_checked
+from bendpam.design.parts import G_N_PER_G, checked_pressure_kpa, checked_vector, json_number, pressures_checked
 from bendpam.design.rod import NEWTON_TOL, continuation, newton
 from bendpam.design.rod3d import Rod3D
 from bendpam.errors import InputError, NoEquilibrium
@@ -49,31 +52,9 @@ __all__ = [
     "Finger3D",
     "Finger3DShape",
     "FingerLoads3D",
-    "checked_vector",
     "plot_finger3d",
     "solve_finger3d",
 ]
-
-
-def checked_vector(name: str, value, unit: str) -> tuple[float, float, float]:
-    """Three finite numbers as a tuple of floats, else a one-line InputError.
-
-    >>> checked_vector("tip_force_n", [0, 0, -1.5], "N")
-    (0.0, 0.0, -1.5)
-    >>> checked_vector("tip_force_n", [0, 1], "N")
-    Traceback (most recent call last):
-    ...
-    bendpam.errors.InputError: tip_force_n = [0, 1] must be three finite numbers (N)
-    """
-    if isinstance(value, str | bytes):
-        raise InputError(f"{name} = {value!r} must be three numbers ({unit})")
-    try:
-        a = np.asarray(value, dtype=float).ravel()
-    except (TypeError, ValueError):
-        raise InputError(f"{name} = {value!r} must be three numbers ({unit})") from None
-    if a.size != 3 or not np.all(np.isfinite(a)):
-        raise InputError(f"{name} = {value!r} must be three finite numbers ({unit})")
-    return float(a[0]), float(a[1]), float(a[2])
 
 
 @dataclass(frozen=True)
@@ -251,13 +232,15 @@ class Finger3DShape:
     directors : (n, 3, 3) columns ``d1`` (in-plane normal), ``d2`` (bending axis), ``d3`` (tangent).
     curvature : the paper's frame curvature ``k'`` (1/mm).  lateral_curvature : about ``d1`` (1/mm).
     twist : rad/mm.  moment : (n, 3) the loads' moment in the director frame (``m.d1, m.d2, m.d3``), N*mm.
-    tip_xyz : fingertip point, mm.  equilibrium, stable, residual_nmm, load_fraction, note, limit, branch:
-    as :class:`~bendpam.design.finger.FingerShape`.
+    tip_xyz : fingertip point, mm.  equilibrium, residual_nmm, load_fraction, note, limit, branch:
+    as :class:`~bendpam.design.finger.FingerShape`.  stable : every section on the stable branch of its
+    law (the 3-D finger has no separate structural-stability check: a structural limit point shows as
+    the load continuation stopping, ``equilibrium=False``).
 
     Examples
     --------
     >>> import bendpam
-    >>> f3 = Finger3D(Finger(bendpam.physics.presets.be_pam()))
+    >>> f3 = Finger3D(Finger(bendpam.physics.presets.be_pam(), nodes=21))
     >>> sh = solve_finger3d(f3, 150.0, FingerLoads3D(tip_force_n=(0.0, 0.0, 0.2)))
     >>> sh.equilibrium, round(sh.tip_z_mm, 2), round(sh.twist_deg, 2)   # the twist moment is below the lock torque
     (True, 3.59, 0.0)
@@ -380,7 +363,8 @@ class Finger3DShape:
 def _compliance_twist(m3, lock):
     """``sign(m3) max(|m3| - lock, 0)``, complex-step safe (the kink decided on the real part)."""
     re = np.real(m3)
-    return np.where(re > lock.real, m3 - lock, np.where(re < -lock.real, m3 + lock, 0.0 * m3))
+    lr = np.real(lock)
+    return np.where(re > lr, m3 - lock, np.where(re < -lr, m3 + lock, 0.0 * m3))
 
 
 class _System:
@@ -405,9 +389,9 @@ class _System:
         md = self.moments(U, lam)[0]
         M, _ = self.br.moment(kp)
         EI, GJ, T = self.tab(kp)
-        T = np.maximum(np.real(T), 0.0) if self.lock else 0.0 * np.real(T)
+        T = np.where(np.real(T) > 0.0, T, 0.0 * T) if self.lock else 0.0 * T  # no lock where the slope is negative
         r = np.stack([EI * k1 - md[..., 0], M + rod.c * md[..., 1],
-                      GJ * tw - _compliance_twist(md[..., 2], np.asarray(T))], -1)
+                      GJ * tw - _compliance_twist(md[..., 2], T)], -1)
         return r.reshape(U.shape) / self.scale
 
 
@@ -444,10 +428,10 @@ def solve_finger3d(finger3d: Finger3D, pressure_kpa, loads: FingerLoads3D | None
     Examples
     --------
     >>> import bendpam
-    >>> f3 = Finger3D(Finger(bendpam.physics.presets.be_pam()))
+    >>> f3 = Finger3D(Finger(bendpam.physics.presets.be_pam(), nodes=21))
     >>> sh = solve_finger3d(f3, 150.0, FingerLoads3D(tip_force_n=(0.0, 0.0, 4.0)))     # 4 N sideways
     >>> round(sh.tip_z_mm, 1), round(sh.out_of_plane_deg, 1), round(sh.twist_deg, 1), sh.equilibrium
-    (64.4, 34.6, 3.0, True)
+    (64.3, 34.7, 3.0, True)
     """
     if not isinstance(finger3d, Finger3D):
         raise TypeError(f"finger3d must be a bendpam.design.finger3d.Finger3D, got {type(finger3d).__name__}")
@@ -519,7 +503,7 @@ def plot_finger3d(shapes, ax=None, title: str | None = None):
     Drawn by :func:`bendpam.present.figures.design.plot_finger3d`, loaded on first use.
 
     >>> import bendpam, matplotlib.pyplot as plt
-    >>> f3 = Finger3D(Finger(bendpam.physics.presets.be_pam()))
+    >>> f3 = Finger3D(Finger(bendpam.physics.presets.be_pam(), nodes=11))
     >>> fig = plot_finger3d([solve_finger3d(f3, 150.0)])
     >>> len(fig.axes)
     1

@@ -30,6 +30,7 @@ __all__ = [
     "checked_pair",
     "checked_pressure_kpa",
     "checked_pressures_kpa",
+    "checked_vector",
     "json_number",
     "pressures_checked",
 ]
@@ -50,15 +51,35 @@ def checked_pair(name: str, value, unit: str) -> tuple[float, float]:
     ...
     bendpam.errors.InputError: tip_force_n = '0,1' must be two numbers (N)
     """
+    a = _numbers(name, value, unit, 2)
+    return a[0], a[1]
+
+
+def checked_vector(name: str, value, unit: str) -> tuple[float, float, float]:
+    """Three finite numbers (a point, a force, a moment in space) as a tuple of floats, else an InputError.
+
+    >>> checked_vector("tip_force_n", [0, 0, -1.5], "N")
+    (0.0, 0.0, -1.5)
+    >>> checked_vector("tip_force_n", [0, 1], "N")
+    Traceback (most recent call last):
+    ...
+    bendpam.errors.InputError: tip_force_n = [0, 1] must be three finite numbers (N)
+    """
+    a = _numbers(name, value, unit, 3)
+    return a[0], a[1], a[2]
+
+
+def _numbers(name: str, value, unit: str, size: int) -> list[float]:
+    words = {2: "two", 3: "three"}[size]
     if isinstance(value, str | bytes):
-        raise InputError(f"{name} = {value!r} must be two numbers ({unit})")
+        raise InputError(f"{name} = {value!r} must be {words} numbers ({unit})")
     try:
         a = np.asarray(value, dtype=float).ravel()
     except (TypeError, ValueError):
-        raise InputError(f"{name} = {value!r} must be two numbers ({unit})") from None
-    if a.size != 2 or not np.all(np.isfinite(a)):
-        raise InputError(f"{name} = {value!r} must be two finite numbers ({unit})")
-    return float(a[0]), float(a[1])
+        raise InputError(f"{name} = {value!r} must be {words} numbers ({unit})") from None
+    if a.size != size or not np.all(np.isfinite(a)):
+        raise InputError(f"{name} = {value!r} must be {words} finite numbers ({unit})")
+    return [float(v) for v in a]
 
 
 def _user_stacklevel() -> int:

@@ -37,7 +37,7 @@ from bendpam.design.grasp import solve_grasp
 from bendpam.design.gripper import Grasp, Gripper
 from bendpam.design.parts import json_number
 
-__all__ = ["GraspTwist", "grasp_twist"]
+__all__ = ["GraspTwist", "grasp_twist", "twist_grasp"]
 
 
 @dataclass(frozen=True)
@@ -62,9 +62,9 @@ class GraspTwist:
     --------
     >>> import bendpam
     >>> gripper = Gripper(bendpam.physics.presets.be_pam().replace(L0_mm=130.0), nodes=21)
-    >>> tw = grasp_twist(gripper, 180.0, 150.0, fractions=(1.0,))     # a 180 mm sphere at 150 kPa
-    >>> tw.lost_by, round(tw.torque_at_loss_nmm), round(tw.at_loss["object_rotation_deg"], 1)   # N*mm, deg
-    ('friction', 58, 3.1)
+    >>> tw = grasp_twist(gripper, 120.0, 150.0)          # a sphere too small for the fingers at 150 kPa
+    >>> tw.lost_by, tw.to_dict()["torque_at_loss_nmm"]
+    ('no grasp', 0.0)
     """
 
     grasp: Grasp
@@ -147,13 +147,38 @@ def grasp_twist(gripper: Gripper, diameter_mm, pressure_kpa, *, fractions=(0.25,
     ``fractions`` of the friction limit ``mu N`` at which each finger is solved (the last is the loss
     of grip by friction unless a finger loses its equilibrium first).  ``sleeve_lock=False`` drops the
     braid's lock torque from the fingers' twist law (a sensitivity check).  See the module notes.
+
+    >>> import bendpam
+    >>> gripper = Gripper(bendpam.physics.presets.be_pam().replace(L0_mm=130.0), nodes=21)
+    >>> tw = grasp_twist(gripper, 180.0, 150.0, fractions=(1.0,))     # a 180 mm sphere at 150 kPa
+    >>> tw.lost_by, round(tw.torque_at_loss_nmm), round(tw.at_loss["object_rotation_deg"], 1)   # N*mm, deg
+    ('friction', 58, 3.1)
     """
+    _fractions(fractions)
+    return twist_grasp(gripper, solve_grasp(gripper, diameter_mm, pressure_kpa), fractions=fractions,
+                       sleeve_lock=sleeve_lock)
+
+
+def _fractions(fractions) -> np.ndarray:
     from bendpam.errors import InputError
 
     fr = np.asarray(fractions, dtype=float).ravel()
     if fr.size == 0 or not np.all((fr > 0.0) & (fr <= 1.0)) or np.any(np.diff(fr) <= 0):
         raise InputError(f"fractions = {fractions!r} must rise within (0, 1] (fractions of the friction limit)")
-    grasp = solve_grasp(gripper, diameter_mm, pressure_kpa)
+    return fr
+
+
+def twist_grasp(gripper: Gripper, grasp: Grasp, *, fractions=(0.25, 0.5, 0.75, 1.0),
+                sleeve_lock: bool = True) -> GraspTwist:
+    """:func:`grasp_twist` from a grasp already solved (:func:`bendpam.design.grasp.solve_grasp` with ``gripper``).
+
+    >>> import bendpam
+    >>> from bendpam.design.grasp import solve_grasp
+    >>> gripper = Gripper(bendpam.physics.presets.be_pam().replace(L0_mm=130.0), nodes=21)
+    >>> twist_grasp(gripper, solve_grasp(gripper, 100.0, 150.0)).lost_by     # too small to reach
+    'no grasp'
+    """
+    fr = _fractions(fractions)
     if grasp.contact == "none" or not grasp.equilibrium:
         return GraspTwist(grasp, math.nan, 0.0, "no grasp", 0.0, (), (), grasp.note or "no contact")
     limit = gripper.mu * grasp.normal_force_n

@@ -260,6 +260,11 @@ def spatial_stiffness(actuator: Actuator, pressure_kpa, curvature_per_mm=None, *
     curvature at each pressure.  Pressures and curvatures broadcast.  ``model`` picks the in-plane law
     (the actuator's own by default); ``frame_shear_modulus_mpa`` defaults to ``E_f / (2 (1 + 0.3))``.
     See the module notes and docs/out-of-plane.md for the derivation.
+
+    >>> import bendpam
+    >>> s = spatial_stiffness(bendpam.physics.presets.bc_pam(), [0.0, 100.0])    # kPa, at the free curvatures
+    >>> s.lateral_stiffness_nmm2.round(-1).tolist(), s.torsion_lock_torque_nmm.round(1).tolist()
+    ([45120.0, 44350.0], [0.0, 171.7])
     """
     law, P, k = _states(actuator, pressure_kpa, curvature_per_mm, model)
     params = actuator.params
@@ -271,23 +276,41 @@ def spatial_stiffness(actuator: Actuator, pressure_kpa, curvature_per_mm=None, *
     M = law.moment(P, k)
     Kin = -law.tangent_stiffness(P, k)
     _EIf, EIs, GJf = frame
-    parts = {"lateral": {"frame_nmm2": EIs}, "torsion": {"frame_nmm2_per_rad": GJf}}
+    parts = {"lateral": {"frame_nmm2": EIs}, "torsion": {"frame_nmm2_per_rad": GJf},
+             "lock": {"energy_slope_nmm": lock}}  # the slope itself (negative: no lock), smooth in k'
     # a negative lock torque (deep reverse bending: the braid's hoop tension gone) means no lock
     return SpatialStiffness(P, k, M, Kin, k_lat, gj, np.maximum(lock, 0.0), parts)
 
 
 def lateral_stiffness_nmm2(actuator: Actuator, pressure_kpa, curvature_per_mm=None, **kw) -> np.ndarray:
-    """Out-of-plane bending stiffness ``EI_lat(P, k')``, N*mm^2 (:func:`spatial_stiffness`)."""
+    """Out-of-plane bending stiffness ``EI_lat(P, k')``, N*mm^2 (:func:`spatial_stiffness`).
+
+    >>> import bendpam
+    >>> round(float(lateral_stiffness_nmm2(bendpam.physics.presets.be_pam(), 150.0, 0.0)))    # N*mm^2
+    45049
+    """
     return spatial_stiffness(actuator, pressure_kpa, curvature_per_mm, **kw).lateral_stiffness_nmm2
 
 
 def torsional_stiffness_nmm2_per_rad(actuator: Actuator, pressure_kpa, curvature_per_mm=None, **kw) -> np.ndarray:
-    """Torsional stiffness ``GJ(P, k')`` of the twisting actuator, N*mm^2/rad (:func:`spatial_stiffness`)."""
+    """Torsional stiffness ``GJ(P, k')`` of the twisting actuator, N*mm^2/rad (:func:`spatial_stiffness`).
+
+    >>> import bendpam
+    >>> round(float(torsional_stiffness_nmm2_per_rad(bendpam.physics.presets.be_pam(), 150.0, 0.0)))
+    8762
+    """
     return spatial_stiffness(actuator, pressure_kpa, curvature_per_mm, **kw).torsional_stiffness_nmm2_per_rad
 
 
 def torsion_lock_torque_nmm(actuator: Actuator, pressure_kpa, curvature_per_mm=None, **kw) -> np.ndarray:
-    """The torque (N*mm) the pressurised braid carries before it twists (:func:`spatial_stiffness`)."""
+    """The torque (N*mm) the pressurised braid carries before it twists (:func:`spatial_stiffness`).
+
+    Straight, ``2 pi R0^3 cot(alpha0) P_a``:
+
+    >>> import bendpam
+    >>> round(float(torsion_lock_torque_nmm(bendpam.physics.presets.be_pam(), 150.0, 0.0)), 1)   # N*mm
+    196.4
+    """
     return spatial_stiffness(actuator, pressure_kpa, curvature_per_mm, **kw).torsion_lock_torque_nmm
 
 
@@ -298,6 +321,12 @@ def section_energy_n(actuator: Actuator, pressure_kpa, curvature_per_mm, lateral
 
     The twist is taken with the ``+alpha0`` fibre family taut (``Pi`` is even in the twist for a
     symmetric braid: the other family is taut for a negative twist).
+
+    >>> import bendpam
+    >>> a = bendpam.physics.presets.be_pam()
+    >>> e = section_energy_n(a, 150.0, 0.008, [0.0, 1e-3])       # N: a lateral curvature of 1e-3 1/mm
+    >>> round(float((e[1] - e[0]) / 0.5e-6), -1)                 # ~ EI_lat (N*mm^2)
+    42790.0
     """
     law, P, k = _states(actuator, pressure_kpa, curvature_per_mm, model)
     k2 = float_array("lateral_curvature_per_mm", lateral_curvature_per_mm, "1/mm")
@@ -343,8 +372,9 @@ class SpatialTable:
         self.knots = lo + t * (hi - lo)
         self._check = (actuator, float(pressure_kpa), kw, lo + 0.5 * (t[1:] + t[:-1]) * (hi - lo))
         st = spatial_stiffness(actuator, float(pressure_kpa), self.knots, **kw)
+        # the lock torque's smooth slope is tabulated (its clipping at 0 is the user's: a kink a spline cannot fit)
         self._values = np.stack([st.lateral_stiffness_nmm2, st.torsional_stiffness_nmm2_per_rad,
-                                 st.torsion_lock_torque_nmm], -1)
+                                 st.parts["lock"]["energy_slope_nmm"]], -1)
         self.coef = CubicSpline(self.knots, self._values).c  # (4, knots - 1, 3)
 
     @cached_property
@@ -352,7 +382,8 @@ class SpatialTable:
         """The largest relative error at the midpoints between knots, over the inner 90 % of the range."""
         actuator, P, kw, km = self._check
         ex = spatial_stiffness(actuator, P, km, **kw)
-        E = np.stack([ex.lateral_stiffness_nmm2, ex.torsional_stiffness_nmm2_per_rad, ex.torsion_lock_torque_nmm], -1)
+        E = np.stack([ex.lateral_stiffness_nmm2, ex.torsional_stiffness_nmm2_per_rad,
+                      ex.parts["lock"]["energy_slope_nmm"]], -1)
         F = np.stack([np.real(v) for v in self(km)], -1)
         floor = np.median(np.abs(self._values), axis=0)  # a sign change (the lock torque) is judged on the typical size
         tm = (km - self.knots[0]) / (self.knots[-1] - self.knots[0])
@@ -360,7 +391,10 @@ class SpatialTable:
         return float(np.max((np.abs(F - E) / (np.abs(E) + floor))[inner]))
 
     def __call__(self, curvature_per_mm):
-        """``(EI_lat N*mm^2, GJ N*mm^2/rad, T_lock N*mm)`` at the curvatures (any shape, complex allowed)."""
+        """``(EI_lat N*mm^2, GJ N*mm^2/rad, T_lock N*mm)`` at the curvatures (any shape, complex allowed).
+
+        ``T_lock`` here is the energy's slope, negative where there is no lock (the rod clips it at 0).
+        """
         k = np.asarray(curvature_per_mm)
         j = np.clip(np.searchsorted(self.knots, np.real(k)) - 1, 0, self.knots.size - 2)
         c = self.coef[:, j]  # (4, ..., 3)

@@ -111,7 +111,7 @@ def plot_finger3d(shapes, ax=None, title: str | None = None):
     >>> from bendpam.physics.presets import be_pam
     >>> from bendpam.design import Finger
     >>> from bendpam.design.finger3d import Finger3D, FingerLoads3D, solve_finger3d
-    >>> sh = solve_finger3d(Finger3D(Finger(be_pam())), 150.0, FingerLoads3D(tip_force_n=(0.0, 0.0, 0.5)))
+    >>> sh = solve_finger3d(Finger3D(Finger(be_pam(), nodes=11)), 150.0, FingerLoads3D(tip_force_n=(0.0, 0.0, 0.5)))
     >>> fig = plot_finger3d([sh])
     >>> fig.axes[0].name
     '3d'
