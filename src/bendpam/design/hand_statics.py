@@ -31,9 +31,9 @@ from typing import Any
 import numpy as np
 
 from bendpam.design.finger import Finger
-from bendpam.design.finger3d import Finger3D, FingerLoads3D, checked_vector, solve_finger3d
+from bendpam.design.finger3d import Finger3D, FingerLoads3D, solve_finger3d
 from bendpam.design.hand import FINGERS, PARTS, Hand, finger_frame, hand_pose, save_result, thumb_base
-from bendpam.design.parts import G_N_PER_G, json_number
+from bendpam.design.parts import G_N_PER_G, checked_vector, json_number
 from bendpam.errors import InputError
 from bendpam.infra.accessors import figure
 from bendpam.validate import did_you_mean, integer, number
