@@ -215,6 +215,15 @@ def test_load_jacobian_is_the_derivative_of_the_load_moment(bx, by, forearm):
         assert J[0, :, j] == pytest.approx(fd[0], rel=1e-5, abs=1e-4)
 
 
+def test_vertical_load_moment_by_hand():
+    # near straight the mass rises by |b|^2 (L^3/6 + lever L^2/2) (hanging): virtual work gives m = -W (L^2/3 + lever L) b
+    L, lev, g = 145.0, 100.0, 550.0 * 9.80665e-3
+    b = np.array([[1e-5, -2e-5]])
+    for forearm, sign in (("down", -1.0), ("up", 1.0)):
+        m, _ = WristLoad(hand_mass_g=0.0, payload_g=550.0, payload_lever_mm=lev, forearm=forearm).moment(b, L)
+        assert m[0] == pytest.approx(sign * g * (L * L / 3.0 + lev * L) * b[0], rel=1e-5)  # O(|b| L)^2
+
+
 @pytest.mark.parametrize("load", [None, WristLoad(payload_g=550.0, forearm="down")])
 def test_wrist_four_directions_are_equal_for_symmetric_actuators(load):
     rows = wrist_directions(Wrist(), 140.0, load)
