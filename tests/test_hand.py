@@ -216,7 +216,8 @@ def test_load_jacobian_is_the_derivative_of_the_load_moment(bx, by, forearm):
 
 
 def test_vertical_load_moment_by_hand():
-    # near straight the mass rises by |b|^2 (L^3/6 + lever L^2/2) (hanging): virtual work gives m = -W (L^2/3 + lever L) b
+    # near straight a hanging mass rises by |b|^2 (L^3/6 + lever L^2/2): virtual work gives
+    # m = -W (L^2/3 + lever L) b (and the opposite with the hand up)
     L, lev, g = 145.0, 100.0, 550.0 * 9.80665e-3
     b = np.array([[1e-5, -2e-5]])
     for forearm, sign in (("down", -1.0), ("up", 1.0)):
