@@ -162,7 +162,10 @@ def _print(hand, pose, kap, ws) -> None:
                    f"{_fmt(reach[n], '9.1f')}")
     typer.echo("tips (mm): " + "; ".join(f"{k} ({', '.join(f'{v:.1f}' for v in t)})" for k, t in pose.tips_mm.items()))
     if kap is not None:
-        typer.echo(f"\nKapandji test: score {kap.score} (points touched by the tip in an unbroken run from 1)")
+        d = kap.to_dict()
+        typer.echo(f"\nKapandji test: score {kap.score} (points touched by the tip in an unbroken run from 1); "
+                   f"touched by the tip: {', '.join(map(str, d['touched_by_tip'])) or 'none'}; by the thumb only: "
+                   f"{', '.join(map(str, d['touched_by_thumb_only'])) or 'none'}")
         typer.echo(f"{'#':>2} {'point':<48} {'d tip (mm)':>10} {'d thumb':>8} {'touched by':>10}  pressures (kPa)")
         for p in kap.points:
             pr = ", ".join(f"{k} {v:.0f}" for k, v in p.pressures_kpa.items())

@@ -232,6 +232,8 @@ class KapandjiResult:
     def to_dict(self) -> dict[str, Any]:
         """The test as a JSON-ready dict: ``points`` (each with ``distance_mm``, ``touched``, ``touched_by``)."""
         return {"contact_tolerance_mm": self.hand.contact_tolerance_mm, "score": self.score,
+                "touched_by_tip": [p.number for p in self.points if p.touched_by == "tip"],
+                "touched_by_thumb_only": [p.number for p in self.points if p.touched_by == "thumb"],
                 "finger_pressures_kpa": {k: float(v) for k, v in self.finger_pressures_kpa.items()},
                 "points": [p.to_dict() for p in self.points]}
 
