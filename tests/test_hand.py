@@ -279,6 +279,9 @@ def test_cli_hand_refuses_in_one_line(capsys, tmp_path):
     f.write_text("[thumb]\nplane_deg = 270\n")
     code, _, err = run(capsys, "hand", "--hand", f)
     assert code == 2 and err.count("\n") == 1 and "plane_deg" in err and "180" in err
+    for bad in (["--gravity", "0,0,0"], ["--gravity", "1,x,0"], ["--workspace", "1"], ["--pressure-kpa", "400"]):
+        code, _, err = run(capsys, "hand", *bad)
+        assert code == 2 and err.count("\n") == 1 and bad[0] in err, (bad, err)
 
 
 def test_cli_wrist_payload_json(capsys):
