@@ -32,7 +32,7 @@ import numpy as np
 
 from bendpam.design.finger import Finger
 from bendpam.design.finger3d import Finger3D, FingerLoads3D, solve_finger3d
-from bendpam.design.hand import FINGERS, PARTS, Hand, finger_frame, hand_pose, save_result, thumb_base
+from bendpam.design.hand import FINGERS, Hand, finger_frame, hand_pose, save_result, thumb_base
 from bendpam.design.parts import G_N_PER_G, checked_vector, json_number
 from bendpam.errors import InputError
 from bendpam.infra.accessors import figure
@@ -222,5 +222,4 @@ def hand_statics(hand: Hand, pressures_kpa: dict | None = None, *, gravity=(0.0,
         notes.append("thumb: " + (why[0] if why else f"the two segments did not settle in {_ROUNDS} rounds"))
     for k, t in tips.items():
         defl[k] = float(np.linalg.norm(t - pose.tips_mm[k]))
-    assert set(PARTS) >= set(shapes)
     return HandStatics(pose, shapes, tips, defl, not notes, "; ".join(notes), tuple(float(v) for v in g), mpl)
