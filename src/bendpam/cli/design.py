@@ -345,9 +345,7 @@ def grasp_cmd(
             raise UserError(f"--diameter-mm: {d:g} mm is not a positive diameter")
     P = pressures_kpa(pressure_kpa, None)
     _budget(len(P) * len(D), "--pressure-kpa x --diameter-mm")
-    if twist and len(P) * len(D) > MAX_TWIST_GRASPS:
-        raise UserError(f"--twist: {len(P) * len(D)} grasps; at most {MAX_TWIST_GRASPS} (each a few 3-D finger "
-                        "solves): give fewer --diameter-mm or --pressure-kpa values")
+    _twist_budget(twist, len(P) * len(D))
     mname = model_for(act, model)
     plot = _plot_target(plot, fig_format)
     gr = Gripper(act, mname, fingers=fingers,
@@ -361,10 +359,7 @@ def grasp_cmd(
         _save_plot(lambda ax: plot_grasp(ds, ax=ax), plot, fig_format)
     rows = [g.to_dict() for row in grasps for g in row]
     if twist:
-        from bendpam.design.twist import twist_grasp
-
-        for r, g in zip(rows, (g for row in grasps for g in row), strict=True):
-            r["twist"] = twist_grasp(gr, g).to_dict()
+        _add_twists(gr, grasps, rows)
     if as_json:
         print_json({**gr.to_dict(), "units": _GRASP_UNITS, "results": rows})
         return
@@ -389,6 +384,20 @@ def _print_grasps(gr, rows: list[dict[str, Any]]) -> None:
                    f"{_fmt(r['peak_lift_mm'], '9.2f')} {_fmt(r['frozen_grip_force_n'], '10.2f')} "
                    f"{_fmt(r['contact_force_n'], '9.2f')} {r['contact']:>8} {_fmt(r['contact_angle_deg'], '8.1f')}"
                    + (f"  {r['note']}" if r["note"] else ""))
+
+
+def _twist_budget(twist: bool, n: int) -> None:
+    if twist and n > MAX_TWIST_GRASPS:
+        raise UserError(f"--twist: {n} grasps; at most {MAX_TWIST_GRASPS} (each a few 3-D finger solves): give "
+                        "fewer --diameter-mm or --pressure-kpa values")
+
+
+def _add_twists(gr, grasps, rows: list[dict[str, Any]]) -> None:
+    """Each grasp twisted about the gripper's axis until the grip slips (:func:`bendpam.design.twist.twist_grasp`)."""
+    from bendpam.design.twist import twist_grasp
+
+    for r, g in zip(rows, (g for row in grasps for g in row), strict=True):
+        r["twist"] = twist_grasp(gr, g).to_dict()
 
 
 def _print_twists(rows: list[dict[str, Any]]) -> None:

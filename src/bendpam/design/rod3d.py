@@ -86,6 +86,16 @@ def segment_maps(w, length):
     return Q, p
 
 
+def _prefix_products(Q):
+    """Inclusive prefix products ``Q_0 Q_1 ... Q_j`` along axis -3 (log2(n) batched products, Hillis-Steele)."""
+    C = np.array(Q)
+    off = 1
+    while off < C.shape[-3]:
+        C[..., off:, :, :] = C[..., :-off, :, :] @ C[..., off:, :, :]
+        off *= 2
+    return C
+
+
 class Rod3D:
     """Geometry and load moments of the discretised spatial finger (batched over leading axes).
 
@@ -135,14 +145,12 @@ class Rod3D:
         Om = self.curvatures(U)
         wm = 0.5 * (Om[..., 1:, :] + Om[..., :-1, :])
         Q, p = segment_maps(wm, self.h)
-        lead = U.shape[:-1]
-        D = np.empty((*lead, self.n, 3, 3), dtype=np.result_type(U, float))
-        x = np.empty((*lead, self.n, 3), dtype=D.dtype)
-        D[..., 0, :, :] = self.D0
-        x[..., 0, :] = self.x0
-        for j in range(self.n - 1):  # the frames compose in order along the rod (vectorised over the batch)
-            D[..., j + 1, :, :] = D[..., j, :, :] @ Q[..., j, :, :]
-            x[..., j + 1, :] = x[..., j, :] + (D[..., j, :, :] @ p[..., j, :, None])[..., 0]
+        C = _prefix_products(Q)  # C_j = Q_0 ... Q_j
+        eye = np.broadcast_to(np.eye(3), (*U.shape[:-1], 1, 3, 3))
+        D = self.D0 @ np.concatenate([eye, C], axis=-3)
+        step = (D[..., :-1, :, :] @ p[..., None])[..., 0]
+        zero = np.zeros((*U.shape[:-1], 1, 3), dtype=step.dtype)
+        x = self.x0 + np.concatenate([zero, np.cumsum(step, axis=-2)], axis=-2)
         De = D[..., -1, :, :]
         xt = x[..., -1, :] + self.ell * De[..., :, 2] + self.b * self.off * De[..., :, 0]
         return D, x, xt
