@@ -52,10 +52,12 @@ from typing import Any
 
 import numpy as np
 
+from bendpam.design.hand import save_result
 from bendpam.design.parts import G_N_PER_G, checked_pressure_kpa, checked_pressures_kpa, json_number
 from bendpam.design.rod import newton_batch
 from bendpam.design.wrist import DEFAULT_LEVER_MM, Wrist
 from bendpam.errors import InputError
+from bendpam.infra.accessors import figure
 from bendpam.physics.limits import section_limits
 from bendpam.validate import integer, number
 
@@ -337,6 +339,26 @@ class WristMap:
         df = self.to_dataframe()
         return {"load": None if self.load is None else self.load.to_dict(),
                 "columns": {c: [json_number(v) if c != "equilibrium" else bool(v) for v in df[c]] for c in df}}
+
+    def plot(self, ax=None, title: str | None = None):
+        """The tilts in the plane of the actuators, coloured by the buckling margin
+        (:func:`~bendpam.present.figures.hand.plot_wrist_map`).
+
+        >>> fig = wrist_map(Wrist(), [[0.0, 150.0, 0.0, 0.0]]).plot()
+        >>> fig.axes[0].get_xlabel()
+        'tilt toward 0 deg (deg)'
+        """
+        return figure("wrist_map")(self, ax=ax, title=title)
+
+    def save(self, out_dir, *, figure_format: str = "png") -> dict[str, str]:
+        """Write ``wrist_map.json`` (:meth:`to_dict`) and ``wrist_map.<format>`` into ``out_dir``; ``{name: path}``.
+
+        >>> import tempfile
+        >>> with tempfile.TemporaryDirectory() as d:
+        ...     sorted(wrist_map(Wrist(), [[0.0, 150.0, 0.0, 0.0]]).save(d))
+        ['wrist_map.json', 'wrist_map.png']
+        """
+        return save_result(out_dir, "wrist_map", self.to_dict(), lambda: self.plot(), figure_format)
 
 
 def _pressure_block(wrist: Wrist, pressures_kpa) -> np.ndarray:

@@ -7,10 +7,11 @@ name                function
 ``kapandji``        :func:`plot_kapandji` (the thumb's closest pose for each Kapandji point)
 ``hand_workspace``  :func:`plot_hand_workspace` (the tips reachable over a pressure grid)
 ``hand_statics``    :func:`plot_hand_statics` (the hand under its weight and tip loads)
+``wrist_map``       :func:`plot_wrist_map` (the wrist's tilt for each pressure combination)
 ==================  ====================================================================
 
 The hand frame is the one of :mod:`bendpam.design.hand` (x radial, y distal, z palmar; mm), drawn
-with equal scales on the three axes.
+with equal scales on the three axes; the wrist's map is drawn in the plane of its actuators.
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ import numpy as np
 from bendpam.infra.accessors import register
 from bendpam.present.figures.style import figure_size, figure_style, new_figure
 
-__all__ = ["plot_hand_pose", "plot_hand_statics", "plot_hand_workspace", "plot_kapandji"]
+__all__ = ["plot_hand_pose", "plot_hand_statics", "plot_hand_workspace", "plot_kapandji", "plot_wrist_map"]
 
 _TOUCH_COLOURS = {"tip": "tab:green", "thumb": "tab:orange", "none": "tab:red"}
 
@@ -188,6 +189,53 @@ def plot_hand_statics(statics, ax=None, title: str | None = None):
         ax.quiver(0.0, 0.0, 0.0, *(40.0 * g), color="tab:red", arrow_length_ratio=0.2)
         ax.text(*(45.0 * g), "g", color="tab:red", fontsize=8)
         _finish(ax, np.vstack(pts), title or "hand under load (grey: unloaded)")
+        if own:
+            fig.tight_layout()
+    return fig
+
+
+@register("wrist_map")
+def plot_wrist_map(wmap, ax=None, title: str | None = None):
+    """Draw an orientation map of the wrist (a :class:`~bendpam.design.wrist_tilt.WristMap`): each pressure
+    combination's tilt as a point ``(tilt cos psi, tilt sin psi)`` (deg) in the plane of the actuators, coloured
+    by the smallest frame-buckling margin (red below 1); crosses where there is no equilibrium (at the origin).
+
+    Examples
+    --------
+    >>> from bendpam.design.wrist import Wrist
+    >>> from bendpam.design.wrist_tilt import wrist_map
+    >>> fig = plot_wrist_map(wrist_map(Wrist(), [[0.0, 150.0, 0.0, 0.0], [150.0, 150.0, 0.0, 0.0]]))
+    >>> len(fig.axes)                                     # the map and its colour bar
+    2
+    """
+    import matplotlib
+
+    with figure_style():
+        own = ax is None
+        if own:
+            fig = new_figure(figure_size("single", 0.9))
+            ax = fig.add_subplot()
+        else:
+            fig = ax.figure
+        t = np.nan_to_num(np.asarray(wmap.tilt_deg, dtype=float))
+        psi = np.radians(np.nan_to_num(np.asarray(wmap.direction_deg, dtype=float)))
+        margin = np.min(np.asarray(wmap.buckling_margin, dtype=float), axis=1)
+        ok = np.asarray(wmap.equilibrium, dtype=bool)
+        norm = matplotlib.colors.Normalize(vmin=0.0, vmax=2.0)
+        sc = ax.scatter(t[ok] * np.cos(psi[ok]), t[ok] * np.sin(psi[ok]), c=np.minimum(margin[ok], 2.0),
+                        cmap="RdYlGn", norm=norm, s=14, edgecolors="k", linewidths=0.3)
+        if np.any(~ok):
+            ax.scatter(np.zeros(int(np.sum(~ok))), np.zeros(int(np.sum(~ok))), marker="x", color="k",
+                       label="no equilibrium")
+            ax.legend(fontsize="x-small")
+        fig.colorbar(sc, ax=ax, label="smallest buckling margin")
+        for r in (15.0, 30.0):
+            a = np.linspace(0.0, 2.0 * np.pi, 181)
+            ax.plot(r * np.cos(a), r * np.sin(a), color="0.7", lw=0.6, ls=":")
+        ax.set_aspect("equal")
+        ax.set_xlabel("tilt toward 0 deg (deg)")
+        ax.set_ylabel("tilt toward 90 deg (deg)")
+        ax.set_title(title or "wrist orientation per pressure combination")
         if own:
             fig.tight_layout()
     return fig
