@@ -34,8 +34,8 @@ def _axes3d(ax):
     return fig, fig.add_subplot(projection="3d"), True
 
 
-def _finish(ax, points: np.ndarray, title: str | None) -> None:
-    """Equal scales around ``points`` (n, 3), labels and the title."""
+def _finish(ax, points: np.ndarray, title: str | None, own: bool) -> None:
+    """Equal scales around ``points`` (n, 3), labels and the title; the layout of a figure of our own."""
     lo, hi = np.nanmin(points, axis=0), np.nanmax(points, axis=0)
     mid, half = (lo + hi) / 2.0, max(float(np.max(hi - lo)) / 2.0, 1.0)
     ax.set_xlim(mid[0] - half, mid[0] + half)
@@ -48,6 +48,8 @@ def _finish(ax, points: np.ndarray, title: str | None) -> None:
     ax.view_init(elev=35, azim=-120)
     if title:
         ax.set_title(title)
+    if own:
+        ax.figure.tight_layout()
 
 
 def _palm(hand) -> np.ndarray:
@@ -89,9 +91,7 @@ def plot_hand_pose(pose, ax=None, title: str | None = None):
         pts = _draw_pose(ax, pose)
         for name, tip in pose.tips_mm.items():
             ax.scatter(*tip, s=8, color="tab:blue" if name == "thumb" else "0.2")
-        _finish(ax, pts, title or "hand pose")
-        if own:
-            fig.tight_layout()
+        _finish(ax, pts, title or "hand pose", own)
     return fig
 
 
@@ -128,9 +128,7 @@ def plot_kapandji(result, ax=None, title: str | None = None):
         for by, c in _TOUCH_COLOURS.items():
             ax.scatter([], [], [], color=c, label=f"touched: {by}")
         ax.legend(fontsize="x-small", loc="upper left")
-        _finish(ax, np.vstack(drawn), title or f"Kapandji test: score {result.score}")
-        if own:
-            fig.tight_layout()
+        _finish(ax, np.vstack(drawn), title or f"Kapandji test: score {result.score}", own)
     return fig
 
 
@@ -159,9 +157,7 @@ def plot_hand_workspace(ws, ax=None, title: str | None = None):
         ax.scatter(*t.T, s=2, color="tab:blue", alpha=0.25, label="thumb tip")
         pts.append(t)
         ax.legend(fontsize="x-small", loc="upper left")
-        _finish(ax, np.vstack(pts), title or "reachable tips")
-        if own:
-            fig.tight_layout()
+        _finish(ax, np.vstack(pts), title or "reachable tips", own)
     return fig
 
 
@@ -188,9 +184,7 @@ def plot_hand_statics(statics, ax=None, title: str | None = None):
         g = np.asarray(statics.gravity)
         ax.quiver(0.0, 0.0, 0.0, *(40.0 * g), color="tab:red", arrow_length_ratio=0.2)
         ax.text(*(45.0 * g), "g", color="tab:red", fontsize=8)
-        _finish(ax, np.vstack(pts), title or "hand under load (grey: unloaded)")
-        if own:
-            fig.tight_layout()
+        _finish(ax, np.vstack(pts), title or "hand under load (grey: unloaded)", own)
     return fig
 
 
