@@ -50,6 +50,24 @@ def test_table_newton_cube_roots_from_a_coarse_table():
     assert x[0] == pytest.approx(1.5, abs=1e-14) and x[1] == 1.0
 
 
+def test_table_newton_stops_on_a_root_found_to_rounding():
+    """A Newton step that rounds onto the bracket's end just set by the iterate is converged, not restarted.
+
+    ``G(x) = (x - 1) + 1e-20`` started at ``x = 1``: ``G = 1e-20 > 0`` makes 1 the bracket's right end
+    and the step ``-1e-20`` rounds back onto it.  Before the fix the midpoint of the bracket replaced
+    it and the point took about twenty more evaluations (bisection toward 1 by halves).
+    """
+    calls = []
+
+    def G(x, idx):
+        calls.append(idx.size)
+        return (x - 1.0) + 1e-20
+
+    x = table_newton(G, np.array([1.0]), np.array([1.0]), np.array([0.5]), np.array([1.5]),
+                     np.array([-0.5]), np.array([0.5]), 1e-14)
+    assert x[0] == 1.0 and len(calls) == 1
+
+
 def test_table_newton_refuses_bad_arguments():
     with pytest.raises(bendpam.errors.InputError):
         table_newton("f", 1.0, 1.0, 0.0, 2.0, -1.0, 1.0, 1e-12)

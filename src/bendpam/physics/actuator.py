@@ -270,6 +270,22 @@ class ModelParams:
         """The cases at ``index`` (array fields only; scalars stay)."""
         return ModelParams(**{k: (np.asarray(v)[index] if np.ndim(v) else v) for k, v in self.__dict__.items()})
 
+    def rows(self, index) -> Any:
+        """The cases at ``index`` as a view that gathers a field only when it is read (once).
+
+        The same values as :meth:`take`, for the hot loops of the root solvers and the margins, which
+        read a few of the fields of many cases.
+
+        Examples
+        --------
+        >>> import numpy as np, bendpam
+        >>> p = bendpam.physics.presets.be_pam().params
+        >>> q = ModelParams(**{k: np.full(3, v, dtype=float) if v is not None else None for k, v in p.__dict__.items()})
+        >>> bool(q.rows(np.array([0, 2])).alpha0.tolist() == q.take(np.array([0, 2])).alpha0.tolist())
+        True
+        """
+        return _Rows(self, index)
+
     def col(self) -> ModelParams:
         """The same cases with a trailing axis, to broadcast against per-case samples."""
         return ModelParams(**{k: (np.asarray(v)[..., None] if np.ndim(v) else v) for k, v in self.__dict__.items()})
@@ -278,6 +294,21 @@ class ModelParams:
     def bend_sign(self):
         """+1 (BE-PAM, bends toward the frame), -1 (BC-PAM) or 0 (neutral braid angle), per case."""
         return np.sign(np.round(np.degrees(self.alpha0) - NEUTRAL_ANGLE_DEG, 9)).astype(int)
+
+
+class _Rows:
+    """:meth:`ModelParams.rows`: the fields of some cases, each gathered on its first read."""
+
+    def __init__(self, params: ModelParams, index):
+        self._params, self._index = params, index
+
+    def __getattr__(self, name: str) -> Any:
+        if name.startswith("_"):
+            raise AttributeError(name)
+        v = getattr(self._params, name)
+        v = np.asarray(v)[self._index] if np.ndim(v) else v
+        setattr(self, name, v)
+        return v
 
 
 @dataclass(frozen=True)

@@ -188,10 +188,14 @@ def table_newton(G, x0, slope0, a, b, ga, gb, tol, maxiter: int = 100):
             slope = np.where(first[act], s0[act], (g - gp[act]) / (xa - xp[act]))
             xn = xa - g / slope
         inside = (xn > np.minimum(lo, hi)) & (xn < np.maximum(lo, hi))
-        xn = np.where(inside, xn, 0.5 * (lo + hi))
+        # a step below tol is converged even where it rounds onto the bracket's end that ``xa`` just
+        # became (a root found to rounding): the midpoint there would restart a converged point
+        small = np.abs(xn - xa) <= tol[act]
+        xn = np.where(inside, xn, np.where(small, np.clip(xn, np.minimum(lo, hi), np.maximum(lo, hi)),
+                                           0.5 * (lo + hi)))
         xp[act], gp[act] = xa, g
         first[act] = False
-        done = ~(neg | pos) | (np.abs(xn - xa) <= tol[act]) | (np.abs(hi - lo) <= tol[act])
+        done = ~(neg | pos) | small | (np.abs(hi - lo) <= tol[act])
         x[act] = np.where(neg | pos, xn, xa)
         act = act[~done]
     return x.reshape(shape)

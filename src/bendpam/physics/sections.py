@@ -58,7 +58,7 @@ class _ExactUPath:
         self.x_max = np.broadcast_to(np.asarray(lim.u_max, dtype=float), (n,)).copy()
 
     def _state(self, u, rows):
-        sub = self.law.params if self.scalar else self.cs.take(rows)
+        sub = self.law.params if self.scalar else self.cs.rows(rows)
         m = self.mod.section_means(u, sub.alpha0, self.law.order)
         R, dR, k = radius_from_u(u, m["ib"], m["dib"], sub.alpha0, sub.R0_start)
         return sub, m, R, dR, k
@@ -199,7 +199,7 @@ class _TablePath:
         self.k_max = self.to_k(self.x_max, np.arange(self.ia.size))
 
     def _state(self, u, rows):
-        sub = self.cs.take(rows)
+        sub = self.cs.rows(rows)
         m = self.tables.means(self.ia[rows], u)
         R, dR, k = radius_from_u(u, m["ib"], m["dib"], sub.alpha0, sub.R0_start)
         return sub, m, R, dR, k
@@ -225,7 +225,7 @@ class _TablePath:
         grid = end[:, None] * np.linspace(0.0, 1.0, 65)
 
         def lumen(u, rows=rows):
-            sub = self.cs.take(rows)
+            sub = self.cs.rows(rows)
             xi = 1.0 / (np.sin(sub.alpha0) * self.tables.ibar(self.ia[rows], u))
             return sub.R0_start * xi * xi * (1.0 + u) - sub.t0_start
 
