@@ -175,3 +175,23 @@ def test_axial_force_means_in_closed_form_equal_the_quadrature(name):
     # by hand at k' = 0: mean cot^2 alpha = cot^2 alpha0, mean lambda1^-2 = 1
     cot2, lm2 = force_balance._axial_means(np.zeros(1), np.cos(a.params.alpha0))
     assert cot2[0] == pytest.approx(1.0 / np.tan(a.params.alpha0) ** 2, rel=1e-14) and lm2[0] == 1.0
+
+
+def test_refined_fold_is_the_maximum_of_the_branch():
+    """The fold's grid search: ``P_a`` at the refined fold is the highest on a dense grid around it (to rounding).
+
+    BC-PAM with the energy model folds (docs/paper-reading.md); a dense grid of 4001 points over two
+    sample intervals each side of the fold, evaluated exactly, finds nothing higher than ``p_end`` beyond
+    rounding, and its best point lies within one grid step of ``x_fold``.
+    """
+    law = MomentLaw(build_cases(presets.bc_pam(), {"alpha0_deg": np.array([40.0, 45.0, 50.0])}), "energy")
+    tab = law.branches(150)
+    folds = np.flatnonzero((tab.kind == branch_mod.BRANCH_END["fold"]) & tab.use_ref)
+    assert folds.size >= 1
+    for c in folds:
+        h = np.max(np.abs(np.diff(tab.xt[c, : tab.last[c] + 1])))
+        xs = tab.x_fold[c] + np.linspace(-2.0, 2.0, 4001) * h
+        A, B = tab.path.coef(xs, np.full(xs.size, c))
+        p = B / A
+        assert tab.p_end[c] >= np.nanmax(p) * (1.0 - 1e-13)
+        assert abs(xs[np.nanargmax(p)] - tab.x_fold[c]) <= 4.0 * h / 4000

@@ -24,7 +24,7 @@ How it is computed
     The kernel evaluates a whole block of cases at once: the braid kinematics and both models
     accept per-case parameter arrays, so the lock-up limits (vectorised bisection), the
     free-bending branch of every case (the same sampling and fold refinement as
-    :func:`bendpam.branch_info`, vectorised: golden-section search on the sampled maximum) and the
+    :func:`bendpam.branch_info`, vectorised: a grid search around the sampled maximum) and the
     roots at every pressure (all pressures of all cases at once: each root's bracket and a cubic
     start from the sampled branch, then Newton's method, about 2.4 evaluations of the law a point,
     :func:`bendpam.physics.branch.solve_free`) are array operations over the block, and the

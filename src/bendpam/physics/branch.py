@@ -183,8 +183,14 @@ def _first_fall(pk, n_ok):
 
 
 def _refine_folds(ev, xk, pk, has_dec, j):
-    """``(x_fold, p_fold, use_ref)``: the sampled fold at ``j``, refined by a golden-section maximisation of
-    ``P_a`` on ``[xk[j-1], xk[j+1]]`` where that finds a higher point (``use_ref``)."""
+    """``(x_fold, p_fold, use_ref)``: the sampled fold at ``j``, refined by a grid search for the maximum of
+    ``P_a`` on ``[xk[j-1], xk[j+1]]`` where that finds a higher point (``use_ref``).
+
+    Each pass evaluates :data:`_FOLD_GRID` interior points of the bracket at once and keeps the two
+    cells around the highest, a factor ``2 / (_FOLD_GRID + 1)`` a pass: :data:`_FOLD_PASSES` passes shrink
+    the bracket to about 1e-10 of a sample interval (as the 48 steps of the golden section it replaced,
+    in a quarter of the passes).
+    """
     n = xk.shape[-1] - 1
     lo = np.take_along_axis(xk, np.clip(j - 1, 0, n)[:, None], -1)[:, 0]
     hi = np.take_along_axis(xk, np.clip(j + 1, 0, n)[:, None], -1)[:, 0]
@@ -196,30 +202,33 @@ def _refine_folds(ev, xk, pk, has_dec, j):
     use_ref = np.zeros(xk.shape[0], dtype=bool)
     if rows.size:
 
-        def p_of(x):
-            Ax, Bx = ev.coef(x, rows)
+        def p_of(x, r):
+            Ax, Bx = ev.coef(x, r)
             with np.errstate(divide="ignore", invalid="ignore"):
                 return Bx / Ax
 
         a, b = a_[rows], b_[rows]
-        g = (math.sqrt(5.0) - 1.0) / 2.0
-        x1, x2 = b - g * (b - a), a + g * (b - a)
-        f1, f2 = p_of(x1), p_of(x2)
-        for _ in range(48):  # the bracket shrinks by 0.618^48 ~ 1e-10 of a sample interval
-            left = f1 > f2  # the maximum lies in [a, x2]
-            b = np.where(left, x2, b)
-            a = np.where(left, a, x1)
-            new = np.where(left, b - g * (b - a), a + g * (b - a))
-            fnew = p_of(new)
-            x1, f1, x2, f2 = (np.where(left, new, x2), np.where(left, fnew, f2),
-                              np.where(left, x1, new), np.where(left, f1, fnew))
+        frac = np.arange(1, _FOLD_GRID + 1) / (_FOLD_GRID + 1.0)
+        rep = np.repeat(rows, _FOLD_GRID)
+        at = np.arange(rows.size)
+        for _ in range(_FOLD_PASSES):
+            xs = a[:, None] + (b - a)[:, None] * frac
+            f = p_of(xs.ravel(), rep).reshape(xs.shape)
+            i = np.argmax(np.where(np.isfinite(f), f, -np.inf), axis=1)
+            a = np.where(i > 0, xs[at, np.maximum(i - 1, 0)], a)
+            b = np.where(i < _FOLD_GRID - 1, xs[at, np.minimum(i + 1, _FOLD_GRID - 1)], b)
         xm = 0.5 * (a + b)
-        pm = p_of(xm)
+        pm = p_of(xm, rows)
         ref = np.isfinite(pm) & (pm > pj[rows])
         use_ref[rows] = ref
         x_fold[rows] = np.where(ref, xm, x_fold[rows])
         p_fold[rows] = np.where(ref, pm, p_fold[rows])
     return x_fold, p_fold, use_ref
+
+
+#: Interior points a pass of the fold's grid search, and the passes (``(2 / 16)^12 ~ 7e-12``).
+_FOLD_GRID = 15
+_FOLD_PASSES = 12
 
 
 def solve_free(law: MomentLaw, tab: BranchTable, pa: np.ndarray, xtol: float = 1e-13) -> tuple[np.ndarray, np.ndarray]:
