@@ -193,12 +193,15 @@ def ibar_closed_form(u, c):
     rD = 1.0 / np.sqrt(D)
     ib = (2.0 / math.pi) * K * rD
     small = m < _DK_SERIES_M
-    ms = np.where(small, m, 0.0)
-    ser = np.zeros_like(ms)
-    for coef in reversed(_DK_SERIES):
-        ser = ser * ms + coef
     mm = np.where(small, 0.5, m)
-    dKdm = np.where(small, ser, (E - (1.0 - mm) * K) / (2.0 * mm * (1.0 - mm)))
+    dKdm = (E - (1.0 - mm) * K) / (2.0 * mm * (1.0 - mm))
+    if np.any(small):  # the series only where it is used (a few points of a branch, near u = 0)
+        dKdm = np.array(np.broadcast_to(dKdm, np.shape(m)))
+        ms = m[small]
+        ser = np.zeros_like(ms)
+        for coef in reversed(_DK_SERIES):
+            ser = ser * ms + coef
+        dKdm[small] = ser
     dm = (4.0 * c * np.where(pos, 1.0, -1.0) - m * dD) / D
     dib = (2.0 / math.pi) * rD * (dKdm * dm - 0.5 * K * dD / D)
     return ib, dib
