@@ -19,7 +19,7 @@ and reports medians, min and max.  Candidates:
 Configurations (BE-PAM and BC-PAM, energy; ``alpha0_deg`` x ``t0_mm`` grids, blocks of 256 cases):
 
 * 200 cases x 1000 pressures (20 cases share a braid angle: the shared-table path);
-* 32 braid angles x 1000 pressures (the default block of a streamed sweep; the exact path);
+* 32 braid angles x 1000 pressures (the default block of a streamed sweep; the exact path), BE-PAM and BC-PAM;
 * 2000 cases x 16 pressures, and 2000 distinct braid angles x 16 pressures.
 
 The free curvatures of each candidate are compared with this code's (NaN pattern, largest difference
@@ -60,6 +60,8 @@ def _config(i: int, quick: bool):
          np.linspace(40.0, 50.0, 5 * n), np.linspace(1.5, 3.0, 20)),
         ("32 angles x 1000 P (one streamed block)", "be-pam", np.linspace(70.0, 300.0, 1000),
          np.linspace(60.0, 80.0, 16 * n), np.array([2.0])),
+        ("BC-PAM 32 angles x 1000 P (one streamed block)", "bc-pam", np.linspace(40.0, 300.0, 1000),
+         np.linspace(40.0, 50.0, 16 * n), np.array([2.0])),
         ("2000 cases x 16 P", "be-pam", np.linspace(80.0, 250.0, 16),
          np.linspace(60.0, 80.0, 50 * n), np.linspace(1.5, 3.0, 20)),
         ("2000 distinct angles x 16 P", "be-pam", np.linspace(80.0, 250.0, 16),
@@ -68,7 +70,7 @@ def _config(i: int, quick: bool):
     return cfgs[i]
 
 
-N_CONFIGS = 5
+N_CONFIGS = 6
 
 
 # ------------------------------------------------------------------------------------------------

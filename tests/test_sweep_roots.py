@@ -195,3 +195,13 @@ def test_refined_fold_is_the_maximum_of_the_branch():
         p = B / A
         assert tab.p_end[c] >= np.nanmax(p) * (1.0 - 1e-13)
         assert abs(xs[np.nanargmax(p)] - tab.x_fold[c]) <= 4.0 * h / 4000
+
+
+def test_lock_up_search_finds_the_sign_change_to_adjacent_floats():
+    """The lock-up limits' sign-change search (15 interior points a pass, 16 passes): ``sqrt(q)`` as the
+    sign change of ``q - u^2`` to the last bits, as the 64 halvings it replaced."""
+    from bendpam.physics.braid import _bisect
+
+    q = np.linspace(0.1, 3.0, 7)
+    u = _bisect(lambda m: q[:, None] - m * m, np.zeros(q.size), np.full(q.size, 2.0))
+    assert_allclose(u, np.sqrt(q), rtol=4e-16)

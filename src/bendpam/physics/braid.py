@@ -473,12 +473,21 @@ class CurvatureLimits:
             )
 
 
-def _bisect(f, a, b, iters: int = 64):
-    """Vectorised bisection for the sign change of ``f`` between ``a`` (f > 0) and ``b`` (f <= 0)."""
-    for _ in range(iters):
-        m = 0.5 * (a + b)
-        pos = f(m) > 0
-        a, b = np.where(pos, m, a), np.where(pos, b, m)
+def _bisect(f, a, b, iters: int = 64, points: int = 15):
+    """Vectorised search for the sign change of ``f`` between ``a`` (f > 0) and ``b`` (f <= 0).
+
+    ``f`` takes ``(cases, points)`` arrays.  Each pass evaluates ``points`` interior points of every
+    bracket at once and keeps the cell where the sign changes (four bits a pass with 15 points), until
+    the bracket has shrunk as much as ``iters`` halvings would shrink it (64: to adjacent floats).
+    """
+    frac = np.arange(1, points + 1) / (points + 1.0)
+    rows = np.arange(np.size(a))
+    for _ in range(math.ceil(iters / math.log2(points + 1.0) - 1e-9)):
+        m = a[:, None] + (b - a)[:, None] * frac
+        pos = f(m) > 0  # f > 0 up to the sign change: the number of leading True is the cell
+        i = np.argmin(np.concatenate([pos, np.zeros((rows.size, 1), dtype=bool)], axis=1), axis=1)
+        a, b = (np.where(i > 0, m[rows, np.maximum(i - 1, 0)], a),
+                np.where(i < points, m[rows, np.minimum(i, points - 1)], b))
     return 0.5 * (a + b)
 
 
@@ -526,7 +535,7 @@ def limits(params, order: int = DEFAULT_ORDER) -> CurvatureLimits:
         j = np.where(has, np.argmax(neg, axis=-1), 1)
         a = np.take_along_axis(grid, (j - 1)[:, None], -1)[:, 0]
         b = np.take_along_axis(grid, j[:, None], -1)[:, 0]
-        root = _bisect(lambda u: lumen(u[:, None])[:, 0], a, b) if has.any() else a
+        root = _bisect(lumen, a, b) if has.any() else a
         ends.append(np.where(has, root, end))
         closes.append(has)
     u_hi, u_lo = ends
