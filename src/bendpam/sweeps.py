@@ -639,7 +639,7 @@ def _dataset(data, names, grids, shape, P, base, model, order) -> Any:
         if name == "branch_end":
             v = v.astype(np.int8)
         unit, long_name = _UNITS[name]
-        vars_[name] = xr.DataArray(v, dims=d, attrs={"units": unit, "long_name": long_name})
+        vars_[name] = (d, v, {"units": unit, "long_name": long_name})  # Variables: no alignment to do
     coords = {n: (n, g, {"units": _UNIT_OF_SUFFIX.get(n.rsplit("_", 1)[-1], n.rsplit("_", 1)[-1])})
               for n, g in zip(names, grids, strict=True)}
     coords["pressure_kpa"] = ("pressure_kpa", P, {"units": "kPa"})
