@@ -8,6 +8,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from bendpam.physics.hysteresis import BoucWen, DahlLaw, MaxwellSlip, PrandtlIshlinskii, ViscousLoop, make_law
 
@@ -288,3 +290,19 @@ def test_the_viscous_member_driven_at_the_tests_times_is_the_steady_cycle():
     away, back = ViscousLoop(math.radians(theta_deg) / 0.03, 0.03).steady_branches(delta, span, period)
     z = steady_z("viscous", theta_deg, d)
     assert np.allclose(z[n:], away, atol=1e-4) and np.allclose(z[:n], back, atol=1e-4)
+
+
+@settings(max_examples=60, deadline=None)
+@given(f=st.lists(st.floats(-1e3, 1e3), min_size=1, max_size=700), a=st.floats(0.0, 1.0),
+       z0=st.floats(-5.0, 5.0))
+def test_first_order_scan_is_lfilter(f, a, z0):
+    """The doubling scan of the viscous loop is SciPy's first-order filter to rounding (and z0 decays as a^(k+1))."""
+    from scipy.signal import lfilter
+
+    from bendpam.physics.hysteresis import first_order_scan
+
+    x = np.asarray(f)
+    want, _ = lfilter([1.0], [1.0, -a], x, zi=[a * z0])
+    got = first_order_scan(x, a) + z0 * a ** np.arange(1, x.size + 1)
+    scale = max(1.0, float(np.abs(x).sum()), abs(z0))
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-12 * scale)

@@ -199,9 +199,9 @@ def _cycle_meat(J: np.ndarray, cycles) -> tuple[np.ndarray, np.ndarray]:
         covered[rows] = True
         dof += n - 1
     if dof:
-        from scipy.stats import t as student
+        from scipy.special import stdtrit  # Student's t quantile (scipy.stats would cost 0.3 s to import)
 
-        meat *= (float(student.ppf(0.975, dof)) / 1.96) ** 2
+        meat *= (float(stdtrit(dof, 0.975)) / 1.96) ** 2
     return meat, covered
 
 

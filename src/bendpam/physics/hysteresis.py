@@ -70,6 +70,7 @@ __all__ = [
     "MaxwellSlip",
     "PrandtlIshlinskii",
     "ViscousLoop",
+    "first_order_scan",
     "loop_branches",
     "loss_ratio",
     "make_law",
@@ -365,6 +366,27 @@ class MaxwellSlip:
         return away, back
 
 
+def first_order_scan(forcing, a: float) -> np.ndarray:
+    """The first-order recurrence ``z_k = a z_(k-1) + f_k`` from ``z_(-1) = 0``, for ``0 <= a <= 1``.
+
+    A prefix scan by doubling (``log2 n`` vectorised passes; every factor ``a^s <= 1``, so it is
+    stable): after the pass of shift ``s`` each ``z_k`` holds ``sum_(j < 2s) a^j f_(k-j)``.  It is
+    :func:`scipy.signal.lfilter` ``([1], [1, -a], f)`` to rounding, without importing
+    :mod:`scipy.signal` (0.5 s, half of a ``bendpam fit``).
+
+    Examples
+    --------
+    >>> first_order_scan(np.array([1.0, 0.0, 0.0, 2.0]), 0.5).tolist()
+    [1.0, 0.5, 0.25, 2.125]
+    """
+    z = np.array(forcing, dtype=float)
+    shift, factor = 1, float(a)
+    while shift < z.size:
+        z[shift:] = z[shift:] + factor * z[:-shift]
+        shift, factor = 2 * shift, factor * factor
+    return z
+
+
 @dataclass(frozen=True)
 class ViscousLoop:
     """A rate-dependent loop: a Maxwell fluid element (spring in series with a dashpot).
@@ -399,9 +421,7 @@ class ViscousLoop:
 
     def z_path(self, theta, time_s, z0: float = 0.0) -> np.ndarray:
         """``z`` along ``theta`` (rad) sampled at the equally spaced times ``time_s`` (s), exact for a
-        path linear between samples (a first-order filter, :func:`scipy.signal.lfilter`)."""
-        from scipy.signal import lfilter
-
+        path linear between samples (a first-order filter, ``z_k = a z_(k-1) + f_k``, :func:`first_order_scan`)."""
         th, t = np.asarray(theta, dtype=float), np.asarray(time_s, dtype=float)
         if th.shape != t.shape or th.ndim != 1:
             raise InputError("theta and time_s must be 1-D arrays of the same length")
@@ -414,7 +434,7 @@ class ViscousLoop:
         a = math.exp(-h / self.tau_s)
         # exact for a constant rate v over a step: z1 = a z0 + (1 - a) v / omega_ref
         forcing = (1.0 - a) * np.diff(th) / h / self.omega_ref_rad_s
-        z, _ = lfilter([1.0], [1.0, -a], forcing, zi=[a * float(z0)])
+        z = first_order_scan(forcing, a) + float(z0) * np.exp(-h / self.tau_s * np.arange(1, forcing.size + 1))
         return np.concatenate([[float(z0)], z])
 
     def steady_branches(self, delta, span, period_s):
