@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The README's story, in order, in one empty folder: predict -> simulate a test -> inspect and
-# process -> fit -> report -> a finger -> a design from targets -> a sweep.  Run it from an empty folder as
-# `bash PATH/TO/bendpam/examples/walkthrough.sh` (it writes into the folder it runs in); tests/test_walkthrough.py
-# runs it and checks what it writes, and that the numbers README.md and docs/tutorial.md quote are what it prints.
+# process -> fit -> report -> a finger -> a design from targets -> a sweep -> the hand and its wrist.
+# Run it from an empty folder as `bash PATH/TO/bendpam/examples/walkthrough.sh` (it writes into the folder it
+# runs in); tests/test_walkthrough.py runs it and checks what it writes, and that the numbers README.md and docs/tutorial.md quote are what it prints.
 set -euo pipefail
 
 # 1. Predict the paper's BE-PAM, and save it as an editable actuator file
@@ -42,3 +42,7 @@ bendpam predict --actuator design-be/design.toml --pressure-kpa 200
 # 9. A design sweep over the braid angle and the bladder wall
 bendpam sweep --preset be-pam --param alpha0_deg=60:80:21 --param t0_mm=1.5:3:4 --pressure-kpa 100:250:16 \
     --out sweep.nc --plot sweep.png
+
+# 10. The soft humanoid hand: its Kapandji test, and the wrist carrying the hand and a 550 g bottle
+bendpam hand --kapandji --out hand
+bendpam wrist --preset bc-pam --pressure-kpa 140 --payload-g 550 --quiet

@@ -188,7 +188,7 @@ def _commands():
 
 #: Commands that print results (a table, values, a summary): each has --json.
 PRINTING = {"actuator", "demo", "design", "finger", "fit", "fit-material", "grasp", "inspect", "predict",
-            "process", "report", "simulate-test", "wrist"}
+            "process", "report", "simulate-test", "wrist", "hand"}
 
 
 def test_every_command_has_readable_help_json_and_force(capsys):

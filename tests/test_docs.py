@@ -133,7 +133,7 @@ def test_markdown_pages_examples_pass():
 # ------------------------------------------------------------------------------------------------
 def test_walkthrough_parses_into_steps():
     steps = docs_figures.walkthrough_steps()
-    assert len(steps) == 9
+    assert len(steps) == 10
     assert all(title and cmds for title, cmds in steps)
     assert all(c.startswith("bendpam ") and "\\" not in c and "  " not in c for _, cmds in steps for c in cmds)
     assert docs_figures.walkthrough_commands()[0] == "bendpam predict --preset be-pam --pressure-kpa 100 150 200"

@@ -89,3 +89,7 @@ def test_walkthrough_runs_in_order(walkthrough):
     assert {t["quantity"]: round(t["achieved"], 1) for t in design["targets"]} == {
         "blocked_moment_nmm": 400.0, "free_angle_deg": 90.0}
     assert (tmp_path / "design-be" / "design.toml").is_file()
+    hand = json.loads((tmp_path / "hand" / "hand.json").read_text())
+    assert [p["number"] for p in hand["kapandji"]["points"]] == list(range(1, 9))
+    assert (tmp_path / "hand" / "kapandji.png").stat().st_size > 1000
+    assert "30 deg needs" in r.stdout

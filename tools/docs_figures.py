@@ -55,6 +55,7 @@ FIGURES: dict[str, str] = {
     "figure7-loop.png": "fit-loop/figure7.png",
     "finger.png": "finger.png",
     "sweep.png": "sweep.png",
+    "kapandji.png": "hand/kapandji.png",
     "report-be.html": "report-be.html",
 }
 

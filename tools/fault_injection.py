@@ -555,6 +555,9 @@ def bad_command_lines(inp: dict[str, Path]) -> list[list[str]]:
         ["grasp", "--preset", "be-pam", "--pressure-kpa", "100:200:1000", "--diameter-mm", "50:200:1000", "--json"],
         ["wrist", "--preset", "be-pam", "--pressure-kpa", "100:200:1000000", "--json"],
         ["grasp", "--preset", "be-pam", "--pressure-kpa", "150", "--diameter-mm", "100", "--fingers", "0"],
+        ["hand", "--pressure-kpa", "100:200:1000000", "--json"],
+        ["hand", "--workspace", "1000", "--json"],
+        ["wrist", "--preset", "bc-pam", "--pressure-kpa", "140", "--payload-g", "-5", "--json"],
     ]
 
 

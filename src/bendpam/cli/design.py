@@ -414,6 +414,17 @@ def _print_twists(rows: list[dict[str, Any]]) -> None:
 
 # ---- wrist --------------------------------------------------------------------------------------
 _HOLDING = ("pressure_kpa", "angle_deg", "holds_horizontal", "capacity_g", "equilibrium", "note")
+_HandMassOpt = Annotated[Optional[float], typer.Option(
+    "--hand-mass-g", help="Mass of the hand (g); default 0 in the holding table, 300 in the tilt of --payload-g.")]
+_HandLeverOpt = Annotated[Optional[float], typer.Option(
+    "--hand-lever-mm", help="Lever of the hand's mass (mm); default 50 in the holding table, 80 in the tilt of "
+    "--payload-g.")]
+_PayloadOpt = Annotated[Optional[float], typer.Option(
+    "--payload-g", help="Tilt in each direction carrying the hand and this payload at --lever-mm (g), with the "
+    "pressures for --tilt-deg and the frame-buckling margins.")]
+_ForearmOpt = Annotated[str, typer.Option(
+    "--forearm", help="With --payload-g: horizontal (actuator at 90 deg on top), up (hand above the wrist) or down.")]
+_TiltOpt = Annotated[float, typer.Option("--tilt-deg", help="With --payload-g: the target tilt (deg).")]
 
 
 def wrist_cmd(
@@ -435,16 +446,27 @@ def wrist_cmd(
         float, typer.Option("--column-stiffness-nmm2", help="Bending stiffness of the column (N*mm^2).")] = 0.0,
     load_g: Annotated[float, typer.Option("--load-g", help="Mass held horizontally (g).")] = 335.0,
     lever_mm: Annotated[float, typer.Option("--lever-mm", help="Lever of the mass beyond the wrist (mm).")] = 100.0,
-    hand_mass_g: Annotated[float, typer.Option("--hand-mass-g", help="Mass of the hand (g).")] = 0.0,
-    hand_lever_mm: Annotated[float, typer.Option("--hand-lever-mm", help="Lever of the hand's mass (mm).")] = 50.0,
+    hand_mass_g: _HandMassOpt = None,
+    hand_lever_mm: _HandLeverOpt = None,
+    payload_g: _PayloadOpt = None,
+    forearm: _ForearmOpt = "horizontal",
+    tilt_deg: _TiltOpt = 30.0,
     as_json: JsonOpt = False,
     plot: PlotOpt = None,
     fig_format: FigureFormatOpt = None,
     quiet: QuietOpt = False,
 ):
-    """Bending angle of a four-actuator wrist per direction, and the load it holds horizontally."""
+    """Bending angle of a four-actuator wrist per direction, and the load it holds horizontally.
+
+    With --payload-g: the tilt reached in each of the four directions at the highest --pressure-kpa,
+    carrying the hand and the payload, the pressures a --tilt-deg tilt needs and the actuators'
+    frame-buckling margins on the way.
+    """
     from bendpam.design.wrist import Wrist, plot_wrist
 
+    tilt_load = _tilt_load(payload_g, forearm, tilt_deg, hand_mass_g, hand_lever_mm, lever_mm)
+    hand_mass_g = 0.0 if hand_mass_g is None else hand_mass_g
+    hand_lever_mm = 50.0 if hand_lever_mm is None else hand_lever_mm
     act = load_actuator(preset, actuator, model)
     P = pressures_kpa(pressure_kpa)
     dirs = parse_values(direction_deg, "--direction-deg") if direction_deg else [0.0, 90.0, 180.0, 270.0]
@@ -461,6 +483,7 @@ def wrist_cmd(
                    plot, fig_format, aspect=1.15)
     results = [_record(r) for r in table.to_dict("records")]
     holding = [{k: d[k] for k in _HOLDING} for d in (h.to_dict() for h in holds)]
+    tilt = _tilt(w, max(P), tilt_load, tilt_deg)
     if as_json:
         obj = {"model": mname, "actuator": act.name or act.kind, "length_mm": w.length_mm, "radius_mm": w.radius_mm,
                "lateral_stiffness_nmm2": w.lateral_stiffness_nmm2, "column_stiffness_nmm2": w.column_stiffness_nmm2,
@@ -469,11 +492,15 @@ def wrist_cmd(
                         "load_moment_nmm": holds[0].load_moment_nmm if holds else None,
                         "pressure_needed_kpa": holds[0].to_dict()["pressure_needed_kpa"] if holds else None},
                "results": results, "holding": holding}
+        if tilt is not None:
+            obj["tilt"] = tilt
         print_json(obj)
         return
     typer.echo(f"wrist of four {act.name or act.kind}, L = {w.length_mm:g} mm, radius {w.radius_mm:g} mm, "
                f"lateral stiffness {w.lateral_stiffness_nmm2:.4g} N·mm² — {mname.replace('_', '-')} model")
     _print_wrist(results, holding, holds, load_g, lever_mm, hand_mass_g, hand_lever_mm)
+    if tilt is not None:
+        _print_tilt(tilt)
     if plot is not None:
         echo_wrote(f"wrote {plot}")
 
@@ -514,6 +541,51 @@ def _print_wrist(results, holding, holds, load_g, lever_mm, hand_mass_g, hand_le
             typer.echo(f"{h['pressure_kpa']:8.4g} {_fmt(h['angle_deg'], '11.2f')} "
                        f"{'yes' if h['holds_horizontal'] else 'no':>10} {_fmt(h['capacity_g'], '12.1f')}"
                        + (f"  {h['note']}" if h["note"] else ""))
+
+
+def _tilt_load(payload_g, forearm: str, tilt_deg: float, hand_mass_g, hand_lever_mm, lever_mm: float):
+    """The load of the --payload-g tilt (None without --payload-g), its options checked."""
+    from bendpam.design.wrist_tilt import DEFAULT_HAND_LEVER_MM, DEFAULT_HAND_MASS_G, FOREARM, WristLoad
+
+    if payload_g is None:
+        return None
+    if forearm not in FOREARM:
+        raise UserError(f"--forearm: {forearm!r} is not allowed; choose {', '.join(FOREARM)}")
+    if not (math.isfinite(tilt_deg) and 0.0 < tilt_deg < 180.0):
+        raise UserError(f"--tilt-deg: {tilt_deg:g} deg must be between 0 and 180")
+    for name, v in (("--payload-g", payload_g), ("--hand-mass-g", hand_mass_g), ("--hand-lever-mm", hand_lever_mm),
+                    ("--lever-mm", lever_mm)):
+        if v is not None and not (math.isfinite(v) and v >= 0.0):
+            raise UserError(f"{name}: {v:g} must be a finite value >= 0")
+    return WristLoad(hand_mass_g=DEFAULT_HAND_MASS_G if hand_mass_g is None else hand_mass_g,
+                     hand_lever_mm=DEFAULT_HAND_LEVER_MM if hand_lever_mm is None else hand_lever_mm,
+                     payload_g=payload_g, payload_lever_mm=lever_mm, forearm=forearm)
+
+
+def _tilt(w, pressure_kpa: float, load, tilt_deg: float) -> dict[str, Any] | None:
+    """The --payload-g section: per direction, the tilt at ``pressure_kpa`` with ``load`` (None: no section)."""
+    if load is None:
+        return None
+    from bendpam.design.wrist_tilt import wrist_directions
+
+    return {"load": load.to_dict(), "target_tilt_deg": tilt_deg,
+            "directions": wrist_directions(w, pressure_kpa, load, target_tilt_deg=tilt_deg)}
+
+
+def _print_tilt(tilt: dict[str, Any]) -> None:
+    """The table of the --payload-g tilt: one row per direction."""
+    ld = tilt["load"]
+    typer.echo(f"\ntilt carrying the hand ({ld['hand_mass_g']:g} g at {ld['hand_lever_mm']:g} mm) and "
+               f"{ld['payload_g']:g} g at {ld['payload_lever_mm']:g} mm, forearm {ld['forearm']}; target "
+               f"{tilt['target_tilt_deg']:g}° (buckling margins: each actuator's smallest on the way)")
+    typer.echo(f"{'dir (deg)':>9} {'P (kPa)':>8} {'tilt (deg)':>10} {'toward':>7} {'reached':>7} "
+               f"{'P for target (kPa)':>26} {'buckling margins':>24}")
+    for r in tilt["directions"]:
+        need = ",".join(_fmt(p, ".0f") for p in r["target"]["pressures_kpa"])
+        mg = ",".join("inf" if m == "inf" else _fmt(m, ".2f") for m in r["min_buckling_margin"])
+        typer.echo(f"{r['direction_deg']:9.4g} {r['pressure_kpa']:8.4g} {_fmt(r['tilt_deg'], '10.1f')} "
+                   f"{_fmt(r['tilt_direction_deg'], '7.0f')} {'yes' if r['reaches_target'] else 'no':>7} "
+                   f"{need:>26} {mg:>24}" + (f"  {r['note']}" if r["note"] else ""))
 
 
 # ---- registration -------------------------------------------------------------------------------

@@ -31,7 +31,7 @@ __all__ = [
     "CHUNK_BYTES", "DEFAULT_VALUE_LIMIT", "FILE_SIZE_LIMITS", "GIB", "MAX_OPTION_VALUES", "MEMORY_BUDGET_GIB",
     "MIB", "SCHEDULER_TIMEOUT_S", "TIME_BUDGET_MIN", "TOML_MAX_DEPTH", "VALUE_LIMITS", "check_input_file",
     "format_bytes", "input_file_problem", "loads_toml", "memory_problem", "nesting_depth", "physical_memory_bytes",
-    "read_input_bytes", "value_limit",
+    "read_input_bytes", "read_toml_file", "value_limit",
 ]
 
 MIB = 1 << 20
@@ -46,6 +46,7 @@ FILE_SIZE_LIMITS: dict[str, int] = {
     "scheduler file": 1 * MIB,          # the JSON file of `dask scheduler --scheduler-file`
     "manifest": 64 * MIB,               # manifest.json of an output set
     "format declaration": 1 * MIB,      # the TOML --format-file of a raw test file: under 2 KiB in practice
+    "hand file": 1 * MIB,               # the TOML description of the soft hand (bendpam hand --hand): about 1 KiB
 }
 
 #: The deepest nesting of tables and arrays a bendpam TOML file may have: ``[actuator]`` and
@@ -244,6 +245,27 @@ def loads_toml(text: str, source: str, *, kind: str = "actuator file", max_depth
         raise FileFormatError(f"{source}: tables or arrays nested {depth} deep; {_article(kind)} nests at most "
                               f"{max_depth} deep")
     return data
+
+
+def read_toml_file(path: str | os.PathLike, kind: str) -> dict:
+    """A small TOML input file of ``kind`` (a key of :data:`FILE_SIZE_LIMITS`) read safely and parsed.
+
+    :func:`read_input_bytes`, UTF-8 and :func:`loads_toml`: every refusal is one
+    :class:`~bendpam.errors.FileFormatError` line naming the file.
+
+    >>> import tempfile, pathlib
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     p = pathlib.Path(d) / "a.toml"
+    ...     _ = p.write_text("[actuator]\\nR0_mm = 9.0\\n")
+    ...     read_toml_file(p, "actuator file")
+    {'actuator': {'R0_mm': 9.0}}
+    """
+    raw = read_input_bytes(path, kind)
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise FileFormatError(f"{path}: not UTF-8 text (byte {exc.start})") from None
+    return loads_toml(text, str(path), kind=kind)
 
 
 def physical_memory_bytes() -> int | None:

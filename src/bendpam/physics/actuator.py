@@ -22,9 +22,9 @@ from typing import Any
 import numpy as np
 import tomli_w
 
-from bendpam.errors import FileFormatError, InputError, OutsideTestedRangeWarning, warn_user
+from bendpam.errors import InputError, OutsideTestedRangeWarning, warn_user
 from bendpam.infra.atomic import atomic_write_text
-from bendpam.infra.budgets import loads_toml, read_input_bytes
+from bendpam.infra.budgets import read_toml_file
 from bendpam.infra.display import summary_html, summary_text
 from bendpam.physics.material import MooneyRivlin
 from bendpam.validate import DEFAULT_MAX_PRESSURE_KPA, PLAUSIBLE, did_you_mean, float_array, number, plausible
@@ -570,12 +570,7 @@ class Actuator:
         (:mod:`bendpam.infra.budgets`); anything else is refused in one line before it is read.
         """
         p = Path(path)
-        raw = read_input_bytes(p, "actuator file")
-        try:
-            text = raw.decode("utf-8")
-        except UnicodeDecodeError as exc:
-            raise FileFormatError(f"{p}: not UTF-8 text (byte {exc.start})") from None
-        data = loads_toml(text, str(p), kind="actuator file")
+        data = read_toml_file(p, "actuator file")
         if "actuator" in data:
             extra = [k for k in data if k not in ("actuator", "hysteresis")]
             if extra:

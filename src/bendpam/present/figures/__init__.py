@@ -9,7 +9,8 @@ every figure is registered.
 * :mod:`~bendpam.present.figures.style`: journal sizes and fonts, new figures, saving them;
 * :mod:`~bendpam.present.figures.models`: moment-curvature maps, the internal stresses, the demo;
 * :mod:`~bendpam.present.figures.lab`: Figures 4 and 7 of the paper (tests and fits);
-* :mod:`~bendpam.present.figures.sweep`: a design sweep.
+* :mod:`~bendpam.present.figures.sweep`: a design sweep;
+* :mod:`~bendpam.present.figures.hand`: the soft hand in 3-D (poses, Kapandji test, workspace).
 """
 
 from bendpam.present.figures.lab import figure4, figure7
@@ -56,5 +57,6 @@ __all__ = [
 ]
 from bendpam.present.figures import (
     design,  # noqa: F401  (registers the design figures)
+    hand,  # noqa: F401  (registers the hand's figures)
     report,  # noqa: F401  (registers the report's figures)
 )
