@@ -22,6 +22,7 @@ from bendpam.cli.options import (
     echo_wrote,
     load_actuator,
     model_for,
+    model_name,
     output_set,
     parse_values,
     pressures_kpa,
@@ -78,10 +79,10 @@ def mujoco_cmd(
         raise UserError(f"--device {device!r}: choose one of {', '.join(DEVICES)}")
     options = _hand_options(device, hand_file, palm_roll_deg, preset, actuator, model, l0_mm)
     act = load_actuator(preset, actuator, model) if device != "hand" or preset or actuator else None
-    if l0_mm is not None:
+    if l0_mm is not None and act is not None:  # (not for the hand: _hand_options refused it)
         if not (math.isfinite(l0_mm) and l0_mm > 0):
             raise UserError(f"--l0-mm: {l0_mm:g} mm must be a positive length")
-        act = act.replace(L0_mm=float(l0_mm))  # (not for the hand: _hand_options refused it)
+        act = act.replace(L0_mm=float(l0_mm))
     if segments is not None and not 2 <= segments <= 200:
         raise UserError(f"--segments: {segments} is outside the allowed range [2, 200]")
     if not (math.isfinite(tip_error_pct) and 0 < tip_error_pct <= 50):
@@ -98,7 +99,7 @@ def mujoco_cmd(
         from bendpam.physics.hysteresis import LoopModel
 
         loop = LoopModel.from_toml(actuator)
-    law_model = model_for(act, model) if act is not None or model is not None else None
+    law_model = model_for(act, model) if act is not None else model_name(model)  # (the default hand: --model's)
     res = mujoco(act, device, law_model=law_model, segments=segments, tip_error_pct=tip_error_pct,
                  pressures_kpa=P, spheres_mm=D, validate=validate, loop=loop, **options)
     summary = res.to_dict()

@@ -35,8 +35,8 @@ import numpy as np
 
 from bendpam.design.finger import FingerLoads, free_tip_trajectory, solve_finger
 from bendpam.design.grasp import solve_grasp
-from bendpam.errors import InputError
 from bendpam.design.hand import PARTS, Hand, default_hand, hand_pose, thumb_chain
+from bendpam.errors import InputError
 from bendpam.export.mjcf import HAND_CHAINS, HAND_TIPS, MujocoHand, MujocoModel, hand_model, mujoco_model
 from bendpam.physics import presets
 from bendpam.physics.actuator import Actuator
@@ -553,7 +553,8 @@ def _hand_reference(exported: MujocoHand, P: dict[str, float]) -> dict[str, np.n
 
 
 def validate_hand(exported: MujocoHand, *, pressures_kpa=None) -> HandValidation:
-    """Quasi-static MuJoCo runs of a hand export against bendpam's unloaded hand (:func:`~bendpam.design.hand.hand_pose`).
+    """Quasi-static MuJoCo runs of a hand export against bendpam's unloaded hand
+    (:func:`~bendpam.design.hand.hand_pose`).
 
     As the finger's free shapes (:func:`validate`; gravity off, 1 ms steps, overdamped hinges and
     palm roll): for each pose of :func:`hand_poses_kpa` a ramp of 100 steps from the previous pose,
