@@ -207,8 +207,18 @@ def test_docs_simulation_block_runs(tmp_path, monkeypatch):
     """The page's own-simulation block runs as written (the pull-out block is the test above at one pressure)."""
     monkeypatch.chdir(tmp_path)
     blocks = re.findall(r"```python\n(.*?)```", DOCS.read_text(encoding="utf-8"), re.S)
-    assert len(blocks) == 2 and "pullout(gripper, 200.0, p)" in blocks[0]
+    assert len(blocks) == 3 and "pullout(gripper, 200.0, p)" in blocks[0]
     exec(compile(blocks[1], str(DOCS), "exec"), {})
+
+
+def test_docs_hand_block_runs(tmp_path, monkeypatch, capsys):
+    """The page's hand block runs as written: the thumb tip after the ramp, somewhere in front of the palm."""
+    monkeypatch.chdir(tmp_path)
+    block = re.findall(r"```python\n(.*?)```", DOCS.read_text(encoding="utf-8"), re.S)[2]
+    assert "HandController(model, hand)" in block
+    exec(compile(block, str(DOCS), "exec"), {})
+    tip = [float(v) for v in capsys.readouterr().out.strip().strip("[]").split()]
+    assert len(tip) == 3 and tip[2] > 0.0 and list(tmp_path.iterdir()) == []
 
 
 # ---- the soft hand (issue 26's hand, device "hand") ------------------------------------------------------------
