@@ -641,7 +641,12 @@ def hand_model(hand: Hand, *, segments: int | None = None, tip_error_pct: float 
         raise InputError(f"hand must be a bendpam.design.hand.Hand, got {type(hand).__name__}")
     if palm_roll_deg is not None:
         palm_roll_deg = number("palm_roll_deg", palm_roll_deg, 0.0, 180.0, unit="deg")
-    P = hand_pressures_kpa(hand) if pressures_kpa is None else np.atleast_1d(np.asarray(pressures_kpa, dtype=float))
+    if pressures_kpa is None:
+        P = hand_pressures_kpa(hand)
+    else:
+        P = np.atleast_1d(np.asarray(pressures_kpa, dtype=float))
+        for p in P:  # (the range's top is the hand's max_pressure_kpa)
+            number("pressures_kpa", p, 0.0, hand.max_pressure_kpa, lo_open=True, unit="kPa")
     dens = densities or Densities()
     chains: dict[str, _Chain] = {}
     errs: dict[str, float] = {}

@@ -41,7 +41,7 @@ from bendpam.export.mjcf import HAND_CHAINS, HAND_TIPS, MujocoHand, MujocoModel,
 from bendpam.physics import presets
 from bendpam.physics.actuator import Actuator
 from bendpam.physics.hysteresis import LoopModel
-from bendpam.physics.models import resolve_model
+from bendpam.physics.models import normalise_model, resolve_model
 from bendpam.sim.mujoco import PamController, import_mujoco
 from bendpam.validate import did_you_mean, number
 
@@ -716,7 +716,7 @@ def _mujoco_hand(actuator, law_model, segments, tip_error_pct, pressures_kpa, sp
             actuator = presets.be_pam(hand.model)
     elif actuator is not None:
         raise InputError("give either a hand (its parts name their actuators) or an actuator for the default hand")
-    elif law_model is not None and law_model != hand.model:
+    elif law_model is not None and normalise_model(law_model) != hand.model:
         raise InputError(f"law_model = {law_model!r}: the hand's model is {hand.model!r} (set it in the hand)")
     base = hand_model(hand, segments=segments, tip_error_pct=tip_error_pct, pressures_kpa=pressures_kpa,
                       palm_roll_deg=palm_roll_deg, densities=densities, actuator=actuator)
