@@ -297,7 +297,8 @@ def test_hand_controller_pressures_and_refusals(tmp_path, capsys):
     assert dict(zip([c.name for c in ctl.pam.chains], ctl.pam.pressure_kpa.tolist()))["thumb_distal"] == 200.0
     ctl.apply(d)
     assert math.degrees(d.ctrl[0]) == pytest.approx(float(hand.part("palm_roll").angle_deg(200.0)), abs=1e-4)
-    for bad, words in (({"thumb": 100.0}, "no hand part 'thumb'"), ({"index": 301.0}, "[0, 300]")):
+    for bad, words in (({"thumb": 100.0}, "no hand part 'thumb'"), ({"index": 301.0}, "[0, 300]"),
+                       (150.0, "by part name")):
         with pytest.raises(bendpam.InputError, match=re.escape(words)):
             ctl.set_pressure_kpa(bad)
     too_high = "pressures_kpa = 350 kPa is outside the allowed range (0, 300] kPa"

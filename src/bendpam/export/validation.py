@@ -405,8 +405,9 @@ class HandController:
 
     The chains' hinge torques are :class:`bendpam.sim.mujoco.PamController`'s, with each part's
     actuator; the palm roll's pressure sets the target of its position-controlled hinge to the palm
-    segment's free bending angle there (:meth:`bendpam.design.hand.HandPart.angle_deg`), as in
-    :func:`bendpam.design.hand.hand_pose`.  A model with a fixed palm roll takes no palm pressure.
+    segment's free bending angle there (interpolated in :meth:`bendpam.design.hand.HandPart.angle_table`,
+    within 1e-5 deg of :func:`bendpam.design.hand.hand_pose`'s).  A model with a fixed palm roll takes
+    no palm pressure.
 
     Parameters
     ----------
@@ -442,6 +443,9 @@ class HandController:
 
     def set_pressure_kpa(self, pressures_kpa: dict) -> None:
         """Set the pressures (kPa, 0 to the hand's ``max_pressure_kpa``) by part name; parts not named: 0 kPa."""
+        if not isinstance(pressures_kpa, dict):
+            raise InputError(f"pressures_kpa: give the pressures by part name (a dict of kPa), got "
+                             f"{type(pressures_kpa).__name__}")
         given = dict(pressures_kpa)
         for name in given:
             if name not in PARTS:
