@@ -301,7 +301,7 @@ def test_hand_controller_pressures_and_refusals(tmp_path, capsys):
                        (150.0, "by part name")):
         with pytest.raises(bendpam.InputError, match=re.escape(words)):
             ctl.set_pressure_kpa(bad)
-    too_high = "pressures_kpa = 350 kPa is outside the allowed range (0, 300] kPa"
+    too_high = "pressures_kpa = 350 kPa is outside the allowed range [0, 300] kPa"
     with pytest.raises(bendpam.InputError, match=re.escape(too_high)):
         hand_model(hand, pressures_kpa=[200.0, 350.0])
     fixed, _ = _model(hand_model(hand, segments=3, palm_roll_deg=30.0))

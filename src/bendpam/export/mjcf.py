@@ -646,7 +646,7 @@ def hand_model(hand: Hand, *, segments: int | None = None, tip_error_pct: float 
     else:
         P = np.atleast_1d(np.asarray(pressures_kpa, dtype=float))
         for p in P:  # (the range's top is the hand's max_pressure_kpa)
-            number("pressures_kpa", p, 0.0, hand.max_pressure_kpa, lo_open=True, unit="kPa")
+            number("pressures_kpa", p, 0.0, hand.max_pressure_kpa, unit="kPa")
     dens = densities or Densities()
     chains: dict[str, _Chain] = {}
     errs: dict[str, float] = {}
