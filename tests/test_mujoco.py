@@ -14,9 +14,10 @@ mujoco = pytest.importorskip("mujoco", reason="MuJoCo's bindings are not install
 import bendpam  # noqa: E402
 from bendpam.cli import main  # noqa: E402
 from bendpam.design.hand import Hand, default_hand, hand_pose, thumb_chain  # noqa: E402
-from bendpam.export import HandController, hand_model, mujoco_model, validate, validate_hand  # noqa: E402
+from bendpam.design.hand_statics import hand_statics  # noqa: E402
+from bendpam.export import Densities, HandController, hand_model, mujoco_model, validate, validate_hand  # noqa: E402
 from bendpam.export.mjcf import chain_tip_xy  # noqa: E402
-from bendpam.export.validation import pullout  # noqa: E402
+from bendpam.export.validation import _hand_run, pullout  # noqa: E402
 from bendpam.physics.hysteresis import LoopModel  # noqa: E402
 from bendpam.sim.mujoco import HingeTable, PamController, chains_of  # noqa: E402
 
@@ -314,3 +315,34 @@ def test_hand_controller_pressures_and_refusals(tmp_path, capsys):
         err = capsys.readouterr().err.strip().splitlines()
         assert code == 2 and len(err) == 1 and words in err[0]
     assert not (tmp_path / "x").exists()
+
+
+def test_hand_fingers_under_gravity_against_hand_statics():
+    """Palm up, the fingers sag under their own weight in their bending planes: MuJoCo's sags against
+    bendpam's spatial rods (``hand_statics``, the export's mass per length).  With the links' masses on the
+    frame line (the rods' weight line) they agree within 3 % of the sag (0.6-1.5 % measured); the export
+    puts them at the tube's centre, outside the curl, and sags more the more a finger curls."""
+    hand = default_hand()
+    ex = hand_model(hand)
+    mpl = Densities().mass_per_length_g_per_mm(BE)
+    P = {"index": 100.0, "middle": 150.0, "ring": 200.0, "little": 250.0}
+    ref = hand_statics(hand, P, gravity=(0.0, 0.0, -1.0), mass_per_length_g_per_mm=mpl, nodes=21)
+    assert ref.equilibrium
+    sags = {}
+    for on_frame_line in (True, False):
+        run = _hand_run(ex)
+        if on_frame_line:
+            run.m.body_ipos[:, 2] = 0.0  # every link's centre of mass onto its frame line
+        for i in range(100):
+            run.ctl.set_pressure_kpa({n: p * (i + 1) / 100 for n, p in P.items()})
+            run.step()
+        assert run.creep()
+        free = {f: run.site(f"{f}_tip") for f in P}
+        run.m.opt.gravity[:] = [0.0, 0.0, -9.80665]
+        assert run.creep()
+        sags[on_frame_line] = {f: run.site(f"{f}_tip") - free[f] for f in P}
+    for f in P:
+        want = ref.tips_mm[f] - ref.pose.tips_mm[f]
+        assert want[2] < -0.2 and abs(want[0]) < 1e-9  # down, in the finger's plane
+        assert np.linalg.norm(sags[True][f] - want) <= 0.03 * np.linalg.norm(want)
+        assert np.linalg.norm(sags[False][f]) > np.linalg.norm(sags[True][f])
