@@ -1,6 +1,8 @@
-"""``bendpam export mujoco``: an actuator's finger or gripper as a MuJoCo model (parsing and printing only).
+"""``bendpam export mujoco``: an actuator's finger or gripper, or the soft hand, as a MuJoCo model (parsing and
+printing only).
 
-The work is :func:`bendpam.export.mujoco_model` and :func:`bendpam.export.validation.validate`.
+The work is :func:`bendpam.export.mujoco_model` (:func:`~bendpam.export.mjcf.hand_model`) and
+:func:`bendpam.export.validation.validate` (:func:`~bendpam.export.validation.validate_hand`).
 """
 
 # no ``from __future__ import annotations``: Typer reads the annotations of the commands as objects (start-up)
@@ -32,14 +34,14 @@ from bendpam.cli.options import (
 __all__ = ["export_app"]
 
 export_app = typer.Typer(no_args_is_help=True, rich_markup_mode=None,
-                         help="Export an actuator's finger or gripper to a simulator (MuJoCo).")
+                         help="Export an actuator's finger or gripper, or the soft hand, to a simulator (MuJoCo).")
 app.add_typer(export_app, name="export")
 
 
 @export_app.command("mujoco", cls=BendpamCommand)
 def mujoco_cmd(
     out: Annotated[Path, typer.Option("--out", help="Output folder: DEVICE.xml (MJCF), one DEVICE-sphere-Dmm.xml "
-                                      "per sphere, actuator.toml, export.json.")],
+                                      "per sphere, actuator.toml (not for a --hand file's hand), export.json.")],
     preset: PresetOpt = None,
     actuator: ActuatorOpt = None,
     model: ModelOpt = None,
@@ -65,12 +67,12 @@ def mujoco_cmd(
                                            "against bendpam (a few seconds).")] = True,
     as_json: Annotated[bool, typer.Option("--json", help="Print export.json's content.")] = False,
 ):
-    """An MJCF model of a bending-PAM finger or gripper: hinge chains driven by the moment law.
+    """An MJCF model of a bending-PAM finger, gripper or soft hand: hinge chains driven by the moment law.
 
     Each actuator is a chain of hinges (their number from the tip-error target), with masses from
     its geometry and contact boxes; bendpam.sim.mujoco applies the moment law at every step with
-    the pressure as the control input. Example: bendpam export mujoco --preset be-pam --device
-    gripper --l0-mm 130 --spheres 200 --out be-gripper
+    the pressure as the control input (the hand: one pressure per part, HandController). Example:
+    bendpam export mujoco --preset be-pam --device gripper --l0-mm 130 --spheres 200 --out be-gripper
     """
     from bendpam.export.mjcf import DEVICES
     from bendpam.export.validation import mujoco
