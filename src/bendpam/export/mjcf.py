@@ -46,15 +46,16 @@ import numpy as np
 
 from bendpam.design.finger import Finger, free_tip_trajectory
 from bendpam.design.gripper import Gripper
+from bendpam.design.hand import FINGERS, PARTS, Hand, finger_frame, thumb_base
 from bendpam.errors import InputError
 from bendpam.physics.actuator import Actuator, bladder_area_mm2
 from bendpam.physics.law import MomentLaw
 from bendpam.validate import number
 
-__all__ = ["DEVICES", "Densities", "MujocoModel", "chain_tip_xy", "default_pressures_kpa", "mujoco_model",
-           "segments_for"]
+__all__ = ["DEVICES", "HAND_CHAINS", "HAND_TIPS", "Densities", "MujocoHand", "MujocoModel", "chain_tip_xy",
+           "default_pressures_kpa", "hand_model", "hand_pressures_kpa", "mujoco_model", "segments_for"]
 
-DEVICES = ("finger", "gripper")
+DEVICES = ("finger", "gripper", "hand")
 #: the paper's test pressures by kind (BE-PAM 100-200 kPa, BC-PAM 40-140 kPa), before the fold cap
 _PAPER_RANGE_KPA = {1: (100.0, 200.0), -1: (40.0, 140.0)}
 _MM = 1e-3  # mm -> m
@@ -328,7 +329,8 @@ class _Chain:
         return {"contype": "1", "conaffinity": "2", "condim": "3", "friction": _fmt(self.mu, 0.005, 0.0001),
                 "mass": "0", "rgba": "0.85 0.55 0.2 1"}
 
-    def write(self, parent: ET.Element, name: str, pos_mm, R: np.ndarray) -> None:
+    def write(self, parent: ET.Element, name: str, pos_mm, R: np.ndarray) -> ET.Element:
+        """The chain ``name`` as a child of ``parent`` at ``pos_mm`` (mm), link axes ``R``; returns its last body."""
         h = self.h
         body = ET.SubElement(parent, "body", name=f"{name}_base", pos=_fmt(*(np.asarray(pos_mm) * _MM)),
                              quat=_fmt(*_quat(R)))
@@ -345,6 +347,7 @@ class _Chain:
         ell, off = self.f.fingertip_mm, self.f.fingertip_offset_mm
         ET.SubElement(body, "site", name=f"{name}_tip", pos=_fmt((0.5 * h + ell) * _MM, 0.0, self.b * off * _MM),
                       size="0.002")
+        return body
 
 
 def mujoco_model(actuator: Actuator, device: str = "finger", *, law_model: str | None = None,
@@ -382,6 +385,8 @@ def mujoco_model(actuator: Actuator, device: str = "finger", *, law_model: str |
         raise InputError(f"actuator must be a bendpam.Actuator, got {type(actuator).__name__}")
     if device not in DEVICES:
         raise InputError(f"device = {device!r} is not known; choose one of {', '.join(DEVICES)}")
+    if device == "hand":
+        raise InputError("the hand's model is bendpam.export.mjcf.hand_model (or bendpam.export.mujoco(..., 'hand'))")
     dens = densities or Densities()
     if device == "gripper":
         gr = gripper or Gripper(actuator, law_model)
@@ -396,9 +401,7 @@ def mujoco_model(actuator: Actuator, device: str = "finger", *, law_model: str |
     if segments is None:
         n, err = segments_for(f, P, tip_error_pct)
     else:
-        if isinstance(segments, bool) or not isinstance(segments, int | np.integer) or not 2 <= segments <= 200:
-            raise InputError(f"segments = {segments!r} is outside the allowed range [2, 200] (an integer)")
-        n = int(segments)
+        n = _checked_segments(segments)
         err = _free_error_pct(f, *_free_tips(f, P), n)
     if sphere_mm is not None:
         sphere_mm = number("sphere_mm", sphere_mm, 0.0, 1e4, lo_open=True, unit="mm")
@@ -500,10 +503,15 @@ def _write_device(root: ET.Element, chain: _Chain, f: Finger, gr: Gripper | None
             ET.SubElement(world, "geom", name="sphere", type="sphere", size=_fmt(R * _MM), pos=_fmt(0, 0, R * _MM),
                           contype="2", conaffinity="1", condim="3", friction=_fmt(gr.mu, 0.005, 0.0001),
                           rgba="0.2 0.5 0.8 1")
-    for nm in names:
+    _write_numerics(custom, {nm: chain for nm in names})
+    return names
+
+
+def _write_numerics(custom: ET.Element, chains: dict[str, _Chain]) -> None:
+    """The ``<custom>`` numerics :class:`bendpam.sim.mujoco.PamController` reads, one pair per chain (in order)."""
+    for nm, chain in chains.items():
         ET.SubElement(custom, "numeric", name=f"bendpam:{nm}:segment_length_mm", data=_fmt(chain.h))
         ET.SubElement(custom, "numeric", name=f"bendpam:{nm}:frame_side", data=str(chain.c))
-    return names
 
 
 def _damping(chain: _Chain) -> float:
@@ -513,3 +521,212 @@ def _damping(chain: _Chain) -> float:
     m = chain.mpl * chain.h * 1e-3
     inertia = m * (chain.h * _MM) ** 2 / 3.0
     return 0.2 * math.sqrt(stiff * inertia)
+
+
+# ------------------------------------------------------------------------------------------------
+# the hand (bendpam.design.hand)
+# ------------------------------------------------------------------------------------------------
+#: the hand's chains (every part but the palm roll, a hinge), in the model's order
+HAND_CHAINS = tuple(p for p in PARTS if p != "palm_roll")
+#: the hand's tips and the chain whose end each is
+HAND_TIPS = {**{f: f for f in FINGERS}, "thumb": "thumb_distal"}
+#: the palm-roll servo's stiffness: this many times the thumb's weight times its reach, per rad
+_ROLL_STIFFNESS = 1000.0
+_G = 9.80665
+# hand frame (t, n, b) columns -> link axes (x along, y out of the plane = -b, z = n)
+_LINK_AXES = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
+
+
+@dataclass(frozen=True)
+class MujocoHand:
+    """An MJCF model of the soft hand of :mod:`bendpam.design.hand` and what it was built from.
+
+    Attributes
+    ----------
+    xml : the MJCF text.  hand : the :class:`~bendpam.design.hand.Hand`.  law_model : its moment-law model.
+    segments : hinges per chain (:data:`HAND_CHAINS`).  pressures_kpa : the pressures they were chosen over.
+    discretisation_tip_error_pct_of_length : per chain, its largest free-shape tip error there, % of its length.
+    mass_g : per chain, g.  timestep_s : the model's time step, s.
+    palm_roll_deg : the fixed palm roll (deg), or None: a position-controlled hinge (actuator ``palm_roll``).
+    actuator : the one actuator of every part (written to ``actuator.toml``), or None (a hand file's own).
+
+    Examples
+    --------
+    >>> from bendpam.design.hand import default_hand
+    >>> m = hand_model(default_hand())
+    >>> m.device, m.segments["index"], m.segments["thumb_distal"], m.palm_roll_deg
+    ('hand', 9, 7, None)
+    """
+
+    xml: str
+    hand: Hand
+    law_model: str
+    segments: dict[str, int]
+    pressures_kpa: tuple[float, ...]
+    discretisation_tip_error_pct_of_length: dict[str, float]
+    mass_g: dict[str, float]
+    timestep_s: float
+    palm_roll_deg: float | None = None
+    actuator: Actuator | None = None
+    device: str = "hand"
+
+    def to_dict(self) -> dict[str, Any]:
+        """The model's description as a JSON-ready dict (units in the key names).
+
+        >>> from bendpam.design.hand import default_hand
+        >>> d = hand_model(default_hand(), segments=6).to_dict()
+        >>> d["segments"]["middle"], d["segment_length_mm"]["middle"], d["palm_roll"]
+        (6, 17.5, 'position-controlled hinge')
+        """
+        hand = self.hand
+        act = self.actuator
+        return {"device": "hand", "actuator": None if act is None else act.name or act.kind, "model": self.law_model,
+                "chains": list(HAND_CHAINS), "segments": dict(self.segments),
+                "length_mm": {c: hand.part(c).length_mm for c in HAND_CHAINS},
+                "segment_length_mm": {c: round(hand.part(c).length_mm / n, 4) for c, n in self.segments.items()},
+                "pressures_kpa": list(self.pressures_kpa),
+                "discretisation_tip_error_pct_of_length": {
+                    c: round(e, 6) for c, e in self.discretisation_tip_error_pct_of_length.items()},
+                "mass_g": {c: round(m, 4) for c, m in self.mass_g.items()}, "timestep_s": self.timestep_s,
+                "palm_roll": "position-controlled hinge" if self.palm_roll_deg is None else "fixed",
+                "palm_roll_deg": self.palm_roll_deg, "hand": hand.to_dict()}
+
+
+def hand_pressures_kpa(hand: Hand, count: int = 3) -> np.ndarray:
+    """The pressures (kPa) a hand export is checked over: from the start of the paper's (or the tested) range
+    of its actuators to the hand's ``max_pressure_kpa``, capped at 95 % of the lowest fold of its parts.
+
+    >>> from bendpam.design.hand import default_hand
+    >>> hand_pressures_kpa(default_hand()).tolist()
+    [100.0, 200.0, 300.0]
+    """
+    lo = min(float(default_pressures_kpa(p.actuator, hand.model, 2)[0]) for p in hand.parts)
+    folds = [float(MomentLaw.of(p.actuator, hand.model).free_branch().max_pressure_kpa) for p in hand.parts]
+    hi = min(hand.max_pressure_kpa, 0.95 * min(folds))
+    return np.linspace(min(lo, 0.5 * hi), hi, count)
+
+
+def hand_model(hand: Hand, *, segments: int | None = None, tip_error_pct: float = 1.0, pressures_kpa=None,
+               palm_roll_deg: float | None = None, densities: Densities | None = None,
+               actuator: Actuator | None = None) -> MujocoHand:
+    """The MJCF model of the soft hand: a hinge chain per BE-PAM part, the palm roll a hinge.
+
+    The model's world frame is bendpam's hand frame (x radial, y distal, z palmar; MuJoCo's m), the
+    palm fixed in it, gravity along ``-z`` (the palm up; set ``model.opt.gravity`` for another
+    orientation).  Each finger is a chain like the finger device's (:func:`mujoco_model`) from
+    :func:`~bendpam.design.hand.finger_frame`, bending toward its ``n``; the palm roll is a hinge
+    (joint and position actuator ``palm_roll``, target in rad) about the index axis carrying the
+    thumb's proximal chain at :func:`~bendpam.design.hand.thumb_base`; the distal chain starts at the
+    proximal one's end, its plane turned by the hand's ``thumb_plane_deg`` (as
+    :func:`~bendpam.design.hand.thumb_chain`).  Each tip carries a contact sphere of the hand's
+    ``radius_mm`` (``NAME_fingertip``) and a site ``NAME_tip`` (the thumb's: ``thumb_distal_tip``).
+
+    Parameters
+    ----------
+    hand : the :class:`~bendpam.design.hand.Hand`.
+    segments : hinges per chain (every chain); default: for each chain the fewest within half of
+        ``tip_error_pct`` (% of its length) over ``pressures_kpa`` (:func:`segments_for`).
+    pressures_kpa : default :func:`hand_pressures_kpa`.
+    palm_roll_deg : a fixed palm roll (deg, 0 to 180) instead of the hinge.
+    densities : the masses' :class:`Densities`.  actuator : the one actuator of every part, if so (for the record).
+
+    Examples
+    --------
+    >>> from bendpam.design.hand import default_hand
+    >>> m = hand_model(default_hand(), palm_roll_deg=90.0, segments=4)
+    >>> m.palm_roll_deg, '<position' in m.xml, m.mass_g["index"] > 0
+    (90.0, False, True)
+    """
+    if not isinstance(hand, Hand):
+        raise InputError(f"hand must be a bendpam.design.hand.Hand, got {type(hand).__name__}")
+    if palm_roll_deg is not None:
+        palm_roll_deg = number("palm_roll_deg", palm_roll_deg, 0.0, 180.0, unit="deg")
+    if pressures_kpa is None:
+        P = hand_pressures_kpa(hand)
+    else:
+        P = np.atleast_1d(np.asarray(pressures_kpa, dtype=float))
+        for p in P:  # (the range's top is the hand's max_pressure_kpa)
+            number("pressures_kpa", p, 0.0, hand.max_pressure_kpa, unit="kPa")
+    dens = densities or Densities()
+    chains: dict[str, _Chain] = {}
+    errs: dict[str, float] = {}
+    for name in HAND_CHAINS:
+        part = hand.part(name)
+        f = Finger(part.actuator, hand.model)
+        if segments is None:
+            n, errs[name] = segments_for(f, P, tip_error_pct)
+        else:
+            n = _checked_segments(segments)
+            errs[name] = _free_error_pct(f, *_free_tips(f, P), n)
+        gr = Gripper(part.actuator, hand.model)
+        assert gr.contact_offset_mm is not None
+        chains[name] = _Chain(f, n, dens, gr.contact_offset_mm, gr.mu)
+    dt = min(_timestep_s(c.f, c, P) for c in chains.values())
+    root = _root_element(hand.part("index").actuator, "hand", max(c.n for c in chains.values()), dt)
+    _write_hand(root, hand, chains, palm_roll_deg)
+    return MujocoHand(xml=ET.tostring(root, encoding="unicode"), hand=hand, law_model=hand.model,
+                      segments={c: ch.n for c, ch in chains.items()}, pressures_kpa=tuple(float(p) for p in P),
+                      discretisation_tip_error_pct_of_length=errs, mass_g={c: ch.mass_g for c, ch in chains.items()},
+                      timestep_s=dt, palm_roll_deg=palm_roll_deg, actuator=actuator)
+
+
+def _checked_segments(segments) -> int:
+    if isinstance(segments, bool) or not isinstance(segments, int | np.integer) or not 2 <= segments <= 200:
+        raise InputError(f"segments = {segments!r} is outside the allowed range [2, 200] (an integer)")
+    return int(segments)
+
+
+def _about_y(angle: float) -> np.ndarray:
+    """Rotation by ``angle`` (rad) about ``-y`` (the palm roll: +x toward +z)."""
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([[c, 0.0, -s], [0.0, 1.0, 0.0], [s, 0.0, c]])
+
+
+def _write_hand(root: ET.Element, hand: Hand, chains: dict[str, _Chain], palm_roll_deg: float | None) -> None:
+    """The palm, the fingers, the palm roll and the thumb into ``root`` (see :func:`hand_model`)."""
+    custom = root.find("custom")
+    assert custom is not None
+    default = ET.SubElement(root, "default")
+    ET.SubElement(default, "joint", damping=_fmt(max(_damping(c) for c in chains.values())), armature="0")
+    world = ET.SubElement(root, "worldbody")
+    ET.SubElement(world, "light", pos="0 0 1", dir="0 0 -1", directional="true")
+    palm = ET.SubElement(world, "body", name="palm")
+    r = hand.radius_mm
+    xs = [xy[0] for xy in hand.finger_bases_mm.values()]
+    top = min(xy[1] for xy in hand.finger_bases_mm.values())
+    ET.SubElement(palm, "geom", name="palm_geom", type="box", pos=_fmt(0.5 * (min(xs) + max(xs)) * _MM,
+                  0.5 * top * _MM, 0.0), size=_fmt((0.5 * (max(xs) - min(xs)) + r) * _MM, 0.5 * top * _MM, r * _MM),
+                  contype="1", conaffinity="2", rgba="0.4 0.4 0.45 1")
+    ends = {}
+    for f in FINGERS:
+        R, p = finger_frame(hand, f)
+        ends[f] = chains[f].write(palm, f, p, R @ _LINK_AXES)
+    axis = np.array([hand.finger_bases_mm["index"][0], 0.0, 0.0])
+    roll = ET.SubElement(palm, "body", name="thumb_roll", pos=_fmt(*(axis * _MM)))
+    thumb_mass = (chains["thumb_proximal"].mass_g + chains["thumb_distal"].mass_g) * 1e-3  # kg
+    reach = (hand.part("thumb_proximal").length_mm + hand.part("thumb_distal").length_mm
+             + math.hypot(hand.thumb_base_mm[0] - axis[0], hand.thumb_base_mm[1])) * _MM
+    if palm_roll_deg is None:
+        top_deg = float(hand.part("palm_roll").angle_table(hand.max_pressure_kpa)[1][-1])
+        kp = _ROLL_STIFFNESS * thumb_mass * _G * reach
+        inertia = thumb_mass * reach ** 2 / 3.0
+        ET.SubElement(roll, "joint", name="palm_roll", type="hinge", axis="0 -1 0",
+                      range=_fmt(0.0, math.radians(top_deg)), damping=_fmt(2.0 * math.sqrt(kp * inertia)))
+        actuators = ET.SubElement(root, "actuator")
+        ET.SubElement(actuators, "position", name="palm_roll", joint="palm_roll", kp=_fmt(kp),
+                      ctrlrange=_fmt(0.0, math.radians(top_deg)))
+    else:
+        roll.set("quat", _fmt(*_quat(_about_y(math.radians(palm_roll_deg)))))
+        ET.SubElement(custom, "numeric", name="bendpam:palm_roll_deg", data=_fmt(palm_roll_deg))
+    pb, Rb = thumb_base(hand, 0.0)
+    ends["thumb_proximal"] = chains["thumb_proximal"].write(roll, "thumb_proximal", pb - axis, Rb @ _LINK_AXES)
+    a = math.radians(hand.thumb_plane_deg)  # the distal plane: the frame turned by -a about the tangent
+    turn = np.array([[1.0, 0.0, 0.0], [0.0, math.cos(a), math.sin(a)], [0.0, -math.sin(a), math.cos(a)]])
+    h1 = chains["thumb_proximal"].h
+    ends["thumb_distal"] = chains["thumb_distal"].write(ends["thumb_proximal"], "thumb_distal", (0.5 * h1, 0.0, 0.0),
+                                                        _LINK_AXES.T @ turn @ _LINK_AXES)
+    for tip, chain in HAND_TIPS.items():
+        c = chains[chain]
+        ET.SubElement(ends[chain], "geom", name=f"{tip}_fingertip", type="sphere", size=_fmt(r * _MM),
+                      pos=_fmt(0.5 * c.h * _MM, 0.0, 0.0), **(c._contact() | {"rgba": "0.3 0.3 0.3 1"}))
+    _write_numerics(custom, chains)

@@ -35,12 +35,18 @@ import numpy as np
 
 from bendpam.design.finger import FingerLoads, free_tip_trajectory, solve_finger
 from bendpam.design.grasp import solve_grasp
+from bendpam.design.hand import PARTS, Hand, default_hand, hand_pose, thumb_chain
 from bendpam.errors import InputError
-from bendpam.export.mjcf import MujocoModel, mujoco_model
+from bendpam.export.mjcf import HAND_CHAINS, HAND_TIPS, MujocoHand, MujocoModel, hand_model, mujoco_model
+from bendpam.physics import presets
+from bendpam.physics.actuator import Actuator
 from bendpam.physics.hysteresis import LoopModel
+from bendpam.physics.models import normalise_model, resolve_model
 from bendpam.sim.mujoco import PamController, import_mujoco
+from bendpam.validate import did_you_mean, number
 
-__all__ = ["QVEL_TOL", "MujocoExport", "Validation", "mujoco", "pullout", "validate"]
+__all__ = ["QVEL_TOL", "HandController", "HandValidation", "MujocoExport", "Validation", "hand_poses_kpa", "mujoco",
+           "pullout", "validate", "validate_hand"]
 
 #: a quasi-static run has settled when every hinge turns slower than this, rad/s
 QVEL_TOL = 1e-6
@@ -96,12 +102,15 @@ def _r(v: float) -> float | None:
 
 
 class _Run:
-    """A quasi-static copy of an exported model with its controller."""
+    """A quasi-static copy of an exported model with its controller (``make_controller(model)``).
 
-    def __init__(self, exported: MujocoModel, dt: float = _DT):
+    ``stiffness`` (N*m/rad, one for all hinges or one per hinge of the controller) sets the damping.
+    """
+
+    def __init__(self, xml: str, make_controller, stiffness, dt: float = _DT):
         mj = import_mujoco()
         self.mj = mj
-        self.m = mj.MjModel.from_xml_string(exported.xml)
+        self.m = mj.MjModel.from_xml_string(xml)
         self.d = mj.MjData(self.m)
         m = self.m
         m.opt.gravity[:] = 0.0
@@ -114,13 +123,23 @@ class _Run:
         mj.mj_forward(m, self.d)
         full = np.zeros((m.nv, m.nv))
         mj.mj_fullM(m, self.d, full)
-        self.ctl = PamController(m, exported.actuator, law_model=exported.law_model)
+        self.ctl = make_controller(m)
+        pam = getattr(self.ctl, "pam", self.ctl)  # (a HandController holds its PamController)
+        hinges = pam._dof_ix
+        if callable(stiffness):
+            stiffness = stiffness(self.ctl)
+        self.diag_inertia = np.diag(full)
+        m.dof_damping[hinges] = np.maximum(3.0 * np.sqrt(stiffness * self.diag_inertia[hinges]), 2.0 * dt * stiffness)
+        self.P = 0.0
+
+    @classmethod
+    def of(cls, exported: MujocoModel, dt: float = _DT) -> _Run:
+        """The run of a finger or gripper export (every hinge damped for its blocked-state stiffness)."""
         f = exported.finger
         h = f.length / exported.segments
         k_stiff = abs(float(f.law.tabulated().tangent_stiffness(float(max(exported.pressures_kpa)), 0.0))) / h * 1e-3
-        hinges = self.ctl._dof_ix
-        m.dof_damping[hinges] = np.maximum(3.0 * np.sqrt(k_stiff * np.diag(full)[hinges]), 2.0 * dt * k_stiff)
-        self.P = 0.0
+        return cls(exported.xml, lambda m: PamController(m, exported.actuator, law_model=exported.law_model),
+                   k_stiff, dt)
 
     def step(self) -> None:
         self.ctl.apply(self.d)
@@ -301,7 +320,7 @@ def _pullout(exported: MujocoModel, gr, diameter_mm: float, P: float) -> dict[st
     ref = solve_grasp(gr, diameter_mm, P)
     ex = mujoco_model(exported.actuator, "gripper", law_model=exported.law_model, segments=exported.segments,
                       pressures_kpa=exported.pressures_kpa, sphere_mm=diameter_mm, gripper=gr)
-    run = _Run(ex, _PULL_DT)
+    run = _Run.of(ex, _PULL_DT)
     mj = run.mj
     sphere = mj.mj_name2id(run.m, mj.mjtObj.mjOBJ_GEOM, "sphere")
     floor = mj.mj_name2id(run.m, mj.mjtObj.mjOBJ_GEOM, "floor")
@@ -352,7 +371,7 @@ def validate(exported: MujocoModel, *, pressures_kpa=None, tip_force_n=None, sph
         single = mujoco_model(exported.actuator, "finger", law_model=exported.law_model, segments=exported.segments,
                               pressures_kpa=exported.pressures_kpa, finger=exported.finger)
     with _mujoco_warnings() as warned:
-        run = _Run(single)
+        run = _Run.of(single)
         free = _free_runs(run, single, P)
         if free:
             loaded = _loaded_run(run, single, max(r["pressure_kpa"] for r in free), tip_force_n)
@@ -378,6 +397,215 @@ def validate(exported: MujocoModel, *, pressures_kpa=None, tip_force_n=None, sph
     return Validation(free, free_err, loaded, loaded["tip_error_pct_of_length"], pull, pull_err, notes)
 
 
+# ------------------------------------------------------------------------------------------------
+# the hand
+# ------------------------------------------------------------------------------------------------
+class HandController:
+    """Drives an exported hand (:func:`bendpam.export.mjcf.hand_model`): one pressure per part of the hand.
+
+    The chains' hinge torques are :class:`bendpam.sim.mujoco.PamController`'s, with each part's
+    actuator; the palm roll's pressure sets the target of its position-controlled hinge to the palm
+    segment's free bending angle there (interpolated in :meth:`bendpam.design.hand.HandPart.angle_table`,
+    within 1e-5 deg of :func:`bendpam.design.hand.hand_pose`'s).  A model with a fixed palm roll takes
+    no palm pressure.
+
+    Parameters
+    ----------
+    model : the ``mujoco.MjModel`` of the hand.  hand : the :class:`~bendpam.design.hand.Hand` it was built from.
+    loop, engine : as :class:`~bendpam.sim.mujoco.PamController`.
+
+    Examples
+    --------
+    >>> import mujoco
+    >>> from bendpam.design.hand import default_hand
+    >>> from bendpam.export.mjcf import hand_model
+    >>> hand = default_hand()
+    >>> m = mujoco.MjModel.from_xml_string(hand_model(hand, segments=4).xml); d = mujoco.MjData(m)
+    >>> ctl = HandController(m, hand)
+    >>> ctl.set_pressure_kpa({"index": 150.0, "palm_roll": 300.0}); ctl.step(m, d, 10)
+    >>> ctl.pam.pressure_kpa.tolist()[:2], round(float(np.degrees(d.ctrl[0])), 1)     # kPa; the roll's target, deg
+    ([150.0, 0.0], 95.9)
+    """
+
+    def __init__(self, model, hand: Hand, *, loop=None, engine: str = "auto"):
+        if not isinstance(hand, Hand):
+            raise InputError(f"hand must be a bendpam.design.hand.Hand, got {type(hand).__name__}")
+        self.hand = hand
+        self.pam = PamController(model, {n: hand.part(n).actuator for n in HAND_CHAINS}, law_model=hand.model,
+                                 loop=loop, engine=engine)
+        names = [c.name for c in self.pam.chains]
+        if sorted(names) != sorted(HAND_CHAINS):
+            raise InputError(f"the model's bending PAMs {names} are not the hand's {list(HAND_CHAINS)}")
+        mj = import_mujoco()
+        self._roll = int(mj.mj_name2id(model, mj.mjtObj.mjOBJ_ACTUATOR, "palm_roll"))  # -1: a fixed roll
+        self.pressures_kpa = dict.fromkeys(PARTS, 0.0)
+        self.palm_roll_rad = 0.0
+
+    def set_pressure_kpa(self, pressures_kpa: dict) -> None:
+        """Set the pressures (kPa, 0 to the hand's ``max_pressure_kpa``) by part name; parts not named: 0 kPa."""
+        if not isinstance(pressures_kpa, dict):
+            raise InputError(f"pressures_kpa: give the pressures by part name (a dict of kPa), got "
+                             f"{type(pressures_kpa).__name__}")
+        given = dict(pressures_kpa)
+        for name in given:
+            if name not in PARTS:
+                raise InputError(f"pressures_kpa: no hand part {name!r}{did_you_mean(name, PARTS)}; "
+                                 f"the parts are {', '.join(PARTS)}")
+        P = {n: number(f"pressures_kpa[{n!r}]", given.get(n, 0.0), 0.0, self.hand.max_pressure_kpa, unit="kPa")
+             for n in PARTS}
+        if self._roll < 0 and P["palm_roll"] > 0:
+            raise InputError("the model's palm roll is a fixed angle: it takes no palm_roll pressure")
+        # the palm segment's free angle from its table (0.1 % of the pressure range apart: within 1e-5 deg)
+        table_kpa, table_deg = self.hand.part("palm_roll").angle_table(self.hand.max_pressure_kpa)
+        roll = float(np.interp(P["palm_roll"], table_kpa, table_deg, right=np.nan))
+        if not math.isfinite(roll):
+            raise InputError(f"palm_roll: no free-bending equilibrium at {P['palm_roll']:g} kPa")
+        self.pam.set_pressure_kpa([P[c.name] for c in self.pam.chains])
+        self.pressures_kpa, self.palm_roll_rad = P, math.radians(roll)
+
+    def apply(self, data) -> None:
+        """The hinge torques into ``data.qfrc_applied`` and the palm roll's target into ``data.ctrl``."""
+        self.pam.apply(data)
+        if self._roll >= 0:
+            data.ctrl[self._roll] = self.palm_roll_rad
+
+    def step(self, model, data, nstep: int = 1) -> None:
+        """``nstep`` MuJoCo steps, :meth:`apply` before each."""
+        mujoco = import_mujoco()
+        for _ in range(int(nstep)):
+            self.apply(data)
+            mujoco.mj_step(model, data)
+
+
+@dataclass(frozen=True)
+class HandValidation:
+    """The figures of :func:`validate_hand`: every tip against :func:`bendpam.design.hand.hand_pose`.
+
+    Attributes
+    ----------
+    tips : one row per pose and tip (``pressures_kpa``, ``tip``, ``length_mm``, both tips in mm,
+        ``tip_error_pct_of_length``, ``settled``).
+    hand_tip_error_pct_of_length : the largest tip error, % of that tip's part (the thumb: both segments).
+    tip_errors_pct_of_length : per tip, its largest error.
+
+    Examples
+    --------
+    >>> HandValidation([], 0.3, {"index": 0.3}).to_dict()["hand_tip_error_pct_of_length"]
+    0.3
+    """
+
+    tips: list[dict[str, Any]]
+    hand_tip_error_pct_of_length: float
+    tip_errors_pct_of_length: dict[str, float]
+    notes: list[str] = field(default_factory=list)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The figures as a JSON-ready dict (units in the key names)."""
+        return {"hand_tip_error_pct_of_length": _r(self.hand_tip_error_pct_of_length),
+                "hand_tip_errors_pct_of_length": {k: _r(v) for k, v in self.tip_errors_pct_of_length.items()},
+                "hand_tips": self.tips, "notes": self.notes}
+
+
+def hand_poses_kpa(exported: MujocoHand, pressures_kpa=None) -> list[dict[str, float]]:
+    """The poses :func:`validate_hand` checks: pose ``i`` gives part ``j`` (in :data:`~bendpam.design.hand.PARTS`
+    order) the pressure ``i + j`` (cyclically) of ``pressures_kpa`` (kPa; default the export's), so that
+    every part meets every pressure and the parts of a pose differ; no palm pressure with a fixed roll.
+
+    >>> from bendpam.design.hand import default_hand
+    >>> from bendpam.export.mjcf import hand_model
+    >>> poses = hand_poses_kpa(hand_model(default_hand(), segments=4), [100.0, 200.0])
+    >>> [p["index"] for p in poses], [p["middle"] for p in poses]
+    ([100.0, 200.0], [200.0, 100.0])
+    """
+    P = sorted(float(p) for p in np.atleast_1d(np.asarray(
+        exported.pressures_kpa if pressures_kpa is None else pressures_kpa, dtype=float)))
+    parts = [p for p in PARTS if exported.palm_roll_deg is None or p != "palm_roll"]
+    return [{n: P[(i + j) % len(P)] for j, n in enumerate(parts)} for i in range(len(P))]
+
+
+def _hand_run(exported: MujocoHand) -> _Run:
+    """The quasi-static run of a hand export: every hinge damped for its part's blocked-state stiffness."""
+    hand = exported.hand
+    top = float(max(exported.pressures_kpa))
+
+    def stiffness(name: str, h: float) -> float:
+        table = hand.part(name).law.tabulated()
+        return abs(float(table.tangent_stiffness(top, 0.0))) / h * 1e-3
+
+    def per_hinge(ctl: HandController) -> np.ndarray:  # in the controller's order of the chains
+        return np.concatenate([np.full(c.segments, stiffness(c.name, c.segment_length_mm)) for c in ctl.pam.chains])
+
+    run = _Run(exported.xml, lambda m: HandController(m, hand), per_hinge)
+    roll = run.ctl._roll
+    if roll >= 0:  # the palm roll's servo: overdamped as the hinges
+        kp = float(run.m.actuator_gainprm[roll, 0])
+        dof = int(run.m.jnt_dofadr[run.m.actuator_trnid[roll, 0]])
+        run.m.dof_damping[dof] = max(3.0 * math.sqrt(kp * run.diag_inertia[dof]), 2.0 * _DT * kp)
+    return run
+
+
+def _hand_reference(exported: MujocoHand, P: dict[str, float]) -> dict[str, np.ndarray]:
+    """bendpam's unloaded tips (mm) at the pressures ``P`` (the thumb at the fixed roll, if the model has one)."""
+    hand = exported.hand
+    pose = hand_pose(hand, P)
+    tips = dict(pose.tips_mm)
+    if exported.palm_roll_deg is not None:
+        a = {n: math.radians(pose.angles_deg[n]) for n in ("thumb_proximal", "thumb_distal")}
+        tips["thumb"] = thumb_chain(hand, a["thumb_proximal"], a["thumb_distal"],
+                                    math.radians(exported.palm_roll_deg))[1]
+    return tips
+
+
+def validate_hand(exported: MujocoHand, *, pressures_kpa=None) -> HandValidation:
+    """Quasi-static MuJoCo runs of a hand export against bendpam's unloaded hand
+    (:func:`~bendpam.design.hand.hand_pose`).
+
+    As the finger's free shapes (:func:`validate`; gravity off, 1 ms steps, overdamped hinges and
+    palm roll): for each pose of :func:`hand_poses_kpa` a ramp of 100 steps from the previous pose,
+    then the creep until ``max |qvel|`` < :data:`QVEL_TOL`; every fingertip and the thumb tip (the
+    sites ``NAME_tip``) against bendpam's, the distance in % of that part's length (the thumb's:
+    both segments).
+
+    Examples
+    --------
+    >>> from bendpam.design.hand import default_hand
+    >>> from bendpam.export.mjcf import hand_model
+    >>> v = validate_hand(hand_model(default_hand()), pressures_kpa=[150.0])
+    >>> v.hand_tip_error_pct_of_length < 1.0, sorted(v.tip_errors_pct_of_length)[:2]
+    (True, ['index', 'little'])
+    """
+    if not isinstance(exported, MujocoHand):
+        raise InputError(f"exported must be a MujocoHand (bendpam.export.mjcf.hand_model), got "
+                         f"{type(exported).__name__}")
+    hand = exported.hand
+    lengths = {t: hand.part(c).length_mm for t, c in HAND_TIPS.items()}
+    lengths["thumb"] += hand.part("thumb_proximal").length_mm
+    rows: list[dict[str, Any]] = []
+    with _mujoco_warnings() as warned:
+        run = _hand_run(exported)
+        before = dict.fromkeys(PARTS, 0.0)
+        for P in hand_poses_kpa(exported, pressures_kpa):
+            for i in range(_RAMP):
+                run.ctl.set_pressure_kpa({n: before.get(n, 0.0) + (p - before.get(n, 0.0)) * (i + 1) / _RAMP
+                                          for n, p in P.items()})
+                run.step()
+            settled, before = run.creep(), P
+            ref = _hand_reference(exported, P)
+            for tip, chain in HAND_TIPS.items():
+                got = run.site(f"{chain}_tip")
+                err = float(np.linalg.norm(got - ref[tip])) / lengths[tip] * 100.0
+                rows.append({"pressures_kpa": dict(P), "tip": tip, "length_mm": lengths[tip],
+                             "mujoco_tip_mm": [_r(v) for v in got], "bendpam_tip_mm": [_r(v) for v in ref[tip]],
+                             "tip_error_pct_of_length": _r(err), "settled": settled})
+    per_tip = {t: max(r["tip_error_pct_of_length"] for r in rows if r["tip"] == t) for t in HAND_TIPS}
+    worst = max(per_tip.values())
+    notes = [f"the pose at {r['pressures_kpa']} did not settle to |qvel| < {QVEL_TOL:g} rad/s"
+             for r in rows if not r["settled"] and r["tip"] == "index"]
+    notes += [f"the {t} tip error {e:.3g} % of its length is above 1 %" for t, e in per_tip.items() if e > 1.0]
+    notes += [f"MuJoCo warned: {w}" for w in sorted(set(warned))]
+    return HandValidation(rows, worst, per_tip, notes)
+
+
 _validate = validate  # (the name ``validate`` is an argument of :func:`mujoco`)
 
 
@@ -393,15 +621,16 @@ class MujocoExport:
     ['actuator.toml', 'export.json', 'finger.xml']
     """
 
-    model: MujocoModel
+    model: MujocoModel | MujocoHand
     sphere_models: dict[float, MujocoModel]
-    validation: Validation | None
+    validation: Validation | HandValidation | None
     loop: LoopModel | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """The model's description, its files and the validation figures (``export.json``), JSON-ready."""
+        toml = ["actuator.toml"] if self.model.actuator is not None else []
         d = self.model.to_dict() | {"spheres_mm": sorted(self.sphere_models),
-                                    "files": [*sorted(self._models()), "actuator.toml", "export.json"]}
+                                    "files": [*sorted(self._models()), *toml, "export.json"]}
         if self.loop is not None:
             d["hysteresis"] = self.loop.to_dict()
         if self.validation is not None:
@@ -419,10 +648,13 @@ class MujocoExport:
 
         from bendpam.infra.outputs import to_json
 
-        toml = self.model.actuator.to_toml()
-        if self.loop is not None:  # the fitted loop, for PamController(..., loop=LoopModel.from_toml(...))
-            toml += "\n" + tomli_w.dumps({"hysteresis": self.loop.to_dict()})
-        return self._models() | {"actuator.toml": toml, "export.json": to_json(self.to_dict())}
+        files = self._models()
+        if self.model.actuator is not None:  # (a hand from a hand file: the file has the actuators)
+            toml = self.model.actuator.to_toml()
+            if self.loop is not None:  # the fitted loop, for PamController(..., loop=LoopModel.from_toml(...))
+                toml += "\n" + tomli_w.dumps({"hysteresis": self.loop.to_dict()})
+            files["actuator.toml"] = toml
+        return files | {"export.json": to_json(self.to_dict())}
 
     def save(self, folder, *, force: bool = False) -> list[str]:
         """Write :meth:`files` into ``folder`` as one output set (staged, swapped in whole, with a manifest)."""
@@ -438,7 +670,7 @@ class MujocoExport:
 def mujoco(actuator, device: str = "finger", *, law_model: str | None = None, segments: int | None = None,
            tip_error_pct: float = 1.0, pressures_kpa=None, spheres_mm=(), validate: bool = True,
            loop: LoopModel | None = None, **options: Any) -> MujocoExport:
-    """Export ``actuator``'s finger or gripper to MuJoCo: the models and, with ``validate``, the figures.
+    """Export ``actuator``'s finger, gripper or hand to MuJoCo: the models and, with ``validate``, the figures.
 
     The device's model is :func:`bendpam.export.mujoco_model` (``options`` go to it: ``gripper``,
     ``finger``, ``densities``); one more model per sphere of ``spheres_mm`` (mm, gripper only);
@@ -446,6 +678,11 @@ def mujoco(actuator, device: str = "finger", *, law_model: str | None = None, se
     without the loop: bendpam's statics are the loop-free law).  ``loop``, a fitted hysteresis loop,
     is written into ``actuator.toml`` beside the actuator for the simulation
     (``PamController(model, actuator, loop=LoopModel.from_toml(path))``).  ``.save(folder)`` writes the files.
+
+    ``device="hand"``: the hand of :func:`bendpam.export.mjcf.hand_model` (``options``: ``hand``, a
+    :class:`~bendpam.design.hand.Hand`, else :func:`~bendpam.design.hand.default_hand` with
+    ``actuator`` in every part (None: the paper's BE-PAM); ``palm_roll_deg``; ``densities``), checked
+    by :func:`validate_hand`; :class:`HandController` drives it.
 
     Examples
     --------
@@ -455,12 +692,36 @@ def mujoco(actuator, device: str = "finger", *, law_model: str | None = None, se
     >>> sorted(ex.files())[:2], ex.model.segments
     (['actuator.toml', 'export.json'], 7)
     """
+    if loop is not None and not isinstance(loop, LoopModel):
+        raise InputError(f"loop must be a bendpam.physics.hysteresis.LoopModel, got {type(loop).__name__}")
+    if device == "hand":
+        return _mujoco_hand(actuator, law_model, segments, tip_error_pct, pressures_kpa, spheres_mm, validate, loop,
+                            **options)
     base = mujoco_model(actuator, device, law_model=law_model, segments=segments, tip_error_pct=tip_error_pct,
                         pressures_kpa=pressures_kpa, **options)
     diam = [float(d) for d in np.atleast_1d(np.asarray(spheres_mm, dtype=float))]
     spheres = {d: mujoco_model(actuator, device, law_model=base.law_model, segments=base.segments,
                                pressures_kpa=base.pressures_kpa, sphere_mm=d, **options) for d in diam}
     val = _validate(base, sphere_mm=diam[0] if diam else 200.0) if validate else None
-    if loop is not None and not isinstance(loop, LoopModel):
-        raise InputError(f"loop must be a bendpam.physics.hysteresis.LoopModel, got {type(loop).__name__}")
     return MujocoExport(base, spheres, val, loop)
+
+
+def _mujoco_hand(actuator, law_model, segments, tip_error_pct, pressures_kpa, spheres_mm, validate, loop,
+                 hand: Hand | None = None, palm_roll_deg: float | None = None, densities=None) -> MujocoExport:
+    """:func:`mujoco` for the hand."""
+    if np.atleast_1d(np.asarray(spheres_mm, dtype=float)).size:
+        raise InputError("the spheres are objects of the gripper's grasp test; the hand export has none")
+    if hand is None:
+        if actuator is not None and not isinstance(actuator, Actuator):
+            raise InputError(f"actuator must be a bendpam.Actuator or None, got {type(actuator).__name__}")
+        model = law_model or (resolve_model(actuator) if actuator is not None else "energy")
+        hand = default_hand(model, actuator)
+        if actuator is None:
+            actuator = presets.be_pam(hand.model)
+    elif actuator is not None:
+        raise InputError("give either a hand (its parts name their actuators) or an actuator for the default hand")
+    elif law_model is not None and normalise_model(law_model) != hand.model:
+        raise InputError(f"law_model = {law_model!r}: the hand's model is {hand.model!r} (set it in the hand)")
+    base = hand_model(hand, segments=segments, tip_error_pct=tip_error_pct, pressures_kpa=pressures_kpa,
+                      palm_roll_deg=palm_roll_deg, densities=densities, actuator=actuator)
+    return MujocoExport(base, {}, validate_hand(base) if validate else None, loop)
