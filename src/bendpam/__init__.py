@@ -144,6 +144,8 @@ _LAZY: dict[str, tuple[str, str | None]] = {
     "lab": ("lab", None),
     "physics": ("physics", None),
     "present": ("present", None),
+    "export": ("export", None),
+    "sim": ("sim", None),
     "infra": ("infra", None),
     "plots": ("present.figures", None),
     "report": ("present.report", None),
