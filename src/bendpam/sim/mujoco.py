@@ -379,35 +379,29 @@ def _kernels():
     except ImportError:
         return None
 
+    @numba.njit(cache=False, nogil=True, inline="always")
+    def hinge(i, qpos, qadr, c_over_h, k0, inv_dk, last, off, cA, cB, pa):  # pragma: no cover - compiled
+        u = (c_over_h[i] * qpos[qadr[i]] - k0[i]) * inv_dk[i]
+        u = min(max(u, 0.0), last[i])
+        j = int(u)
+        t = u - j
+        j += off[i]
+        p = pa[i]
+        w0 = p * cA[j, 0] - cB[j, 0]
+        w1 = p * cA[j, 1] - cB[j, 1]
+        w2 = p * cA[j, 2] - cB[j, 2]
+        w3 = p * cA[j, 3] - cB[j, 3]
+        return ((w0 * t + w1) * t + w2) * t + w3
+
     @numba.njit(cache=False, nogil=True)
     def moments(qpos, qadr, c_over_h, k0, inv_dk, last, off, cA, cB, pa, out):  # pragma: no cover - compiled
         for i in range(qadr.size):
-            u = (c_over_h[i] * qpos[qadr[i]] - k0[i]) * inv_dk[i]
-            u = min(max(u, 0.0), last[i])
-            j = int(u)
-            t = u - j
-            j += off[i]
-            p = pa[i]
-            w0 = p * cA[j, 0] - cB[j, 0]
-            w1 = p * cA[j, 1] - cB[j, 1]
-            w2 = p * cA[j, 2] - cB[j, 2]
-            w3 = p * cA[j, 3] - cB[j, 3]
-            out[i] = ((w0 * t + w1) * t + w2) * t + w3
+            out[i] = hinge(i, qpos, qadr, c_over_h, k0, inv_dk, last, off, cA, cB, pa)
 
     @numba.njit(cache=False, nogil=True)
     def apply(qpos, qadr, dadr, c_over_h, k0, inv_dk, last, off, cA, cB, pa, scale, qfrc):  # pragma: no cover
         for i in range(qadr.size):
-            u = (c_over_h[i] * qpos[qadr[i]] - k0[i]) * inv_dk[i]
-            u = min(max(u, 0.0), last[i])
-            j = int(u)
-            t = u - j
-            j += off[i]
-            p = pa[i]
-            w0 = p * cA[j, 0] - cB[j, 0]
-            w1 = p * cA[j, 1] - cB[j, 1]
-            w2 = p * cA[j, 2] - cB[j, 2]
-            w3 = p * cA[j, 3] - cB[j, 3]
-            qfrc[dadr[i]] = scale[i] * (((w0 * t + w1) * t + w2) * t + w3)
+            qfrc[dadr[i]] = scale[i] * hinge(i, qpos, qadr, c_over_h, k0, inv_dk, last, off, cA, cB, pa)
 
     return moments, apply
 
