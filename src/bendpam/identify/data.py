@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -65,6 +66,18 @@ class FitData:
     period_s: np.ndarray | None = None  # (n,) each test's mean cycle period, s (NaN: not known)
     rate: np.ndarray | None = None  # each point's bending rate at a constant crosshead speed, relative to k' = 0
     time_s: np.ndarray | None = None  # each point's time since its branch began (cycle mean, s); None: not kept
+
+    @cached_property
+    def branch_rows(self) -> dict[int, np.ndarray]:
+        """The rows of each branch of each test in time order, keyed ``2 seg + (branch < 0)`` (needs ``branch``
+        and ``time_s``; computed once: the fit's loop laws evaluate it at every step)."""
+        assert self.branch is not None and self.time_s is not None
+        key = 2 * self.seg + (self.branch < 0)
+        rows = {}
+        for k in np.unique(key):
+            r = np.flatnonzero(key == k)
+            rows[int(k)] = r[np.argsort(self.time_s[r], kind="stable")]
+        return rows
 
     def thin(self, step: int) -> FitData:
         """Every ``step``-th point (weights scaled so the objective keeps its scale): for the grid stage."""

@@ -110,10 +110,7 @@ def _viscous_in_time(theta_c: float, d: FitData) -> np.ndarray:
     branches in closed form (``z`` is continuous at the reversals).
     """
     assert d.time_s is not None and d.branch is not None and d.delta is not None and d.span is not None
-    order = {}
-    for key in np.unique(2 * d.seg + (d.branch < 0)):
-        rows = np.flatnonzero(2 * d.seg + (d.branch < 0) == key)
-        order[int(key)] = rows[np.argsort(d.time_s[rows], kind="stable")]
+    order = d.branch_rows
     dt = np.concatenate([np.diff(d.time_s[r]) for r in order.values()])
     dd = np.concatenate([np.diff(d.delta[r]) for r in order.values()])
     ok = dt > 0
