@@ -277,15 +277,15 @@ def test_the_shipped_coverage_record_is_read_and_the_tool_writes_it(tmp_path):
 
 
 def test_the_viscous_member_driven_at_the_tests_times_is_the_steady_cycle():
-    from types import SimpleNamespace as NS
-
+    from bendpam.identify.data import FitData
     from bendpam.identify.ensemble import steady_z
 
     span, period, n = 0.3, 20.0, 61  # a triangle at a constant rate of 0.03 rad/s, sampled on 61 points a branch
     delta = np.linspace(0.0, span, n)
-    d = NS(seg=np.zeros(2 * n, int), branch=np.repeat([1, -1], n), delta=np.tile(delta, 2),
-           span=np.full(2 * n, span), time_s=np.tile(delta / (2.0 * span / period), 2), kc=np.zeros(2 * n),
-           period_s=None, rate=None)
+    one, points = np.ones(1), np.zeros(2 * n)  # one test; its curves play no part in the loop law
+    d = FitData(P=one, k=[points], M=[points], BM=one, BM_se=one, K=one, K_se=one, w=points, kc=points, Mc=points,
+                Pc=points, seg=np.zeros(2 * n, int), branch=np.repeat([1, -1], n), delta=np.tile(delta, 2),
+                span=np.full(2 * n, span), time_s=np.tile(delta / (2.0 * span / period), 2))
     theta_deg = 8.0
     away, back = ViscousLoop(math.radians(theta_deg) / 0.03, 0.03).steady_branches(delta, span, period)
     z = steady_z("viscous", theta_deg, d)
