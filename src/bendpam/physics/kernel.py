@@ -103,29 +103,45 @@ class SplineKernel:
         self._n1 = n1
         self._last = kj.size - 2
         self._scale = n1 / math.pi
-        if self._scale * _ACOS8_ERR >= _GUESS_TOL:
-            raise InputError(f"SplineKernel takes at most 10^7 knots, not {kj.size}")
         self._shift = n1 - 0.5  # the guess half an interval low: the true interval is the guess or the next
-        self._inv_lo, self._inv_hi = 1.0 / float(kj[0]), 1.0 / float(kj[-1])
-        self._m_lo, self._m_hi = -2.0 * self._inv_lo, -2.0 * self._inv_hi
+        lo, hi = float(kj[0]), float(kj[-1])
+        self._inv_lo, self._inv_hi = 1.0 / lo, 1.0 / hi
+        # NumPy's guess: r = 1 + k m, m = -2 / (the lock-up limit on k's side), as 1 + (a k + b |k|) with a -+ b = m
+        # on each side (no np.where).  Rounding moves r by at most (6 ratio + 1) eps (ratio: of the two limits); m
+        # shrunk by 4 (1 + ratio) eps keeps r in [-1, 1] (no clip).  r is then off by at most 14 (1 + ratio) eps,
+        # arccos(r) by sqrt(2 x that).
+        ratio = max(-lo, hi) / min(-lo, hi)
+        eps = float(np.finfo(float).eps)
+        shrink = 4.0 * (1.0 + ratio) * eps
+        m_lo, m_hi = -2.0 * (1.0 - shrink) / lo, -2.0 * (1.0 - shrink) / hi
+        err = math.sqrt(2.0 * 14.0 * (1.0 + ratio) * eps) + 1e-14
+        if not (ratio < 1e12 and self._scale * max(err, _ACOS8_ERR) < _GUESS_TOL):
+            raise InputError(f"SplineKernel's {kj.size} knots are too many, or its limits {lo:g} and {hi:g} "
+                             "too unequal, to find a point's interval in one step")
+        self._a, self._b = np.array(0.5 * (m_lo + m_hi)), np.array(0.5 * (m_hi - m_lo))
+        self._sc, self._sh, self._one = np.array(self._scale), np.array(self._shift), np.array(1.0)
         self._next = np.append(kj[1:-1], np.inf)  # the knot after each interval's start (none after the last)
+        self._zk = kj[:-1].astype(complex)  # each interval's start + 0i
         self._zcols = tuple(_complex(c[:, i], c[:, 4 + i]) for i in range(4))  # a_i + i g_i
 
     def interval(self, k) -> np.ndarray:
         """The knot interval of each real curvature ``k`` (1/mm): the largest knot ``<= k``, within [0, intervals)."""
-        k = np.asarray(k, dtype=float)
-        return self._interval(k.reshape(-1)).reshape(k.shape)
+        kk = np.clip(np.asarray(k, dtype=float), self.knots_per_mm[0], self.knots_per_mm[-1]).reshape(-1)
+        return self._interval(kk, np.empty(kk.size), np.empty(kk.size)).reshape(np.shape(k))
 
-    def _interval(self, kk: np.ndarray) -> np.ndarray:
-        r = np.where(kk < 0.0, kk * self._m_lo, kk * self._m_hi)  # -2 k / (lock-up limit on k's side)
-        r += 1.0
-        np.clip(r, -1.0, 1.0, out=r)
-        th = np.arccos(r)
-        th *= self._scale
-        np.copysign(th, kk, out=th)  # k < 0: n1 - th (left piece), k >= 0: n1 + th
-        th += self._shift
-        j = th.astype(np.intp)  # in [0, intervals): th is in [-0.5, 2 n1 - 0.5] up to rounding
-        j += kk >= np.take(self._next, j)
+    def _interval(self, kk: np.ndarray, t: np.ndarray, r: np.ndarray) -> np.ndarray:
+        """The intervals of curvatures within the knots (``t``, ``r``: work arrays of ``kk``'s size)."""
+        np.abs(kk, out=t)
+        t *= self._b
+        np.multiply(kk, self._a, out=r)
+        r += t
+        r += self._one  # 1 - 2 k / (lock-up limit on k's side), in [-1, 1]
+        np.arccos(r, out=r)
+        r *= self._sc
+        np.copysign(r, kk, out=r)  # k < 0: n1 - th (left piece), k >= 0: n1 + th
+        r += self._sh
+        j = r.astype(np.intp)  # in [0, intervals): r is in [-0.5, 2 n1 - 0.5] up to rounding
+        j += kk >= self._next.take(j)
         return j
 
     def evaluate(self, P, k, out, limit_kpa: float, k_min: float, k_max: float,
@@ -156,26 +172,31 @@ class SplineKernel:
         ``A`` and ``G`` run through Horner's steps together as one complex number ``A + iG`` (four
         gathers instead of eight): a product with ``dx + 0i`` is ``(a dx - g 0) + i (a 0 + g dx)``,
         and with one product exactly zero each part is ``a dx`` and ``g dx`` rounded once, as in the
-        compiled loop's real arithmetic.
+        compiled loop's real arithmetic.  Constants are 0-d arrays and gathers ``ndarray.take`` (the
+        cheapest calls: a block spends a tenth of its time in call overhead).
         """
         z3, z2, z1, z0 = self._zcols
-        kj, Ps = self.knots_per_mm, self.P_start_kpa
-        pa_all = max(float(P[0]) - Ps, 0.0) if P.size == 1 else None
+        zk, Ps, zero = self._zk, np.array(self.P_start_kpa), np.array(0.0)
+        pa_all = np.array(max(float(P[0]) - self.P_start_kpa, 0.0)) if P.size == 1 else None
+        t, r = np.empty(min(CHUNK, k.size)), np.empty(min(CHUNK, k.size))
         for s0 in range(0, k.size, CHUNK):
             kk = k[s0:s0 + CHUNK]
-            j = self._interval(kk)
-            dx = (kk - np.take(kj, j)).astype(complex)
-            V = np.take(z3, j)
+            if kk.size < t.size:
+                t, r = t[:kk.size], r[:kk.size]
+            j = self._interval(kk, t, r)
+            dx = zk.take(j)  # knot + 0i
+            np.subtract(kk, dx.real, out=dx.real)  # k - knot + 0i
+            V = z3.take(j)
             V *= dx
-            V += np.take(z2, j)
+            V += z2.take(j)
             V *= dx
-            V += np.take(z1, j)
+            V += z1.take(j)
             V *= dx
-            V += np.take(z0, j)
+            V += z0.take(j)
             A, G = V.real, V.imag
             if pa_all is None:
-                pa = P[s0:s0 + CHUNK] - Ps
-                np.maximum(pa, 0.0, out=pa)
+                pa = np.subtract(P[s0:s0 + CHUNK], Ps, out=t)
+                np.maximum(pa, zero, out=pa)
                 A *= pa
             else:
                 A *= pa_all
