@@ -97,7 +97,7 @@ def test_fine_table_stays_identical():
 
 @pytest.mark.parametrize(("lo", "hi", "n1"), [(-1e-3, 50.0, 64), (-20.0, 1e-4, 300), (-0.5, 0.5, 2)])
 def test_unequal_limits_stay_identical(lo, hi, n1):
-    """Limits 10^4-10^5 apart: the one-formula guess (1 + a k + b |k|, no clip) still lands on the interval."""
+    """Limits 10^4-10^5 apart: the guess without np.where or clip (1 + min(k m_lo, k m_hi)) lands on the interval."""
     t = np.cos(np.linspace(0.0, np.pi, n1 + 1))
     kj = np.concatenate([0.5 * lo * (1.0 + t), 0.5 * hi * (1.0 - t[1:])])
     rng = np.random.default_rng(n1)
@@ -112,11 +112,11 @@ def test_unequal_limits_stay_identical(lo, hi, n1):
     assert kern.interval(np.array([2.0 * lo, -np.inf, 2.0 * hi, np.inf])).tolist() == [0, 0, kj.size - 2, kj.size - 2]
 
 
-def test_a_table_the_guess_cannot_serve_is_refused():
-    kj = np.array([-1e-13, -5e-14, 0.0, 0.5, 1.0])  # limits 10^13 apart
-    with pytest.raises(InputError, match=r"SplineKernel's 5 knots are too many, or its limits -1e-13 and 1 too "
-                                         "unequal") as e:
-        SplineKernel(kj, np.zeros((4, 8)), 10.0)
+def test_a_table_the_guess_cannot_serve_is_refused(monkeypatch):
+    monkeypatch.setattr(K, "_GUESS_TOL", 1e-9)  # as if 5 knots were 2 x 10^7: the guess would be too coarse
+    with pytest.raises(InputError, match=r"SplineKernel takes at most 2 x 10\^7 knots \(a first guess must land "
+                                         r"within a quarter interval\), not 5") as e:
+        SplineKernel(np.array([-1.0, -0.5, 0.0, 0.5, 1.0]), np.zeros((4, 8)), 10.0)
     assert "\n" not in str(e.value)
 
 

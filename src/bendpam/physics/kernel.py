@@ -107,19 +107,14 @@ class SplineKernel:
         self._shift = n1 - 0.5  # the guess half an interval low: the true interval is the guess or the next
         lo, hi = float(kj[0]), float(kj[-1])
         self._inv_lo, self._inv_hi = 1.0 / lo, 1.0 / hi
-        # NumPy's guess: r = 1 + k m, m = -2 / (the lock-up limit on k's side), as 1 + (a k + b |k|) with a -+ b = m
-        # on each side (no np.where).  Rounding moves r by at most (6 ratio + 1) eps (ratio: of the two limits); m
-        # shrunk by 4 (1 + ratio) eps keeps r in [-1, 1] (no clip).  r is then off by at most 14 (1 + ratio) eps,
-        # arccos(r) by sqrt(2 x that).
-        ratio = max(-lo, hi) / min(-lo, hi)
+        # NumPy's guess: r = 1 + k m with m = -2 / (the lock-up limit on k's side), i.e. 1 + min(k m_lo, k m_hi) (the
+        # product with the other side's m is the positive one: no np.where).  The m shrunk by 4 eps keep r in [-1, 1]
+        # through the rounding (no clip); r is then off by at most 11 eps, arccos(r) by sqrt(22 eps) rad.
         eps = float(np.finfo(float).eps)
-        shrink = 4.0 * (1.0 + ratio) * eps
-        m_lo, m_hi = -2.0 * (1.0 - shrink) / lo, -2.0 * (1.0 - shrink) / hi
-        err = math.sqrt(2.0 * 14.0 * (1.0 + ratio) * eps) + 1e-14
-        if not (ratio < 1e12 and self._scale * max(err, _ACOS8_ERR) < _GUESS_TOL):
-            raise InputError(f"SplineKernel's {kj.size} knots are too many, or its limits {lo:g} and {hi:g} "
-                             "too unequal, to find a point's interval in one step")
-        self._a, self._b = np.array(0.5 * (m_lo + m_hi)), np.array(0.5 * (m_hi - m_lo))
+        if self._scale * max(math.sqrt(22.0 * eps) + 1e-14, _ACOS8_ERR) >= _GUESS_TOL:
+            raise InputError(f"SplineKernel takes at most 2 x 10^7 knots (a first guess must land within a quarter "
+                             f"interval), not {kj.size}")
+        self._m_lo, self._m_hi = np.array(-2.0 * (1.0 - 4.0 * eps) / lo), np.array(-2.0 * (1.0 - 4.0 * eps) / hi)
         self._sc, self._sh, self._one = np.array(self._scale), np.array(self._shift), np.array(1.0)
         self._next = np.append(kj[1:-1], np.inf)  # the knot after each interval's start (none after the last)
         self._zk = kj[:-1].astype(complex)  # each interval's start + 0i
@@ -138,10 +133,9 @@ class SplineKernel:
 
     def _interval(self, kk: np.ndarray, t: np.ndarray, r: np.ndarray) -> np.ndarray:
         """The intervals of curvatures within the knots (``t``, ``r``: work arrays of ``kk``'s size)."""
-        np.abs(kk, out=t)
-        t *= self._b
-        np.multiply(kk, self._a, out=r)
-        r += t
+        np.multiply(kk, self._m_lo, out=t)
+        np.multiply(kk, self._m_hi, out=r)
+        np.minimum(r, t, out=r)
         r += self._one  # 1 - 2 k / (lock-up limit on k's side), in [-1, 1]
         np.arccos(r, out=r)
         r *= self._sc
