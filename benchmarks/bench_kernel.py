@@ -7,8 +7,11 @@ force-balance:
 * ``main``: the fast path of the 0.4.0 main branch (``MomentTable.moment`` and ``_moment_kernel`` as
   they were, copied verbatim below as :func:`main_moment`, on this table's spline coefficients):
   ``check_pressure`` and ``check_curvature`` (about eight passes), then 8192-point blocks;
+* ``before``: ``MomentTable.moment`` with ``BENDPAM_KERNEL=numpy`` and the NumPy kernel as it was
+  before this pass of tuning (commit 7e1a5ed, copied verbatim below as :class:`BeforeKernel`):
+  a guess of the interval through ``np.where`` and ``np.clip``, Python-float constants, ``np.take``;
 * ``numpy``: ``MomentTable.moment`` with ``BENDPAM_KERNEL=numpy`` (one min and one max per input,
-  8192-point blocks, as before);
+  8192-point blocks);
 * ``numba``: the same with ``BENDPAM_KERNEL=numba`` (the compiled loop, one core);
 * ``cubicspline``: SciPy's ``CubicSpline`` through the same knots and values (the strongest
   library baseline of issue 24; no input checks), ``M = P_a A - k' G``.
@@ -26,7 +29,9 @@ Run: ``python benchmarks/bench_kernel.py [--quick]``.
 
 from __future__ import annotations
 
+import copy
 import json
+import math
 import os
 import subprocess
 import sys
@@ -41,7 +46,7 @@ from _timing import Recorder, header, standalone
 from bench_reader import interleaved
 
 import bendpam
-from bendpam.physics.kernel import KERNEL_ENV
+from bendpam.physics.kernel import CHUNK, KERNEL_ENV, SplineKernel
 
 CASES = [("be-pam", "energy"), ("bc-pam", "force_balance")]
 P_MAX_KPA = 300.0
@@ -103,6 +108,53 @@ def _main_kernel(table, P, k, out, chunk: int = 8192) -> None:
         np.subtract(A, G, out=out[s0:s0 + chunk])
 
 
+class BeforeKernel(SplineKernel):
+    """``SplineKernel``'s NumPy kernel of commit 7e1a5ed (before this tuning), verbatim but for the names."""
+
+    def __init__(self, kern: SplineKernel):
+        super().__init__(kern.knots_per_mm, kern.coef, kern.P_start_kpa)
+        kj = self.knots_per_mm
+        self._m_lo, self._m_hi = -2.0 / float(kj[0]), -2.0 / float(kj[-1])
+        self._scale, self._shift = self._n1 / math.pi, self._n1 - 0.5
+
+    def _interval_before(self, kk: np.ndarray) -> np.ndarray:
+        r = np.where(kk < 0.0, kk * self._m_lo, kk * self._m_hi)  # -2 k / (lock-up limit on k's side)
+        r += 1.0
+        np.clip(r, -1.0, 1.0, out=r)
+        th = np.arccos(r)
+        th *= self._scale
+        np.copysign(th, kk, out=th)  # k < 0: n1 - th (left piece), k >= 0: n1 + th
+        th += self._shift
+        j = th.astype(np.intp)  # in [0, intervals): th is in [-0.5, 2 n1 - 0.5] up to rounding
+        j += kk >= np.take(self._next, j)
+        return j
+
+    def _moment_numpy(self, P, k, out) -> None:
+        z3, z2, z1, z0 = self._zcols
+        kj, Ps = self.knots_per_mm, self.P_start_kpa
+        pa_all = max(float(P[0]) - Ps, 0.0) if P.size == 1 else None
+        for s0 in range(0, k.size, CHUNK):
+            kk = k[s0:s0 + CHUNK]
+            j = self._interval_before(kk)
+            dx = (kk - np.take(kj, j)).astype(complex)
+            V = np.take(z3, j)
+            V *= dx
+            V += np.take(z2, j)
+            V *= dx
+            V += np.take(z1, j)
+            V *= dx
+            V += np.take(z0, j)
+            A, G = V.real, V.imag
+            if pa_all is None:
+                pa = P[s0:s0 + CHUNK] - Ps
+                np.maximum(pa, 0.0, out=pa)
+                A *= pa
+            else:
+                A *= pa_all
+            G *= kk
+            np.subtract(A, G, out=out[s0:s0 + CHUNK])
+
+
 def _with_kernel(name, fn):
     def run():
         old = os.environ.get(KERNEL_ENV)
@@ -133,6 +185,8 @@ def _case(rec: Recorder, name: str, model: str, n: int, reps: int) -> dict:
     spl = CubicSpline(kj, v)
     Ak, Bk = tab.coefficients(k)
     Ps = tab.P_start_kpa
+    before = copy.copy(tab)
+    before.kernel = BeforeKernel(tab.kernel)
 
     def cubic(P=P):
         v = spl(k)
@@ -141,26 +195,33 @@ def _case(rec: Recorder, name: str, model: str, n: int, reps: int) -> dict:
     out = {}
     for label, PP in (("random P", P), ("one P", 150.0)):
         cands = {"main": lambda PP=PP: main_moment(tab, PP, k),
+                 "before": _with_kernel("numpy", lambda PP=PP: before.moment(PP, k)),
                  "numpy": _with_kernel("numpy", lambda PP=PP: tab.moment(PP, k)),
                  "numba": _with_kernel("numba", lambda PP=PP: tab.moment(PP, k)),
                  "cubicspline": lambda PP=PP: cubic(PP)}
         wall, cpu = interleaved(cands, reps, n)
         st = {c: {"wall_median_s": wall[c].median, "wall_min_s": wall[c].min, "cpu_median_s": cpu[c].median,
-                  "cpu_min_s": cpu[c].min} for c in cands}
+                  "cpu_min_s": cpu[c].min, "cpu_max_s": cpu[c].max} for c in cands}
         m_np, m_nb, m_main = cands["numpy"](), cands["numba"](), cands["main"]()
+        same_before = bool(np.array_equal(m_np, cands["before"]()))
         scale = np.abs(np.maximum(np.asarray(PP) - Ps, 0.0) * Ak) + np.abs(Bk)
         scale = np.maximum(scale, 1e-3 * np.median(scale))
-        check = {"numba_equals_numpy": bool(np.array_equal(m_np, m_nb)),
+        check = {"numba_equals_numpy": bool(np.array_equal(m_np, m_nb)), "numpy_equals_before": same_before,
                  "points_differing_from_main": int(np.count_nonzero(m_np != m_main)),
                  "max_rel_diff_from_main": float(np.max(np.abs(m_np - m_main) / scale)),
                  "max_rel_diff_cubicspline": float(np.max(np.abs(cands["cubicspline"]() - m_np) / scale))}
         print(f"{name + ' ' + model:20} {label:9}" + "".join(
             f" {c}: {n / s['cpu_median_s']:.3g}/s cpu ({n / s['wall_median_s']:.3g} wall)" for c, s in st.items()))
-        print(f"{'':30} numba == numpy bit for bit: {check['numba_equals_numpy']}; differs from main at "
-              f"{check['points_differing_from_main']} of {n} points, by at most {check['max_rel_diff_from_main']:.1e} "
-              f"(relative to |P_a A| + |B|); CubicSpline within {check['max_rel_diff_cubicspline']:.1e}")
+        print(f"{'':30} NumPy kernel before -> now, CPU rate of the median (slowest) repeat: "
+              f"{n / st['before']['cpu_median_s']:.3g} ({n / st['before']['cpu_max_s']:.3g}) -> "
+              f"{n / st['numpy']['cpu_median_s']:.3g} ({n / st['numpy']['cpu_max_s']:.3g}) /s")
+        print(f"{'':30} numba == numpy bit for bit: {check['numba_equals_numpy']}, numpy == before: {same_before}; "
+              f"differs from main at {check['points_differing_from_main']} of {n} points, by at most "
+              f"{check['max_rel_diff_from_main']:.1e} (relative to |P_a A| + |B|); CubicSpline within "
+              f"{check['max_rel_diff_cubicspline']:.1e}")
         rec.record("kernel", f"{name}/{model}/{label}", {"n": n, "timing": st, "check": check})
-        out[label] = {c: n / s["cpu_median_s"] for c, s in st.items()} | {"ok": check["numba_equals_numpy"]}
+        out[label] = {c: n / s["cpu_median_s"] for c, s in st.items()} | {
+            "ok": check["numba_equals_numpy"], "same_before": same_before}
     return out
 
 
@@ -193,15 +254,17 @@ def first_use(rec: Recorder) -> dict:
 def run(rec: Recorder, quick: bool = False) -> None:
     n = 200_000 if quick else 1_000_000
     reps = 5 if quick else 15
-    header(f"Fast-path kernels: {n:,} points, main (0.4.0) vs numpy vs numba vs CubicSpline, {reps} interleaved "
-           "repeats; rates per second of one core's CPU time (median), wall-clock rate in brackets")
+    header(f"Fast-path kernels: {n:,} points, main (0.4.0) vs before vs numpy vs numba vs CubicSpline, {reps} "
+           "interleaved repeats; rates per second of one core's CPU time (median), wall-clock rate in brackets")
     rates = [_case(rec, name, model, n, reps) for name, model in CASES]
-    worst = {c: min(r[lab][c] for r in rates for lab in r) for c in ("main", "numpy", "numba", "cubicspline")}
+    worst = {c: min(r[lab][c] for r in rates for lab in r) for c in ("main", "before", "numpy", "numba", "cubicspline")}
     ident = all(r[lab]["ok"] for r in rates for lab in r)
+    same = all(r[lab]["same_before"] for r in rates for lab in r)
     rec.row("fast path, numba kernel (one core, CPU time)", worst["numba"], "evals/s", f">= {TARGET_NUMBA:.0e}",
             worst["numba"] >= TARGET_NUMBA, "worst of 2 actuators x random/one P")
     rec.row("fast path, NumPy kernel (CPU time)", worst["numpy"], "evals/s", f">= {TARGET_NUMPY:.0e}",
-            worst["numpy"] >= TARGET_NUMPY, f"main 0.4.0: {worst['main']:.3g}/s")
+            worst["numpy"] >= TARGET_NUMPY, f"before: {worst['before']:.3g}/s, main 0.4.0: {worst['main']:.3g}/s")
+    rec.row("NumPy kernel: same results as before", "yes" if same else "NO", "", "identical", same)
     rec.row("numba vs NumPy kernel: bit-identical", "yes" if ident else "NO", "", "identical", ident)
     rec.row("NumPy kernel vs CubicSpline (same knots)", worst["numpy"] / worst["cubicspline"], "x", "", None,
             f"numba {worst['numba'] / worst['cubicspline']:.3g} x")

@@ -95,6 +95,31 @@ def test_fine_table_stays_identical():
     assert np.array_equal(kern.interval(k), want)
 
 
+@pytest.mark.parametrize(("lo", "hi", "n1"), [(-1e-3, 50.0, 64), (-20.0, 1e-4, 300), (-0.5, 0.5, 2)])
+def test_unequal_limits_stay_identical(lo, hi, n1):
+    """Limits 10^4-10^5 apart: the guess without np.where or clip (1 + min(k m_lo, k m_hi)) lands on the interval."""
+    t = np.cos(np.linspace(0.0, np.pi, n1 + 1))
+    kj = np.concatenate([0.5 * lo * (1.0 + t), 0.5 * hi * (1.0 - t[1:])])
+    rng = np.random.default_rng(n1)
+    kern = SplineKernel(kj, rng.normal(size=(kj.size - 1, 8)), 25.0)
+    near0 = rng.uniform(0.0, 1e-3, 500) * (lo if -lo < hi else hi)  # near 0 on the short side
+    k = np.concatenate([_edge_points(kern, lo, hi, rng, 5000), near0])
+    a, b = _both(kern, rng.uniform(0.0, 300.0, k.size), k, lo=lo, hi=hi)
+    assert np.array_equal(a, b)
+    want = np.clip(np.searchsorted(kj, k, side="right") - 1, 0, kj.size - 2)
+    assert np.array_equal(kern.interval(k), want)
+    # outside the knots: the first or the last interval (the public method clamps; the kernels never see these)
+    assert kern.interval(np.array([2.0 * lo, -np.inf, 2.0 * hi, np.inf])).tolist() == [0, 0, kj.size - 2, kj.size - 2]
+
+
+def test_a_table_the_guess_cannot_serve_is_refused(monkeypatch):
+    monkeypatch.setattr(K, "_GUESS_TOL", 1e-9)  # as if 5 knots were 2 x 10^7: the guess would be too coarse
+    with pytest.raises(InputError, match=r"SplineKernel takes at most 2 x 10\^7 knots \(a first guess must land "
+                                         r"within a quarter interval\), not 5") as e:
+        SplineKernel(np.array([-1.0, -0.5, 0.0, 0.5, 1.0]), np.zeros((4, 8)), 10.0)
+    assert "\n" not in str(e.value)
+
+
 @settings(max_examples=8, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(actuators(), st.integers(0, 2**32 - 1))
 def test_numba_bit_identical_on_drawn_actuators(act, seed):

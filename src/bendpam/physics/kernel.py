@@ -5,7 +5,8 @@ r"""The evaluation kernels of the fast path: ``M = max(P - P_start, 0) A(k') - k
 **bit-identical** results (the same arithmetic in the same order, no fused multiply-add, no
 fast-math):
 
-* ``"numpy"``: NumPy in blocks of :data:`CHUNK` points that stay in cache, in-place ufuncs;
+* ``"numpy"``: NumPy in blocks of :data:`CHUNK` points that stay in cache, in-place ufuncs, about
+  30 NumPy calls a block;
 * ``"numba"``: one compiled loop (`numba <https://numba.pydata.org>`_, the optional extra
   ``bendpam[fast]``), with the range checks fused into the loop.  It is compiled on its first use
   in a process that asks for it (numba is imported then, never at ``import bendpam``) and cached on
@@ -48,8 +49,8 @@ __all__ = ["CHUNK", "KERNEL_ENV", "NUMBA_MIN_POINTS", "SplineKernel", "kernel_ch
 KERNEL_ENV = "BENDPAM_KERNEL"
 #: ``auto`` takes the compiled kernel for calls of at least this many points (when numba imports).
 NUMBA_MIN_POINTS = 1 << 18
-#: Points per block of the NumPy kernel: its temporaries (64 KiB each) stay in cache and below glibc's first mmap
-#: threshold (128 KiB), so a process that has not yet freed a large array does not page-fault them in afresh.
+#: Points per block of the NumPy kernel: its temporaries (64 KiB real, 128 KiB complex) stay in the L2 cache, and the
+#: call overhead (about 12 us a block) is under a tenth of a block's time; 6144-16384 measured within a few per cent.
 CHUNK = 8192
 _KERNELS = ("auto", "numpy", "numba")
 # The compiled kernel's first guess of arccos(x), x in [0, 1]: sqrt(1 - x) times a polynomial,
@@ -103,29 +104,45 @@ class SplineKernel:
         self._n1 = n1
         self._last = kj.size - 2
         self._scale = n1 / math.pi
-        if self._scale * _ACOS8_ERR >= _GUESS_TOL:
-            raise InputError(f"SplineKernel takes at most 10^7 knots, not {kj.size}")
         self._shift = n1 - 0.5  # the guess half an interval low: the true interval is the guess or the next
-        self._inv_lo, self._inv_hi = 1.0 / float(kj[0]), 1.0 / float(kj[-1])
-        self._m_lo, self._m_hi = -2.0 * self._inv_lo, -2.0 * self._inv_hi
+        lo, hi = float(kj[0]), float(kj[-1])
+        self._inv_lo, self._inv_hi = 1.0 / lo, 1.0 / hi
+        # NumPy's guess: r = 1 + k m with m = -2 / (the lock-up limit on k's side), i.e. 1 + min(k m_lo, k m_hi) (the
+        # product with the other side's m is the positive one: no np.where).  The m shrunk by 4 eps keep r in [-1, 1]
+        # through the rounding (no clip); r is then off by at most 11 eps, arccos(r) by sqrt(22 eps) rad.
+        eps = float(np.finfo(float).eps)
+        if self._scale * max(math.sqrt(22.0 * eps) + 1e-14, _ACOS8_ERR) >= _GUESS_TOL:
+            raise InputError(f"SplineKernel takes at most 2 x 10^7 knots (a first guess must land within a quarter "
+                             f"interval), not {kj.size}")
+        self._m_lo, self._m_hi = np.array(-2.0 * (1.0 - 4.0 * eps) / lo), np.array(-2.0 * (1.0 - 4.0 * eps) / hi)
+        self._sc, self._sh, self._one = np.array(self._scale), np.array(self._shift), np.array(1.0)
         self._next = np.append(kj[1:-1], np.inf)  # the knot after each interval's start (none after the last)
+        self._zk = kj[:-1].astype(complex)  # each interval's start + 0i
         self._zcols = tuple(_complex(c[:, i], c[:, 4 + i]) for i in range(4))  # a_i + i g_i
 
     def interval(self, k) -> np.ndarray:
         """The knot interval of each real curvature ``k`` (1/mm): the largest knot ``<= k``, within [0, intervals)."""
-        k = np.asarray(k, dtype=float)
-        return self._interval(k.reshape(-1)).reshape(k.shape)
+        kk = np.minimum(np.asarray(k, dtype=float).reshape(-1), self.knots_per_mm[-1])
+        np.maximum(kk, self.knots_per_mm[0], out=kk)  # outside the knots: the first or the last interval
+        j = np.empty(kk.size, dtype=np.intp)
+        t, r = np.empty(min(CHUNK, kk.size)), np.empty(min(CHUNK, kk.size))
+        for s0 in range(0, kk.size, CHUNK):
+            m = min(CHUNK, kk.size - s0)
+            j[s0:s0 + m] = self._interval(kk[s0:s0 + m], t[:m], r[:m])
+        return j.reshape(np.shape(k))
 
-    def _interval(self, kk: np.ndarray) -> np.ndarray:
-        r = np.where(kk < 0.0, kk * self._m_lo, kk * self._m_hi)  # -2 k / (lock-up limit on k's side)
-        r += 1.0
-        np.clip(r, -1.0, 1.0, out=r)
-        th = np.arccos(r)
-        th *= self._scale
-        np.copysign(th, kk, out=th)  # k < 0: n1 - th (left piece), k >= 0: n1 + th
-        th += self._shift
-        j = th.astype(np.intp)  # in [0, intervals): th is in [-0.5, 2 n1 - 0.5] up to rounding
-        j += kk >= np.take(self._next, j)
+    def _interval(self, kk: np.ndarray, t: np.ndarray, r: np.ndarray) -> np.ndarray:
+        """The intervals of curvatures within the knots (``t``, ``r``: work arrays of ``kk``'s size)."""
+        np.multiply(kk, self._m_lo, out=t)
+        np.multiply(kk, self._m_hi, out=r)
+        np.minimum(r, t, out=r)
+        r += self._one  # 1 - 2 k / (lock-up limit on k's side), in [-1, 1]
+        np.arccos(r, out=r)
+        r *= self._sc
+        np.copysign(r, kk, out=r)  # k < 0: n1 - th (left piece), k >= 0: n1 + th
+        r += self._sh
+        j = r.astype(np.intp)  # in [0, intervals): r is in [-0.5, 2 n1 - 0.5] up to rounding
+        j += kk >= self._next.take(j)
         return j
 
     def evaluate(self, P, k, out, limit_kpa: float, k_min: float, k_max: float,
@@ -156,26 +173,31 @@ class SplineKernel:
         ``A`` and ``G`` run through Horner's steps together as one complex number ``A + iG`` (four
         gathers instead of eight): a product with ``dx + 0i`` is ``(a dx - g 0) + i (a 0 + g dx)``,
         and with one product exactly zero each part is ``a dx`` and ``g dx`` rounded once, as in the
-        compiled loop's real arithmetic.
+        compiled loop's real arithmetic.  Constants are 0-d arrays and gathers ``ndarray.take`` (the
+        cheapest calls: a block spends a tenth of its time in call overhead).
         """
         z3, z2, z1, z0 = self._zcols
-        kj, Ps = self.knots_per_mm, self.P_start_kpa
-        pa_all = max(float(P[0]) - Ps, 0.0) if P.size == 1 else None
+        zk, Ps, zero = self._zk, np.array(self.P_start_kpa), np.array(0.0)
+        pa_all = np.array(max(float(P[0]) - self.P_start_kpa, 0.0)) if P.size == 1 else None
+        t, r = np.empty(min(CHUNK, k.size)), np.empty(min(CHUNK, k.size))
         for s0 in range(0, k.size, CHUNK):
             kk = k[s0:s0 + CHUNK]
-            j = self._interval(kk)
-            dx = (kk - np.take(kj, j)).astype(complex)
-            V = np.take(z3, j)
+            if kk.size < t.size:
+                t, r = t[:kk.size], r[:kk.size]
+            j = self._interval(kk, t, r)
+            dx = zk.take(j)  # knot + 0i
+            np.subtract(kk, dx.real, out=dx.real)  # k - knot + 0i
+            V = z3.take(j)
             V *= dx
-            V += np.take(z2, j)
+            V += z2.take(j)
             V *= dx
-            V += np.take(z1, j)
+            V += z1.take(j)
             V *= dx
-            V += np.take(z0, j)
+            V += z0.take(j)
             A, G = V.real, V.imag
             if pa_all is None:
-                pa = P[s0:s0 + CHUNK] - Ps
-                np.maximum(pa, 0.0, out=pa)
+                pa = np.subtract(P[s0:s0 + CHUNK], Ps, out=t)
+                np.maximum(pa, zero, out=pa)
                 A *= pa
             else:
                 A *= pa_all
