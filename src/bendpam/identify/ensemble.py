@@ -42,7 +42,9 @@ friction amplitude ``A(P)`` every member shares), so it cannot be refitted as a 
 
 from __future__ import annotations
 
+import dataclasses
 import math
+from typing import NamedTuple
 
 import numpy as np
 
@@ -50,7 +52,22 @@ from bendpam.identify.data import FitData
 from bendpam.identify.result import PARAMETERS, EnsembleMember, UncertaintyBudget, parameter_field
 from bendpam.identify.uncertainty import Uncertainty, lag1_autocorrelation, material_gradients
 
-__all__ = ["akaike_weights", "effective_points", "steady_z", "systematic_covariance", "uncertainty_budget"]
+__all__ = ["MEMBER_EXTRA", "MemberFit", "akaike_weights", "effective_points", "model_average", "played_path",
+           "steady_z", "systematic_covariance", "uncertainty_budget"]
+
+#: The parameters a member of the ensemble adds to the reported fit's: the standard linear solid's second pair
+#: of amplitudes (its Maxwell branch; the first pair weighs the dashpot) and the play's gap (deg).
+MEMBER_EXTRA: dict[str, tuple[str, ...]] = {"zener": ("a0_2", "a1_2"), "pi_play": ("gap",)}
+
+
+class MemberFit(NamedTuple):
+    """One member's fit: its values by short name, its weighted sum of squares and its own statistical
+    covariance (``names`` its order; an empty ``names`` takes the reported fit's)."""
+
+    values: dict[str, float]
+    ssr: float
+    names: tuple[str, ...] = ()
+    cov: np.ndarray | None = None
 
 
 def steady_z(law: str, theta_deg: float, d: FitData) -> np.ndarray:
@@ -70,6 +87,10 @@ def steady_z(law: str, theta_deg: float, d: FitData) -> np.ndarray:
     from bendpam.physics.hysteresis import ViscousLoop, make_law
 
     assert d.branch is not None and d.delta is not None and d.span is not None, "a loop fit is built on branch data"
+    if law == "zener":
+        return _zener(theta_deg, d)
+    if law == "pi_play":
+        law = "pi"
     if law == "viscous" and getattr(d, "time_s", None) is not None:
         return _viscous_in_time(math.radians(theta_deg), d)
     if law == "viscous" and getattr(d, "rate", None) is not None:
@@ -85,6 +106,78 @@ def steady_z(law: str, theta_deg: float, d: FitData) -> np.ndarray:
     else:
         z_away, z_back = make_law(law, theta_deg).steady_branches(d.delta, d.span)
     return np.where(d.branch < 0, z_away, z_back)
+
+
+def _zener(theta_deg: float, d: FitData) -> np.ndarray:
+    """The standard linear solid's two parts (rows x 2): the dashpot's rate and the Maxwell branch's ``z``.
+
+    The dashpot's part is the bending rate of each branch point over the fastest of the set (from the
+    test's own times; without them the fixture's rate profile at a constant crosshead speed, or a
+    constant rate), signed as ``z``; the Maxwell branch is the ``"viscous"`` member's.
+    """
+    assert d.branch is not None and d.delta is not None
+    sign = np.where(d.branch < 0, 1.0, -1.0)
+    z_m = steady_z("viscous", theta_deg, d)
+    if getattr(d, "time_s", None) is not None:
+        rate = np.zeros(d.kc.size)
+        for r in d.branch_rows.values():
+            if r.size > 1:
+                rate[r] = np.abs(np.gradient(d.delta[r], d.time_s[r]))
+        top = float(np.max(rate))
+        z_d = sign * (rate / top if top > 0 else np.ones(rate.size))
+    else:
+        z_d = sign * (d.rate if getattr(d, "rate", None) is not None else np.ones(d.kc.size))
+    return np.column_stack([z_d, z_m])
+
+
+def played_path(d: FitData, gap_deg: float) -> tuple[np.ndarray, np.ndarray, FitData]:
+    """The path behind a fixture's dead zone: ``(curvatures, moment factors, data with the played loop path)``.
+
+    The crosshead closes a gap of ``gap_deg`` (the bending angle it is worth at the straight state) at each
+    reversal before the plates follow: a play operator (:func:`bendpam.physics.hysteresis.play`) on the
+    stroke, anchored at the blocked state reached by pushing.  Leaving the blocked state the plates lag,
+    ``theta_p = theta - gap r(k)`` (``r`` the fixture's rate profile ``dbeta/ds`` over its straight-state value,
+    :attr:`FitData.rate`: the gap's angle shrinks as the plates pitch; 1 where the fixture is not known), held
+    at 0 while the gap closes; going back they stay at the lagged free end until the crosshead reaches it.
+    The quasi-static moment is the model's at the played curvature, converted by the processing at the
+    measured angle: the factor ``r(k_p) / r(k)`` (eq 7, ``lever = 1 / (2 dbeta/ds)``).  ``delta`` and ``span``
+    of the returned data are the played loop path's.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as NS
+    >>> d = NS(kc=np.array([0.0, 0.005, 0.01, 0.01, 0.005, 0.0]), branch=np.array([-1, -1, -1, 1, 1, 1]),
+    ...        delta=np.array([0.0, 0.5, 1.0, 0.0, 0.5, 1.0]), span=np.full(6, 1.0), K=np.array([0.01]),
+    ...        seg=np.zeros(6, int), rate=None)
+    >>> kq, fac, dp = played_path(d, float(np.degrees(0.2)))   # 0.2 rad: away 0, 0.3, 0.8; back 0.8, 0.5, 0
+    >>> (kq * 1e3).round(6).tolist(), dp.delta.round(6).tolist(), float(dp.span[0])
+    ([0.0, 3.0, 8.0, 8.0, 5.0, 0.0], [0.0, 0.3, 0.8, 0.0, 0.3, 0.8], 0.8)
+    """
+    assert d.branch is not None and d.delta is not None and d.span is not None
+    g = math.radians(float(gap_deg))
+    span = np.asarray(d.span, dtype=float)
+    away = d.branch < 0
+    th = np.where(away, d.delta, span - d.delta)  # the measured bending angle
+    rate = getattr(d, "rate", None)
+    if rate is None:
+        def r_of(k):
+            return np.ones(np.shape(k))
+    else:
+        o = np.argsort(d.kc, kind="stable")
+        def r_of(k):
+            return np.interp(k, d.kc[o], rate[o])
+    K = np.asarray(d.K, dtype=float)[d.seg]
+    to_k = np.divide(K, span, out=np.zeros(span.size), where=span > 0)  # 1 / L0
+    end = np.maximum(span - g * r_of(K), 0.0)  # the played free end
+    th_p = np.where(away, np.clip(th - g * r_of(d.kc), 0.0, end), np.minimum(th, end))
+    kq = th_p * to_k
+    fac = r_of(kq) / r_of(d.kc)
+    played = {"delta": np.where(away, th_p, end - th_p), "span": end}
+    if dataclasses.is_dataclass(d) and not isinstance(d, type):
+        return kq, fac, dataclasses.replace(d, **played)
+    from types import SimpleNamespace
+
+    return kq, fac, SimpleNamespace(**{**vars(d), **played})
 
 
 def _branch_response(t: np.ndarray, delta: np.ndarray, end: float, tau: float, w_ref: float, n: int = 400):
@@ -204,17 +297,60 @@ def _material(values: dict[str, float], fitted) -> tuple[float, float]:
     return 2.0 * S, (c01 / S if S else math.nan)
 
 
-def uncertainty_budget(unc: Uncertainty, fitted, fits: dict[str, tuple[dict[str, float], float]], r: np.ndarray,
-                       groups: np.ndarray, law: str | None, n_resampled: int) -> UncertaintyBudget:
-    """Set ``unc``'s systematic covariance from the loop laws' fits and return the two parts of the errors.
+def model_average(values: np.ndarray, covs: np.ndarray, weights: np.ndarray):
+    """Burnham & Anderson's model-averaged estimate and its unconditional covariance, in two parts.
+
+    ``v_bar = sum_i w_i v_i``; statistical ``sum_i w_i C_i`` (each member's own covariance ``C_i``) and
+    systematic ``sum_i w_i (v_i - v_bar)(v_i - v_bar)^T`` (the members' spread about the average).  ``values``
+    has one row per member, ``covs`` one matrix per member; rows with a NaN (failed refits) are left out.
+
+    >>> v_bar, stat, sys_ = model_average(np.array([[1.0], [3.0]]), np.array([[[0.5]], [[0.5]]]), np.array([0.5, 0.5]))
+    >>> v_bar.tolist(), stat.tolist(), sys_.tolist()
+    ([2.0], [[0.5]], [[1.0]])
+    """
+    v, c = np.asarray(values, dtype=float), np.asarray(covs, dtype=float)
+    ok = np.all(np.isfinite(v), axis=1) & np.all(np.isfinite(c), axis=(1, 2))
+    w = np.asarray(weights, dtype=float)[ok]
+    if not ok.any() or w.sum() <= 0:
+        p = v.shape[1]
+        return np.full(p, math.nan), np.zeros((p, p)), np.zeros((p, p))
+    w = w / w.sum()
+    v_bar = w @ v[ok]
+    return v_bar, np.einsum("i,ijk->jk", w, c[ok]), systematic_covariance(v_bar, v[ok], w)
+
+
+def _member_covariances(unc: Uncertainty, fits: dict, laws: list[str], idx: list[int]) -> np.ndarray:
+    """Each member's own statistical covariance of the model parameters ``idx`` of ``unc.names`` (the reported
+    fit's where a member brings none)."""
+    names = [unc.names[j] for j in idx]
+    out = []
+    for k in laws:
+        f = fits[k]
+        own, cov = tuple(getattr(f, "names", ())), getattr(f, "cov", None)
+        if cov is None or not set(names) <= set(own):
+            out.append(unc.cov_stat[np.ix_(idx, idx)])
+        else:
+            j = [own.index(n) for n in names]
+            out.append(np.asarray(cov)[np.ix_(j, j)])
+    return np.array(out).reshape(len(laws), len(idx), len(idx))
+
+
+def uncertainty_budget(unc: Uncertainty, fitted, fits: dict, r: np.ndarray, groups: np.ndarray, law: str | None,
+                       n_resampled: int) -> UncertaintyBudget:
+    """Average the model parameters over the loop laws' fits (in ``unc``) and return the two parts of the errors.
+
+    With an ensemble the reported model parameters become the Akaike-weighted average of the members'
+    (:func:`model_average`), their statistical covariance the weighted average of the members' own, and
+    their systematic covariance the members' weighted spread about the average: Burnham & Anderson's
+    unconditional variance.  The loop's own parameters stay the reported law's.
 
     Parameters
     ----------
-    unc : the fit's :class:`~bendpam.identify.uncertainty.Uncertainty` (statistical); its systematic
-        covariance is set here.
+    unc : the fit's :class:`~bendpam.identify.uncertainty.Uncertainty`; its model parameters, statistical
+        and systematic covariance are set here.
     fitted : the fitted actuator (for the shear modulus and shape of the ensemble's members).
-    fits : ``{law: (values by short name, weighted sum of squares)}``, the reported law first; empty:
-        no ensemble (no loop model, or switched off).
+    fits : ``{law: MemberFit}`` (or ``(values by short name, weighted sum of squares)``: the reported fit's
+        covariance), the reported law first; empty: no ensemble (no loop model, or switched off).
     r, groups : the reported fit's weighted residuals and their groups (for the effective points).
     law : the reported law (None: mean curves).
     n_resampled : how many tests had their cycles resampled.
@@ -226,8 +362,8 @@ def uncertainty_budget(unc: Uncertainty, fitted, fits: dict[str, tuple[dict[str,
     >>> unc = Uncertainty({"alpha0": 70.0}, ["alpha0"], np.array([[0.0009]]), 0.0, 0, {}, 0.0, 40, 0.95)
     >>> fits = {"pi": ({"alpha0": 70.0}, 1.0), "dahl": ({"alpha0": 70.4}, 1.0)}
     >>> b = uncertainty_budget(unc, bendpam.physics.presets.be_pam(), fits, np.ones(40), np.zeros(40, int), "pi", 0)
-    >>> b.statistical, b.systematic, [m.weight for m in b.ensemble]     # equal fits: half the weight each
-    ({'alpha0_deg': 0.03}, {'alpha0_deg': 0.2}, [0.5, 0.5])
+    >>> unc.values["alpha0"], b.statistical, b.systematic, [m.weight for m in b.ensemble]   # equal fits
+    (70.2, {'alpha0_deg': 0.03}, {'alpha0_deg': 0.2}, [0.5, 0.5])
     """
     names = unc.names
     members: list[EnsembleMember] = []
@@ -236,18 +372,21 @@ def uncertainty_budget(unc: Uncertainty, fitted, fits: dict[str, tuple[dict[str,
         m_eff = effective_points(r, groups)
         laws = list(fits)
         w = akaike_weights([fits[k][1] for k in laws], m_eff)
-        ref = np.array([unc.values[n] for n in names])
-        V = np.array([[fits[k][0].get(n, math.nan) if n in PARAMETERS else ref[j] for j, n in enumerate(names)]
-                      for k in laws])
-        unc.set_systematic(systematic_covariance(ref, V, w))
+        idx = [j for j, n in enumerate(names) if n in PARAMETERS]
+        V = np.array([[fits[k][0].get(names[j], math.nan) for j in idx] for k in laws]).reshape(len(laws), len(idx))
+        v_bar, c_stat, c_sys = model_average(V, _member_covariances(unc, fits, laws, idx), w)
+        if np.all(np.isfinite(v_bar)):
+            unc.average(idx, v_bar, c_stat, c_sys)
+            fitted = fitted.replace(**{PARAMETERS[names[j]][0]: float(v) for j, v in zip(idx, v_bar, strict=True)})
         for k, wk in zip(laws, w, strict=True):
             vals = {parameter_field(n): float(fits[k][0][n]) for n in names if n in PARAMETERS}
             if "C10" in names or "C01" in names:
                 vals["shear_modulus_kpa"], vals["shape"] = _material(fits[k][0], fitted)
             members.append(EnsembleMember(k, float(wk), math.sqrt(max(fits[k][1], 0.0)), vals))
         weighting = (f"Akaike weights on {m_eff:.0f} effective points (the {r.size} residuals discounted for their "
-                     "lag-1 autocorrelation); systematic part: the weighted spread of the laws' values about the "
-                     f"reported ({law}) fit")
+                     "lag-1 autocorrelation); reported: the weighted average of the laws' values, with Burnham & "
+                     "Anderson's unconditional variance (statistical: the laws' own covariances, weighted; "
+                     f"systematic: their weighted spread about the average); the loop's parameters are the {law} fit's")
     stat = {parameter_field(n): float(v) for n, v in zip(names, unc.sd_stat, strict=True)}
     sys_ = {parameter_field(n): float(v) for n, v in zip(names, unc.sd_sys, strict=True)}
     if "C10" in names or "C01" in names:
