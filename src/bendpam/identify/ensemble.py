@@ -56,8 +56,9 @@ __all__ = ["MEMBER_EXTRA", "MemberFit", "akaike_weights", "effective_points", "m
            "steady_z", "systematic_covariance", "uncertainty_budget"]
 
 #: The parameters a member of the ensemble adds to the reported fit's: the standard linear solid's second pair
-#: of amplitudes (its Maxwell branch; the first pair weighs the dashpot) and the play's gap (deg).
-MEMBER_EXTRA: dict[str, tuple[str, ...]] = {"zener": ("a0_2", "a1_2"), "pi_play": ("gap",)}
+#: of amplitudes (its Maxwell branch; the first pair weighs the dashpot), the play's gap (deg) and the breakaway
+#: law's static-to-kinetic friction ratio.
+MEMBER_EXTRA: dict[str, tuple[str, ...]] = {"zener": ("a0_2", "a1_2"), "pi_play": ("gap",), "stiction": ("ratio",)}
 
 
 class MemberFit(NamedTuple):
@@ -70,11 +71,12 @@ class MemberFit(NamedTuple):
     cov: np.ndarray | None = None
 
 
-def steady_z(law: str, theta_deg: float, d: FitData) -> np.ndarray:
+def steady_z(law: str, theta_deg: float, d: FitData, ratio: float | None = None) -> np.ndarray:
     """The loop variable ``z`` of every point of ``d`` on the steady cycle of ``law`` (angle in degrees).
 
     ``d`` holds both branches (:func:`bendpam.identify.data.branch_data`); the unloading branch
-    (``branch < 0``) leaves the blocked state.
+    (``branch < 0``) leaves the blocked state.  ``ratio`` is the breakaway law's static-to-kinetic friction
+    ratio (``"stiction"``; default that of :class:`~bendpam.physics.hysteresis.Breakaway`).
 
     Examples
     --------
@@ -84,13 +86,16 @@ def steady_z(law: str, theta_deg: float, d: FitData) -> np.ndarray:
     >>> steady_z("dahl", 5.0, d).round(3).tolist()   # turning points +-(1 - E)/(1 + E), E = exp(-0.2 rad / 5 deg)
     [0.816, -0.816]
     """
-    from bendpam.physics.hysteresis import ViscousLoop, make_law
+    from bendpam.physics.hysteresis import Breakaway, ViscousLoop, make_law
 
     assert d.branch is not None and d.delta is not None and d.span is not None, "a loop fit is built on branch data"
     if law == "zener":
         return _zener(theta_deg, d)
     if law == "pi_play":
         law = "pi"
+    if law == "stiction" and ratio is not None:
+        z_away, z_back = Breakaway(math.radians(theta_deg), ratio=max(float(ratio), 1.0)).steady_branches(d.delta, d.span)
+        return np.where(d.branch < 0, z_away, z_back)
     if law == "viscous" and getattr(d, "time_s", None) is not None:
         return _viscous_in_time(math.radians(theta_deg), d)
     if law == "viscous" and getattr(d, "rate", None) is not None:

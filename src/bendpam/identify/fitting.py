@@ -246,7 +246,7 @@ class _Problem:
     def set_free(self, free: list[str]) -> None:
         """The varied parameters: the nonlinear ones (searched) and the linear ones (projected)."""
         self.free = list(free)
-        self.nonlin = [p for p in self.free if p in _NONLINEAR or p in ("theta_h", "gap")]
+        self.nonlin = [p for p in self.free if p in _NONLINEAR or p in ("theta_h", "gap", "ratio")]
         self.lin = [p for p in self.free if p not in self.nonlin]
         self.cone = "C10" in self.lin and "C01" in self.lin
         self.int_names, self.T, self.lo, self.hi = self._internal()
@@ -340,14 +340,14 @@ class _Problem:
             hit = self._z_cache[("played", gap)] = played_path(self.d, gap)
         return hit
 
-    def _z(self, theta_deg: float, gap: float = 0.0) -> np.ndarray:
-        z = self._z_cache.get((theta_deg, gap))
+    def _z(self, theta_deg: float, gap: float = 0.0, ratio: float | None = None) -> np.ndarray:
+        z = self._z_cache.get((theta_deg, gap, ratio))
         if z is None:
             if len(self._z_cache) > 256:
                 self._z_cache.clear()
             assert self.law is not None, "a loop fit has a law"
-            z = steady_z(self.law, theta_deg, self.d if gap <= 0 else self._played(gap)[2])
-            self._z_cache[(theta_deg, gap)] = z
+            z = steady_z(self.law, theta_deg, self.d if gap <= 0 else self._played(gap)[2], ratio)
+            self._z_cache[(theta_deg, gap, ratio)] = z
         return z
 
     def design(self, nl: dict[str, float]):
@@ -361,7 +361,7 @@ class _Problem:
             if p not in self.lin:
                 c0 = c0 + col * fixed[p]
         if self.law:
-            z = self._z(float(nl["theta_h"]), float(nl.get("gap", 0.0))).reshape(d.kc.size, -1)
+            z = self._z(float(nl["theta_h"]), float(nl.get("gap", 0.0)), nl.get("ratio")).reshape(d.kc.size, -1)
             pa = np.maximum(d.Pc - a.P_start_kpa, 0.0)
             for j, (n0, n1) in enumerate((("a0", "a1"), ("a0_2", "a1_2"))[: z.shape[1]]):
                 cols[n0], cols[n1] = -z[:, j], -z[:, j] * pa
@@ -591,7 +591,7 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool):
 def _bounds(actuator: Actuator, d: FitData, bounds) -> dict[str, tuple[float, float]]:
     bnd = _default_bounds(actuator, float(d.P.min()))
     bnd.update({"theta_h": (0.2, 90.0), "a0": (0.0, 10.0 * float(d.BM.max())), "a1": (0.0, 100.0), "gap": (0.0, 5.0)})
-    bnd.update({"a0_2": bnd["a0"], "a1_2": bnd["a1"]})  # the ensemble's standard linear solid's second amplitudes
+    bnd.update({"a0_2": bnd["a0"], "a1_2": bnd["a1"], "ratio": (1.0, 3.0)})  # the ensemble members' own
     for k, v in (bounds or {}).items():
         key = "shape" if str(k).strip().lower() in ("shape", "beta") else parse_free([k])[0]
         try:
@@ -826,9 +826,13 @@ def _law_refit(prob: _Problem, bnd, nl, alt: str, corr_flag: float, cycles=(), o
         p2.set_free([*prob.free, *extra])
     nfev = 0
     best = (math.inf, dict(nl))
+    own = {"gap": (0.25, 0.5, 1.0, 2.0), "ratio": (1.2, 1.5, 2.0)}  # short grids of the members' own parameters
+    grid: list[dict[str, float]] = [{}]
+    for p in extra:
+        grid = [{**g, p: v} for g in grid for v in own[p]] if p in own else grid
     for th in _THETA_GRID:
-        for g in ((0.25, 0.5, 1.0, 2.0) if "gap" in extra else (None,)):
-            trial = {**nl, "theta_h": float(th), **({} if g is None else {"gap": g})}
+        for g in grid:
+            trial = {**nl, "theta_h": float(th), **g}
             r, _ = p2.project(trial)
             nfev += 1
             if float(r @ r) < best[0]:
