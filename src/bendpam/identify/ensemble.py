@@ -89,8 +89,8 @@ def steady_z(law: str, theta_deg: float, d: FitData, ratio: float | None = None)
     from bendpam.physics.hysteresis import Breakaway, ViscousLoop, make_law
 
     assert d.branch is not None and d.delta is not None and d.span is not None, "a loop fit is built on branch data"
-    if law == "zener":
-        return _zener(theta_deg, d)
+    if law in ("zener", "dashpot"):  # "dashpot": the dashpot's part alone (its Maxwell column 0)
+        return _zener(theta_deg, d, law == "zener")
     if law == "pi_play":
         law = "pi"
     if law == "stiction" and ratio is not None:
@@ -113,7 +113,7 @@ def steady_z(law: str, theta_deg: float, d: FitData, ratio: float | None = None)
     return np.where(d.branch < 0, z_away, z_back)
 
 
-def _zener(theta_deg: float, d: FitData) -> np.ndarray:
+def _zener(theta_deg: float, d: FitData, with_maxwell: bool = True) -> np.ndarray:
     """The standard linear solid's two parts (rows x 2): the dashpot's rate and the Maxwell branch's ``z``.
 
     The dashpot's part is the bending rate of each branch point over the fastest of the set (from the
@@ -122,7 +122,7 @@ def _zener(theta_deg: float, d: FitData) -> np.ndarray:
     """
     assert d.branch is not None and d.delta is not None
     sign = np.where(d.branch < 0, 1.0, -1.0)
-    z_m = steady_z("viscous", theta_deg, d)
+    z_m = steady_z("viscous", theta_deg, d) if with_maxwell else np.zeros(d.kc.size)
     if getattr(d, "time_s", None) is not None:
         rate = np.zeros(d.kc.size)
         for r in d.branch_rows.values():

@@ -117,7 +117,15 @@ from bendpam.identify.diagnose import (
     has_loop,
     identifiability,
 )
-from bendpam.identify.ensemble import MEMBER_EXTRA, MemberFit, played_path, steady_z, uncertainty_budget
+from bendpam.identify.ensemble import (
+    MEMBER_EXTRA,
+    MemberFit,
+    akaike_weights,
+    effective_points,
+    played_path,
+    steady_z,
+    uncertainty_budget,
+)
 from bendpam.identify.metrics import score
 from bendpam.identify.numerics import bounded_lstsq, chebyshev_interpolation, halfline
 from bendpam.identify.result import (
@@ -340,14 +348,19 @@ class _Problem:
             hit = self._z_cache[("played", gap)] = played_path(self.d, gap)
         return hit
 
-    def _z(self, theta_deg: float, gap: float = 0.0, ratio: float | None = None) -> np.ndarray:
-        z = self._z_cache.get((theta_deg, gap, ratio))
+    def _z(self, theta_deg: float, gap: float = 0.0, ratio: float | None = None, law: str | None = None):
+        law = law or self.law
+        key = (law, theta_deg, gap, ratio)  # the cache is shared by the ensemble's members
+        z = self._z_cache.get(key)
         if z is None:
-            if len(self._z_cache) > 256:
+            if len(self._z_cache) > 512:
                 self._z_cache.clear()
-            assert self.law is not None, "a loop fit has a law"
-            z = steady_z(self.law, theta_deg, self.d if gap <= 0 else self._played(gap)[2], ratio)
-            self._z_cache[(theta_deg, gap, ratio)] = z
+            assert law is not None, "a loop fit has a law"
+            if law == "zener":  # the dashpot's part, and the viscous member's Maxwell branch (cached)
+                z = np.column_stack([self._z(0.0, law="dashpot")[:, 0], self._z(theta_deg, law="viscous")])
+            else:
+                z = steady_z(law, theta_deg, self.d if gap <= 0 else self._played(gap)[2], ratio)
+            self._z_cache[key] = z
         return z
 
     def design(self, nl: dict[str, float]):
@@ -570,13 +583,21 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool):
     if run.law and law_uncertainty:
         fits[run.law] = MemberFit(dict(unc.values), _ssr(run.prob, run.nl, run.lin), tuple(unc.names),
                                   unc.cov_stat.copy())
+        solved = {}
         for alt in (a for a in ENSEMBLE if a != run.law):
             try:
-                fits[alt], n = _law_refit(run.prob, run.bnd, run.nl, alt, corr_flag, run.cycles, run.offsets)
+                fits[alt], n, solved[alt] = _law_refit(run.prob, run.bnd, run.nl, alt)
             except FitError:  # this law cannot describe the curves at all: it has no weight
                 continue
             run.nfev += n
     r = run.prob.residual_full(np.concatenate([[run.nl[p] for p in run.prob.nonlin], run.lin]))
+    if fits:  # each member's own statistical covariance, where it has weight (the others add nothing)
+        w = akaike_weights([f.ssr for f in fits.values()], effective_points(r, run.prob.groups))
+        for (alt, f), wk in zip(list(fits.items()), w, strict=True):
+            if alt in solved and wk > 1e-4:
+                u2 = _uncertainty(*solved[alt][:1], run.bnd, *solved[alt][1:], corr_flag, run.cycles, run.offsets)
+                fits[alt] = f._replace(names=tuple(u2.names), cov=u2.cov_stat)
+                run.nfev += u2.nfev
     shape_bound = unc.at_bound.get("S_lo", False) or unc.at_bound.get("S_hi", False)
     budget = uncertainty_budget(unc, run.prob.actuator(unc.values), fits, r, run.prob.groups, run.law,
                                 0 if shape_bound else len(run.cycles))
@@ -812,21 +833,22 @@ def _uncertainty(prob: _Problem, bnd, nl_best, lin, corr_flag: float, cycles=(),
     return Uncertainty(values, names, cov, rho, nfev, bound_names, float(r @ r), m, corr_flag)
 
 
-def _law_refit(prob: _Problem, bnd, nl, alt: str, corr_flag: float, cycles=(), offsets=()):
-    """The fit with another loop law ``alt`` (warm start, angle grid) and its own statistical covariance:
-    ``(MemberFit, nfev)``.  A member with parameters of its own (:data:`~bendpam.identify.ensemble.MEMBER_EXTRA`)
-    varies them too (the play's gap from a short grid).
+def _law_refit(prob: _Problem, bnd, nl, alt: str):
+    """The fit with another loop law ``alt`` (warm start, angle grid): ``(MemberFit without its covariance, nfev,
+    (problem, nonlinear, linear values))``.  A member with parameters of its own
+    (:data:`~bendpam.identify.ensemble.MEMBER_EXTRA`) varies them too, from short grids.
 
-    The search stops at ``xtol = 1e-7``: the ensemble's values need to be good to well within their spread.
+    The search stops at ``xtol = 1e-5`` (alpha0 to about 1e-3 deg): the ensemble's values need to be good to well
+    within their standard errors, not to the last digit.
     """
-    p2 = copy.copy(prob)  # the same data and kinematics (their cache is shared), another loop law
-    p2.law, p2._z_cache = alt, {}
+    p2 = copy.copy(prob)  # the same data and kinematics (their caches are shared), another loop law
+    p2.law = alt
     extra = MEMBER_EXTRA.get(alt, ())
     if extra:
         p2.set_free([*prob.free, *extra])
     nfev = 0
     best = (math.inf, dict(nl))
-    own = {"gap": (0.25, 0.5, 1.0, 2.0), "ratio": (1.2, 1.5, 2.0)}  # short grids of the members' own parameters
+    own = {"gap": (0.25, 0.5, 1.0, 2.0), "ratio": (1.25, 1.75)}  # short grids of the members' own parameters
     grid: list[dict[str, float]] = [{}]
     for p in extra:
         grid = [{**g, p: v} for g in grid for v in own[p]] if p in own else grid
@@ -837,9 +859,8 @@ def _law_refit(prob: _Problem, bnd, nl, alt: str, corr_flag: float, cycles=(), o
             nfev += 1
             if float(r @ r) < best[0]:
                 best = (float(r @ r), trial)
-    nl2, lin2, _, _, n = _search(p2, bnd, best, tol=1e-7)
-    u2 = _uncertainty(p2, bnd, nl2, lin2, corr_flag, cycles, offsets)
-    return MemberFit(p2.to_user(nl2, lin2), _ssr(p2, nl2, lin2), tuple(u2.names), u2.cov_stat), nfev + n + u2.nfev
+    nl2, lin2, _, _, n = _search(p2, bnd, best, tol=1e-5)
+    return MemberFit(p2.to_user(nl2, lin2), _ssr(p2, nl2, lin2)), nfev + n, (p2, nl2, lin2)
 
 
 def _profile(prob: _Problem, bnd, nl, unc: Uncertainty, n_points: int):

@@ -586,9 +586,11 @@ class Breakaway:
         is too narrow to break away, ``z_b = ratio span / (2 theta_s)``).
         """
         span = np.asarray(span, dtype=float)
-        zb = np.ones(span.shape)
+        spans, inverse = np.unique(span, return_inverse=True)  # the fixed point once per distinct span
+        zb = np.ones(spans.shape)
         for _ in range(40):
-            zb = 0.5 * (zb + self._branch(-zb, span))
+            zb = 0.5 * (zb + self._branch(-zb, spans))
+        zb = zb[inverse].reshape(span.shape)
         up = self._branch(-zb, np.minimum(np.asarray(delta, dtype=float), span))
         return up, -up
 
