@@ -58,17 +58,20 @@ __all__ = ["MEMBER_EXTRA", "MemberFit", "akaike_weights", "effective_points", "m
 #: The parameters a member of the ensemble adds to the reported fit's: the standard linear solid's second pair
 #: of amplitudes (its Maxwell branch; the first pair weighs the dashpot), the play's gap (deg) and the breakaway
 #: law's static-to-kinetic friction ratio.
-MEMBER_EXTRA: dict[str, tuple[str, ...]] = {"zener": ("a0_2", "a1_2"), "pi_play": ("gap",), "stiction": ("ratio",)}
+MEMBER_EXTRA: dict[str, tuple[str, ...]] = {"zener": ("a0_2", "a1_2"), "pi_play": ("gap",), "stiction": ("ratio",),
+                                             "pi_maxwell": ("theta_2", "a0_2", "a1_2")}
 
 
 class MemberFit(NamedTuple):
-    """One member's fit: its values by short name, its weighted sum of squares and its own statistical
-    covariance (``names`` its order; an empty ``names`` takes the reported fit's)."""
+    """One member's fit: its values by short name, its weighted sum of squares, its own statistical
+    covariance (``names`` its order; an empty ``names`` takes the reported fit's) and how many parameters
+    it varies (``n_params``; 0: as many as every other member)."""
 
     values: dict[str, float]
     ssr: float
     names: tuple[str, ...] = ()
     cov: np.ndarray | None = None
+    n_params: int = 0
 
 
 def steady_z(law: str, theta_deg: float, d: FitData, ratio: float | None = None) -> np.ndarray:
@@ -257,21 +260,31 @@ def effective_points(r: np.ndarray, groups: np.ndarray) -> float:
     return max(total, 1.0)
 
 
-def akaike_weights(ssr, m_eff: float) -> np.ndarray:
-    """Akaike weights of models with equal parameter counts from their sums of squares.
+def akaike_weights(ssr, m_eff: float, n_params=None) -> np.ndarray:
+    """Akaike weights of least-squares models from their sums of squares and parameter counts (AICc).
+
+    ``AICc_i = m_eff ln(SSR_i) + 2 k_i + 2 k_i (k_i + 1) / (m_eff - k_i - 1)`` (a model with
+    ``m_eff <= k_i + 1`` gets no weight); ``n_params`` None: equal counts, the sums of squares alone.
 
     >>> akaike_weights([1.0, 1.0], 50.0).tolist()
     [0.5, 0.5]
     >>> w = akaike_weights([1.0, 1.1], 50.0)   # 10 % more SSR on 50 effective points: Delta = 4.77
     >>> round(float(w[1]), 3)
     0.084
+    >>> w = akaike_weights([1.0, 1.0], 50.0, [6, 8])   # two parameters more for no better fit: Delta = 4.97
+    >>> round(float(w[1]), 3)
+    0.077
     """
     s = np.asarray(ssr, dtype=float)
-    ok = np.isfinite(s) & (s > 0)
+    k = np.zeros(s.size) if n_params is None else np.asarray(n_params, dtype=float)
+    with np.errstate(divide="ignore"):
+        pen = np.where(m_eff > k + 1, 2.0 * k + 2.0 * k * (k + 1) / np.maximum(m_eff - k - 1, 1e-300), np.inf)
+    ok = np.isfinite(s) & (s > 0) & np.isfinite(pen)
     w = np.zeros(s.size)
     if not ok.any():
         return w
-    delta = m_eff * np.log(s[ok] / s[ok].min())
+    aic = m_eff * np.log(s[ok]) + pen[ok]
+    delta = aic - aic.min()
     e = np.exp(-0.5 * delta)
     w[ok] = e / e.sum()
     return w
@@ -322,6 +335,12 @@ def model_average(values: np.ndarray, covs: np.ndarray, weights: np.ndarray):
     w = w / w.sum()
     v_bar = w @ v[ok]
     return v_bar, np.einsum("i,ijk->jk", w, c[ok]), systematic_covariance(v_bar, v[ok], w)
+
+
+def _counts(fits: dict, laws: list[str]) -> list[int] | None:
+    """The members' parameter counts (None when any is not known: equal counts)."""
+    k = [int(getattr(fits[law], "n_params", 0)) for law in laws]
+    return k if all(k) else None
 
 
 def _member_covariances(unc: Uncertainty, fits: dict, laws: list[str], idx: list[int]) -> np.ndarray:
@@ -376,7 +395,7 @@ def uncertainty_budget(unc: Uncertainty, fitted, fits: dict, r: np.ndarray, grou
     if fits:
         m_eff = effective_points(r, groups)
         laws = list(fits)
-        w = akaike_weights([fits[k][1] for k in laws], m_eff)
+        w = akaike_weights([fits[k][1] for k in laws], m_eff, _counts(fits, laws))
         idx = [j for j, n in enumerate(names) if n in PARAMETERS]
         V = np.array([[fits[k][0].get(names[j], math.nan) for j in idx] for k in laws]).reshape(len(laws), len(idx))
         v_bar, c_stat, c_sys = model_average(V, _member_covariances(unc, fits, laws, idx), w)

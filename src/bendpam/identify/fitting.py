@@ -254,7 +254,7 @@ class _Problem:
     def set_free(self, free: list[str]) -> None:
         """The varied parameters: the nonlinear ones (searched) and the linear ones (projected)."""
         self.free = list(free)
-        self.nonlin = [p for p in self.free if p in _NONLINEAR or p in ("theta_h", "gap", "ratio")]
+        self.nonlin = [p for p in self.free if p in _NONLINEAR or p in ("theta_h", "theta_2", "gap", "ratio")]
         self.lin = [p for p in self.free if p not in self.nonlin]
         self.cone = "C10" in self.lin and "C01" in self.lin
         self.int_names, self.T, self.lo, self.hi = self._internal()
@@ -348,9 +348,10 @@ class _Problem:
             hit = self._z_cache[("played", gap)] = played_path(self.d, gap)
         return hit
 
-    def _z(self, theta_deg: float, gap: float = 0.0, ratio: float | None = None, law: str | None = None):
+    def _z(self, theta_deg: float, gap: float = 0.0, ratio: float | None = None, law: str | None = None,
+           theta_2: float | None = None):
         law = law or self.law
-        key = (law, theta_deg, gap, ratio)  # the cache is shared by the ensemble's members
+        key = (law, theta_deg, gap, ratio, theta_2)  # the cache is shared by the ensemble's members
         z = self._z_cache.get(key)
         if z is None:
             if len(self._z_cache) > 512:
@@ -358,6 +359,8 @@ class _Problem:
             assert law is not None, "a loop fit has a law"
             if law == "zener":  # the dashpot's part, and the viscous member's Maxwell branch (cached)
                 z = np.column_stack([self._z(0.0, law="dashpot")[:, 0], self._z(theta_deg, law="viscous")])
+            elif law == "pi_maxwell":  # friction and a Maxwell branch of its own angle
+                z = np.column_stack([self._z(theta_deg, law="pi"), self._z(float(theta_2 or 1.0), law="viscous")])
             else:
                 z = steady_z(law, theta_deg, self.d if gap <= 0 else self._played(gap)[2], ratio)
             self._z_cache[key] = z
@@ -374,7 +377,8 @@ class _Problem:
             if p not in self.lin:
                 c0 = c0 + col * fixed[p]
         if self.law:
-            z = self._z(float(nl["theta_h"]), float(nl.get("gap", 0.0)), nl.get("ratio")).reshape(d.kc.size, -1)
+            z = self._z(float(nl["theta_h"]), float(nl.get("gap", 0.0)), nl.get("ratio"),
+                        theta_2=nl.get("theta_2")).reshape(d.kc.size, -1)
             pa = np.maximum(d.Pc - a.P_start_kpa, 0.0)
             for j, (n0, n1) in enumerate((("a0", "a1"), ("a0_2", "a1_2"))[: z.shape[1]]):
                 cols[n0], cols[n1] = -z[:, j], -z[:, j] * pa
@@ -582,7 +586,7 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool):
     fits: dict[str, MemberFit] = {}
     if run.law and law_uncertainty:
         fits[run.law] = MemberFit(dict(unc.values), _ssr(run.prob, run.nl, run.lin), tuple(unc.names),
-                                  unc.cov_stat.copy())
+                                  unc.cov_stat.copy(), len(run.prob.free))
         solved = {}
         for alt in (a for a in ENSEMBLE if a != run.law):
             try:
@@ -592,7 +596,8 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool):
             run.nfev += n
     r = run.prob.residual_full(np.concatenate([[run.nl[p] for p in run.prob.nonlin], run.lin]))
     if fits:  # each member's own statistical covariance, where it has weight (the others add nothing)
-        w = akaike_weights([f.ssr for f in fits.values()], effective_points(r, run.prob.groups))
+        w = akaike_weights([f.ssr for f in fits.values()], effective_points(r, run.prob.groups),
+                           [f.n_params for f in fits.values()])
         for (alt, f), wk in zip(list(fits.items()), w, strict=True):
             if alt in solved and wk > 1e-4:
                 u2 = _uncertainty(*solved[alt][:1], run.bnd, *solved[alt][1:], corr_flag, run.cycles, run.offsets)
@@ -612,7 +617,7 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool):
 def _bounds(actuator: Actuator, d: FitData, bounds) -> dict[str, tuple[float, float]]:
     bnd = _default_bounds(actuator, float(d.P.min()))
     bnd.update({"theta_h": (0.2, 90.0), "a0": (0.0, 10.0 * float(d.BM.max())), "a1": (0.0, 100.0), "gap": (0.0, 5.0)})
-    bnd.update({"a0_2": bnd["a0"], "a1_2": bnd["a1"], "ratio": (1.0, 3.0)})  # the ensemble members' own
+    bnd.update({"a0_2": bnd["a0"], "a1_2": bnd["a1"], "ratio": (1.0, 3.0), "theta_2": bnd["theta_h"]})  # members' own
     for k, v in (bounds or {}).items():
         key = "shape" if str(k).strip().lower() in ("shape", "beta") else parse_free([k])[0]
         try:
@@ -848,7 +853,7 @@ def _law_refit(prob: _Problem, bnd, nl, alt: str):
         p2.set_free([*prob.free, *extra])
     nfev = 0
     best = (math.inf, dict(nl))
-    own = {"gap": (0.25, 0.5, 1.0, 2.0), "ratio": (1.25, 1.75)}  # short grids of the members' own parameters
+    own = {"gap": (0.25, 0.5, 1.0, 2.0), "ratio": (1.25, 1.75), "theta_2": (2.0, 8.0, 30.0)}  # short grids of the members' own parameters
     grid: list[dict[str, float]] = [{}]
     for p in extra:
         grid = [{**g, p: v} for g in grid for v in own[p]] if p in own else grid
@@ -860,7 +865,7 @@ def _law_refit(prob: _Problem, bnd, nl, alt: str):
             if float(r @ r) < best[0]:
                 best = (float(r @ r), trial)
     nl2, lin2, _, _, n = _search(p2, bnd, best, tol=1e-5)
-    return MemberFit(p2.to_user(nl2, lin2), _ssr(p2, nl2, lin2)), nfev + n, (p2, nl2, lin2)
+    return MemberFit(p2.to_user(nl2, lin2), _ssr(p2, nl2, lin2), n_params=len(p2.free)), nfev + n, (p2, nl2, lin2)
 
 
 def _profile(prob: _Problem, bnd, nl, unc: Uncertainty, n_points: int):
