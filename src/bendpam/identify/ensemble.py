@@ -44,7 +44,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -97,7 +97,8 @@ def steady_z(law: str, theta_deg: float, d: FitData, ratio: float | None = None)
     if law == "pi_play":
         law = "pi"
     if law == "stiction" and ratio is not None:
-        z_away, z_back = Breakaway(math.radians(theta_deg), ratio=max(float(ratio), 1.0)).steady_branches(d.delta, d.span)
+        law_s = Breakaway(math.radians(theta_deg), ratio=max(float(ratio), 1.0))  # below 1 at a Jacobian's step
+        z_away, z_back = law_s.steady_branches(d.delta, d.span)
         return np.where(d.branch < 0, z_away, z_back)
     if law == "viscous" and getattr(d, "time_s", None) is not None:
         return _viscous_in_time(math.radians(theta_deg), d)
@@ -126,7 +127,7 @@ def _zener(theta_deg: float, d: FitData, with_maxwell: bool = True) -> np.ndarra
     assert d.branch is not None and d.delta is not None
     sign = np.where(d.branch < 0, 1.0, -1.0)
     z_m = steady_z("viscous", theta_deg, d) if with_maxwell else np.zeros(d.kc.size)
-    if getattr(d, "time_s", None) is not None:
+    if d.time_s is not None:
         rate = np.zeros(d.kc.size)
         for r in d.branch_rows.values():
             if r.size > 1:
@@ -138,7 +139,7 @@ def _zener(theta_deg: float, d: FitData, with_maxwell: bool = True) -> np.ndarra
     return np.column_stack([z_d, z_m])
 
 
-def played_path(d: FitData, gap_deg: float) -> tuple[np.ndarray, np.ndarray, FitData]:
+def played_path(d: FitData, gap_deg: float) -> tuple[np.ndarray, np.ndarray, Any]:
     """The path behind a fixture's dead zone: ``(curvatures, moment factors, data with the played loop path)``.
 
     The crosshead closes a gap of ``gap_deg`` (the bending angle it is worth at the straight state) at each

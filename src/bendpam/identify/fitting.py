@@ -600,7 +600,8 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool):
                            [f.n_params for f in fits.values()])
         for (alt, f), wk in zip(list(fits.items()), w, strict=True):
             if alt in solved and wk > 1e-4:
-                u2 = _uncertainty(*solved[alt][:1], run.bnd, *solved[alt][1:], corr_flag, run.cycles, run.offsets)
+                p2, nl2, lin2 = solved[alt]
+                u2 = _uncertainty(p2, run.bnd, nl2, lin2, corr_flag, run.cycles, run.offsets)
                 fits[alt] = f._replace(names=tuple(u2.names), cov=u2.cov_stat)
                 run.nfev += u2.nfev
     shape_bound = unc.at_bound.get("S_lo", False) or unc.at_bound.get("S_hi", False)
@@ -853,7 +854,8 @@ def _law_refit(prob: _Problem, bnd, nl, alt: str):
         p2.set_free([*prob.free, *extra])
     nfev = 0
     best = (math.inf, dict(nl))
-    own = {"gap": (0.25, 0.5, 1.0, 2.0), "ratio": (1.25, 1.75), "theta_2": (2.0, 8.0, 30.0)}  # short grids of the members' own parameters
+    # short grids of the members' own parameters
+    own = {"gap": (0.25, 0.5, 1.0, 2.0), "ratio": (1.25, 1.75), "theta_2": (2.0, 8.0, 30.0)}
     grid: list[dict[str, float]] = [{}]
     for p in extra:
         grid = [{**g, p: v} for g in grid for v in own[p]] if p in own else grid
@@ -869,7 +871,7 @@ def _law_refit(prob: _Problem, bnd, nl, alt: str):
 
 
 def _profile(prob: _Problem, bnd, nl, unc: Uncertainty, n_points: int):
-    """The objective minimised over everything else against alpha0, around the optimum."""
+    """The reported loop law's objective minimised over everything else against alpha0, around its optimum."""
     if "alpha0" not in prob.nonlin or n_points < 3:
         return None, 0
     from scipy.optimize import least_squares
@@ -906,8 +908,8 @@ def _profile(prob: _Problem, bnd, nl, unc: Uncertainty, n_points: int):
             x_prev = sol.x
             r = sol.fun
         obj[j] = float(r @ r)
-    sd = float(unc.sd[i])
-    return Profile([float(x) for x in alphas], [float(x) for x in obj], (a_hat - 2 * sd, a_hat + 2 * sd)), nfev
+    sd, mid = float(unc.sd[i]), float(unc.values["alpha0"])  # the reported value: the ensemble's average
+    return Profile([float(x) for x in alphas], [float(x) for x in obj], (mid - 2 * sd, mid + 2 * sd)), nfev
 
 
 def _result(processed, actuator: Actuator, run: _Run, unc: Uncertainty, tension, t0: float,

@@ -86,7 +86,8 @@ __all__ = [
 
 LAWS = ("pi", "dahl")
 #: The loop laws whose fits make the identification's systematic (model-form) uncertainty.
-ENSEMBLE = ("pi", "dahl", "bouc_wen", "maxwell_slip", "stiction", "viscous", "viscous_period", "zener", "pi_play", "pi_maxwell")
+ENSEMBLE = ("pi", "dahl", "bouc_wen", "maxwell_slip", "stiction", "viscous", "viscous_period", "zener", "pi_play",
+            "pi_maxwell")
 
 
 def _segments(theta: np.ndarray):
