@@ -272,9 +272,9 @@ def akaike_weights(ssr, m_eff: float, n_params=None) -> np.ndarray:
     >>> w = akaike_weights([1.0, 1.1], 50.0)   # 10 % more SSR on 50 effective points: Delta = 4.77
     >>> round(float(w[1]), 3)
     0.084
-    >>> w = akaike_weights([1.0, 1.0], 50.0, [6, 8])   # two parameters more for no better fit: Delta = 4.97
+    >>> w = akaike_weights([1.0, 1.0], 50.0, [6, 8])   # two parameters more for no better fit: Delta = 5.56
     >>> round(float(w[1]), 3)
-    0.077
+    0.058
     """
     s = np.asarray(ssr, dtype=float)
     k = np.zeros(s.size) if n_params is None else np.asarray(n_params, dtype=float)
