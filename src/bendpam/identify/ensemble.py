@@ -189,17 +189,45 @@ def played_path(d: FitData, gap_deg: float) -> tuple[np.ndarray, np.ndarray, Any
     return kq, fac, SimpleNamespace(**{**vars(d), **played})
 
 
-def _branch_response(t: np.ndarray, delta: np.ndarray, end: float, tau: float, w_ref: float, n: int = 400):
-    """A Maxwell fluid's response from ``z = 0`` along one branch, the angle ``delta`` (rad) reached at the times
-    ``t`` (s, increasing, from the reversal) and ``end`` (rad) at its far end: ``(times, z, z at the end)``."""
-    from bendpam.physics.hysteresis import ViscousLoop
-
-    tt, dd = np.concatenate([[0.0], t]), np.concatenate([[0.0], delta])
-    v_end = (dd[-1] - dd[-2]) / max(tt[-1] - tt[-2], 1e-9) if tt.size > 2 else 0.0
-    t_end = tt[-1] + max(end - dd[-1], 0.0) / v_end if v_end > 0 else tt[-1]
-    tu = np.linspace(0.0, max(t_end, tt[-1] + 1e-9), n)
-    z = ViscousLoop(tau, w_ref).z_path(np.interp(tu, np.append(tt, t_end), np.append(dd, end)), tu)
-    return tu, z, float(z[-1])
+def _viscous_paths(d: FitData, n: int = 400) -> dict:
+    """What the Maxwell fluid's steady cycles need of ``d`` whatever its time constant, computed once per data set
+    (kept in ``d``'s ``__dict__``, as :attr:`FitData.branch_rows`): each branch's angle resampled on ``n`` equal
+    time steps from its reversal to its far end (linear in time between the points, at the branch's end rate
+    after the last one), and where each point falls on that grid."""
+    got = vars(d).get("_viscous_paths")
+    if got is not None and got["n"] == n:
+        return got
+    assert d.time_s is not None and d.branch is not None and d.delta is not None and d.span is not None
+    order = d.branch_rows
+    dt = np.concatenate([np.diff(d.time_s[r]) for r in order.values()])
+    dd = np.concatenate([np.diff(d.delta[r]) for r in order.values()])
+    ok = dt > 0
+    w_ref = float(np.max(dd[ok] / dt[ok])) if ok.any() and np.any(dd[ok] > 0) else 1.0
+    rows, paths, T, pairs = [], [], [], []
+    frac = np.linspace(0.0, 1.0, n)
+    for i in np.unique(d.seg):
+        r1, r2 = order.get(2 * int(i)), order.get(2 * int(i) + 1)  # loading (toward the blocked state), unloading
+        if r1 is None or r2 is None:
+            continue  # a test with one branch only keeps no loop
+        pairs.append((len(rows), len(rows) + 1))
+        for r in (r1, r2):
+            tt, da = np.concatenate([[0.0], d.time_s[r]]), np.concatenate([[0.0], d.delta[r]])
+            end = float(d.span[r][0])
+            v_end = (da[-1] - da[-2]) / max(tt[-1] - tt[-2], 1e-9) if tt.size > 2 else 0.0
+            t_end = tt[-1] + max(end - da[-1], 0.0) / v_end if v_end > 0 else tt[-1]
+            T.append(max(t_end, tt[-1] + 1e-9))
+            paths.append(np.interp(frac * T[-1], np.append(tt, t_end), np.append(da, end)))
+            rows.append(r)
+    H = np.array(T) / (n - 1)
+    brow = np.concatenate([np.full(r.size, b) for b, r in enumerate(rows)]) if rows else np.zeros(0, int)
+    at = np.concatenate(rows) if rows else np.zeros(0, int)
+    pos = np.clip(d.time_s[at] / H[brow], 0.0, n - 1.0) if rows else np.zeros(0)
+    j = np.minimum(np.floor(pos).astype(int), n - 2)
+    got = {"n": n, "w_ref": w_ref, "H": H, "T": np.array(T), "dpath": np.diff(np.array(paths), axis=1) if rows
+           else np.zeros((0, n - 1)), "at": at, "brow": brow, "j": j, "f": pos - j,
+           "pairs": np.array(pairs, dtype=int).reshape(-1, 2)}
+    vars(d)["_viscous_paths"] = got
+    return got
 
 
 def _viscous_in_time(theta_c: float, d: FitData) -> np.ndarray:
@@ -208,34 +236,32 @@ def _viscous_in_time(theta_c: float, d: FitData) -> np.ndarray:
 
     ``omega_ref`` is the fastest bending rate of the set and ``tau = theta_c / omega_ref``.  Each branch is
     filtered exactly from ``z = 0`` (the angle linear in time between the points; before the first and after
-    the last point at the branch's end rate); the linear response then gives the periodic start of both
-    branches in closed form (``z`` is continuous at the reversals).
+    the last point at the branch's end rate), all branches at once (a first-order scan by doubling, as
+    :func:`bendpam.physics.hysteresis.first_order_scan`, one row a branch); the linear response then gives the
+    periodic start of both branches in closed form (``z`` is continuous at the reversals).
     """
-    assert d.time_s is not None and d.branch is not None and d.delta is not None and d.span is not None
-    order = d.branch_rows
-    dt = np.concatenate([np.diff(d.time_s[r]) for r in order.values()])
-    dd = np.concatenate([np.diff(d.delta[r]) for r in order.values()])
-    ok = dt > 0
-    w_ref = float(np.max(dd[ok] / dt[ok])) if ok.any() and np.any(dd[ok] > 0) else 1.0
-    tau = max(theta_c / w_ref, 1e-9)
-    z = np.zeros(d.kc.size)  # a test with one branch only keeps no loop
-    for i in np.unique(d.seg):
-        parts: list[tuple | None] = []
-        for key in (2 * int(i), 2 * int(i) + 1):  # loading (toward the blocked state), then unloading
-            r = order.get(key)
-            if r is None:
-                parts.append(None)
-                continue
-            parts.append((r, *_branch_response(d.time_s[r], d.delta[r], float(d.span[r][0]), tau, w_ref)))
-        if parts[0] is None or parts[1] is None:
-            continue
-        (r1, t1, z1, e1), (r2, t2, z2, e2) = parts[0], parts[1]
-        a1, a2 = math.exp(-t1[-1] / tau), math.exp(-t2[-1] / tau)
-        # s z (the sign of the motion) starts at y1 on one branch, y2 = -(a1 y1 + e1) on the other, and back
-        y1 = (a2 * e1 - e2) / (1.0 - a1 * a2) if a1 * a2 < 1.0 else 0.0
-        y2 = -(a1 * y1 + e1)
-        z[r1] = -(np.interp(d.time_s[r1], t1, z1) + y1 * np.exp(-d.time_s[r1] / tau))
-        z[r2] = np.interp(d.time_s[r2], t2, z2) + y2 * np.exp(-d.time_s[r2] / tau)
+    g = _viscous_paths(d)
+    z = np.zeros(d.kc.size)
+    if g["at"].size == 0:
+        return z
+    tau = max(theta_c / g["w_ref"], 1e-9)
+    a = np.exp(-g["H"] / tau)
+    Z = ((1.0 - a) / g["H"] / g["w_ref"])[:, None] * g["dpath"]  # exact for a constant rate over each step
+    shift, fac = 1, a.copy()
+    while shift < Z.shape[1]:
+        Z[:, shift:] = Z[:, shift:] + fac[:, None] * Z[:, :-shift]
+        shift, fac = 2 * shift, fac * fac
+    Z = np.hstack([np.zeros((Z.shape[0], 1)), Z])
+    e, A = Z[:, -1], np.exp(-g["T"] / tau)
+    b1, b2 = g["pairs"][:, 0], g["pairs"][:, 1]
+    # s z (the sign of the motion) starts at y1 on one branch, y2 = -(a1 y1 + e1) on the other, and back
+    den = 1.0 - A[b1] * A[b2]
+    y1 = np.where(den > 0, (A[b2] * e[b1] - e[b2]) / np.where(den > 0, den, 1.0), 0.0)
+    Y, S = np.zeros(e.size), np.ones(e.size)
+    Y[b1], Y[b2], S[b1] = y1, -(A[b1] * y1 + e[b1]), -1.0
+    br, j, f, at = g["brow"], g["j"], g["f"], g["at"]
+    assert d.time_s is not None
+    z[at] = S[br] * (Z[br, j] * (1.0 - f) + Z[br, j + 1] * f + Y[br] * np.exp(-d.time_s[at] / tau))
     return z
 
 
