@@ -1,29 +1,37 @@
 """The model's own doubt: an ensemble of loop laws, weighted by how well each fits (issue 23 item 2).
 
 No loop law is known to be the actuator's.  With a loop model the fit is repeated with every law
-of :data:`bendpam.physics.hysteresis.ENSEMBLE` (Prandtl-Ishlinskii, Dahl, Bouc-Wen, Maxwell-slip
-and a rate-dependent viscous loop), each warm-started from the fit and with the quasi-static
-parameters free as in it; the spread of the parameters across the laws is the systematic part of
-their uncertainty.
+of :data:`bendpam.physics.hysteresis.ENSEMBLE` (Prandtl-Ishlinskii, Dahl, Bouc-Wen, Maxwell-slip,
+breakaway stiction, rate-dependent viscous loops, the standard linear solid, friction with a Maxwell
+branch and a fixture with a dead zone), each warm-started from the fit and with the quasi-static
+parameters free as in it.  The reported model parameters are their weighted average.
 
-Weights (Akaike weights on an effective number of points)
-    Each law has the same parameters (the loop's angle and its two amplitudes), so Akaike's
-    criterion compares the sums of squares alone: ``AIC_i = m_eff ln(SSR_i) + const``.  The
-    residuals of a curve are strongly correlated (the processing's low-pass filter, and the
-    model's own misfit), so ``m`` points carry the information of fewer independent ones:
-    ``m_eff = sum_g n_g (1 - rho_g) / (1 + rho_g)`` over the residual groups (curves or branches)
-    with their lag-1 autocorrelation ``rho_g`` (clipped to [0, 0.95]) at the reported fit.
-    ``w_i = exp(-Delta_i / 2) / sum_j exp(-Delta_j / 2)`` with ``Delta_i = m_eff ln(SSR_i / SSR_min)``:
-    a law that fits worse gets less weight, one that fits much worse none.
+Weights (Akaike weights, AICc, on an effective number of points)
+    ``AICc_i = m_eff ln(SSR_i) + 2 k_i + 2 k_i (k_i + 1) / (m_eff - k_i - 1)`` with ``k_i`` the parameters
+    law ``i`` varies (the members of :data:`MEMBER_EXTRA` vary more).  The residuals of a curve are
+    strongly correlated (the processing's low-pass filter, and the model's own misfit), so ``m`` points
+    carry the information of fewer independent ones: ``m_eff = sum_g n_g (1 - rho_g) / (1 + rho_g)`` over
+    the residual groups (curves or branches) with their lag-1 autocorrelation ``rho_g`` (clipped to
+    [0, 0.95]) at the reported fit.  ``w_i = exp(-Delta_i / 2) / sum_j exp(-Delta_j / 2)``,
+    ``Delta_i = AICc_i - min AICc``: a law that fits worse, or no better with more parameters, gets less.
 
-Systematic covariance
-    The reported values are the default law's; the systematic covariance is the weighted spread
-    of the laws' values ABOUT them, ``sum_i w_i (v_i - v_0)(v_i - v_0)^T``: if a better-fitting law
-    moves a parameter, the reported value may be off by as much.
+Model average (Burnham & Anderson)
+    The reported value of each model parameter is ``v_bar = sum_i w_i v_i``; its covariance is the
+    unconditional one, ``sum_i w_i (C_i + (v_i - v_bar)(v_i - v_bar)^T)``: the statistical part
+    ``sum_i w_i C_i`` (each law's own covariance, :func:`bendpam.identify.uncertainty.sandwich_covariance`
+    at its own fit, for every law with weight) and the systematic part, the laws' weighted spread about
+    the average (:func:`model_average`).  The loop's own parameters are the default law's.
 
-The rate-dependent law
-    A viscous loop (a dashpot with a Maxwell element, :class:`~bendpam.physics.hysteresis.ViscousLoop`)
-    needs the bending rate.  A processed set keeps each branch point's time (the cycle mean of
+Members with parameters of their own (:data:`MEMBER_EXTRA`)
+    ``"zener"``, the standard linear solid's loop (:class:`~bendpam.physics.hysteresis.ZenerLoop`): a
+    dashpot (the bending rate) and a Maxwell branch (the ``"viscous"`` member's ``z``), each with its own
+    amplitudes.  ``"pi_maxwell"``: Prandtl-Ishlinskii friction and a Maxwell branch of its own angle.
+    ``"pi_play"``: a play operator on the stroke (:func:`played_path`); the quasi-static model and the
+    loop are evaluated at the played curvature.  ``"stiction"``: the breakaway law's friction ratio.
+
+The rate-dependent laws
+    A viscous loop (a Maxwell element, :class:`~bendpam.physics.hysteresis.ViscousLoop`) needs the
+    bending rate.  A processed set keeps each branch point's time (the cycle mean of
     :attr:`~bendpam.lab.processed.PressureResult.branch_times_s`), so ``"viscous"`` is the Maxwell fluid
     driven by the bending angle at the test's own times, on its steady cycle (``omega_ref`` the
     fastest rate of the set, ``tau = theta_c / omega_ref``).  A set saved before 0.4 keeps no time;
@@ -34,10 +42,6 @@ The rate-dependent law
     each test at its own constant rate ``2 span / period``
     (:func:`bendpam.identify.data.cycle_period_s`; a common period when the samples were not kept),
     ``theta_c`` that of the fastest test.
-
-The backlash of a fixture is not a member: its loop is the quasi-static curve shifted along the
-curvature by the dead zone (a moment that scales with the local stiffness ``dM/dk'``, not with the
-friction amplitude ``A(P)`` every member shares), so it cannot be refitted as a law for ``z``.
 """
 
 from __future__ import annotations

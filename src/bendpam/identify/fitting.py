@@ -65,9 +65,10 @@ Uncertainty (both parts are reported separately: ``FitResult.uncertainty``)
        residuals; a drift correction adds its own doubt as an offset.
     2. Systematic (the loop law): no law is known to be the actuator's.  The fit is repeated with
        every law of :data:`bendpam.physics.hysteresis.ENSEMBLE` (warm-started, the quasi-static
-       parameters free as in the fit); the weighted spread of the parameters about the reported
-       fit, with Akaike weights on the residuals' effective number of points, is added to the
-       covariance (:mod:`bendpam.identify.ensemble`).
+       parameters free as in the fit, some laws with parameters of their own); the reported model
+       parameters are the average over the laws with Akaike weights (AICc on the residuals' effective
+       number of points), their covariance the unconditional one: the laws' own covariances
+       (statistical) and their spread about the average (systematic) (:mod:`bendpam.identify.ensemble`).
     3. The profile of alpha0 (the objective minimised over everything else, against alpha0) is
        kept in ``FitResult.alpha0_profile``.
     Pairs with ``|corr| > corr_flag`` are flagged, with the combination the data determine and
@@ -343,10 +344,9 @@ class _Problem:
         return hit
 
     def _played(self, gap: float):
-        hit = self._z_cache.get(("played", gap))
-        if hit is None:
-            hit = self._z_cache[("played", gap)] = played_path(self.d, gap)
-        return hit
+        if ("played", gap) not in self._z_cache:
+            self._z_cache[("played", gap)] = played_path(self.d, gap)
+        return self._z_cache[("played", gap)]
 
     def _z(self, theta_deg: float, gap: float = 0.0, ratio: float | None = None, law: str | None = None,
            theta_2: float | None = None):
@@ -840,13 +840,9 @@ def _uncertainty(prob: _Problem, bnd, nl_best, lin, corr_flag: float, cycles=(),
 
 
 def _law_refit(prob: _Problem, bnd, nl, alt: str):
-    """The fit with another loop law ``alt`` (warm start, angle grid): ``(MemberFit without its covariance, nfev,
-    (problem, nonlinear, linear values))``.  A member with parameters of its own
-    (:data:`~bendpam.identify.ensemble.MEMBER_EXTRA`) varies them too, from short grids.
-
-    The search stops at ``xtol = 1e-5`` (alpha0 to about 1e-3 deg): the ensemble's values need to be good to well
-    within their standard errors, not to the last digit.
-    """
+    """The fit with another loop law ``alt`` (warm start, angle grid; a member's own parameters from short grids):
+    ``(MemberFit without its covariance, nfev, (problem, nonlinear, linear values))``.  The search stops at
+    ``xtol = 1e-5`` (alpha0 to about 1e-3 deg): well within the standard errors the values serve."""
     p2 = copy.copy(prob)  # the same data and kinematics (their caches are shared), another loop law
     p2.law = alt
     extra = MEMBER_EXTRA.get(alt, ())
@@ -854,8 +850,7 @@ def _law_refit(prob: _Problem, bnd, nl, alt: str):
         p2.set_free([*prob.free, *extra])
     nfev = 0
     best = (math.inf, dict(nl))
-    # short grids of the members' own parameters
-    own = {"gap": (0.25, 0.5, 1.0, 2.0), "ratio": (1.25, 1.75), "theta_2": (2.0, 8.0, 30.0)}
+    own = {"gap": (0.25, 0.5, 1.0, 2.0), "ratio": (1.25, 1.75), "theta_2": (2.0, 8.0, 30.0)}  # members' own grids
     grid: list[dict[str, float]] = [{}]
     for p in extra:
         grid = [{**g, p: v} for g in grid for v in own[p]] if p in own else grid
