@@ -69,7 +69,12 @@ MEMBER_EXTRA: dict[str, tuple[str, ...]] = {"zener": ("a0_2", "a1_2"), "pi_play"
 class MemberFit(NamedTuple):
     """One member's fit: its values by short name, its weighted sum of squares, its own statistical
     covariance (``names`` its order; an empty ``names`` takes the reported fit's) and how many parameters
-    it varies (``n_params``; 0: as many as every other member)."""
+    it varies (``n_params``; 0: as many as every other member).
+
+    >>> f = MemberFit({"alpha0": 70.1}, 2.5e-4, n_params=6)
+    >>> f._replace(names=("alpha0",), cov=np.array([[1e-4]])).names, f.n_params
+    (('alpha0',), 6)
+    """
 
     values: dict[str, float]
     ssr: float
