@@ -212,7 +212,10 @@ def _viscous_paths(d: FitData, n: int = 400) -> dict:
     dd = np.concatenate([np.diff(d.delta[r]) for r in order.values()])
     ok = dt > 0
     w_ref = float(np.max(dd[ok] / dt[ok])) if ok.any() and np.any(dd[ok] > 0) else 1.0
-    rows, paths, T, pairs = [], [], [], []
+    rows: list[np.ndarray] = []
+    paths: list[np.ndarray] = []
+    T: list[float] = []
+    pairs: list[tuple[int, int]] = []
     frac = np.linspace(0.0, 1.0, n)
     for i in np.unique(d.seg):
         r1, r2 = order.get(2 * int(i)), order.get(2 * int(i) + 1)  # loading (toward the blocked state), unloading
