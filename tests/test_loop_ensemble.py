@@ -182,6 +182,10 @@ def test_fit_reports_the_ensemble_and_both_parts(loop_fit, tmp_path):
     for name, field in (("alpha0", "alpha0_deg"), ("C10", "C10_kpa")):
         assert r.parameters[name].stderr == pytest.approx(math.hypot(b.statistical[field], b.systematic[field]))
     assert r.material.se_shear_modulus_kpa == pytest.approx(b.total["shear_modulus_kpa"])
+    # the reported model parameters are the members' weighted average (Burnham & Anderson)
+    for field in ("alpha0_deg", "C10_kpa", "C01_kpa"):
+        avg = sum(m.weight * m.values[field] for m in b.ensemble)
+        assert getattr(r.actuator, field) == pytest.approx(avg, rel=1e-9, abs=1e-9)
     # fit.json has both parts, and they come back
     r.save(tmp_path)
     import json
@@ -415,3 +419,20 @@ def test_a_fixture_with_backlash_is_fitted_by_the_play_member():
     se = r.parameters["alpha0"].stderr
     assert abs(r.actuator.alpha0_deg - truth["alpha0_deg"]) < 2.0 * se
     assert abs(members["pi"].values["alpha0_deg"] - truth["alpha0_deg"]) > 3.0 * se
+
+
+def test_the_zener_member_is_the_dashpot_rate_and_the_viscous_member():
+    from bendpam.identify.data import FitData
+    from bendpam.identify.ensemble import steady_z
+
+    span, n = 0.3, 31
+    delta = np.linspace(0.0, span, n)
+    one, points = np.ones(1), np.zeros(2 * n)
+    t_load, t_unload = delta / 0.03, delta / 0.015  # loading at 0.03 rad/s, unloading at half that rate
+    d = FitData(P=one, k=[points], M=[points], BM=one, BM_se=one, K=one, K_se=one, w=points, kc=points, Mc=points,
+                Pc=points, seg=np.zeros(2 * n, int), branch=np.repeat([1, -1], n), delta=np.tile(delta, 2),
+                span=np.full(2 * n, span), time_s=np.concatenate([t_load, t_unload]))
+    z = steady_z("zener", 6.0, d)
+    assert z.shape == (2 * n, 2)
+    assert np.allclose(z[:n, 0], -1.0) and np.allclose(z[n:, 0], 0.5)  # the rate over the fastest, signed as z
+    assert np.allclose(z[:, 1], steady_z("viscous", 6.0, d))

@@ -740,7 +740,8 @@ class FitResult:
             lines.append("  standard errors, statistical / systematic: " + ", ".join(
                 f"{k} {b.statistical[k]:.2g} / {b.systematic.get(k, 0.0):.2g}" for k in keys))
             if b.ensemble:
-                lines.append("  loop laws (weight): " + ", ".join(f"{m.law} {m.weight:.2f}" for m in b.ensemble))
+                lines.append("  loop laws (weight; the model parameters are their weighted average): "
+                             + ", ".join(f"{m.law} {m.weight:.2f}" for m in b.ensemble))
         lines += [f"  identifiability: {s}" for s in self.identifiability]
         lines += [f"  note: {f}" for f in self.flags]
         return "\n".join(lines)
