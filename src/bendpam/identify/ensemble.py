@@ -1,29 +1,37 @@
 """The model's own doubt: an ensemble of loop laws, weighted by how well each fits (issue 23 item 2).
 
 No loop law is known to be the actuator's.  With a loop model the fit is repeated with every law
-of :data:`bendpam.physics.hysteresis.ENSEMBLE` (Prandtl-Ishlinskii, Dahl, Bouc-Wen, Maxwell-slip
-and a rate-dependent viscous loop), each warm-started from the fit and with the quasi-static
-parameters free as in it; the spread of the parameters across the laws is the systematic part of
-their uncertainty.
+of :data:`bendpam.physics.hysteresis.ENSEMBLE` (Prandtl-Ishlinskii, Dahl, Bouc-Wen, Maxwell-slip,
+breakaway stiction, rate-dependent viscous loops, the standard linear solid, friction with a Maxwell
+branch and a fixture with a dead zone), each warm-started from the fit and with the quasi-static
+parameters free as in it.  The reported model parameters are their weighted average.
 
-Weights (Akaike weights on an effective number of points)
-    Each law has the same parameters (the loop's angle and its two amplitudes), so Akaike's
-    criterion compares the sums of squares alone: ``AIC_i = m_eff ln(SSR_i) + const``.  The
-    residuals of a curve are strongly correlated (the processing's low-pass filter, and the
-    model's own misfit), so ``m`` points carry the information of fewer independent ones:
-    ``m_eff = sum_g n_g (1 - rho_g) / (1 + rho_g)`` over the residual groups (curves or branches)
-    with their lag-1 autocorrelation ``rho_g`` (clipped to [0, 0.95]) at the reported fit.
-    ``w_i = exp(-Delta_i / 2) / sum_j exp(-Delta_j / 2)`` with ``Delta_i = m_eff ln(SSR_i / SSR_min)``:
-    a law that fits worse gets less weight, one that fits much worse none.
+Weights (Akaike weights, AICc, on an effective number of points)
+    ``AICc_i = m_eff ln(SSR_i) + 2 k_i + 2 k_i (k_i + 1) / (m_eff - k_i - 1)`` with ``k_i`` the parameters
+    law ``i`` varies (the members of :data:`MEMBER_EXTRA` vary more).  The residuals of a curve are
+    strongly correlated (the processing's low-pass filter, and the model's own misfit), so ``m`` points
+    carry the information of fewer independent ones: ``m_eff = sum_g n_g (1 - rho_g) / (1 + rho_g)`` over
+    the residual groups (curves or branches) with their lag-1 autocorrelation ``rho_g`` (clipped to
+    [0, 0.95]) at the reported fit.  ``w_i = exp(-Delta_i / 2) / sum_j exp(-Delta_j / 2)``,
+    ``Delta_i = AICc_i - min AICc``: a law that fits worse, or no better with more parameters, gets less.
 
-Systematic covariance
-    The reported values are the default law's; the systematic covariance is the weighted spread
-    of the laws' values ABOUT them, ``sum_i w_i (v_i - v_0)(v_i - v_0)^T``: if a better-fitting law
-    moves a parameter, the reported value may be off by as much.
+Model average (Burnham & Anderson)
+    The reported value of each model parameter is ``v_bar = sum_i w_i v_i``; its covariance is the
+    unconditional one, ``sum_i w_i (C_i + (v_i - v_bar)(v_i - v_bar)^T)``: the statistical part
+    ``sum_i w_i C_i`` (each law's own covariance, :func:`bendpam.identify.uncertainty.sandwich_covariance`
+    at its own fit, for every law with weight) and the systematic part, the laws' weighted spread about
+    the average (:func:`model_average`).  The loop's own parameters are the default law's.
 
-The rate-dependent law
-    A viscous loop (a dashpot with a Maxwell element, :class:`~bendpam.physics.hysteresis.ViscousLoop`)
-    needs the bending rate.  A processed set keeps each branch point's time (the cycle mean of
+Members with parameters of their own (:data:`MEMBER_EXTRA`)
+    ``"zener"``, the standard linear solid's loop (:class:`~bendpam.physics.hysteresis.ZenerLoop`): a
+    dashpot (the bending rate) and a Maxwell branch (the ``"viscous"`` member's ``z``), each with its own
+    amplitudes.  ``"pi_maxwell"``: Prandtl-Ishlinskii friction and a Maxwell branch of its own angle.
+    ``"pi_play"``: a play operator on the stroke (:func:`played_path`); the quasi-static model and the
+    loop are evaluated at the played curvature.  ``"stiction"``: the breakaway law's friction ratio.
+
+The rate-dependent laws
+    A viscous loop (a Maxwell element, :class:`~bendpam.physics.hysteresis.ViscousLoop`) needs the
+    bending rate.  A processed set keeps each branch point's time (the cycle mean of
     :attr:`~bendpam.lab.processed.PressureResult.branch_times_s`), so ``"viscous"`` is the Maxwell fluid
     driven by the bending angle at the test's own times, on its steady cycle (``omega_ref`` the
     fastest rate of the set, ``tau = theta_c / omega_ref``).  A set saved before 0.4 keeps no time;
@@ -34,15 +42,13 @@ The rate-dependent law
     each test at its own constant rate ``2 span / period``
     (:func:`bendpam.identify.data.cycle_period_s`; a common period when the samples were not kept),
     ``theta_c`` that of the fastest test.
-
-The backlash of a fixture is not a member: its loop is the quasi-static curve shifted along the
-curvature by the dead zone (a moment that scales with the local stiffness ``dM/dk'``, not with the
-friction amplitude ``A(P)`` every member shares), so it cannot be refitted as a law for ``z``.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -50,14 +56,39 @@ from bendpam.identify.data import FitData
 from bendpam.identify.result import PARAMETERS, EnsembleMember, UncertaintyBudget, parameter_field
 from bendpam.identify.uncertainty import Uncertainty, lag1_autocorrelation, material_gradients
 
-__all__ = ["akaike_weights", "effective_points", "steady_z", "systematic_covariance", "uncertainty_budget"]
+__all__ = ["MEMBER_EXTRA", "MemberFit", "akaike_weights", "effective_points", "model_average", "played_path",
+           "steady_z", "systematic_covariance", "uncertainty_budget"]
+
+#: The parameters a member of the ensemble adds to the reported fit's: the standard linear solid's second pair
+#: of amplitudes (its Maxwell branch; the first pair weighs the dashpot), the play's gap (deg) and the breakaway
+#: law's static-to-kinetic friction ratio.
+MEMBER_EXTRA: dict[str, tuple[str, ...]] = {"zener": ("a0_2", "a1_2"), "pi_play": ("gap",), "stiction": ("ratio",),
+                                             "pi_maxwell": ("theta_2", "a0_2", "a1_2")}
 
 
-def steady_z(law: str, theta_deg: float, d: FitData) -> np.ndarray:
+class MemberFit(NamedTuple):
+    """One member's fit: its values by short name, its weighted sum of squares, its own statistical
+    covariance (``names`` its order; an empty ``names`` takes the reported fit's) and how many parameters
+    it varies (``n_params``; 0: as many as every other member).
+
+    >>> f = MemberFit({"alpha0": 70.1}, 2.5e-4, n_params=6)
+    >>> f._replace(names=("alpha0",), cov=np.array([[1e-4]])).names, f.n_params
+    (('alpha0',), 6)
+    """
+
+    values: dict[str, float]
+    ssr: float
+    names: tuple[str, ...] = ()
+    cov: np.ndarray | None = None
+    n_params: int = 0
+
+
+def steady_z(law: str, theta_deg: float, d: FitData, ratio: float | None = None) -> np.ndarray:
     """The loop variable ``z`` of every point of ``d`` on the steady cycle of ``law`` (angle in degrees).
 
     ``d`` holds both branches (:func:`bendpam.identify.data.branch_data`); the unloading branch
-    (``branch < 0``) leaves the blocked state.
+    (``branch < 0``) leaves the blocked state.  ``ratio`` is the breakaway law's static-to-kinetic friction
+    ratio (``"stiction"``; default that of :class:`~bendpam.physics.hysteresis.Breakaway`).
 
     Examples
     --------
@@ -67,9 +98,17 @@ def steady_z(law: str, theta_deg: float, d: FitData) -> np.ndarray:
     >>> steady_z("dahl", 5.0, d).round(3).tolist()   # turning points +-(1 - E)/(1 + E), E = exp(-0.2 rad / 5 deg)
     [0.816, -0.816]
     """
-    from bendpam.physics.hysteresis import ViscousLoop, make_law
+    from bendpam.physics.hysteresis import Breakaway, ViscousLoop, make_law
 
     assert d.branch is not None and d.delta is not None and d.span is not None, "a loop fit is built on branch data"
+    if law in ("zener", "dashpot"):  # "dashpot": the dashpot's part alone (its Maxwell column 0)
+        return _zener(theta_deg, d, law == "zener")
+    if law == "pi_play":
+        law = "pi"
+    if law == "stiction" and ratio is not None:
+        law_s = Breakaway(math.radians(theta_deg), ratio=max(float(ratio), 1.0))  # below 1 at a Jacobian's step
+        z_away, z_back = law_s.steady_branches(d.delta, d.span)
+        return np.where(d.branch < 0, z_away, z_back)
     if law == "viscous" and getattr(d, "time_s", None) is not None:
         return _viscous_in_time(math.radians(theta_deg), d)
     if law == "viscous" and getattr(d, "rate", None) is not None:
@@ -87,17 +126,120 @@ def steady_z(law: str, theta_deg: float, d: FitData) -> np.ndarray:
     return np.where(d.branch < 0, z_away, z_back)
 
 
-def _branch_response(t: np.ndarray, delta: np.ndarray, end: float, tau: float, w_ref: float, n: int = 400):
-    """A Maxwell fluid's response from ``z = 0`` along one branch, the angle ``delta`` (rad) reached at the times
-    ``t`` (s, increasing, from the reversal) and ``end`` (rad) at its far end: ``(times, z, z at the end)``."""
-    from bendpam.physics.hysteresis import ViscousLoop
+def _zener(theta_deg: float, d: FitData, with_maxwell: bool = True) -> np.ndarray:
+    """The standard linear solid's two parts (rows x 2): the dashpot's rate and the Maxwell branch's ``z``.
 
-    tt, dd = np.concatenate([[0.0], t]), np.concatenate([[0.0], delta])
-    v_end = (dd[-1] - dd[-2]) / max(tt[-1] - tt[-2], 1e-9) if tt.size > 2 else 0.0
-    t_end = tt[-1] + max(end - dd[-1], 0.0) / v_end if v_end > 0 else tt[-1]
-    tu = np.linspace(0.0, max(t_end, tt[-1] + 1e-9), n)
-    z = ViscousLoop(tau, w_ref).z_path(np.interp(tu, np.append(tt, t_end), np.append(dd, end)), tu)
-    return tu, z, float(z[-1])
+    The dashpot's part is the bending rate of each branch point over the fastest of the set (from the
+    test's own times; without them the fixture's rate profile at a constant crosshead speed, or a
+    constant rate), signed as ``z``; the Maxwell branch is the ``"viscous"`` member's.
+    """
+    assert d.branch is not None and d.delta is not None
+    sign = np.where(d.branch < 0, 1.0, -1.0)
+    z_m = steady_z("viscous", theta_deg, d) if with_maxwell else np.zeros(d.kc.size)
+    if d.time_s is not None:
+        rate = np.zeros(d.kc.size)
+        for r in d.branch_rows.values():
+            if r.size > 1:
+                rate[r] = np.abs(np.gradient(d.delta[r], d.time_s[r]))
+        top = float(np.max(rate))
+        z_d = sign * (rate / top if top > 0 else np.ones(rate.size))
+    else:
+        z_d = sign * (d.rate if getattr(d, "rate", None) is not None else np.ones(d.kc.size))
+    return np.column_stack([z_d, z_m])
+
+
+def played_path(d: FitData, gap_deg: float) -> tuple[np.ndarray, np.ndarray, Any]:
+    """The path behind a fixture's dead zone: ``(curvatures, moment factors, data with the played loop path)``.
+
+    The crosshead closes a gap of ``gap_deg`` (the bending angle it is worth at the straight state) at each
+    reversal before the plates follow: a play operator (:func:`bendpam.physics.hysteresis.play`) on the
+    stroke, anchored at the blocked state reached by pushing.  Leaving the blocked state the plates lag,
+    ``theta_p = theta - gap r(k)`` (``r`` the fixture's rate profile ``dbeta/ds`` over its straight-state value,
+    :attr:`FitData.rate`: the gap's angle shrinks as the plates pitch; 1 where the fixture is not known), held
+    at 0 while the gap closes; going back they stay at the lagged free end until the crosshead reaches it.
+    The quasi-static moment is the model's at the played curvature, converted by the processing at the
+    measured angle: the factor ``r(k_p) / r(k)`` (eq 7, ``lever = 1 / (2 dbeta/ds)``).  ``delta`` and ``span``
+    of the returned data are the played loop path's.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as NS
+    >>> d = NS(kc=np.array([0.0, 0.005, 0.01, 0.01, 0.005, 0.0]), branch=np.array([-1, -1, -1, 1, 1, 1]),
+    ...        delta=np.array([0.0, 0.5, 1.0, 0.0, 0.5, 1.0]), span=np.full(6, 1.0), K=np.array([0.01]),
+    ...        seg=np.zeros(6, int), rate=None)
+    >>> kq, fac, dp = played_path(d, float(np.degrees(0.2)))   # 0.2 rad: away 0, 0.3, 0.8; back 0.8, 0.5, 0
+    >>> (kq * 1e3).round(6).tolist(), dp.delta.round(6).tolist(), float(dp.span[0])
+    ([0.0, 3.0, 8.0, 8.0, 5.0, 0.0], [0.0, 0.3, 0.8, 0.0, 0.3, 0.8], 0.8)
+    """
+    assert d.branch is not None and d.delta is not None and d.span is not None
+    g = math.radians(float(gap_deg))
+    span = np.asarray(d.span, dtype=float)
+    away = d.branch < 0
+    th = np.where(away, d.delta, span - d.delta)  # the measured bending angle
+    rate = getattr(d, "rate", None)
+    if rate is None:
+        def r_of(k):
+            return np.ones(np.shape(k))
+    else:
+        o = np.argsort(d.kc, kind="stable")
+        def r_of(k):
+            return np.interp(k, d.kc[o], rate[o])
+    K = np.asarray(d.K, dtype=float)[d.seg]
+    to_k = np.divide(K, span, out=np.zeros(span.size), where=span > 0)  # 1 / L0
+    end = np.maximum(span - g * r_of(K), 0.0)  # the played free end
+    th_p = np.where(away, np.clip(th - g * r_of(d.kc), 0.0, end), np.minimum(th, end))
+    kq = th_p * to_k
+    fac = r_of(kq) / r_of(d.kc)
+    played = {"delta": np.where(away, th_p, end - th_p), "span": end}
+    if dataclasses.is_dataclass(d) and not isinstance(d, type):
+        return kq, fac, dataclasses.replace(d, **played)
+    from types import SimpleNamespace
+
+    return kq, fac, SimpleNamespace(**{**vars(d), **played})
+
+
+def _viscous_paths(d: FitData, n: int = 400) -> dict:
+    """What the Maxwell fluid's steady cycles need of ``d`` whatever its time constant, computed once per data set
+    (kept in ``d``'s ``__dict__``, as :attr:`FitData.branch_rows`): each branch's angle resampled on ``n`` equal
+    time steps from its reversal to its far end (linear in time between the points, at the branch's end rate
+    after the last one), and where each point falls on that grid."""
+    got = vars(d).get("_viscous_paths")
+    if got is not None and got["n"] == n:
+        return got
+    assert d.time_s is not None and d.branch is not None and d.delta is not None and d.span is not None
+    order = d.branch_rows
+    dt = np.concatenate([np.diff(d.time_s[r]) for r in order.values()])
+    dd = np.concatenate([np.diff(d.delta[r]) for r in order.values()])
+    ok = dt > 0
+    w_ref = float(np.max(dd[ok] / dt[ok])) if ok.any() and np.any(dd[ok] > 0) else 1.0
+    rows: list[np.ndarray] = []
+    paths: list[np.ndarray] = []
+    T: list[float] = []
+    pairs: list[tuple[int, int]] = []
+    frac = np.linspace(0.0, 1.0, n)
+    for i in np.unique(d.seg):
+        r1, r2 = order.get(2 * int(i)), order.get(2 * int(i) + 1)  # loading (toward the blocked state), unloading
+        if r1 is None or r2 is None:
+            continue  # a test with one branch only keeps no loop
+        pairs.append((len(rows), len(rows) + 1))
+        for r in (r1, r2):
+            tt, da = np.concatenate([[0.0], d.time_s[r]]), np.concatenate([[0.0], d.delta[r]])
+            end = float(d.span[r][0])
+            v_end = (da[-1] - da[-2]) / max(tt[-1] - tt[-2], 1e-9) if tt.size > 2 else 0.0
+            t_end = tt[-1] + max(end - da[-1], 0.0) / v_end if v_end > 0 else tt[-1]
+            T.append(max(t_end, tt[-1] + 1e-9))
+            paths.append(np.interp(frac * T[-1], np.append(tt, t_end), np.append(da, end)))
+            rows.append(r)
+    H = np.array(T) / (n - 1)
+    brow = np.concatenate([np.full(r.size, b) for b, r in enumerate(rows)]) if rows else np.zeros(0, int)
+    at = np.concatenate(rows) if rows else np.zeros(0, int)
+    pos = np.clip(d.time_s[at] / H[brow], 0.0, n - 1.0) if rows else np.zeros(0)
+    j = np.minimum(np.floor(pos).astype(int), n - 2)
+    got = {"n": n, "w_ref": w_ref, "H": H, "T": np.array(T), "dpath": np.diff(np.array(paths), axis=1) if rows
+           else np.zeros((0, n - 1)), "at": at, "brow": brow, "j": j, "f": pos - j,
+           "pairs": np.array(pairs, dtype=int).reshape(-1, 2)}
+    vars(d)["_viscous_paths"] = got
+    return got
 
 
 def _viscous_in_time(theta_c: float, d: FitData) -> np.ndarray:
@@ -106,34 +248,32 @@ def _viscous_in_time(theta_c: float, d: FitData) -> np.ndarray:
 
     ``omega_ref`` is the fastest bending rate of the set and ``tau = theta_c / omega_ref``.  Each branch is
     filtered exactly from ``z = 0`` (the angle linear in time between the points; before the first and after
-    the last point at the branch's end rate); the linear response then gives the periodic start of both
-    branches in closed form (``z`` is continuous at the reversals).
+    the last point at the branch's end rate), all branches at once (a first-order scan by doubling, as
+    :func:`bendpam.physics.hysteresis.first_order_scan`, one row a branch); the linear response then gives the
+    periodic start of both branches in closed form (``z`` is continuous at the reversals).
     """
-    assert d.time_s is not None and d.branch is not None and d.delta is not None and d.span is not None
-    order = d.branch_rows
-    dt = np.concatenate([np.diff(d.time_s[r]) for r in order.values()])
-    dd = np.concatenate([np.diff(d.delta[r]) for r in order.values()])
-    ok = dt > 0
-    w_ref = float(np.max(dd[ok] / dt[ok])) if ok.any() and np.any(dd[ok] > 0) else 1.0
-    tau = max(theta_c / w_ref, 1e-9)
-    z = np.zeros(d.kc.size)  # a test with one branch only keeps no loop
-    for i in np.unique(d.seg):
-        parts: list[tuple | None] = []
-        for key in (2 * int(i), 2 * int(i) + 1):  # loading (toward the blocked state), then unloading
-            r = order.get(key)
-            if r is None:
-                parts.append(None)
-                continue
-            parts.append((r, *_branch_response(d.time_s[r], d.delta[r], float(d.span[r][0]), tau, w_ref)))
-        if parts[0] is None or parts[1] is None:
-            continue
-        (r1, t1, z1, e1), (r2, t2, z2, e2) = parts[0], parts[1]
-        a1, a2 = math.exp(-t1[-1] / tau), math.exp(-t2[-1] / tau)
-        # s z (the sign of the motion) starts at y1 on one branch, y2 = -(a1 y1 + e1) on the other, and back
-        y1 = (a2 * e1 - e2) / (1.0 - a1 * a2) if a1 * a2 < 1.0 else 0.0
-        y2 = -(a1 * y1 + e1)
-        z[r1] = -(np.interp(d.time_s[r1], t1, z1) + y1 * np.exp(-d.time_s[r1] / tau))
-        z[r2] = np.interp(d.time_s[r2], t2, z2) + y2 * np.exp(-d.time_s[r2] / tau)
+    g = _viscous_paths(d)
+    z = np.zeros(d.kc.size)
+    if g["at"].size == 0:
+        return z
+    tau = max(theta_c / g["w_ref"], 1e-9)
+    a = np.exp(-g["H"] / tau)
+    Z = ((1.0 - a) / g["H"] / g["w_ref"])[:, None] * g["dpath"]  # exact for a constant rate over each step
+    shift, fac = 1, a.copy()
+    while shift < Z.shape[1]:
+        Z[:, shift:] = Z[:, shift:] + fac[:, None] * Z[:, :-shift]
+        shift, fac = 2 * shift, fac * fac
+    Z = np.hstack([np.zeros((Z.shape[0], 1)), Z])
+    e, A = Z[:, -1], np.exp(-g["T"] / tau)
+    b1, b2 = g["pairs"][:, 0], g["pairs"][:, 1]
+    # s z (the sign of the motion) starts at y1 on one branch, y2 = -(a1 y1 + e1) on the other, and back
+    den = 1.0 - A[b1] * A[b2]
+    y1 = np.where(den > 0, (A[b2] * e[b1] - e[b2]) / np.where(den > 0, den, 1.0), 0.0)
+    Y, S = np.zeros(e.size), np.ones(e.size)
+    Y[b1], Y[b2], S[b1] = y1, -(A[b1] * y1 + e[b1]), -1.0
+    br, j, f, at = g["brow"], g["j"], g["f"], g["at"]
+    assert d.time_s is not None
+    z[at] = S[br] * (Z[br, j] * (1.0 - f) + Z[br, j + 1] * f + Y[br] * np.exp(-d.time_s[at] / tau))
     return z
 
 
@@ -159,21 +299,31 @@ def effective_points(r: np.ndarray, groups: np.ndarray) -> float:
     return max(total, 1.0)
 
 
-def akaike_weights(ssr, m_eff: float) -> np.ndarray:
-    """Akaike weights of models with equal parameter counts from their sums of squares.
+def akaike_weights(ssr, m_eff: float, n_params=None) -> np.ndarray:
+    """Akaike weights of least-squares models from their sums of squares and parameter counts (AICc).
+
+    ``AICc_i = m_eff ln(SSR_i) + 2 k_i + 2 k_i (k_i + 1) / (m_eff - k_i - 1)`` (a model with
+    ``m_eff <= k_i + 1`` gets no weight); ``n_params`` None: equal counts, the sums of squares alone.
 
     >>> akaike_weights([1.0, 1.0], 50.0).tolist()
     [0.5, 0.5]
     >>> w = akaike_weights([1.0, 1.1], 50.0)   # 10 % more SSR on 50 effective points: Delta = 4.77
     >>> round(float(w[1]), 3)
     0.084
+    >>> w = akaike_weights([1.0, 1.0], 50.0, [6, 8])   # two parameters more for no better fit: Delta = 5.56
+    >>> round(float(w[1]), 3)
+    0.058
     """
     s = np.asarray(ssr, dtype=float)
-    ok = np.isfinite(s) & (s > 0)
+    k = np.zeros(s.size) if n_params is None else np.asarray(n_params, dtype=float)
+    with np.errstate(divide="ignore"):
+        pen = np.where(m_eff > k + 1, 2.0 * k + 2.0 * k * (k + 1) / np.maximum(m_eff - k - 1, 1e-300), np.inf)
+    ok = np.isfinite(s) & (s > 0) & np.isfinite(pen)
     w = np.zeros(s.size)
     if not ok.any():
         return w
-    delta = m_eff * np.log(s[ok] / s[ok].min())
+    aic = m_eff * np.log(s[ok]) + pen[ok]
+    delta = aic - aic.min()
     e = np.exp(-0.5 * delta)
     w[ok] = e / e.sum()
     return w
@@ -204,17 +354,66 @@ def _material(values: dict[str, float], fitted) -> tuple[float, float]:
     return 2.0 * S, (c01 / S if S else math.nan)
 
 
-def uncertainty_budget(unc: Uncertainty, fitted, fits: dict[str, tuple[dict[str, float], float]], r: np.ndarray,
-                       groups: np.ndarray, law: str | None, n_resampled: int) -> UncertaintyBudget:
-    """Set ``unc``'s systematic covariance from the loop laws' fits and return the two parts of the errors.
+def model_average(values: np.ndarray, covs: np.ndarray, weights: np.ndarray):
+    """Burnham & Anderson's model-averaged estimate and its unconditional covariance, in two parts.
+
+    ``v_bar = sum_i w_i v_i``; statistical ``sum_i w_i C_i`` (each member's own covariance ``C_i``) and
+    systematic ``sum_i w_i (v_i - v_bar)(v_i - v_bar)^T`` (the members' spread about the average).  ``values``
+    has one row per member, ``covs`` one matrix per member; rows with a NaN (failed refits) are left out.
+
+    >>> v_bar, stat, sys_ = model_average(np.array([[1.0], [3.0]]), np.array([[[0.5]], [[0.5]]]), np.array([0.5, 0.5]))
+    >>> v_bar.tolist(), stat.tolist(), sys_.tolist()
+    ([2.0], [[0.5]], [[1.0]])
+    """
+    v, c = np.asarray(values, dtype=float), np.asarray(covs, dtype=float)
+    ok = np.all(np.isfinite(v), axis=1) & np.all(np.isfinite(c), axis=(1, 2))
+    w = np.asarray(weights, dtype=float)[ok]
+    if not ok.any() or w.sum() <= 0:
+        p = v.shape[1]
+        return np.full(p, math.nan), np.zeros((p, p)), np.zeros((p, p))
+    w = w / w.sum()
+    v_bar = w @ v[ok]
+    return v_bar, np.einsum("i,ijk->jk", w, c[ok]), systematic_covariance(v_bar, v[ok], w)
+
+
+def _counts(fits: dict, laws: list[str]) -> list[int] | None:
+    """The members' parameter counts (None when any is not known: equal counts)."""
+    k = [int(getattr(fits[law], "n_params", 0)) for law in laws]
+    return k if all(k) else None
+
+
+def _member_covariances(unc: Uncertainty, fits: dict, laws: list[str], idx: list[int]) -> np.ndarray:
+    """Each member's own statistical covariance of the model parameters ``idx`` of ``unc.names`` (the reported
+    fit's where a member brings none)."""
+    names = [unc.names[j] for j in idx]
+    out = []
+    for k in laws:
+        f = fits[k]
+        own, cov = tuple(getattr(f, "names", ())), getattr(f, "cov", None)
+        if cov is None or not set(names) <= set(own):
+            out.append(unc.cov_stat[np.ix_(idx, idx)])
+        else:
+            j = [own.index(n) for n in names]
+            out.append(np.asarray(cov)[np.ix_(j, j)])
+    return np.array(out).reshape(len(laws), len(idx), len(idx))
+
+
+def uncertainty_budget(unc: Uncertainty, fitted, fits: dict, r: np.ndarray, groups: np.ndarray, law: str | None,
+                       n_resampled: int) -> UncertaintyBudget:
+    """Average the model parameters over the loop laws' fits (in ``unc``) and return the two parts of the errors.
+
+    With an ensemble the reported model parameters become the Akaike-weighted average of the members'
+    (:func:`model_average`), their statistical covariance the weighted average of the members' own, and
+    their systematic covariance the members' weighted spread about the average: Burnham & Anderson's
+    unconditional variance.  The loop's own parameters stay the reported law's.
 
     Parameters
     ----------
-    unc : the fit's :class:`~bendpam.identify.uncertainty.Uncertainty` (statistical); its systematic
-        covariance is set here.
+    unc : the fit's :class:`~bendpam.identify.uncertainty.Uncertainty`; its model parameters, statistical
+        and systematic covariance are set here.
     fitted : the fitted actuator (for the shear modulus and shape of the ensemble's members).
-    fits : ``{law: (values by short name, weighted sum of squares)}``, the reported law first; empty:
-        no ensemble (no loop model, or switched off).
+    fits : ``{law: MemberFit}`` (or ``(values by short name, weighted sum of squares)``: the reported fit's
+        covariance), the reported law first; empty: no ensemble (no loop model, or switched off).
     r, groups : the reported fit's weighted residuals and their groups (for the effective points).
     law : the reported law (None: mean curves).
     n_resampled : how many tests had their cycles resampled.
@@ -226,8 +425,8 @@ def uncertainty_budget(unc: Uncertainty, fitted, fits: dict[str, tuple[dict[str,
     >>> unc = Uncertainty({"alpha0": 70.0}, ["alpha0"], np.array([[0.0009]]), 0.0, 0, {}, 0.0, 40, 0.95)
     >>> fits = {"pi": ({"alpha0": 70.0}, 1.0), "dahl": ({"alpha0": 70.4}, 1.0)}
     >>> b = uncertainty_budget(unc, bendpam.physics.presets.be_pam(), fits, np.ones(40), np.zeros(40, int), "pi", 0)
-    >>> b.statistical, b.systematic, [m.weight for m in b.ensemble]     # equal fits: half the weight each
-    ({'alpha0_deg': 0.03}, {'alpha0_deg': 0.2}, [0.5, 0.5])
+    >>> unc.values["alpha0"], b.statistical, b.systematic, [m.weight for m in b.ensemble]   # equal fits
+    (70.2, {'alpha0_deg': 0.03}, {'alpha0_deg': 0.2}, [0.5, 0.5])
     """
     names = unc.names
     members: list[EnsembleMember] = []
@@ -235,19 +434,22 @@ def uncertainty_budget(unc: Uncertainty, fitted, fits: dict[str, tuple[dict[str,
     if fits:
         m_eff = effective_points(r, groups)
         laws = list(fits)
-        w = akaike_weights([fits[k][1] for k in laws], m_eff)
-        ref = np.array([unc.values[n] for n in names])
-        V = np.array([[fits[k][0].get(n, math.nan) if n in PARAMETERS else ref[j] for j, n in enumerate(names)]
-                      for k in laws])
-        unc.set_systematic(systematic_covariance(ref, V, w))
+        w = akaike_weights([fits[k][1] for k in laws], m_eff, _counts(fits, laws))
+        idx = [j for j, n in enumerate(names) if n in PARAMETERS]
+        V = np.array([[fits[k][0].get(names[j], math.nan) for j in idx] for k in laws]).reshape(len(laws), len(idx))
+        v_bar, c_stat, c_sys = model_average(V, _member_covariances(unc, fits, laws, idx), w)
+        if np.all(np.isfinite(v_bar)):
+            unc.average(idx, v_bar, c_stat, c_sys)
+            fitted = fitted.replace(**{PARAMETERS[names[j]][0]: float(v) for j, v in zip(idx, v_bar, strict=True)})
         for k, wk in zip(laws, w, strict=True):
             vals = {parameter_field(n): float(fits[k][0][n]) for n in names if n in PARAMETERS}
             if "C10" in names or "C01" in names:
                 vals["shear_modulus_kpa"], vals["shape"] = _material(fits[k][0], fitted)
             members.append(EnsembleMember(k, float(wk), math.sqrt(max(fits[k][1], 0.0)), vals))
         weighting = (f"Akaike weights on {m_eff:.0f} effective points (the {r.size} residuals discounted for their "
-                     "lag-1 autocorrelation); systematic part: the weighted spread of the laws' values about the "
-                     f"reported ({law}) fit")
+                     "lag-1 autocorrelation); reported: the weighted average of the laws' values, with Burnham & "
+                     "Anderson's unconditional variance (statistical: the laws' own covariances, weighted; "
+                     f"systematic: their weighted spread about the average); the loop's parameters are the {law} fit's")
     stat = {parameter_field(n): float(v) for n, v in zip(names, unc.sd_stat, strict=True)}
     sys_ = {parameter_field(n): float(v) for n, v in zip(names, unc.sd_sys, strict=True)}
     if "C10" in names or "C01" in names:

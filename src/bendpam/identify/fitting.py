@@ -65,9 +65,10 @@ Uncertainty (both parts are reported separately: ``FitResult.uncertainty``)
        residuals; a drift correction adds its own doubt as an offset.
     2. Systematic (the loop law): no law is known to be the actuator's.  The fit is repeated with
        every law of :data:`bendpam.physics.hysteresis.ENSEMBLE` (warm-started, the quasi-static
-       parameters free as in the fit); the weighted spread of the parameters about the reported
-       fit, with Akaike weights on the residuals' effective number of points, is added to the
-       covariance (:mod:`bendpam.identify.ensemble`).
+       parameters free as in the fit, some laws with parameters of their own); the reported model
+       parameters are the average over the laws with Akaike weights (AICc on the residuals' effective
+       number of points), their covariance the unconditional one: the laws' own covariances
+       (statistical) and their spread about the average (systematic) (:mod:`bendpam.identify.ensemble`).
     3. The profile of alpha0 (the objective minimised over everything else, against alpha0) is
        kept in ``FitResult.alpha0_profile``.
     Pairs with ``|corr| > corr_flag`` are flagged, with the combination the data determine and
@@ -117,7 +118,15 @@ from bendpam.identify.diagnose import (
     has_loop,
     identifiability,
 )
-from bendpam.identify.ensemble import steady_z, uncertainty_budget
+from bendpam.identify.ensemble import (
+    MEMBER_EXTRA,
+    MemberFit,
+    akaike_weights,
+    effective_points,
+    played_path,
+    steady_z,
+    uncertainty_budget,
+)
 from bendpam.identify.metrics import score
 from bendpam.identify.numerics import bounded_lstsq, chebyshev_interpolation, halfline
 from bendpam.identify.result import (
@@ -228,11 +237,7 @@ class _Problem:
         self.shape_fixed = shape_fixed
         self.tension = tension
         self.sign = actuator.bend_sign or 1
-        self.free = [*free, "theta_h", "a0", "a1"] if law else list(free)
-        self.nonlin = [p for p in self.free if p in _NONLINEAR or p == "theta_h"]
-        self.lin = [p for p in self.free if p not in self.nonlin]
-        self.cone = "C10" in self.lin and "C01" in self.lin
-        self.int_names, self.T, self.lo, self.hi = self._internal()
+        self.set_free([*free, "theta_h", "a0", "a1"] if law else list(free))
         w, y, grp = data.w, data.Mc, data.group
         if tension is not None:
             n = tension.stretch.size
@@ -246,6 +251,14 @@ class _Problem:
         self._z_cache: dict = {}
         if not self._interpolation_ok():
             self.W = None
+
+    def set_free(self, free: list[str]) -> None:
+        """The varied parameters: the nonlinear ones (searched) and the linear ones (projected)."""
+        self.free = list(free)
+        self.nonlin = [p for p in self.free if p in _NONLINEAR or p in ("theta_h", "theta_2", "gap", "ratio")]
+        self.lin = [p for p in self.free if p not in self.nonlin]
+        self.cone = "C10" in self.lin and "C01" in self.lin
+        self.int_names, self.T, self.lo, self.hi = self._internal()
 
     # -- linear parameters: internal coordinates -> user values (user = T @ internal) ---------
     def _internal(self):
@@ -309,46 +322,66 @@ class _Problem:
         return bool(np.all(np.abs(approx - exact) <= 1e-9 * scale))
 
     def _qs(self, nl: dict[str, float]):
-        """The actuator and ``(A, b10, b01)`` (per kPa) at the data's curvatures for the kinematics in ``nl``."""
-        key = tuple(sorted((p, float(v)) for p, v in nl.items() if p in PARAMETERS))
+        """The actuator, ``(A, b10, b01)`` (per kPa) and the frame's curvature column at the data's curvatures
+        for the kinematics in ``nl`` (with a ``gap``: at the played curvatures, as the fixture converts them)."""
+        gap = float(nl.get("gap", 0.0))
+        key = (tuple(sorted((p, float(v)) for p, v in nl.items() if p in PARAMETERS)), gap)
         hit = self._qs_cache.get(key)
         if hit is None:
             if len(self._qs_cache) > 256:
                 self._qs_cache.clear()
-            a = self.base.replace(**{PARAMETERS[p][0]: v for p, v in key})
+            a = self.base.replace(**{PARAMETERS[p][0]: v for p, v in key[0]})
             law = MomentLaw(a, self.model, eq19_factor=self.eq19, order=self.order)
+            kq, fac = (self.d.kc, 1.0) if gap <= 0 else self._played(gap)[:2]
             if self.W is not None:
-                cols = self.W @ np.column_stack(law.basis(self.sign * self.nodes))
-                hit = (a, cols[:, 0], cols[:, 1], cols[:, 2])
+                W = self.W if gap <= 0 else chebyshev_interpolation(kq, float(self.d.kc.max()) or 1e-9, _CHEB_NODES)[1]
+                cols = W @ np.column_stack(law.basis(self.sign * self.nodes))
+                hit = (a, cols[:, 0] * fac, cols[:, 1] * fac, cols[:, 2] * fac, kq * fac)
             else:
-                hit = (a, *law.basis(self.sign * self.d.kc))
+                A, b10, b01 = law.basis(self.sign * kq)
+                hit = (a, A * fac, b10 * fac, b01 * fac, kq * fac)
             self._qs_cache[key] = hit
         return hit
 
-    def _z(self, theta_deg: float) -> np.ndarray:
-        z = self._z_cache.get(theta_deg)
+    def _played(self, gap: float):
+        if ("played", gap) not in self._z_cache:
+            self._z_cache[("played", gap)] = played_path(self.d, gap)
+        return self._z_cache[("played", gap)]
+
+    def _z(self, theta_deg: float, gap: float = 0.0, ratio: float | None = None, law: str | None = None,
+           theta_2: float | None = None):
+        law = law or self.law
+        key = (law, theta_deg, gap, ratio, theta_2)  # the cache is shared by the ensemble's members
+        z = self._z_cache.get(key)
         if z is None:
-            if len(self._z_cache) > 256:
+            if len(self._z_cache) > 512:
                 self._z_cache.clear()
-            assert self.law is not None, "a loop fit has a law"
-            z = steady_z(self.law, theta_deg, self.d)
-            self._z_cache[theta_deg] = z
+            assert law is not None, "a loop fit has a law"
+            if law == "zener":  # the dashpot's part, and the viscous member's Maxwell branch (cached)
+                z = np.column_stack([self._z(0.0, law="dashpot")[:, 0], self._z(theta_deg, law="viscous")])
+            elif law == "pi_maxwell":  # friction and a Maxwell branch of its own angle
+                z = np.column_stack([self._z(theta_deg, law="pi"), self._z(float(theta_2 or 1.0), law="viscous")])
+            else:
+                z = steady_z(law, theta_deg, self.d if gap <= 0 else self._played(gap)[2], ratio)
+            self._z_cache[key] = z
         return z
 
     def design(self, nl: dict[str, float]):
         """Fixed part ``c0`` and columns ``X`` (per internal linear unit) of every row of the model."""
-        a, A, b10, b01 = self._qs(nl)
+        a, A, b10, b01, k_frame = self._qs(nl)
         s, d = self.sign, self.d
-        cols = {"C10": -s * b10, "C01": -s * b01, "P_start": -s * A, "E_f": -a.frame_inertia_mm4 * d.kc}
+        cols = {"C10": -s * b10, "C01": -s * b01, "P_start": -s * A, "E_f": -a.frame_inertia_mm4 * k_frame}
         c0 = s * d.Pc * A
         fixed = {"C10": a.C10_kpa, "C01": a.C01_kpa, "P_start": a.P_start_kpa, "E_f": a.frame_modulus_mpa}
         for p, col in cols.items():
             if p not in self.lin:
                 c0 = c0 + col * fixed[p]
         if self.law:
-            z = self._z(float(nl["theta_h"]))
-            cols["a0"] = -z
-            cols["a1"] = -z * np.maximum(d.Pc - a.P_start_kpa, 0.0)
+            z = self._z(float(nl["theta_h"]), float(nl.get("gap", 0.0)), nl.get("ratio"),
+                        theta_2=nl.get("theta_2")).reshape(d.kc.size, -1)
+            pa = np.maximum(d.Pc - a.P_start_kpa, 0.0)
+            for j, (n0, n1) in enumerate((("a0", "a1"), ("a0_2", "a1_2"))[: z.shape[1]]):
+                cols[n0], cols[n1] = -z[:, j], -z[:, j] * pa
         X = np.column_stack([cols[p] for p in self.lin]) if self.lin else np.zeros((c0.size, 0))
         if self.tension is not None:
             lam = self.tension.stretch
@@ -550,17 +583,27 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool):
 
     unc = _uncertainty(run.prob, run.bnd, run.nl, run.lin, corr_flag, run.cycles, run.offsets)
     run.nfev += unc.nfev
-    fits: dict[str, tuple[dict[str, float], float]] = {}
+    fits: dict[str, MemberFit] = {}
     if run.law and law_uncertainty:
-        fits[run.law] = (unc.values, _ssr(run.prob, run.nl, run.lin))
+        fits[run.law] = MemberFit(dict(unc.values), _ssr(run.prob, run.nl, run.lin), tuple(unc.names),
+                                  unc.cov_stat.copy(), len(run.prob.free))
+        solved = {}
         for alt in (a for a in ENSEMBLE if a != run.law):
             try:
-                values, ssr, n = _law_refit(run.prob, run.bnd, run.nl, alt)
+                fits[alt], n, solved[alt] = _law_refit(run.prob, run.bnd, run.nl, alt)
             except FitError:  # this law cannot describe the curves at all: it has no weight
                 continue
             run.nfev += n
-            fits[alt] = (values, ssr)
     r = run.prob.residual_full(np.concatenate([[run.nl[p] for p in run.prob.nonlin], run.lin]))
+    if fits:  # each member's own statistical covariance, where it has weight (the others add nothing)
+        w = akaike_weights([f.ssr for f in fits.values()], effective_points(r, run.prob.groups),
+                           [f.n_params for f in fits.values()])
+        for (alt, f), wk in zip(list(fits.items()), w, strict=True):
+            if alt in solved and wk > 1e-4:
+                p2, nl2, lin2 = solved[alt]
+                u2 = _uncertainty(p2, run.bnd, nl2, lin2, corr_flag, run.cycles, run.offsets)
+                fits[alt] = f._replace(names=tuple(u2.names), cov=u2.cov_stat)
+                run.nfev += u2.nfev
     shape_bound = unc.at_bound.get("S_lo", False) or unc.at_bound.get("S_hi", False)
     budget = uncertainty_budget(unc, run.prob.actuator(unc.values), fits, r, run.prob.groups, run.law,
                                 0 if shape_bound else len(run.cycles))
@@ -574,7 +617,8 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool):
 
 def _bounds(actuator: Actuator, d: FitData, bounds) -> dict[str, tuple[float, float]]:
     bnd = _default_bounds(actuator, float(d.P.min()))
-    bnd.update({"theta_h": (0.2, 90.0), "a0": (0.0, 10.0 * float(d.BM.max())), "a1": (0.0, 100.0)})
+    bnd.update({"theta_h": (0.2, 90.0), "a0": (0.0, 10.0 * float(d.BM.max())), "a1": (0.0, 100.0), "gap": (0.0, 5.0)})
+    bnd.update({"a0_2": bnd["a0"], "a1_2": bnd["a1"], "ratio": (1.0, 3.0), "theta_2": bnd["theta_h"]})  # members' own
     for k, v in (bounds or {}).items():
         key = "shape" if str(k).strip().lower() in ("shape", "beta") else parse_free([k])[0]
         try:
@@ -796,26 +840,33 @@ def _uncertainty(prob: _Problem, bnd, nl_best, lin, corr_flag: float, cycles=(),
 
 
 def _law_refit(prob: _Problem, bnd, nl, alt: str):
-    """The fit with another loop law ``alt`` (warm start, angle grid): ``(values, ssr, nfev)``.
-
-    The search stops at ``xtol = 1e-7``: the ensemble's values need to be good to well within their spread.
-    """
-    p2 = copy.copy(prob)  # the same data and kinematics (their cache is shared), another loop law
-    p2.law, p2._z_cache = alt, {}
+    """The fit with another loop law ``alt`` (warm start, angle grid; a member's own parameters from short grids):
+    ``(MemberFit without its covariance, nfev, (problem, nonlinear, linear values))``.  The search stops at
+    ``xtol = 1e-5`` (alpha0 to about 1e-3 deg): well within the standard errors the values serve."""
+    p2 = copy.copy(prob)  # the same data and kinematics (their caches are shared), another loop law
+    p2.law = alt
+    extra = MEMBER_EXTRA.get(alt, ())
+    if extra:
+        p2.set_free([*prob.free, *extra])
     nfev = 0
     best = (math.inf, dict(nl))
+    own = {"gap": (0.25, 0.5, 1.0, 2.0), "ratio": (1.25, 1.75), "theta_2": (2.0, 8.0, 30.0)}  # members' own grids
+    grid: list[dict[str, float]] = [{}]
+    for p in extra:
+        grid = [{**g, p: v} for g in grid for v in own[p]] if p in own else grid
     for th in _THETA_GRID:
-        trial = {**nl, "theta_h": float(th)}
-        r, _ = p2.project(trial)
-        nfev += 1
-        if float(r @ r) < best[0]:
-            best = (float(r @ r), trial)
-    nl2, lin2, _, _, n = _search(p2, bnd, best, tol=1e-7)
-    return p2.to_user(nl2, lin2), _ssr(p2, nl2, lin2), nfev + n
+        for g in grid:
+            trial = {**nl, "theta_h": float(th), **g}
+            r, _ = p2.project(trial)
+            nfev += 1
+            if float(r @ r) < best[0]:
+                best = (float(r @ r), trial)
+    nl2, lin2, _, _, n = _search(p2, bnd, best, tol=1e-5)
+    return MemberFit(p2.to_user(nl2, lin2), _ssr(p2, nl2, lin2), n_params=len(p2.free)), nfev + n, (p2, nl2, lin2)
 
 
 def _profile(prob: _Problem, bnd, nl, unc: Uncertainty, n_points: int):
-    """The objective minimised over everything else against alpha0, around the optimum."""
+    """The reported loop law's objective minimised over everything else against alpha0, around its optimum."""
     if "alpha0" not in prob.nonlin or n_points < 3:
         return None, 0
     from scipy.optimize import least_squares
@@ -852,8 +903,8 @@ def _profile(prob: _Problem, bnd, nl, unc: Uncertainty, n_points: int):
             x_prev = sol.x
             r = sol.fun
         obj[j] = float(r @ r)
-    sd = float(unc.sd[i])
-    return Profile([float(x) for x in alphas], [float(x) for x in obj], (a_hat - 2 * sd, a_hat + 2 * sd)), nfev
+    sd, mid = float(unc.sd[i]), float(unc.values["alpha0"])  # the reported value: the ensemble's average
+    return Profile([float(x) for x in alphas], [float(x) for x in obj], (mid - 2 * sd, mid + 2 * sd)), nfev
 
 
 def _result(processed, actuator: Actuator, run: _Run, unc: Uncertainty, tension, t0: float,

@@ -219,8 +219,9 @@ class MaterialFit:
 class Profile:
     """The profile of alpha0: the fit objective minimised over every other parameter, against alpha0.
 
-    ``objective`` is the weighted sum of squares (eq 53 scale: NRMSE^2 of the fitted curves);
-    ``interval_deg`` the reported alpha0 +- 2 standard errors (statistical and systematic).
+    ``objective`` is the weighted sum of squares of the reported loop law's fit (eq 53 scale: NRMSE^2 of
+    its curves), smallest at that law's alpha0; ``interval_deg`` the reported alpha0 (with a loop, the
+    ensemble's average over the loop laws) +- 2 standard errors (statistical and systematic).
 
     >>> prof = Profile([69.6, 69.7, 69.8], [2.1e-3, 1.6e-3, 2.2e-3], (69.65, 69.75))
     >>> Profile.from_dict(prof.to_dict()) == prof
@@ -739,7 +740,8 @@ class FitResult:
             lines.append("  standard errors, statistical / systematic: " + ", ".join(
                 f"{k} {b.statistical[k]:.2g} / {b.systematic.get(k, 0.0):.2g}" for k in keys))
             if b.ensemble:
-                lines.append("  loop laws (weight): " + ", ".join(f"{m.law} {m.weight:.2f}" for m in b.ensemble))
+                lines.append("  loop laws (weight; the model parameters are their weighted average): "
+                             + ", ".join(f"{m.law} {m.weight:.2f}" for m in b.ensemble))
         lines += [f"  identifiability: {s}" for s in self.identifiability]
         lines += [f"  note: {f}" for f in self.flags]
         return "\n".join(lines)

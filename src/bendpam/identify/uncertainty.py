@@ -88,6 +88,24 @@ class Uncertainty:
         with np.errstate(invalid="ignore", divide="ignore"):
             return self.cov / np.outer(sd, sd)
 
+    def average(self, idx, values, cov_stat, cov_sys) -> None:
+        """Replace the values and the covariance of the parameters ``idx`` (positions in ``names``) by a model
+        average's (:func:`bendpam.identify.ensemble.model_average`); the other parameters keep theirs.
+
+        >>> unc = Uncertainty({"a": 1.0, "b": 2.0}, ["a", "b"], np.diag([1.0, 4.0]), 0.0, 0, {}, 0.0, 9, 0.95)
+        >>> unc.average([0], np.array([1.5]), np.array([[2.0]]), np.array([[0.25]]))
+        >>> unc.values, unc.sd.tolist(), unc.sd_sys.tolist()
+        ({'a': 1.5, 'b': 2.0}, [1.5, 2.0], [0.5, 0.0])
+        """
+        ix = np.ix_(idx, idx)
+        for j, v in zip(idx, values, strict=True):
+            self.values[self.names[j]] = float(v)
+        self.cov_stat = self.cov_stat.copy()
+        self.cov_stat[ix] = cov_stat
+        cov_s = np.zeros_like(self.cov_stat)
+        cov_s[ix] = cov_sys
+        self.set_systematic(cov_s)
+
     def set_systematic(self, cov_sys: np.ndarray) -> None:
         """The systematic covariance (the loop laws' spread, :mod:`bendpam.identify.ensemble`); ``cov`` is the sum."""
         self.cov_sys = np.asarray(cov_sys, dtype=float)

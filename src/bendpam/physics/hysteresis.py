@@ -35,7 +35,11 @@ Laws for ``z`` (both rate-independent: they depend on the path, not on its speed
 
 The loop laws above are rate-independent.  :class:`ViscousLoop` (``"viscous"``, a Maxwell fluid:
 a spring in series with a dashpot, ``tau dz/dt + z = (dtheta/dt) / omega_ref``) depends on the
-rate; the identification's ensemble of loop laws (:data:`ENSEMBLE`) uses it, a saved loop does not.
+rate, and so does :class:`ZenerLoop` (``"zener"``, the standard linear solid's loop: a dashpot in
+parallel with one Maxwell branch); the identification's ensemble of loop laws (:data:`ENSEMBLE`)
+uses them, a saved loop does not.  :func:`play` is the play (backlash) operator: the ensemble's
+``"pi_play"`` member evaluates the quasi-static moment and the Prandtl-Ishlinskii loop at the
+played path of a fixture with a dead zone.
 
 Amplitude (:class:`LoopModel`)
     * ``"linear"`` (default): ``A = a0 + a1 P_active`` with ``a0`` (N*mm) the residual friction of
@@ -70,17 +74,20 @@ __all__ = [
     "MaxwellSlip",
     "PrandtlIshlinskii",
     "ViscousLoop",
+    "ZenerLoop",
     "first_order_scan",
     "loop_branches",
     "loss_ratio",
     "make_law",
+    "play",
     "predict_cycle",
     "predict_cycles",
 ]
 
 LAWS = ("pi", "dahl")
 #: The loop laws whose fits make the identification's systematic (model-form) uncertainty.
-ENSEMBLE = ("pi", "dahl", "bouc_wen", "maxwell_slip", "stiction", "viscous", "viscous_period")
+ENSEMBLE = ("pi", "dahl", "bouc_wen", "maxwell_slip", "stiction", "viscous", "viscous_period", "zener", "pi_play",
+            "pi_maxwell")
 
 
 def _segments(theta: np.ndarray):
@@ -454,6 +461,79 @@ class ViscousLoop:
 
 
 @dataclass(frozen=True)
+class ZenerLoop:
+    """The loop of a standard linear solid: a dashpot in parallel with one Maxwell branch (generalised Maxwell, n = 1).
+
+    ``z = share z_d + (1 - share) z_m`` with the dashpot's ``z_d = (dtheta/dt) / omega_ref`` and the Maxwell
+    branch's ``tau dz_m/dt + z_m = (dtheta/dt) / omega_ref`` (:class:`ViscousLoop`): in steady motion at the
+    reference rate both parts reach 1.  :meth:`components` gives the two parts apart (a fit weighs them
+    with amplitudes of their own).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> law = ZenerLoop(tau_s=2.0, omega_ref_rad_s=0.1, share=0.5)
+    >>> t = np.linspace(0.0, 2.0, 201)
+    >>> round(float(law.z_path(0.1 * t, t)[-1]), 4)       # 1/2 + 1/2 (1 - exp(-1)) at the reference rate
+    0.8161
+    >>> [round(float(x), 4) for x in law.components(0.05 * t, t)[:, -1]]   # half the rate: 1/2, 1/2 (1 - e^-1)
+    [0.5, 0.3161]
+    """
+
+    tau_s: float = 1.0
+    omega_ref_rad_s: float = 1.0
+    share: float = 0.5
+
+    def __post_init__(self) -> None:
+        ViscousLoop(self.tau_s, self.omega_ref_rad_s)  # the same checks
+        if not (math.isfinite(self.share) and 0.0 <= self.share <= 1.0):
+            raise InputError(f"share = {self.share!r} is outside the allowed range [0, 1]")
+
+    name = "zener"
+
+    def components(self, theta, time_s, z0: float = 0.0) -> np.ndarray:
+        """``(z_d, z_m)`` (2 x n) along ``theta`` (rad) at the equally spaced ``time_s`` (s); ``z_m`` starts at ``z0``.
+
+        ``z_d`` is the rate of each step (the path is linear between samples; the first sample takes the
+        first step's rate).
+        """
+        th, t = np.asarray(theta, dtype=float), np.asarray(time_s, dtype=float)
+        z_m = ViscousLoop(self.tau_s, self.omega_ref_rad_s).z_path(th, t, z0)
+        rate = np.diff(th) / np.diff(t) if th.size > 1 else np.zeros(0)
+        z_d = np.concatenate([rate[:1], rate]) / self.omega_ref_rad_s if th.size > 1 else np.zeros(th.size)
+        return np.vstack([z_d, z_m])
+
+    def z_path(self, theta, time_s, z0: float = 0.0) -> np.ndarray:
+        """``z`` along ``theta`` (rad) sampled at the equally spaced times ``time_s`` (s)."""
+        z_d, z_m = self.components(theta, time_s, z0)
+        return self.share * z_d + (1.0 - self.share) * z_m
+
+
+def play(path, width: float, start: float | None = None) -> np.ndarray:
+    """The play (backlash) operator: the output stays in ``[x - width, x]`` and moves only when pushed.
+
+    A fixture with a dead zone of ``width`` (the path's unit): the driven side follows the driving one
+    only once the gap is closed.  ``start`` is the output at the first sample (default: the path's,
+    the gap open on the side the path leaves to).
+
+    Examples
+    --------
+    >>> play(np.array([0.0, 1.0, 3.0, 2.5, 1.0, 2.0]), 1.0).tolist()   # lags by 1 going up, follows going down
+    [0.0, 0.0, 2.0, 2.0, 1.0, 1.0]
+    """
+    x = np.asarray(path, dtype=float)
+    w = float(width)
+    if not (math.isfinite(w) and w >= 0.0):
+        raise InputError(f"width = {width!r} must be >= 0")
+    out = np.empty(x.size)
+    a = float(x[0]) if start is None else float(start)
+    for i, xi in enumerate(x.tolist()):  # a scalar recursion (a path of a few thousand samples)
+        a = min(max(a, xi - w), xi)
+        out[i] = a
+    return out
+
+
+@dataclass(frozen=True)
 class Breakaway:
     """Breakaway friction (stiction): static friction ``ratio`` times the kinetic one, ``z`` in units of the kinetic.
 
@@ -507,9 +587,11 @@ class Breakaway:
         is too narrow to break away, ``z_b = ratio span / (2 theta_s)``).
         """
         span = np.asarray(span, dtype=float)
-        zb = np.ones(span.shape)
+        spans, inverse = np.unique(span, return_inverse=True)  # the fixed point once per distinct span
+        zb = np.ones(spans.shape)
         for _ in range(40):
-            zb = 0.5 * (zb + self._branch(-zb, span))
+            zb = 0.5 * (zb + self._branch(-zb, spans))
+        zb = zb[inverse].reshape(span.shape)
         up = self._branch(-zb, np.minimum(np.asarray(delta, dtype=float), span))
         return up, -up
 
