@@ -436,3 +436,11 @@ def test_the_zener_member_is_the_dashpot_rate_and_the_viscous_member():
     assert z.shape == (2 * n, 2)
     assert np.allclose(z[:n, 0], -1.0) and np.allclose(z[n:, 0], 0.5)  # the rate over the fastest, signed as z
     assert np.allclose(z[:, 1], steady_z("viscous", 6.0, d))
+
+
+def test_every_member_of_the_ensemble_has_a_name_in_words():
+    """The report names each loop law in words; a member without a label would print its code name."""
+    from bendpam.physics.hysteresis import ENSEMBLE
+    from bendpam.present.report.text import LAW_LABEL
+
+    assert set(ENSEMBLE) <= set(LAW_LABEL)

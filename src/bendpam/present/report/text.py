@@ -43,7 +43,10 @@ MODEL_LABEL = {"energy": "energy", "force_balance": "force-balance"}
 LAW_LABEL = {"pi": "Prandtl-Ishlinskii", "dahl": "Dahl", "bouc_wen": "Bouc-Wen", "maxwell_slip": "Maxwell-slip",
              "stiction": "breakaway (stiction)",
              "viscous": "viscous (the test's time; else a constant crosshead speed)",
-             "viscous_period": "viscous (constant cycle period)"}
+             "viscous_period": "viscous (constant cycle period)",
+             "zener": "standard linear solid (a dashpot and a Maxwell branch)",
+             "pi_play": "Prandtl-Ishlinskii after a fixture play (backlash)",
+             "pi_maxwell": "Prandtl-Ishlinskii and a Maxwell branch"}
 
 
 def escape(x) -> str:
