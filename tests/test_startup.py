@@ -128,6 +128,8 @@ def test_fit_with_its_figure_imports_no_pyplot(processed_dir, tmp_path):
     assert "matplotlib" in modules
     assert loaded(modules, "matplotlib.pyplot") == []
     assert loaded(modules, "bendpam.design") == []  # one figure does not load the design layer (issue 24 item 6)
+    assert loaded(modules, "bendpam.present.figures") == ["bendpam.present.figures", "bendpam.present.figures.lab",
+                                                          "bendpam.present.figures.style"]  # the lab figure only
 
 
 @pytest.mark.parametrize("columns", ["80", "60", "200"])
@@ -162,3 +164,75 @@ def test_a_full_stdout_is_one_error_line(args, tmp_path):
         r = subprocess.run([sys.executable, "-c", code, *args], stdout=full, stderr=subprocess.PIPE, text=True,
                            cwd=tmp_path, timeout=120)
     assert r.returncode == 2 and r.stderr == "bendpam: error: No space left on device\n", r.stderr
+
+
+def test_the_command_table_is_the_apps():
+    """``COMMANDS`` (what ``bendpam --help`` is built from) names every command of the app, in its order, with the
+    module that registers it and the first paragraph of its help."""
+    import typer.main
+
+    from bendpam.cli import app
+    from bendpam.cli.app import COMMANDS
+
+    group = typer.main.get_command(app)
+    assert list(group.commands) == list(COMMANDS)
+    for name, cmd in group.commands.items():
+        module, first = COMMANDS[name]
+        assert " ".join((cmd.help or "").split("\n\n")[0].split()) == first, name
+        assert not (cmd.hidden or cmd.deprecated or cmd.short_help), name
+        where = cmd.callback.__module__ if cmd.callback is not None else f"bendpam.cli.{module}"
+        assert where == f"bendpam.cli.{module}", name
+
+
+def test_a_command_imports_its_own_module_only(tmp_path):
+    modules, stdout = modules_after(["fit", "--help"], tmp_path)
+    assert "--no-figure" in stdout
+    assert sorted(m for m in modules if m.startswith("bendpam.cli")) == [
+        "bendpam.cli", "bendpam.cli.app", "bendpam.cli.identify", "bendpam.cli.options"]
+    modules, _ = modules_after(["--help"], tmp_path)
+    assert sorted(m for m in modules if m.startswith("bendpam.cli")) == ["bendpam.cli", "bendpam.cli.app",
+                                                                         "bendpam.cli.options"]
+
+
+def test_the_app_read_after_one_command_has_every_command_in_order(tmp_path):
+    """A command run in this process loads its module only; reading the app afterwards loads the rest, in order."""
+    code = ("import json, sys, typer.main\n"
+            "from bendpam.cli import app, main\n"
+            "rc = main(['actuator', '--preset', 'be-pam'])\n"
+            "print(json.dumps([rc, list(typer.main.get_command(app).commands)]))\n")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path, timeout=300)
+    from bendpam.cli.app import COMMANDS
+
+    rc, names = json.loads(r.stdout.strip().splitlines()[-1])
+    assert rc == 0 and names == list(COMMANDS), r.stderr
+
+
+def test_the_figures_registered_on_first_use_are_the_modules_own(tmp_path):
+    """``bendpam.present.figures`` registers each figure's name before its module is imported; the table it uses
+    is what the modules register, and the first use of a name draws with the module's own function."""
+    code = """
+import importlib, json, sys
+import bendpam.infra.accessors as acc
+seen = {}
+real = acc.register
+def spy(name):
+    def deco(fn):
+        seen[name] = fn.__module__.rsplit(".", 1)[-1]
+        return real(name)(fn)
+    return deco
+acc.register = spy
+import bendpam.present.figures as figs
+stand_ins = dict(seen)
+seen.clear()
+before = sorted(m for m in sys.modules if m.startswith("matplotlib"))
+for module in sorted(set(figs._REGISTERED.values())):
+    importlib.import_module("bendpam.present.figures." + module)
+print(json.dumps([figs._REGISTERED, seen, before, acc.figure("figure7").__module__]))
+"""
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path, timeout=300)
+    assert r.returncode == 0, r.stderr
+    table, registered, matplotlib_before, figure7_home = json.loads(r.stdout.strip().splitlines()[-1])
+    assert registered == table
+    assert matplotlib_before == []
+    assert figure7_home == "bendpam.present.figures.lab"
+
