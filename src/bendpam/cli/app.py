@@ -17,6 +17,7 @@ it returns with status 0, or all rolled back.
 
 # no ``from __future__ import annotations``: Typer reads the annotations of the commands as objects (start-up)
 
+import os
 import sys
 import traceback
 import warnings
@@ -201,6 +202,9 @@ def _one_line(exc: BaseException) -> str:
 def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
     """``warnings.showwarning`` while a command runs: bendpam's warnings are one ``bendpam: warning:`` line each.
 
+    So is a ``UserWarning`` located in bendpam's own code (a library function warning its caller,
+    here a command: ``curves.npz`` not used, and why).
+
     A :class:`~bendpam.errors.ModelMismatchWarning` or
     :class:`~bendpam.errors.OutsideTestedRangeWarning` is printed once per command, however many
     computations of the command raise it.
@@ -217,8 +221,14 @@ def _show_warning(message, category, filename, lineno, file=None, line=None) -> 
                 return
             _SHOWN.set(shown | {text})
         typer.echo(f"bendpam: warning: {text}", err=True)
+    elif issubclass(category, UserWarning) and str(filename).startswith(_PACKAGE):  # raised for bendpam's own code
+        typer.echo(f"bendpam: warning: {str(message).strip().splitlines()[0]}", err=True)
     else:
         _SHOW_WARNING(message, category, filename, lineno, file, line)
+
+
+#: The folder of the bendpam package: a warning located in it is about bendpam's own call (one line too).
+_PACKAGE = os.path.dirname(os.path.dirname(os.path.abspath(__file__))) + os.sep
 
 
 #: The once-per-command warnings already printed by the running command.
