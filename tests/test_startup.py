@@ -2,8 +2,9 @@
 
 ``bendpam --help`` and ``--version`` import no NumPy (nor pandas, pyplot, ``scipy.io``);
 ``bendpam predict`` prints its few rows without pandas; ``bendpam fit`` imports no pyplot (no
-matplotlib at all without a figure).  ``fit`` still reads ``curves.nc`` through xarray's SciPy
-backend (``scipy.io``): bendpam keeps to the field's NetCDF libraries rather than a reader of its own.
+matplotlib at all without a figure) and no ``scipy.io``: it reads the processed set's ``curves.npz``
+with NumPy (``curves.nc`` stays the file of record; tests/test_processing_npz.py).  ``--help`` imports
+none of the command modules, a command its own module only.
 Each command runs through the console script's entry (:func:`bendpam_entry.main`) in a new
 process, which then lists ``sys.modules``.  No timings here: ``benchmarks/bench_startup.py``
 measures them.
@@ -118,6 +119,7 @@ def test_fit_without_a_figure_imports_no_matplotlib(processed_dir, tmp_path):
                                 "--no-figure", "--quiet"], tmp_path)
     assert (tmp_path / "fit" / "fit.json").is_file()
     assert loaded(modules, "matplotlib") == [], "`bendpam fit --no-figure` imports matplotlib"
+    assert loaded(modules, "scipy.io") == [] and loaded(modules, "xarray") == []  # curves.npz, read by NumPy
 
 
 @pytest.mark.slow
@@ -236,3 +238,43 @@ print(json.dumps([figs._REGISTERED, seen, before, acc.figure("figure7").__module
     assert matplotlib_before == []
     assert figure7_home == "bendpam.present.figures.lab"
 
+
+
+@pytest.fixture(scope="module")
+def fine_fit(tmp_path_factory):
+    """A processed set on a fine curvature grid (2000 points) and its fit with a loop."""
+    import bendpam
+    from bendpam.identify.fitting import fit
+    from bendpam.lab import RawTest
+    from bendpam.lab.processing import ProcessingOptions, process_tests
+    from bendpam.lab.simulate import SimulationSettings, simulate_test
+
+    be, settings = bendpam.physics.presets.be_pam(), SimulationSettings(cycles=2, rate_hz=5.0, seed=2)
+    raws = [RawTest(simulate_test(be, p, settings=settings)[0], Path(f"be_{p:g}kPa.csv"), "csv", pressure_kpa=p)
+            for p in (100.0, 200.0)]
+    processed = process_tests(raws, keep_series=False, options=ProcessingOptions(grid_points=2000))
+    return processed, fit(processed, be, free=("alpha0",))
+
+
+def test_figure7_draws_a_fine_grid_with_what_its_pixels_show(fine_fit):
+    """Figure 7 (a) draws each line with at most about 512 points and 26 markers per pressure, the last point kept;
+    the model's loop is computed on the points drawn (the same values as on the whole grid)."""
+    import numpy as np
+
+    from bendpam.physics.hysteresis import loop_branches
+    from bendpam.present.figures import figure7
+
+    processed, res = fine_fit
+    assert res.loop is not None
+    ax = figure7(processed, res).axes[0]
+    thin, thick = ax.collections[0].get_segments(), ax.collections[1].get_segments()
+    markers = ax.collections[2].get_offsets()
+    assert len(thin) == len(thick) == 2 * len(processed.results)
+    assert all(500 <= len(seg) <= 512 for seg in thin + thick)
+    assert len(markers) <= 26 * len(processed.results)
+    r = processed.results[0]
+    assert thin[0][-1].tolist() == [r.curvature_grid[-1], r.mean_loading[-1]]  # the end of the branch is drawn
+    up, _ = loop_branches(res.actuator, res.loop, r.pressure_kpa, float(r.free_curvature[0]), r.curvature_grid,
+                          res.model)
+    drawn = np.searchsorted(r.curvature_grid, thick[0][:, 0])
+    np.testing.assert_allclose(thick[0][:, 1], up[drawn], rtol=1e-12, atol=1e-9)
