@@ -585,7 +585,7 @@ def _write_npz(ds: xr.Dataset, nc) -> Path:
 def _trusted_npz(nc) -> Path | None:
     """The ``curves.npz`` beside ``nc`` when it was written with this very ``nc`` (the sha256 it records), else None.
 
-    A set written before 0.4.1 has none (``nc`` is read, silently).  One that was written with
+    A set written before 0.4 has none (``nc`` is read, silently).  One that was written with
     another ``curves.nc`` (the set was edited since, e.g. with xarray) or cannot be read is not
     used, and a warning says why.
     """
@@ -681,7 +681,7 @@ def load_processed(path) -> ProcessedSet:
 
     The arrays come from the ``curves.npz`` beside ``curves.nc`` when it was written with that very
     file (it records its sha256), with :func:`numpy.load`; else from ``curves.nc`` (a set saved
-    before 0.4.1, or one whose ``curves.nc`` was changed since: a warning then says why).  Both
+    before 0.4, or one whose ``curves.nc`` was changed since: a warning then says why).  Both
     give the same set.  The curves, per-cycle values, branch times, fixture and sources come back; the options are the
     defaults and the samples (:attr:`PressureResult.series`) are not stored.  A set saved before
     0.4 has no branch times (:attr:`PressureResult.branch_times_s` is None): a fit then
