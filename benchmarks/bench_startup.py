@@ -38,12 +38,12 @@ import json
 import os
 import subprocess
 import sys
-import tarfile
 import tempfile
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).parent))
 from _timing import Recorder, bendpam_cli, compare, header, standalone
+from bench_sweep_speed import _checkout as checkout  # src/ of a commit, by git archive
 
 ROOT = Path(__file__).resolve().parent.parent
 HEAVY = ("numpy", "pandas", "matplotlib", "matplotlib.pyplot", "scipy", "scipy.io", "xarray", "dask", "pydantic")
@@ -69,16 +69,6 @@ def env(cache: str, src: Path = ROOT / "src") -> dict[str, str]:
     e["PYTHONPATH"] = os.pathsep.join([str(src), *filter(None, [os.environ.get("PYTHONPATH")])])
     e["PYTHONPYCACHEPREFIX"] = cache
     return e
-
-
-def checkout(ref: str, into: Path) -> Path:
-    """``src/`` of commit ``ref`` unpacked under ``into`` (``git archive``; the repository is not touched)."""
-    tar = into / "src.tar"
-    with open(tar, "wb") as f:
-        subprocess.run(["git", "-C", str(ROOT), "archive", ref, "src"], stdout=f, check=True)
-    with tarfile.open(tar) as t:
-        t.extractall(into, filter="data")
-    return into / "src"
 
 
 def runner(cmd: list[str], e: dict[str, str], cwd: str):
