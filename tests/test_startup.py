@@ -278,3 +278,15 @@ def test_figure7_draws_a_fine_grid_with_what_its_pixels_show(fine_fit):
                           res.model)
     drawn = np.searchsorted(r.curvature_grid, thick[0][:, 0])
     np.testing.assert_allclose(thick[0][:, 1], up[drawn], rtol=1e-12, atol=1e-9)
+
+
+def test_shell_completion_completes_the_commands(tmp_path):
+    """Typer's shell completion (``_BENDPAM_COMPLETE`` set, no arguments) answers with the commands, not the help."""
+    import os
+
+    code = "import sys, bendpam_entry; sys.argv = ['bendpam']; sys.exit(bendpam_entry.main())"
+    env = {**os.environ, "_BENDPAM_COMPLETE": "complete_bash", "COMP_WORDS": "bendpam fi", "COMP_CWORD": "1"}
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path, env=env,
+                       timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.split() == ["fit", "fit-material", "finger"]

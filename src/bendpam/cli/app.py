@@ -353,8 +353,8 @@ def main(argv: list[str] | None = None) -> int:
     2
     """
     args = list(sys.argv[1:] if argv is None else argv)
-    if not args or args == ["--help"]:  # nothing runs: no output group, no signal handling (start-up)
-        return _print_root_help()
+    if (not args or args == ["--help"]) and "_BENDPAM_COMPLETE" not in os.environ:  # (shell completion: Typer's)
+        return _print_root_help()  # nothing runs: no output group, no signal handling (start-up)
     from bendpam.errors import BendpamError
     from bendpam.infra.signals import Interrupted, forget_written, interrupted_line, interrupts, quiet_logging
 
