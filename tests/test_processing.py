@@ -168,7 +168,7 @@ def test_write_and_load_processed(simulated, tmp_path):
     d, truth = simulated[("be-pam", "csv")]
     ps = process_tests([read_test(d / f) for f in truth["files"]])
     written = write_processed(ps, tmp_path / "out")
-    assert set(written) == {"curves.nc", "curves.csv", "summary.json", "figure4.png"}
+    assert set(written) == {"curves.nc", "curves.npz", "curves.csv", "summary.json", "figure4.png"}
     summ = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert set(summ["pressures"][0]) >= {
         "pressure_kpa", "cycles", "blocked_moment_nmm", "blocked_moment_se_nmm", "blocked_moment_mean_curve_nmm",

@@ -2,8 +2,9 @@
 
 ``bendpam --help`` and ``--version`` import no NumPy (nor pandas, pyplot, ``scipy.io``);
 ``bendpam predict`` prints its few rows without pandas; ``bendpam fit`` imports no pyplot (no
-matplotlib at all without a figure).  ``fit`` still reads ``curves.nc`` through xarray's SciPy
-backend (``scipy.io``): bendpam keeps to the field's NetCDF libraries rather than a reader of its own.
+matplotlib at all without a figure) and no ``scipy.io``: it reads the processed set's ``curves.npz``
+with NumPy (``curves.nc`` stays the file of record; tests/test_processing_npz.py).  ``--help`` imports
+none of the command modules, a command its own module only.
 Each command runs through the console script's entry (:func:`bendpam_entry.main`) in a new
 process, which then lists ``sys.modules``.  No timings here: ``benchmarks/bench_startup.py``
 measures them.
@@ -118,6 +119,7 @@ def test_fit_without_a_figure_imports_no_matplotlib(processed_dir, tmp_path):
                                 "--no-figure", "--quiet"], tmp_path)
     assert (tmp_path / "fit" / "fit.json").is_file()
     assert loaded(modules, "matplotlib") == [], "`bendpam fit --no-figure` imports matplotlib"
+    assert loaded(modules, "scipy.io") == [] and loaded(modules, "xarray") == []  # curves.npz, read by NumPy
 
 
 @pytest.mark.slow
@@ -128,6 +130,8 @@ def test_fit_with_its_figure_imports_no_pyplot(processed_dir, tmp_path):
     assert "matplotlib" in modules
     assert loaded(modules, "matplotlib.pyplot") == []
     assert loaded(modules, "bendpam.design") == []  # one figure does not load the design layer (issue 24 item 6)
+    assert loaded(modules, "bendpam.present.figures") == ["bendpam.present.figures", "bendpam.present.figures.lab",
+                                                          "bendpam.present.figures.style"]  # the lab figure only
 
 
 @pytest.mark.parametrize("columns", ["80", "60", "200"])
@@ -162,3 +166,127 @@ def test_a_full_stdout_is_one_error_line(args, tmp_path):
         r = subprocess.run([sys.executable, "-c", code, *args], stdout=full, stderr=subprocess.PIPE, text=True,
                            cwd=tmp_path, timeout=120)
     assert r.returncode == 2 and r.stderr == "bendpam: error: No space left on device\n", r.stderr
+
+
+def test_the_command_table_is_the_apps():
+    """``COMMANDS`` (what ``bendpam --help`` is built from) names every command of the app, in its order, with the
+    module that registers it and the first paragraph of its help."""
+    import typer.main
+
+    from bendpam.cli import app
+    from bendpam.cli.app import COMMANDS
+
+    group = typer.main.get_command(app)
+    assert list(group.commands) == list(COMMANDS)
+    for name, cmd in group.commands.items():
+        module, first = COMMANDS[name]
+        assert " ".join((cmd.help or "").split("\n\n")[0].split()) == first, name
+        assert not (cmd.hidden or cmd.deprecated or cmd.short_help), name
+        where = cmd.callback.__module__ if cmd.callback is not None else f"bendpam.cli.{module}"
+        assert where == f"bendpam.cli.{module}", name
+
+
+def test_a_command_imports_its_own_module_only(tmp_path):
+    modules, stdout = modules_after(["fit", "--help"], tmp_path)
+    assert "--no-figure" in stdout
+    assert sorted(m for m in modules if m.startswith("bendpam.cli")) == [
+        "bendpam.cli", "bendpam.cli.app", "bendpam.cli.identify", "bendpam.cli.options"]
+    modules, _ = modules_after(["--help"], tmp_path)
+    assert sorted(m for m in modules if m.startswith("bendpam.cli")) == ["bendpam.cli", "bendpam.cli.app",
+                                                                         "bendpam.cli.options"]
+
+
+def test_the_app_read_after_one_command_has_every_command_in_order(tmp_path):
+    """A command run in this process loads its module only; reading the app afterwards loads the rest, in order."""
+    code = ("import json, sys, typer.main\n"
+            "from bendpam.cli import app, main\n"
+            "rc = main(['actuator', '--preset', 'be-pam'])\n"
+            "print(json.dumps([rc, list(typer.main.get_command(app).commands)]))\n")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path, timeout=300)
+    from bendpam.cli.app import COMMANDS
+
+    rc, names = json.loads(r.stdout.strip().splitlines()[-1])
+    assert rc == 0 and names == list(COMMANDS), r.stderr
+
+
+def test_the_figures_registered_on_first_use_are_the_modules_own(tmp_path):
+    """``bendpam.present.figures`` registers each figure's name before its module is imported; the table it uses
+    is what the modules register, and the first use of a name draws with the module's own function."""
+    code = """
+import importlib, json, sys
+import bendpam.infra.accessors as acc
+seen = {}
+real = acc.register
+def spy(name):
+    def deco(fn):
+        seen[name] = fn.__module__.rsplit(".", 1)[-1]
+        return real(name)(fn)
+    return deco
+acc.register = spy
+import bendpam.present.figures as figs
+stand_ins = dict(seen)
+seen.clear()
+before = sorted(m for m in sys.modules if m.startswith("matplotlib"))
+for module in sorted(set(figs._REGISTERED.values())):
+    importlib.import_module("bendpam.present.figures." + module)
+print(json.dumps([figs._REGISTERED, seen, before, acc.figure("figure7").__module__]))
+"""
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path, timeout=300)
+    assert r.returncode == 0, r.stderr
+    table, registered, matplotlib_before, figure7_home = json.loads(r.stdout.strip().splitlines()[-1])
+    assert registered == table
+    assert matplotlib_before == []
+    assert figure7_home == "bendpam.present.figures.lab"
+
+
+
+@pytest.fixture(scope="module")
+def fine_fit(tmp_path_factory):
+    """A processed set on a fine curvature grid (2000 points) and its fit with a loop."""
+    import bendpam
+    from bendpam.identify.fitting import fit
+    from bendpam.lab import RawTest
+    from bendpam.lab.processing import ProcessingOptions, process_tests
+    from bendpam.lab.simulate import SimulationSettings, simulate_test
+
+    be, settings = bendpam.physics.presets.be_pam(), SimulationSettings(cycles=2, rate_hz=5.0, seed=2)
+    raws = [RawTest(simulate_test(be, p, settings=settings)[0], Path(f"be_{p:g}kPa.csv"), "csv", pressure_kpa=p)
+            for p in (100.0, 200.0)]
+    processed = process_tests(raws, keep_series=False, options=ProcessingOptions(grid_points=2000))
+    return processed, fit(processed, be, free=("alpha0",))
+
+
+def test_figure7_draws_a_fine_grid_with_what_its_pixels_show(fine_fit):
+    """Figure 7 (a) draws each line with at most about 512 points and 26 markers per pressure, the last point kept;
+    the model's loop is computed on the points drawn (the same values as on the whole grid)."""
+    import numpy as np
+
+    from bendpam.physics.hysteresis import loop_branches
+    from bendpam.present.figures import figure7
+
+    processed, res = fine_fit
+    assert res.loop is not None
+    ax = figure7(processed, res).axes[0]
+    thin, thick = ax.collections[0].get_segments(), ax.collections[1].get_segments()
+    markers = ax.collections[2].get_offsets()
+    assert len(thin) == len(thick) == 2 * len(processed.results)
+    assert all(500 <= len(seg) <= 512 for seg in thin + thick)
+    assert len(markers) <= 26 * len(processed.results)
+    r = processed.results[0]
+    assert thin[0][-1].tolist() == [r.curvature_grid[-1], r.mean_loading[-1]]  # the end of the branch is drawn
+    up, _ = loop_branches(res.actuator, res.loop, r.pressure_kpa, float(r.free_curvature[0]), r.curvature_grid,
+                          res.model)
+    drawn = np.searchsorted(r.curvature_grid, thick[0][:, 0])
+    np.testing.assert_allclose(thick[0][:, 1], up[drawn], rtol=1e-12, atol=1e-9)
+
+
+def test_shell_completion_completes_the_commands(tmp_path):
+    """Typer's shell completion (``_BENDPAM_COMPLETE`` set, no arguments) answers with the commands, not the help."""
+    import os
+
+    code = "import sys, bendpam_entry; sys.argv = ['bendpam']; sys.exit(bendpam_entry.main())"
+    env = {**os.environ, "_BENDPAM_COMPLETE": "complete_bash", "COMP_WORDS": "bendpam fi", "COMP_CWORD": "1"}
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path, env=env,
+                       timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.split() == ["fit", "fit-material", "finger"]

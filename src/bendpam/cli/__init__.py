@@ -11,17 +11,14 @@
 * :mod:`.inverse`: ``design`` (inverse design from targets);
 * :mod:`.report`: ``report``;
 * :mod:`.export`: ``export mujoco`` (a finger or gripper as a MuJoCo model).
+
+The command modules are imported when the app's commands are first read (``typer.main.get_command(app)``, the
+CLI reference, ``app()``), and :func:`main` imports the module of the command it runs only:
+``bendpam --help`` imports none of them (:class:`~bendpam.cli.app.LazyTyper`).
 """
 
 from __future__ import annotations
 
-from bendpam.cli import design, export, hand, identify, inverse, lab, predict, report, sweep  # noqa: F401  (registers the commands)
 from bendpam.cli.app import app, main
-from bendpam.cli.options import use_bendpam_commands
-
-report.register(app)
-design.register(app)
-hand.register(app)
-use_bendpam_commands(app)  # one grammar for lists, --force where a command writes, readable help
 
 __all__ = ["app", "main"]

@@ -17,9 +17,12 @@ it returns with status 0, or all rolled back.
 
 # no ``from __future__ import annotations``: Typer reads the annotations of the commands as objects (start-up)
 
+import os
 import sys
 import traceback
 import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 from contextvars import ContextVar
 from typing import Annotated, Any, Optional
 
@@ -27,11 +30,128 @@ import typer
 
 from bendpam.cli.options import FORCE_HELP, RUN_ARGS, RUN_COMMAND, RUN_FORCE, WROTE_LINES
 
-__all__ = ["DECLARATION_HINT_CLI", "ISSUES_URL", "app", "cli_words", "main", "root_help"]
+__all__ = ["COMMANDS", "DECLARATION_HINT_CLI", "ISSUES_URL", "LazyTyper", "app", "cli_words", "main", "root_help"]
 
 ISSUES_URL = "the bendpam issue tracker (include the command line and bendpam --version)"
 
-app = typer.Typer(
+#: Every command of ``bendpam`` in the order of its help: name -> (the module of :mod:`bendpam.cli` that registers
+#: it, the first paragraph of its help on one line).  ``bendpam --help`` is built from this table without importing
+#: the command modules, and a command runs with its own module imported only (:class:`LazyTyper`); a test checks
+#: the table against the app's commands.
+COMMANDS: dict[str, tuple[str, str]] = {
+    "fit": ("identify", "Identify model parameters (alpha0, C10, C01, ...) from processed cyclic tests (section 3.4)."),
+    "fit-material": ("identify", "Fit Mooney-Rivlin C10, C01 to a uniaxial tension test of the bladder material."),
+    "design": ("inverse", "Inverse design: actuator parameters within ranges that meet targets at pressures, with "
+               "safety margins."),
+    "inspect": ("lab", "What the reader understood of each file (format, encoding, channels, units, values), before "
+                "processing."),
+    "process": ("lab", "Process raw four-point-bending cyclic tests into moment-curvature curves and Table 2 values."),
+    "simulate-test": ("lab", "Write the raw files a testing machine would record for a model actuator (a virtual "
+                      "test)."),
+    "predict": ("predict", "Blocked moment and free bending curvature/angle at each pressure (and, with --cycle, the "
+                "loop)."),
+    "curve": ("predict", "Moment-curvature curves M(P, k') as CSV or a figure."),
+    "stresses": ("predict", "Force-balance internal stresses around the cross-section (eq 37-48)."),
+    "actuator": ("predict", "Show an actuator (TOML, derived values, lock-up limits) or save it as an editable TOML "
+                 "file."),
+    "demo": ("predict", "Predictions for the paper's BE-PAM and BC-PAM with both models, and a moment-curvature "
+             "figure."),
+    "sweep": ("sweep", "Design sweep: actuator parameters crossed with pressures (in-process or on Dask)."),
+    "report": ("report", "Process raw cyclic tests, fit the models and write ONE self-contained HTML report."),
+    "finger": ("design", "Equilibrium shape and tip pose of a finger under tip force, tip mass and self-weight."),
+    "grasp": ("design", "Grip (pull-out) force of an N-finger gripper on spheres against diameter and pressure."),
+    "wrist": ("design", "Bending angle of a four-actuator wrist per direction, and the load it holds horizontally."),
+    "hand": ("hand", "Pose, reachable workspace and Kapandji test of the soft humanoid hand (BE-PAM fingers, "
+             "two-segment thumb)."),
+    "export": ("export", "Export an actuator's finger or gripper, or the soft hand, to a simulator (MuJoCo)."),
+}
+
+
+def _command_name(info: Any) -> str:
+    """The name of a registered command (Typer's name for it: the function's, with dashes)."""
+    return info.name or typer.main.get_command_name(getattr(info.callback, "__name__", ""))
+
+
+class LazyTyper(typer.Typer):
+    """A Typer app whose command modules (:data:`COMMANDS`) are imported when its commands are first read.
+
+    Reading :attr:`registered_commands` or :attr:`registered_groups` -- Typer does when it builds
+    the command line, and so do ``typer.main.get_command(app)`` and the CLI reference -- imports
+    every command module, in the order of :data:`COMMANDS`, and orders the commands as that table.
+    Inside :meth:`only` they are what the modules imported so far registered: :func:`main` runs a
+    command with its own module imported only (start-up).
+
+    >>> from bendpam.cli.app import app
+    >>> [_command_name(c) for c in app.registered_commands][:3]
+    ['fit', 'fit-material', 'design']
+    """
+
+    def __init__(self, **kwargs: Any) -> None:
+        self._pending: list[str] = []
+        self._loading = self._partial = False
+        self._commands: list[Any] = []
+        self._groups: list[Any] = []
+        super().__init__(**kwargs)
+        self._pending = list(dict.fromkeys(module for module, _ in COMMANDS.values()))
+
+    @property  # type: ignore[override]
+    def registered_commands(self) -> list[Any]:
+        self._load_all()
+        return self._commands
+
+    @registered_commands.setter
+    def registered_commands(self, value: list[Any]) -> None:
+        self._commands = value
+
+    @property  # type: ignore[override]
+    def registered_groups(self) -> list[Any]:
+        self._load_all()
+        return self._groups
+
+    @registered_groups.setter
+    def registered_groups(self, value: list[Any]) -> None:
+        self._groups = value
+
+    def _load_all(self) -> None:
+        if self._pending and not (self._loading or self._partial):
+            self.load(list(self._pending))
+            order = {name: i for i, name in enumerate(COMMANDS)}
+            for infos in (self._commands, self._groups):
+                infos.sort(key=lambda info: order.get(_command_name(info), len(order)))
+
+    def load(self, modules: list[str]) -> None:
+        """Import these command modules of :mod:`bendpam.cli` (once each) and register their commands."""
+        import importlib
+
+        from bendpam.cli.options import use_bendpam_commands
+
+        self._loading = True
+        try:
+            for name in modules:
+                if name in self._pending:
+                    self._pending.remove(name)
+                    register = getattr(importlib.import_module(f"bendpam.cli.{name}"), "register", None)
+                    if register is not None:
+                        register(self)
+            use_bendpam_commands(self)  # one grammar for lists, --force where a command writes, readable help
+        finally:
+            self._loading = False
+
+    @contextmanager
+    def only(self, name: str | None) -> Iterator[None]:
+        """Within this block the app has the commands of ``name``'s module only (all for another name)."""
+        if name not in COMMANDS:
+            yield
+            return
+        self.load([COMMANDS[name][0]])
+        self._partial = True
+        try:
+            yield
+        finally:
+            self._partial = False
+
+
+app = LazyTyper(
     add_completion=True,  # --install-completion / --show-completion (README "Command line")
     no_args_is_help=True,
     pretty_exceptions_enable=False,
@@ -82,6 +202,9 @@ def _one_line(exc: BaseException) -> str:
 def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
     """``warnings.showwarning`` while a command runs: bendpam's warnings are one ``bendpam: warning:`` line each.
 
+    So is a ``UserWarning`` located in bendpam's own code (a library function warning its caller,
+    here a command: ``curves.npz`` not used, and why).
+
     A :class:`~bendpam.errors.ModelMismatchWarning` or
     :class:`~bendpam.errors.OutsideTestedRangeWarning` is printed once per command, however many
     computations of the command raise it.
@@ -98,8 +221,14 @@ def _show_warning(message, category, filename, lineno, file=None, line=None) -> 
                 return
             _SHOWN.set(shown | {text})
         typer.echo(f"bendpam: warning: {text}", err=True)
+    elif issubclass(category, UserWarning) and str(filename).startswith(_PACKAGE):  # raised for bendpam's own code
+        typer.echo(f"bendpam: warning: {str(message).strip().splitlines()[0]}", err=True)
     else:
         _SHOW_WARNING(message, category, filename, lineno, file, line)
+
+
+#: The folder of the bendpam package: a warning located in it is about bendpam's own call (one line too).
+_PACKAGE = os.path.dirname(os.path.dirname(os.path.abspath(__file__))) + os.sep
 
 
 #: The once-per-command warnings already printed by the running command.
@@ -123,6 +252,15 @@ def _lift_force(args: list[str]) -> list[str]:
     rest = list(args)
     rest.remove("--force")
     return ["--force", *rest]
+
+
+def _command_of(args: list[str]) -> str | None:
+    """The command a command line runs: its first word that is not an option (the root options take no value).
+
+    >>> _command_of(["--force", "fit", "proc", "--out", "f"]), _command_of(["--install-completion"])
+    ('fit', None)
+    """
+    return next((a for a in args if not a.startswith("-")), None)
 
 
 def _run(args: list[str]) -> Any:
@@ -168,30 +306,29 @@ def cli_words(text: str) -> str:
 
 
 def root_help() -> str:
-    """The text of ``bendpam --help``, built without the commands' options.
+    """The text of ``bendpam --help``, built from :data:`COMMANDS` without importing the commands.
 
     Typer builds every command's options from its signature before it shows the root help, which
     lists only the commands' names and first lines.  This builds the root help of a copy of the app
-    whose commands have the same names and docstrings but no options: the same text (a test
-    compares them) in a fraction of the start-up.
+    whose commands have the names and first paragraphs of :data:`COMMANDS` but no options: the same
+    text (a test compares them) in a fraction of the start-up.
 
     >>> root_help().splitlines()[0]
     'Usage: bendpam [OPTIONS] COMMAND [ARGS]...'
     """
     import copy
 
+    from typer.models import CommandInfo
+
     light = copy.copy(app)
-    light.registered_commands = []
-    for info in app.registered_commands:
-        stub = copy.copy(info)
-        callback = info.callback
+    light._pending, light._groups, light._commands = [], [], []
+    for name, (_, text) in COMMANDS.items():
 
         def nothing() -> None:
             """(a command without options)"""
 
-        nothing.__name__, nothing.__doc__ = getattr(callback, "__name__", "command"), getattr(callback, "__doc__", None)
-        stub.callback = nothing
-        light.registered_commands.append(stub)
+        nothing.__doc__ = text
+        light._commands.append(CommandInfo(name=name, callback=nothing))
     group = typer.main.get_command(light)
     return group.get_help(typer.Context(group, info_name="bendpam"))
 
@@ -216,8 +353,8 @@ def main(argv: list[str] | None = None) -> int:
     2
     """
     args = list(sys.argv[1:] if argv is None else argv)
-    if not args or args == ["--help"]:  # nothing runs: no output group, no signal handling (start-up)
-        return _print_root_help()
+    if (not args or args == ["--help"]) and "_BENDPAM_COMPLETE" not in os.environ:  # (shell completion: Typer's)
+        return _print_root_help()  # nothing runs: no output group, no signal handling (start-up)
     from bendpam.errors import BendpamError
     from bendpam.infra.signals import Interrupted, forget_written, interrupted_line, interrupts, quiet_logging
 
@@ -226,10 +363,11 @@ def main(argv: list[str] | None = None) -> int:
     tokens = (RUN_ARGS.set(list(args)), RUN_COMMAND.set(None), RUN_FORCE.set(False))
     shown = _SHOWN.set(frozenset())
     try:
-        args = _lift_force(args)
-        with interrupts(on_signal=quiet_logging), warnings.catch_warnings():
-            warnings.showwarning = _show_warning
-            rv = _run(args)
+        with app.only(_command_of(args)):  # only the command's own module is imported (start-up)
+            args = _lift_force(args)
+            with interrupts(on_signal=quiet_logging), warnings.catch_warnings():
+                warnings.showwarning = _show_warning
+                rv = _run(args)
         if isinstance(rv, int) and not isinstance(rv, bool):  # typer.Exit(code) inside a command
             return rv
     except Interrupted as exc:

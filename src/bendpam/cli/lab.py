@@ -206,7 +206,7 @@ def process(
     for info in processed.files:
         typer.echo(_flags(file_line(info)))
     _print_table2(processed.summary())
-    echo_wrote(f"wrote {out}/ (curves.nc, curves.csv, summary.json{', ' + fig_name if figure else ''})")
+    echo_wrote(f"wrote {out}/ (curves.nc, curves.npz, curves.csv, summary.json{', ' + fig_name if figure else ''})")
 
 
 def _check_process_inputs(out: Path | None, l0_mm: float, format_file: Path | None) -> Path:

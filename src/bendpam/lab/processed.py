@@ -3,9 +3,12 @@
 :func:`bendpam.lab.processing.process_tests` turns raw tests into a :class:`ProcessedSet`: one
 :class:`PressureResult` per pressure (the branches on a common curvature grid, the blocked moment,
 the free-bending curvature and the energy-loss ratio of every cycle) and, across pressures, the
-deadband (:func:`deadband_fit`).  The set is saved as ``curves.nc`` (NetCDF), ``curves.csv``,
-``summary.json`` and ``figure4.png`` (:meth:`ProcessedSet.save`, :func:`write_processed`) and read
-back by :func:`load_processed`.  :class:`ProcessingOptions` records the settings of the processing.
+deadband (:func:`deadband_fit`).  The set is saved as ``curves.nc`` (NetCDF), ``curves.npz`` (the
+same variables and attributes as plain NumPy arrays), ``curves.csv``, ``summary.json`` and
+``figure4.png`` (:meth:`ProcessedSet.save`, :func:`write_processed`) and read back by
+:func:`load_processed`: from ``curves.npz`` when it was written with the ``curves.nc`` beside it
+(no NetCDF library to import), else from ``curves.nc``.  :class:`ProcessingOptions` records the
+settings of the processing.
 
 Values are magnitudes, as in the paper (N*mm, 1/mm, kPa).
 """
@@ -27,6 +30,8 @@ from bendpam.lab.drift import DRIFT_METHODS, DriftEstimate
 from bendpam.physics.fixture import Fixture
 
 if TYPE_CHECKING:  # pandas and xarray are imported by the functions that use them (fast start-up of `fit`)
+    from pathlib import Path
+
     import pandas as pd
     import xarray as xr
 
@@ -469,9 +474,12 @@ class ProcessedSet:
         return figure_by_name("figure4")(self, title)
 
     def save(self, out_dir, *, figure: bool = True) -> dict[str, str]:
-        """Write ``curves.nc`` (xarray/NetCDF), ``curves.csv``, ``summary.json`` and ``figure4.png``.
+        """Write ``curves.nc`` (xarray/NetCDF), ``curves.npz``, ``curves.csv``, ``summary.json`` and ``figure4.png``.
 
-        Every file is written atomically.  Returns ``{name: path}`` of the files written.
+        ``curves.npz`` holds the variables and attributes of ``curves.nc`` as plain arrays (no
+        pickles) and the sha256 of the ``curves.nc`` it was written with, so that
+        :func:`load_processed` reads it only beside that very file.  Every file is written atomically.
+        Returns ``{name: path}`` of the files written.
         """
         import json
         from pathlib import Path
@@ -487,6 +495,7 @@ class ProcessedSet:
         with atomic_path(out / "curves.nc") as tmp:
             ds.to_netcdf(tmp)
         written["curves.nc"] = str(out / "curves.nc")
+        written["curves.npz"] = str(_write_npz(ds, out / "curves.nc"))
         atomic_write_text(out / "curves.csv", self.to_frame().to_csv(index=False, float_format="%.10g"))
         written["curves.csv"] = str(out / "curves.csv")
         atomic_write_text(out / "summary.json", json.dumps(json_safe(self.summary()), indent=2, allow_nan=False))
@@ -527,7 +536,7 @@ class ProcessedSet:
 # outputs
 # ------------------------------------------------------------------------------------------------
 def write_processed(processed: ProcessedSet, out_dir, *, figure: bool = True) -> dict[str, str]:
-    """Write ``curves.nc``, ``curves.csv``, ``summary.json`` (and ``figure4.png``): :meth:`ProcessedSet.save`.
+    """Write ``curves.nc``, ``curves.npz``, ``curves.csv``, ``summary.json`` (and ``figure4.png``): ``save``.
 
     Examples
     --------
@@ -544,9 +553,63 @@ def write_processed(processed: ProcessedSet, out_dir, *, figure: bool = True) ->
     ...     written = write_processed(process_tests(raws), folder, figure=False)
     ...     names = sorted(Path(path).name for path in written.values())
     >>> names
-    ['curves.csv', 'curves.nc', 'summary.json']
+    ['curves.csv', 'curves.nc', 'curves.npz', 'summary.json']
     """
     return processed.save(out_dir, figure=figure)
+
+
+#: The entries of ``curves.npz`` besides the variables of ``curves.nc``: its attributes (JSON text) and the
+#: sha256 of the ``curves.nc`` written with it.
+_NPZ_ATTRS, _NPZ_NC_SHA256 = "_attrs_json", "_curves_nc_sha256"
+
+
+def _write_npz(ds: xr.Dataset, nc) -> Path:
+    """Write ``curves.npz`` beside the ``curves.nc`` just written from ``ds``: its variables, attributes and sha256."""
+    import json
+
+    from bendpam.infra.atomic import atomic_path
+    from bendpam.infra.fsops import hash_file
+
+    arrays: dict[str, Any] = {str(k): np.asarray(ds[k].values) for k in ds.variables}
+    if any(a.dtype.hasobject for a in arrays.values()):  # np.load(allow_pickle=False) could not read them back
+        raise ProcessingError(f"{nc}: a variable of the processed set holds Python objects, not numbers or text")
+    attrs = {k: v.item() if isinstance(v, np.generic) else v for k, v in ds.attrs.items()}
+    arrays[_NPZ_ATTRS] = np.array(json.dumps(attrs, allow_nan=True))
+    arrays[_NPZ_NC_SHA256] = np.array(hash_file(nc)[1])
+    npz = nc.with_suffix(".npz")
+    with atomic_path(npz) as tmp, open(tmp, "wb") as fh:
+        np.savez(fh, **arrays)
+    return npz
+
+
+def _trusted_npz(nc) -> Path | None:
+    """The ``curves.npz`` beside ``nc`` when it was written with this very ``nc`` (the sha256 it records), else None.
+
+    A set written before 0.4 has none (``nc`` is read, silently).  One that was written with
+    another ``curves.nc`` (the set was edited since, e.g. with xarray) or cannot be read is not
+    used, and a warning says why.
+    """
+    import warnings
+    import zipfile
+
+    from bendpam.infra.fsops import hash_file
+
+    npz = nc.with_suffix(".npz")
+    if not npz.is_file():
+        return None
+    check_input_file(npz, "processed curves file")
+    verify_input(npz)  # as curves.nc: a set with a manifest is read only as bendpam wrote it
+    try:
+        with np.load(npz, allow_pickle=False) as z:
+            recorded = str(z[_NPZ_NC_SHA256])
+    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as exc:
+        why = f"it cannot be read ({type(exc).__name__})"
+    else:
+        if recorded == hash_file(nc)[1]:
+            return npz
+        why = f"it was written with another {nc.name} (that file was changed or replaced since)"
+    warnings.warn(f"{npz}: not used, {why}; reading {nc} instead", UserWarning, stacklevel=3)
+    return None
 
 
 class _Curves:
@@ -562,12 +625,20 @@ class _Curves:
 
 
 def _read_curves(nc):
-    """A ``curves.nc`` as :class:`_Curves`: SciPy's NetCDF-3 reader (what bendpam writes), else xarray.
+    """A ``curves.nc`` or ``curves.npz`` as :class:`_Curves`: NumPy, SciPy's NetCDF-3 reader, else xarray.
 
-    SciPy's reader is used for NetCDF-3 files (xarray's own scipy backend reads them the same way;
-    every variable is float64 or int with NaN as the fill value, so no CF decoding is needed), which
+    A ``curves.npz`` (:func:`_write_npz`) is read with :func:`numpy.load` (no pickles).  SciPy's
+    reader is used for NetCDF-3 files (xarray's own scipy backend reads them the same way; every
+    variable is float64 or int with NaN as the fill value, so no CF decoding is needed), which
     spares ``bendpam fit`` importing xarray, pandas and Dask.  Other files (NetCDF-4) go through xarray.
     """
+    if str(nc).endswith(".npz"):
+        import json
+
+        with np.load(nc, allow_pickle=False) as z:
+            values = {k: z[k] for k in z.files if k not in (_NPZ_ATTRS, _NPZ_NC_SHA256)}
+            attrs = json.loads(str(z[_NPZ_ATTRS]))
+        return _Curves(values, attrs)
     with open(nc, "rb") as fh:
         magic = fh.read(3)
     if magic == b"CDF":
@@ -608,7 +679,10 @@ def as_processed(processed) -> ProcessedSet:
 def load_processed(path) -> ProcessedSet:
     """Read the output of :func:`write_processed` (a folder or its ``curves.nc``) back.
 
-    The curves, per-cycle values, branch times, fixture and sources come back; the options are the
+    The arrays come from the ``curves.npz`` beside ``curves.nc`` when it was written with that very
+    file (it records its sha256), with :func:`numpy.load`; else from ``curves.nc`` (a set saved
+    before 0.4, or one whose ``curves.nc`` was changed since: a warning then says why).  Both
+    give the same set.  The curves, per-cycle values, branch times, fixture and sources come back; the options are the
     defaults and the samples (:attr:`PressureResult.series`) are not stored.  A set saved before
     0.4 has no branch times (:attr:`PressureResult.branch_times_s` is None): a fit then
     approximates the bending rate (see :mod:`bendpam.identify.ensemble`) and says so.
@@ -638,10 +712,12 @@ def load_processed(path) -> ProcessedSet:
         raise ProcessingError(f"{p}: no curves.nc here; give the output folder of 'bendpam process'")
     check_input_file(nc, "processed curves file")  # a regular file of a sane size (a pipe would hang the read)
     verify_input(nc)  # a set that bendpam wrote is read only as it wrote it (its manifest's hashes)
+    source = _trusted_npz(nc) or nc  # the same variables, without a NetCDF reader to import
     try:
-        ds = _read_curves(nc)
+        ds = _read_curves(source)
     except Exception as exc:
-        raise ProcessingError(f"{nc}: cannot read as a bendpam processed-curves file ({type(exc).__name__})") from None
+        raise ProcessingError(f"{source}: cannot read as a bendpam processed-curves file ({type(exc).__name__})") \
+            from None
     need = {"moment_nmm", "blocked_moment_cycle_nmm", "free_curvature_cycle_per_mm", "energy_loss_ratio_cycle"}
     if not need <= set(ds.data_vars):
         raise ProcessingError(f"{nc}: not a bendpam processed-curves file (missing {sorted(need - set(ds.data_vars))})")

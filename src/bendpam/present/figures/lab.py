@@ -25,6 +25,13 @@ __all__ = ["figure4", "figure7"]
 #: Samples drawn per pressure in Figure 4 (a); a longer test is drawn every n-th sample, which the
 #: panel cannot tell apart and which keeps the figure's memory bounded.
 _LOOP_POINTS = 200_000
+#: Points drawn per line in Figure 7 (a): a panel is about 2 in wide, 600 pixel columns at 300 dpi,
+#: so a line of the curvature grid (101 points by default, up to 100 000) is drawn every n-th point
+#: past 512 (the model's branches are computed on those points only).
+_LINE_POINTS = 512
+#: Markers of the mean curve per pressure in Figure 7 (a) (every 4th point of the default grid), and
+#: at most about this many in the panel (fewer per pressure when there are many pressures).
+_MARKERS, _MARKERS_TOTAL = 26, 1000
 
 
 def _viridis(n: int) -> np.ndarray:
@@ -130,8 +137,33 @@ def figure4(processed, title: str = ""):
     return fig
 
 
+def _every_nth(n: int, at_most: int) -> np.ndarray:
+    """Indices of every m-th of ``n`` points, the last one included, so that at most about ``at_most`` are drawn.
+
+    >>> _every_nth(5, 512).tolist(), _every_nth(10, 4).tolist()
+    ([0, 1, 2, 3, 4], [0, 3, 6, 9])
+    """
+    idx = np.arange(0, n, max(1, -(-n // at_most)))
+    return idx if idx[-1] == n - 1 else np.append(idx, n - 1)
+
+
+def _loop_lines(act, loop, res, ks: list[np.ndarray], model) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The model's loop branches ``(upper, lower)`` of each test on its curvatures ``ks`` (one call for one size)."""
+    if len({k.size for k in ks}) == 1:  # one row per test (the usual set: one grid size)
+        P = np.array([[r.pressure_kpa] for r in res])
+        kf = np.array([[float(r.free_curvature[0])] for r in res])
+        up, low = loop_branches(act, loop, P, kf, np.stack(ks), model)
+        return list(zip(up, low, strict=True))
+    return [loop_branches(act, loop, r.pressure_kpa, float(r.free_curvature[0]), k, model)
+            for r, k in zip(res, ks, strict=True)]
+
+
 def _fit_curves_panel(ax, processed, fit_result) -> None:
-    """Figure 7 (a): the data's branches (thin), mean curves (markers) and the model's curves (thick)."""
+    """Figure 7 (a): the data's branches (thin), mean curves (markers) and the model's curves (thick).
+
+    Each line is drawn with at most about :data:`_LINE_POINTS` points and each mean curve with
+    :data:`_MARKERS` markers (fewer with many pressures), whatever the size of the curvature grid.
+    """
     act, model = fit_result.actuator, fit_result.model
     loop = getattr(fit_result, "loop", None)
     s = act.bend_sign or 1
@@ -142,16 +174,21 @@ def _fit_curves_panel(ax, processed, fit_result) -> None:
     # one collection per kind of line and one scatter for the markers (a few artists, not five per
     # pressure: drawing 25 pressures stays fast)
     thin, thick, thick_c, mk_x, mk_y, mk_c = [], [], [], [], [], []
-    for i, (c, r) in enumerate(zip(colors, res, strict=True)):
-        k = r.curvature_grid
-        thin += [np.column_stack([k, r.mean_loading]), np.column_stack([k, r.mean_unloading])]
-        mk_x.append(k[::4])
-        mk_y.append(r.mean_curve[::4])
-        mk_c += [c] * k[::4].size
+    markers = max(3, min(_MARKERS, _MARKERS_TOTAL // max(len(res), 1)))
+    lines = [_every_nth(r.curvature_grid.size, _LINE_POINTS) for r in res]
+    loops = _loop_lines(act, loop, res, [r.curvature_grid[line] for r, line in zip(res, lines, strict=True)],
+                        model) if loop is not None else None
+    for i, (c, r, line) in enumerate(zip(colors, res, lines, strict=True)):
+        k = r.curvature_grid[line]
+        thin += [np.column_stack([k, r.mean_loading[line]]), np.column_stack([k, r.mean_unloading[line]])]
+        mark = slice(None, None, max(4, -(-r.curvature_grid.size // markers)))
+        mk_x.append(r.curvature_grid[mark])
+        mk_y.append(r.mean_curve[mark])
+        mk_c += [c] * mk_x[-1].size
         if i in shown:
             ax.plot([], [], "o", color=c, ms=3, label=f"{r.pressure_kpa:g} kPa")
-        if loop is not None:
-            up, low = loop_branches(act, loop, r.pressure_kpa, float(r.free_curvature[0]), k, model)
+        if loops is not None:
+            up, low = loops[i]
             thick += [np.column_stack([k, up]), np.column_stack([k, low])]
             thick_c += [c, c]
         else:
