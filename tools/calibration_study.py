@@ -1,6 +1,6 @@
 """The calibration study of bendpam's error bars (issue 23): do the fit's standard errors hold?
 
-    python tools/calibration_study.py [--seeds 10] [--set main|holdout] [--cases CASE ...] [--jobs 1] [--out FILE]
+    python tools/calibration_study.py [--seeds 10] [--set main|holdout|holdout2] [--cases CASE ...] [--jobs 1] [--out FILE]
 
 For every case of :data:`raw_generators.CASES` (or of :data:`raw_generators.HOLDOUT` with ``--set holdout``:
 cases kept out of any tuning) and every seed, raw test files are made by the
@@ -50,8 +50,8 @@ from bendpam.version import __version__  # noqa: E402
 START, END = "<!-- calibration-table:start -->", "<!-- calibration-table:end -->"
 #: The case sets: ``main`` (:data:`raw_generators.CASES`, what the error bars are tuned and judged on) and
 #: ``holdout`` (:data:`raw_generators.HOLDOUT`, other parameters and combined faults, kept out of any tuning).
-SETS = {"main": gen.CASES, "holdout": gen.HOLDOUT}
-ALL_CASES = {**gen.CASES, **gen.HOLDOUT}
+SETS = {"main": gen.CASES, "holdout": gen.HOLDOUT, "holdout2": gen.HOLDOUT2}
+ALL_CASES = {**gen.CASES, **gen.HOLDOUT, **gen.HOLDOUT2}
 
 
 def markers(case_set: str) -> tuple[str, str]:
@@ -376,10 +376,10 @@ def main(argv=None) -> int:
     ap.add_argument("--first-seed", type=int, default=0)
     ap.add_argument("--set", dest="case_set", choices=list(SETS), default="main",
                     help="main (default): the cases the error bars are judged on; holdout: other parameters and "
-                    "combined faults, kept out of any tuning")
+                    "combined faults, kept out of any tuning; holdout2: a second such set, scored once")
     ap.add_argument("--cases", nargs="+", choices=list(ALL_CASES), metavar="CASE",
                     help=f"cases to run (default: the whole set; main: {', '.join(gen.CASES)}; holdout: "
-                    f"{', '.join(gen.HOLDOUT)})")
+                    f"{', '.join(gen.HOLDOUT)}; holdout2: {', '.join(gen.HOLDOUT2)})")
     ap.add_argument("--jobs", type=int, default=1, help="processes (default 1; the machine may be shared)")
     ap.add_argument("--fit", dest="fit_options", action="append", default=[], metavar="KEY=VALUE",
                     help="a keyword of bendpam.identify.fitting.fit, as a Python literal (law_uncertainty=False, "
