@@ -278,6 +278,12 @@ def test_branch_times_are_kept_and_an_old_set_loads_without_them(simulated, tmp_
     write_processed(ps, tmp_path / "out", figure=False)
     with xr.open_dataset(tmp_path / "out" / "curves.nc") as ds:
         assert ds["time_s"].attrs["units"] == "s"
+    import pandas as pd  # the spreadsheet copy carries the same times, row for row; empty for the mean curves
+
+    table = pd.read_csv(tmp_path / "out" / "curves.csv")
+    rows = table[(table["pressure_kpa"] == r.pressure_kpa) & (table["cycle"] == 1) & (table["branch"] == "loading")]
+    assert_allclose(rows["time_s"].to_numpy(), t_load, rtol=1e-9)
+    assert table.loc[table["cycle"] == 0, "time_s"].isna().all()
     back = load_processed(tmp_path / "out")
     for r0, r1 in zip(ps.results, back.results):
         assert_allclose(r1.branch_times_s, r0.branch_times_s)

@@ -511,23 +511,27 @@ class ProcessedSet:
         return load_processed(path)
 
     def to_frame(self) -> pd.DataFrame:
-        """Tidy table of the resampled branches: pressure, cycle, branch, curvature, moment, replicate."""
+        """Tidy table of the resampled branches: pressure, cycle, branch, curvature, moment, replicate, and
+        ``time_s``, the test's time at each point of a cycle's branch (empty for the mean curves, and for
+        sets processed before branch times were kept)."""
         import pandas as pd
 
         rows = []
         for r in self.results:
+            times = r.branch_times_s
             for ci in range(r.n_cycles):
                 for bi, name in enumerate(BRANCHES):
                     rows.append(pd.DataFrame({
                         "pressure_kpa": r.pressure_kpa, "cycle": ci + 1, "branch": name,
                         "curvature_per_mm": r.curvature_grid, "moment_nmm": r.branches[ci, bi],
-                        "replicate": r.replicate,
+                        "replicate": r.replicate, "time_s": times[ci, bi] if times is not None else np.nan,
                     }))
             for name, arr in (("mean_loading", r.mean_loading), ("mean_unloading", r.mean_unloading),
                               ("mean", r.mean_curve)):
                 rows.append(pd.DataFrame({
                     "pressure_kpa": r.pressure_kpa, "cycle": 0, "branch": name,
                     "curvature_per_mm": r.curvature_grid, "moment_nmm": arr, "replicate": r.replicate,
+                    "time_s": np.nan,
                 }))
         return pd.concat(rows, ignore_index=True)
 
