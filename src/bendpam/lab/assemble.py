@@ -48,6 +48,7 @@ from bendpam.lab.pressure import (
     pressure_out_of_range,
 )
 from bendpam.lab.rawtest import COLUMNS, RawTest
+from bendpam.lab.rates import fill_empty_cells
 from bendpam.lab.read_error import ReadError, show
 
 __all__ = ["assemble", "check_values"]
@@ -206,6 +207,20 @@ def _drop_spikes(samples: _Samples, channels: Channels, label: Path | str, repai
             warnings.append(
                 f"dropped {bad.size} spike sample(s) in column {name!r} at line(s) {where}"
             )
+    if not keep.all():
+        samples.keep(keep)
+
+
+def _fill_empty(samples: _Samples, data: ColumnData, channels: Channels, label: Path | str, repair: bool,
+                warnings: list[str]) -> None:  # fmt: skip
+    """Empty cells of time, stroke or force: interpolated, dropped or refused by their pattern (:mod:`~bendpam.lab.rates`)."""
+    clocks = {}
+    for name, col in data.clocks.items():
+        arr = _column(data, name)
+        clocks[name] = (arr * (unit_factor("time", col.unit or "s") or 1.0), col.source)
+    sources = {role: str(ch["source"] or role) for role, ch in channels.items()}
+    keep = fill_empty_cells(samples.values, samples.lines, sources, clocks, data.empty_first, label, repair,
+                            warnings)  # fmt: skip
     if not keep.all():
         samples.keep(keep)
 
@@ -441,6 +456,8 @@ def _samples(parsed: Parsed, rate_hz: float | None, repair: bool, warnings: list
     counter = _column(data, "counter") if ch.counter is not None else None
     sample_rate = _time_from_rate(values, source_units, channels, p, blk, rate_hz, warnings)
     samples = _Samples(values, lines, counter)
+    if data.empty_first:
+        _fill_empty(samples, data, channels, label, repair, warnings)
     _drop_padding(samples, channels, warnings)
     _drop_spikes(samples, channels, label, repair, warnings)
     segments = _check_time(samples, channels, label, repair, warnings)

@@ -1,0 +1,225 @@
+"""Empty cells in the columns read: channels sampled at other rates, channels that end first.
+
+Testing-machine software writes channels sampled at different rates into one table.  What the
+empty cells of a column mean is decided from their pattern, never from the file's name:
+
+* **its own clock**: the column is shorter than the others and another time column of the block
+  ends on the same row (HBM catman writes one time column per rate group, ``Time 1 - default
+  sample rate`` and ``Time 1 - slow sample rate``): the column's values belong to that clock and
+  are interpolated linearly to the times of the time column read;
+* **a value every m rows** (m >= 1.5, evenly spread): a channel sampled slower on the same clock;
+  the empty cells between its values are interpolated linearly in time;
+* **empty after its last value** (or before its first), with no clock of its own: the rows are
+  dropped (a channel that ended first, an end record with fewer numbers), as long as they are few
+  (at most :data:`MAX_TAIL_FRACTION` of the rows, or 3): more would mean a slower channel whose
+  times are unknown, which is refused;
+* anything else (an empty cell here and there) is refused, as before, or with ``repair`` its
+  rows are dropped.
+
+Rows within one sampling period of a slower channel's first or last value take that value (its
+sample holds until the next); rows further out are dropped.  Every decision is one warning line.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from bendpam.lab.channels import ColumnInfo, classify_column
+from bendpam.lab.read_error import ReadError
+
+__all__ = ["MAX_TAIL_FRACTION", "MIN_RATE_VALUES", "fill_empty_cells", "other_clocks"]
+
+#: Rows after a column's last value (without a clock of its own) dropped at most, as a fraction of the rows.
+MAX_TAIL_FRACTION = 0.05
+#: Values a column sampled slower must have (evenly spread) for its empty cells to be interpolated.
+MIN_RATE_VALUES = 5
+
+
+def other_clocks(columns: Sequence[ColumnInfo], time: ColumnInfo) -> list[tuple[str, ColumnInfo]]:
+    """The block's time columns other than ``time``, named ``clock1``, ``clock2``, ...
+
+    Parameters
+    ----------
+    columns : sequence of ColumnInfo
+        The block's columns.
+    time : ColumnInfo
+        The time column read.
+
+    Returns
+    -------
+    list of (str, ColumnInfo)
+
+    Examples
+    --------
+    >>> cols = [ColumnInfo(0, "Time 1 - default sample rate", "Time 1 - default sample rate", "s"),
+    ...         ColumnInfo(1, "Time 1 - slow sample rate", "Time 1 - slow sample rate", "s"),
+    ...         ColumnInfo(2, "Load", "Load", "kN")]
+    >>> [(name, col.source) for name, col in other_clocks(cols, cols[0])]
+    [('clock1', 'Time 1 - slow sample rate')]
+    """
+    out = []
+    for col in columns:
+        if col.index == time.index:
+            continue
+        if any(c.role == "time" and c.unit_ok for c in classify_column(col)):
+            out.append((f"clock{len(out) + 1}", col))
+    return out
+
+
+def _span(lines: np.ndarray, rows: np.ndarray) -> str:
+    a, b = int(lines[rows[0]]), int(lines[rows[-1]])
+    return f"line {a}" if a == b else f"lines {a}-{b}"
+
+
+def _regular(idx: np.ndarray) -> float | None:
+    """Rows per value when the values sit evenly every m >= 1.5 rows (within a row), else None.
+
+    At least :data:`MIN_RATE_VALUES` values: one empty cell between two values is no pattern.
+    """
+    if idx.size < MIN_RATE_VALUES:
+        return None
+    r = (idx[-1] - idx[0]) / (idx.size - 1)
+    if r < 1.5 or np.max(np.abs(idx - (idx[0] + r * np.arange(idx.size)))) > 1.0:
+        return None
+    return float(r)
+
+
+def _own_clock(ok: np.ndarray, clocks: dict[str, tuple[np.ndarray, str]]) -> tuple[np.ndarray, str] | None:
+    """A time column with values on exactly the rows of ``ok`` and rising: the column's own clock."""
+    for c, name in clocks.values():
+        if np.array_equal(np.isfinite(c), ok) and np.all(np.diff(c[ok]) > 0):
+            return c[ok], name
+    return None
+
+
+def _fill_one(x: np.ndarray, t: np.ndarray, source: str, time_source: str, lines: np.ndarray,
+              clocks: dict[str, tuple[np.ndarray, str]], notes: list[str]) -> np.ndarray | None:  # fmt: skip
+    """Fill one column's empty cells in place; the rows to keep, or None if the pattern is not one of a rate."""
+    n = x.size
+    ok = np.isfinite(x)
+    idx = np.flatnonzero(ok)
+    if idx.size < 2:
+        return None
+    keep = np.ones(n, dtype=bool)
+    own = _own_clock(ok, clocks)
+    if own is not None:  # values on their own clock: to the times of the time column read
+        ct, clock = own
+        period = float(np.median(np.diff(ct)))
+        x[:] = np.interp(t, ct, x[idx])
+        keep = (t >= ct[0] - period) & (t <= ct[-1] + period)
+        held = np.flatnonzero(keep & ((t < ct[0]) | (t > ct[-1])))
+        notes.append(f"column {source!r} is sampled on its own clock {clock!r} (every {period:.4g} s, "
+                     f"{idx.size} values for {n} rows): its values interpolated linearly to the times of "
+                     f"{time_source!r}" + (f"; {_span(lines, held)} within one period past its first or last "
+                                           f"value hold that value" if held.size else "")
+                     + (f"; {_span(lines, np.flatnonzero(~keep))} further out dropped" if not keep.all() else ""))
+        return keep
+    inner = idx[-1] - idx[0] + 1 > idx.size
+    r = _regular(idx) if inner else 1.0
+    if r is None:
+        return None
+    if inner:
+        gap = np.flatnonzero(~ok[idx[0]:idx[-1]]) + idx[0]
+        rows = np.arange(n, dtype=np.float64)
+        base = t if np.all(np.diff(t[idx[0]:idx[-1] + 1]) > 0) else rows
+        x[gap] = np.interp(base[gap], base[idx], x[idx])
+        notes.append(f"{_span(lines, idx)}: column {source!r} has a value every {r:.3g} rows (sampled "
+                     f"slower): its {gap.size} empty cells interpolated linearly in time")
+    rows_i = np.arange(n)
+    head, tail = rows_i < idx[0], rows_i > idx[-1]
+    hold = (head & (idx[0] - rows_i < r)) | (tail & (rows_i - idx[-1] < r))
+    x[head & hold], x[tail & hold] = x[idx[0]], x[idx[-1]]
+    keep = ~((head | tail) & ~hold)
+    if not keep.all():
+        if inner or (~keep).sum() > max(3, MAX_TAIL_FRACTION * n):
+            return None
+        notes.append(f"{_span(lines, np.flatnonzero(~keep))}: column {source!r} is empty (its channel ended "
+                     f"first, or an end record with fewer numbers): {(~keep).sum()} row(s) dropped")
+    return keep
+
+
+def fill_empty_cells(values: dict[str, np.ndarray], lines: np.ndarray, sources: dict[str, str],
+                     clocks: dict[str, tuple[np.ndarray, str]], empty_first: dict[str, tuple[int, str]],
+                     label: Path | str, repair: bool, warnings: list[str]) -> np.ndarray:  # fmt: skip
+    """Fill or drop the empty cells (NaN) of time, stroke and force by their pattern (module docstring).
+
+    Parameters
+    ----------
+    values : dict of str to numpy.ndarray
+        role -> values in s, mm, N, NaN where the cell was empty; filled in place.
+    lines : numpy.ndarray
+        The line of each row.
+    sources : dict of str to str
+        role -> the column's name as written.
+    clocks : dict of str to (numpy.ndarray, str)
+        The block's other time columns: values in s (NaN where empty) and name.
+    empty_first : dict of str to (int, str)
+        role -> line and refusal message of its first empty cell.
+    label : pathlib.Path or str
+        The file, as named in messages.
+    repair : bool
+        Drop the rows of an empty cell that fits no pattern instead of refusing it.
+    warnings : list of str
+        One line per decision is appended.
+
+    Returns
+    -------
+    numpy.ndarray
+        The rows to keep (bool).
+
+    Raises
+    ------
+    ReadError
+        An empty cell that fits no pattern, without ``repair`` (the message of the first one).
+
+    Examples
+    --------
+    Force sampled at a third of the rate of time and stroke, one row past its last value:
+
+    >>> import numpy as np
+    >>> v = {"time": np.arange(8) * 0.1, "stroke": np.arange(8.0),
+    ...      "force": np.array([0.0, np.nan, np.nan, 3, np.nan, np.nan, 6, np.nan])}
+    >>> notes = []
+    >>> keep = fill_empty_cells(v, np.arange(2, 10), {"time": "t", "stroke": "s", "force": "F"}, {},
+    ...                         {}, "x.csv", False, notes)
+    >>> np.round(v["force"], 6).tolist(), keep.all()
+    ([0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 6.0], np.True_)
+    >>> notes
+    ["lines 2-8: column 'F' has a value every 3 rows (sampled slower): its 4 empty cells interpolated linearly in time"]
+    """
+    keep = np.ones(lines.size, dtype=bool)
+    roles = [r for r in ("time", "stroke", "force") if r in values and not np.isfinite(values[r]).all()]
+    if "time" in roles:  # the time column read: only rows before its first or after its last value go
+        t = values["time"]
+        idx = np.flatnonzero(np.isfinite(t))
+        contiguous = idx.size >= 2 and idx[-1] - idx[0] + 1 == idx.size
+        if contiguous and lines.size - idx.size <= max(3, MAX_TAIL_FRACTION * lines.size):
+            drop = ~np.isfinite(t)
+            warnings.append(f"{_span(lines, np.flatnonzero(drop))}: the time column {sources['time']!r} is empty "
+                            f"(an end record with fewer numbers?): {drop.sum()} row(s) dropped")
+            keep &= ~drop
+        else:
+            keep &= _irregular("time", sources["time"], values, lines, empty_first, label, repair, warnings)
+        roles.remove("time")
+    t = values.get("time", np.arange(lines.size, dtype=np.float64))
+    for role in roles:
+        got = _fill_one(values[role], t, sources[role], sources.get("time", "time"), lines, clocks, warnings)
+        keep &= got if got is not None else _irregular(role, sources[role], values, lines, empty_first, label, repair, warnings)
+    return keep
+
+
+def _irregular(role: str, column: str, values: dict[str, np.ndarray], lines: np.ndarray,
+               empty_first: dict[str, tuple[int, str]], label: Path | str, repair: bool,
+               warnings: list[str]) -> np.ndarray:  # fmt: skip
+    """Empty cells that fit no pattern: refused (the first one's message) or, with ``repair``, their rows dropped."""
+    bad = ~np.isfinite(values[role])
+    if not repair:
+        line, message = empty_first.get(role, (int(lines[np.argmax(bad)]), f"empty cell in the {role} column"))
+        raise ReadError(message, label, line, column)
+    shown = ", ".join(str(int(v)) for v in lines[bad][:5]) + (f" (and {bad.sum() - 5} more)" if bad.sum() > 5 else "")
+    warnings.append(f"dropped {bad.sum()} row(s) with a non-finite or empty value at line(s) {shown}")
+    return ~bad
+
