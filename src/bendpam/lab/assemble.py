@@ -47,8 +47,8 @@ from bendpam.lab.pressure import (
     pressure_from_filename,
     pressure_out_of_range,
 )
-from bendpam.lab.rawtest import COLUMNS, RawTest
 from bendpam.lab.rates import fill_empty_cells
+from bendpam.lab.rawtest import COLUMNS, RawTest
 from bendpam.lab.read_error import ReadError, show
 
 __all__ = ["assemble", "check_values"]
@@ -213,7 +213,10 @@ def _drop_spikes(samples: _Samples, channels: Channels, label: Path | str, repai
 
 def _fill_empty(samples: _Samples, data: ColumnData, channels: Channels, label: Path | str, repair: bool,
                 warnings: list[str]) -> None:  # fmt: skip
-    """Empty cells of time, stroke or force: interpolated, dropped or refused by their pattern (:mod:`~bendpam.lab.rates`)."""
+    """Empty cells of time, stroke or force: interpolated, dropped or refused by their pattern.
+
+    The patterns are those of :mod:`bendpam.lab.rates` (a channel sampled at another rate, a column that ends first).
+    """
     clocks = {}
     for name, col in data.clocks.items():
         arr = _column(data, name)

@@ -60,7 +60,7 @@ def other_clocks(columns: Sequence[ColumnInfo], time: ColumnInfo) -> list[tuple[
     >>> [(name, col.source) for name, col in other_clocks(cols, cols[0])]
     [('clock1', 'Time 1 - slow sample rate')]
     """
-    out = []
+    out: list[tuple[str, ColumnInfo]] = []
     for col in columns:
         if col.index == time.index:
             continue
@@ -207,7 +207,9 @@ def fill_empty_cells(values: dict[str, np.ndarray], lines: np.ndarray, sources: 
     t = values.get("time", np.arange(lines.size, dtype=np.float64))
     for role in roles:
         got = _fill_one(values[role], t, sources[role], sources.get("time", "time"), lines, clocks, warnings)
-        keep &= got if got is not None else _irregular(role, sources[role], values, lines, empty_first, label, repair, warnings)
+        if got is None:
+            got = _irregular(role, sources[role], values, lines, empty_first, label, repair, warnings)
+        keep &= got
     return keep
 
 
