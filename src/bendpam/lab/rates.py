@@ -22,18 +22,28 @@ sample holds until the next); rows further out are dropped.  Every decision is o
 
 from __future__ import annotations
 
+import re
 from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 
-from bendpam.lab.channels import ColumnInfo, classify_column
+from bendpam.lab.channels import ColumnInfo, classify_column, normalize_name
+from bendpam.lab.layout import MetaItem
 from bendpam.lab.read_error import ReadError
 
-__all__ = ["MAX_TAIL_FRACTION", "MIN_RATE_VALUES", "fill_empty_cells", "other_clocks"]
+__all__ = ["MAX_END_RECORDS", "MAX_TAIL_FRACTION", "MIN_RATE_VALUES", "counted_samples", "fill_empty_cells", "other_clocks"]
 
 #: Rows after a column's last value (without a clock of its own) dropped at most, as a fraction of the rows.
 MAX_TAIL_FRACTION = 0.05
+#: Metadata keys that count the samples written (``Number of points``, ``Samples``, ``Anzahl Messpunkte``, ...).
+_COUNT_KEY = re.compile(
+    r"(?:(?:total )?number of|no|nb|nbr|num|anzahl(?: der)?|nombre de|numero di|numero de|liczba)?\s*"
+    r"(?:data |measured |measurement |recorded )?(?:points|samples|pts|records|scans|messpunkte|punkte|"
+    r"datenpunkte|messwerte|points de mesure|punti|puntos|punktow|punktów|próbek)"
+)
+#: Rows after the counted ones read as end records at most.
+MAX_END_RECORDS = 3
 #: Values a column sampled slower must have (evenly spread) for its empty cells to be interpolated.
 MIN_RATE_VALUES = 5
 
@@ -225,3 +235,29 @@ def _irregular(role: str, column: str, values: dict[str, np.ndarray], lines: np.
     warnings.append(f"dropped {bad.sum()} row(s) with a non-finite or empty value at line(s) {shown}")
     return ~bad
 
+
+
+def counted_samples(items: Sequence[tuple[int, MetaItem]]) -> tuple[int, str] | None:
+    """The number of samples the metadata declare (``Number of points : 2701``), and the line saying it.
+
+    Parameters
+    ----------
+    items : sequence of (int, MetaItem)
+        ``(line, item)`` of the metadata lines above the data.
+
+    Returns
+    -------
+    (int, str) or None
+        The count and ``"line N: 'key : value'"``, or None when no line counts the samples.
+
+    Examples
+    --------
+    >>> counted_samples([(3, MetaItem("Span", "10,0")), (11, MetaItem("Number of points", "2701"))])
+    (2701, "line 11: 'Number of points : 2701'")
+    >>> counted_samples([(2, MetaItem("Points per cycle", "200"))]) is None
+    True
+    """
+    for line, item in items:
+        if _COUNT_KEY.fullmatch(normalize_name(item.key)) and re.fullmatch(r"\s*\d+\s*", item.value):
+            return int(item.value), f"line {line}: '{item.key} : {item.value.strip()}'"
+    return None
