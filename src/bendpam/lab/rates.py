@@ -32,7 +32,8 @@ from bendpam.lab.channels import ColumnInfo, classify_column, normalize_name
 from bendpam.lab.layout import MetaItem
 from bendpam.lab.read_error import ReadError
 
-__all__ = ["MAX_END_RECORDS", "MAX_TAIL_FRACTION", "MIN_RATE_VALUES", "counted_samples", "fill_empty_cells", "other_clocks"]
+__all__ = ["MAX_END_RECORDS", "MAX_TAIL_FRACTION", "MIN_RATE_VALUES", "counted_samples", "fill_empty_cells", "other_clocks",
+           "resample_to_time"]
 
 #: Rows after a column's last value (without a clock of its own) dropped at most, as a fraction of the rows.
 MAX_TAIL_FRACTION = 0.05
@@ -101,8 +102,62 @@ def _own_clock(ok: np.ndarray, clocks: dict[str, tuple[np.ndarray, str]]) -> tup
     """A time column with values on exactly the rows of ``ok`` and rising: the column's own clock."""
     for c, name in clocks.values():
         if np.array_equal(np.isfinite(c), ok) and np.all(np.diff(c[ok]) > 0):
-            return c[ok], name
+            return c, name
     return None
+
+
+def resample_to_time(x: np.ndarray, clock_s: np.ndarray, t: np.ndarray, lines: np.ndarray, *, source: str,
+                     clock: str, time: str) -> tuple[np.ndarray, np.ndarray, str]:  # fmt: skip
+    """A channel sampled on its own clock, interpolated linearly to the times ``t`` of the time column read.
+
+    Rows within one of its sampling periods before its first or after its last value take that
+    value (a sample holds until the next); rows further out are to be dropped.
+
+    Parameters
+    ----------
+    x, clock_s : numpy.ndarray
+        The channel's values and its clock (s), NaN where a row has none; the rows where both
+        are numbers are its samples (its clock must rise over them).
+    t : numpy.ndarray
+        The time (s) of every row.
+    lines : numpy.ndarray
+        The line of every row (for the note).
+    source, clock, time : str
+        The names of the channel's column, of its clock and of the time column read.
+
+    Returns
+    -------
+    values : numpy.ndarray
+        The channel at the times ``t``.
+    keep : numpy.ndarray
+        The rows within its samples' span (and one period beyond).
+    note : str
+        One line saying what was done.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(6) * 0.05                               # s, the fast clock
+    >>> slow = np.array([0.0, 0.1, 0.2, np.nan, np.nan, np.nan])
+    >>> load = np.array([0.0, 1.0, 2.0, np.nan, np.nan, np.nan])
+    >>> v, keep, note = resample_to_time(load, slow, t, np.arange(3, 9), source="Load", clock="Time slow",
+    ...                                  time="Time")
+    >>> v.tolist(), keep.tolist()
+    ([0.0, 0.5, 1.0, 1.5, 2.0, 2.0], [True, True, True, True, True, True])
+    >>> note
+    "column 'Load' is sampled on its own clock 'Time slow' (every 0.1 s, 3 values for 6 rows): its values interpolated linearly to the times of 'Time'; line 8 within one period past its first or last value hold that value"
+    """
+    ok = np.isfinite(x) & np.isfinite(clock_s)
+    ct, xs = clock_s[ok], x[ok]
+    period = float(np.median(np.diff(ct)))
+    keep = (t >= ct[0] - period) & (t <= ct[-1] + period)
+    held = np.flatnonzero(keep & ((t < ct[0]) | (t > ct[-1])))
+    note = (f"column {source!r} is sampled on its own clock {clock!r} (every {period:.4g} s, {xs.size} values for "
+            f"{x.size} rows): its values interpolated linearly to the times of {time!r}"
+            + (f"; {_span(lines, held)} within one period past its first or last value hold that value"
+               if held.size else "")
+            + (f"; {_span(lines, np.flatnonzero(~keep))} further out dropped" if not keep.all() else ""))
+    return np.interp(t, ct, xs), keep, note
 
 
 def _fill_one(x: np.ndarray, t: np.ndarray, source: str, time_source: str, lines: np.ndarray,
@@ -116,16 +171,9 @@ def _fill_one(x: np.ndarray, t: np.ndarray, source: str, time_source: str, lines
     keep = np.ones(n, dtype=bool)
     own = _own_clock(ok, clocks)
     if own is not None:  # values on their own clock: to the times of the time column read
-        ct, clock = own
-        period = float(np.median(np.diff(ct)))
-        x[:] = np.interp(t, ct, x[idx])
-        keep = (t >= ct[0] - period) & (t <= ct[-1] + period)
-        held = np.flatnonzero(keep & ((t < ct[0]) | (t > ct[-1])))
-        notes.append(f"column {source!r} is sampled on its own clock {clock!r} (every {period:.4g} s, "
-                     f"{idx.size} values for {n} rows): its values interpolated linearly to the times of "
-                     f"{time_source!r}" + (f"; {_span(lines, held)} within one period past its first or last "
-                                           f"value hold that value" if held.size else "")
-                     + (f"; {_span(lines, np.flatnonzero(~keep))} further out dropped" if not keep.all() else ""))
+        new, keep, note = resample_to_time(x, own[0], t, lines, source=source, clock=own[1], time=time_source)
+        x[:] = new
+        notes.append(note)
         return keep
     inner = idx[-1] - idx[0] + 1 > idx.size
     r = _regular(idx) if inner else 1.0
@@ -190,15 +238,25 @@ def fill_empty_cells(values: dict[str, np.ndarray], lines: np.ndarray, sources: 
     Force sampled at a third of the rate of time and stroke, one row past its last value:
 
     >>> import numpy as np
-    >>> v = {"time": np.arange(8) * 0.1, "stroke": np.arange(8.0),
-    ...      "force": np.array([0.0, np.nan, np.nan, 3, np.nan, np.nan, 6, np.nan])}
+    >>> force = np.full(14, np.nan)
+    >>> force[::3] = [0.0, 3.0, 6.0, 9.0, 12.0]                 # N, every third row
+    >>> v = {"time": np.arange(14) * 0.1, "stroke": np.arange(14.0), "force": force}
     >>> notes = []
-    >>> keep = fill_empty_cells(v, np.arange(2, 10), {"time": "t", "stroke": "s", "force": "F"}, {},
+    >>> keep = fill_empty_cells(v, np.arange(2, 16), {"time": "t", "stroke": "s", "force": "F"}, {},
     ...                         {}, "x.csv", False, notes)
-    >>> np.round(v["force"], 6).tolist(), keep.all()
-    ([0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 6.0], np.True_)
+    >>> np.round(v["force"], 6).tolist()[9:], bool(keep.all())
+    ([9.0, 10.0, 11.0, 12.0, 12.0], True)
     >>> notes
-    ["lines 2-8: column 'F' has a value every 3 rows (sampled slower): its 4 empty cells interpolated linearly in time"]
+    ["lines 2-14: column 'F' has a value every 3 rows (sampled slower): its 8 empty cells interpolated linearly in time"]
+
+    An empty cell here and there is no pattern: refused (or, with ``repair``, its row dropped):
+
+    >>> v["force"][5] = np.nan
+    >>> fill_empty_cells(v, np.arange(2, 16), {"time": "t", "stroke": "s", "force": "F"}, {},
+    ...                  {"force": (7, "empty cell in column 'F'")}, "x.csv", False, notes)
+    Traceback (most recent call last):
+    ...
+    bendpam.lab.read_error.ReadError: x.csv:7: empty cell in column 'F'
     """
     keep = np.ones(lines.size, dtype=bool)
     roles = [r for r in ("time", "stroke", "force") if r in values and not np.isfinite(values[r]).all()]
