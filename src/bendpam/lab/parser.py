@@ -729,7 +729,8 @@ class Parser:
                 continue
             num, nonempty = numeric_cells(cells)
             datalike = num >= 2 and 2 * num >= nonempty
-            if problem is None and (not empty or (datalike and blank_run is None)):
+            numbers = datalike or 0 < num == nonempty  # a row of numbers, some cells empty
+            if problem is None and (not empty or (numbers and blank_run is None)):
                 for role, col, cell in empty:  # NaN: a channel sampled slower, or an end record (rates.py)
                     data.empty_first.setdefault(role, (ln, self._row_problem(role, col, cell, dec, blk, line)))
                 rows.append(vals)

@@ -7,7 +7,7 @@ empty cells of a column mean is decided from their pattern, never from the file'
   ends on the same row (HBM catman writes one time column per rate group, ``Time 1 - default
   sample rate`` and ``Time 1 - slow sample rate``): the column's values belong to that clock and
   are interpolated linearly to the times of the time column read;
-* **a value every m rows** (m >= 1.5, evenly spread): a channel sampled slower on the same clock;
+* **a value every m rows** (m >= 1.2, evenly spread: each within a row of ``first + k m``): a channel sampled slower on the same clock;
   the empty cells between its values are interpolated linearly in time;
 * **empty after its last value** (or before its first), with no clock of its own: the rows are
   dropped (a channel that ended first, an end record with fewer numbers), as long as they are few
@@ -86,14 +86,14 @@ def _span(lines: np.ndarray, rows: np.ndarray) -> str:
 
 
 def _regular(idx: np.ndarray) -> float | None:
-    """Rows per value when the values sit evenly every m >= 1.5 rows (within a row), else None.
+    """Rows per value when the values sit evenly every m >= 1.2 rows (within a row), else None.
 
     At least :data:`MIN_RATE_VALUES` values: one empty cell between two values is no pattern.
     """
     if idx.size < MIN_RATE_VALUES:
         return None
     r = (idx[-1] - idx[0]) / (idx.size - 1)
-    if r < 1.5 or np.max(np.abs(idx - (idx[0] + r * np.arange(idx.size)))) > 1.0:
+    if r < 1.2 or np.max(np.abs(idx - (idx[0] + r * np.arange(idx.size)))) > 1.0:
         return None
     return float(r)
 
