@@ -7,8 +7,9 @@ empty cells of a column mean is decided from their pattern, never from the file'
   ends on the same row (HBM catman writes one time column per rate group, ``Time 1 - default
   sample rate`` and ``Time 1 - slow sample rate``): the column's values belong to that clock and
   are interpolated linearly to the times of the time column read;
-* **a value every m rows** (m >= 1.2, evenly spread: each within a row of ``first + k m``): a channel sampled slower on the same clock;
-  the empty cells between its values are interpolated linearly in time;
+* **a value every m rows** (m >= 1.2, evenly spread: each within a row of ``first + k m``): a
+  channel sampled slower on the same clock; the empty cells between its values are interpolated
+  linearly in time;
 * **empty after its last value** (or before its first), with no clock of its own: the rows are
   dropped (a channel that ended first, an end record with fewer numbers), as long as they are few
   (at most :data:`MAX_TAIL_FRACTION` of the rows, or 3): more would mean a slower channel whose
@@ -32,8 +33,8 @@ from bendpam.lab.channels import ColumnInfo, classify_column, normalize_name
 from bendpam.lab.layout import MetaItem
 from bendpam.lab.read_error import ReadError
 
-__all__ = ["MAX_END_RECORDS", "MAX_TAIL_FRACTION", "MIN_RATE_VALUES", "counted_samples", "fill_empty_cells", "other_clocks",
-           "resample_to_time"]
+__all__ = ["MAX_END_RECORDS", "MAX_TAIL_FRACTION", "MIN_RATE_VALUES", "counted_samples", "fill_empty_cells",
+           "other_clocks", "resample_to_time"]
 
 #: Rows after a column's last value (without a clock of its own) dropped at most, as a fraction of the rows.
 MAX_TAIL_FRACTION = 0.05
@@ -144,8 +145,11 @@ def resample_to_time(x: np.ndarray, clock_s: np.ndarray, t: np.ndarray, lines: n
     ...                                  time="Time")
     >>> v.tolist(), keep.tolist()
     ([0.0, 0.5, 1.0, 1.5, 2.0, 2.0], [True, True, True, True, True, True])
-    >>> note
-    "column 'Load' is sampled on its own clock 'Time slow' (every 0.1 s, 3 values for 6 rows): its values interpolated linearly to the times of 'Time'; line 8 within one period past its first or last value hold that value"
+    >>> import textwrap
+    >>> print(textwrap.fill(note, 100))
+    column 'Load' is sampled on its own clock 'Time slow' (every 0.1 s, 3 values for 6 rows): its
+    values interpolated linearly to the times of 'Time'; line 8 within one period past its first or
+    last value hold that value
     """
     ok = np.isfinite(x) & np.isfinite(clock_s)
     ct, xs = clock_s[ok], x[ok]
@@ -237,6 +241,7 @@ def fill_empty_cells(values: dict[str, np.ndarray], lines: np.ndarray, sources: 
     --------
     Force sampled at a third of the rate of time and stroke, one row past its last value:
 
+    >>> import textwrap
     >>> import numpy as np
     >>> force = np.full(14, np.nan)
     >>> force[::3] = [0.0, 3.0, 6.0, 9.0, 12.0]                 # N, every third row
@@ -246,8 +251,9 @@ def fill_empty_cells(values: dict[str, np.ndarray], lines: np.ndarray, sources: 
     ...                         {}, "x.csv", False, notes)
     >>> np.round(v["force"], 6).tolist()[9:], bool(keep.all())
     ([9.0, 10.0, 11.0, 12.0, 12.0], True)
-    >>> notes
-    ["lines 2-14: column 'F' has a value every 3 rows (sampled slower): its 8 empty cells interpolated linearly in time"]
+    >>> print(textwrap.fill(notes[0], 100))
+    lines 2-14: column 'F' has a value every 3 rows (sampled slower): its 8 empty cells interpolated
+    linearly in time
 
     An empty cell here and there is no pattern: refused (or, with ``repair``, its row dropped):
 
