@@ -267,16 +267,9 @@ def fill_empty_cells(values: dict[str, np.ndarray], lines: np.ndarray, sources: 
     keep = np.ones(lines.size, dtype=bool)
     roles = [r for r in ("time", "stroke", "force") if r in values and not np.isfinite(values[r]).all()]
     if "time" in roles:  # the time column read: only rows before its first or after its last value go
-        t = values["time"]
-        idx = np.flatnonzero(np.isfinite(t))
-        contiguous = idx.size >= 2 and idx[-1] - idx[0] + 1 == idx.size
-        if contiguous and lines.size - idx.size <= max(3, MAX_TAIL_FRACTION * lines.size):
-            drop = ~np.isfinite(t)
-            warnings.append(f"{_span(lines, np.flatnonzero(drop))}: the time column {sources['time']!r} is empty "
-                            f"(an end record with fewer numbers?): {drop.sum()} row(s) dropped")
-            keep &= ~drop
-        else:
-            keep &= _irregular("time", sources["time"], values, lines, empty_first, label, repair, warnings)
+        keep &= _time_rows(values["time"], lines, sources["time"], warnings)
+        if not keep.any():
+            keep = _irregular("time", sources["time"], values, lines, empty_first, label, repair, warnings)
         roles.remove("time")
     t = values.get("time", np.arange(lines.size, dtype=np.float64))
     for role in roles:
@@ -285,6 +278,18 @@ def fill_empty_cells(values: dict[str, np.ndarray], lines: np.ndarray, sources: 
             got = _irregular(role, sources[role], values, lines, empty_first, label, repair, warnings)
         keep &= got
     return keep
+
+
+def _time_rows(t: np.ndarray, lines: np.ndarray, source: str, warnings: list[str]) -> np.ndarray:
+    """Rows to keep when the time column has empty cells: only a few at its ends go (all False: no pattern)."""
+    idx = np.flatnonzero(np.isfinite(t))
+    contiguous = idx.size >= 2 and idx[-1] - idx[0] + 1 == idx.size
+    if not (contiguous and lines.size - idx.size <= max(3, MAX_TAIL_FRACTION * lines.size)):
+        return np.zeros(t.size, dtype=bool)
+    drop = ~np.isfinite(t)
+    warnings.append(f"{_span(lines, np.flatnonzero(drop))}: the time column {source!r} is empty "
+                    f"(an end record with fewer numbers?): {drop.sum()} row(s) dropped")
+    return ~drop
 
 
 def _irregular(role: str, column: str, values: dict[str, np.ndarray], lines: np.ndarray,
