@@ -188,7 +188,7 @@ def test_clock_is_refused_for_time(tmp_path):
 
 def test_an_empty_time_cell_reads_only_at_the_end(tmp_path):
     rows = ["time_s,stroke_mm,force_n"] + [f"{0.1 * i:.3g},{0.01 * i:.3g},{i:.1f}" for i in range(30)]
-    raw = read_test(_write(tmp_path, "tail.csv", "\n".join(rows + [",0.31,31"]) + "\n"))
+    raw = read_test(_write(tmp_path, "tail.csv", "\n".join([*rows, ",0.31,31"]) + "\n"))
     assert len(raw.data) == 30 and any(w.startswith("line 32: the time column 'time_s' is empty") for w in raw.warnings)
     rows[11] = ",0.1,10"
     with pytest.raises(ReadError, match=r"tail2\.csv:12: .*an empty cell in column 'time_s'"):
