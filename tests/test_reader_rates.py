@@ -193,3 +193,22 @@ def test_an_empty_time_cell_reads_only_at_the_end(tmp_path):
     rows[11] = ",0.1,10"
     with pytest.raises(ReadError, match=r"tail2\.csv:12: .*an empty cell in column 'time_s'"):
         read_test(_write(tmp_path, "tail2.csv", "\n".join(rows) + "\n"))
+
+
+def test_a_broken_pattern_is_refused_at_the_row_that_breaks_it(tmp_path):
+    text = _every(2, n=200).splitlines()
+    text[101] = text[101].rsplit(",", 1)[0] + ","  # row 100 (line 102) should hold a value
+    path = _write(tmp_path, "broken.csv", "\n".join(text) + "\n")
+    with pytest.raises(ReadError) as err:
+        read_test(path)
+    assert str(err.value) == (f"{path}:102: an empty cell in column 'force_n' breaks its pattern (a value every 2 "
+                              "rows up to line 100); expected a value every 2 rows, as sampled at one rate")
+
+
+def test_a_long_table_with_a_slower_channel_reads_in_blocks(tmp_path):
+    n = 30_000  # more than a piece of lines: the rows after the first empty cell go through the C parser
+    text = _every(3, n=n)
+    raw = read_test(_write(tmp_path, "long.csv", text))
+    t = raw.data["time_s"].to_numpy()
+    assert len(raw.data) == n
+    assert_allclose(raw.data["force_n"], _force(np.minimum(t, 0.05 * (n - 1 - (n - 1) % 3))), rtol=1e-9)

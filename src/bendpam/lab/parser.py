@@ -633,7 +633,7 @@ class Parser:
                 if left is not None:
                     self._sink.reserve(self._sink.n + n + int(1.02 * left * n / max(len(text), 1)) + 4096)
                 sized = True
-            arrs = self._fast(text, n, blk, needed, dec, data)
+            arrs = self._fast(text, n, blk, needed, dec, data, start)
             if arrs is not None:
                 self._keep_rows(blk, arrs, np.arange(start, start + n, dtype=np.int32))
                 continue
@@ -655,7 +655,7 @@ class Parser:
         for off in range(0, len(lines), _PIECE_LINES):
             piece = lines[off:off + _PIECE_LINES]
             first = start + off
-            arrs = self._fast("\n".join(piece), len(piece), blk, needed, dec, data)
+            arrs = self._fast("\n".join(piece), len(piece), blk, needed, dec, data, first)
             if arrs is not None:
                 self._keep_rows(blk, arrs, np.arange(first, first + len(piece), dtype=np.int32))
                 continue
@@ -665,7 +665,8 @@ class Parser:
                 return True
         return False
 
-    def _fast(self, text: str, n: int, blk: Block, needed, dec: str, data: ColumnData) -> list[np.ndarray] | None:
+    def _fast(self, text: str, n: int, blk: Block, needed, dec: str, data: ColumnData,
+              start: int = 0) -> list[np.ndarray] | None:  # fmt: skip
         """The needed columns of ``n`` lines of numbers by the C parser, or None if any line is odd.
 
         Once the optional cycle counter is known to hold a non-number, it is no longer parsed
@@ -674,10 +675,32 @@ class Parser:
         counter_off = needed[-1][0] == "counter" and data.counter_bad_line is not None
         idx = [col.index for _role, col in (needed[:-1] if counter_off else needed)]
         arrs = c_numbers(text, sep=blk.sep, decimal=dec, columns=idx, n_rows=n)
+        if arrs is None and data.empty_first:  # empty cells seen already (a slower channel): keep them as NaN
+            arrs = self._fast_empty(text, n, blk, needed[:len(idx)], dec, data, start)
         if arrs is None:
             return None
         if counter_off:
             arrs.append(np.full(n, np.nan))
+        return arrs
+
+    def _fast_empty(self, text: str, n: int, blk: Block, needed, dec: str, data: ColumnData,
+                    start: int) -> list[np.ndarray] | None:  # fmt: skip
+        """The C parser with empty cells as NaN (lines from ``start``), when every row has a time, stroke or force."""
+        arrs = c_numbers(text, sep=blk.sep, decimal=dec, columns=[col.index for _r, col in needed], n_rows=n,
+                         empty_nan=True)  # fmt: skip
+        if arrs is None:
+            return None
+        core = [(k, role, col) for k, (role, col) in enumerate(needed) if role in ROLES]
+        if not np.logical_or.reduce([np.isfinite(arrs[k]) for k, _r, _c in core]).all():
+            return None  # a row without any (a blank line): the line-by-line path sees where the block ends
+        for k, role, col in core:
+            bad = np.flatnonzero(np.isnan(arrs[k]))
+            if bad.size and role not in data.empty_first:
+                line = text.split("\n", int(bad[0]) + 1)[int(bad[0])]
+                data.empty_first[role] = (start + int(bad[0]),
+                                          self._row_problem(role, col, "", dec, blk, line))
+        if needed[-1][0] == "counter" and data.counter_bad_line is None and np.isnan(arrs[-1]).any():
+            data.counter_bad_line = start + int(np.flatnonzero(np.isnan(arrs[-1]))[0])
         return arrs
 
     def _row_problem(self, role: str, col: ColumnInfo, cell: str | None, dec: str, blk: Block,

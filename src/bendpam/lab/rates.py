@@ -7,7 +7,7 @@ empty cells of a column mean is decided from their pattern, never from the file'
   ends on the same row (HBM catman writes one time column per rate group, ``Time 1 - default
   sample rate`` and ``Time 1 - slow sample rate``): the column's values belong to that clock and
   are interpolated linearly to the times of the time column read;
-* **a value every m rows** (m >= 1.2, evenly spread: each within a row of ``first + k m``): a
+* **a value every m rows** (m >= 1.2, evenly spread: steps of floor(m) or ceil(m) rows): a
   channel sampled slower on the same clock; the empty cells between its values are interpolated
   linearly in time;
 * **empty after its last value** (or before its first), with no clock of its own: the rows are
@@ -87,15 +87,17 @@ def _span(lines: np.ndarray, rows: np.ndarray) -> str:
 
 
 def _regular(idx: np.ndarray) -> float | None:
-    """Rows per value when the values sit evenly every m >= 1.2 rows (within a row), else None.
+    """Rows per value when the values sit evenly every m >= 1.2 rows (steps of floor(m) or ceil(m) rows), else None.
 
     At least :data:`MIN_RATE_VALUES` values: one empty cell between two values is no pattern.
     """
     if idx.size < MIN_RATE_VALUES:
         return None
     r = (idx[-1] - idx[0]) / (idx.size - 1)
-    if r < 1.2 or np.max(np.abs(idx - (idx[0] + r * np.arange(idx.size)))) > 1.0:
-        return None
+    steps = np.diff(idx)
+    if r < 1.2 or steps.min() < np.floor(r) or steps.max() > np.ceil(r) or \
+            np.max(np.abs(idx - (idx[0] + r * np.arange(idx.size)))) > 1.0:
+        return None  # a step of another length: a missing value, not a rate
     return float(r)
 
 
@@ -299,6 +301,14 @@ def _irregular(role: str, column: str, values: dict[str, np.ndarray], lines: np.
     bad = ~np.isfinite(values[role])
     if not repair:
         line, message = empty_first.get(role, (int(lines[np.argmax(bad)]), f"empty cell in the {role} column"))
+        idx = np.flatnonzero(~bad)
+        steps = np.diff(idx)
+        med = float(np.median(steps)) if steps.size else 1.0
+        if med >= 1.2 and (steps > np.ceil(med)).any():  # a slower channel's pattern, broken further down
+            j = int(np.flatnonzero(steps > np.ceil(med))[0])
+            line = int(lines[idx[j] + int(np.ceil(med))])
+            message = (f"an empty cell in column {column!r} breaks its pattern (a value every {med:g} rows up to "
+                       f"line {int(lines[idx[j]])}); expected a value every {med:g} rows, as sampled at one rate")
         raise ReadError(message, label, line, column)
     shown = ", ".join(str(int(v)) for v in lines[bad][:5]) + (f" (and {bad.sum() - 5} more)" if bad.sum() > 5 else "")
     warnings.append(f"dropped {bad.sum()} row(s) with a non-finite or empty value at line(s) {shown}")
