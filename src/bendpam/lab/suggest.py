@@ -328,7 +328,10 @@ def _from_detection(path: Path, parsed: Any, raw: Any) -> str:
         name = ast.literal_eval(m.group(2)) if m else None
         if name is not None:
             clocks[role] = name if names.count(name) == 1 else names.index(name) + 1
-    return _render(path, "filled in with what detection found", keys, columns, [], clocks)
+    notes = ["CHECK: detection interpolated the empty cells of a channel sampled slower on the same clock; "
+             "a declaration refuses empty cells (except on a channel's own clock)"] if any(
+        "(sampled slower)" in w for w in raw.warnings) else []
+    return _render(path, "filled in with what detection found", keys, columns, notes, clocks)
 
 
 def suggest_declaration(path: str | os.PathLike) -> str:
