@@ -47,6 +47,7 @@ from bendpam.lab.pressure import (
     pressure_from_filename,
     pressure_out_of_range,
 )
+from bendpam.lab.rates import MAX_END_RECORDS, counted_samples, fill_empty_cells
 from bendpam.lab.rawtest import COLUMNS, RawTest
 from bendpam.lab.read_error import ReadError, show
 
@@ -207,6 +208,36 @@ def _drop_spikes(samples: _Samples, channels: Channels, label: Path | str, repai
                 f"dropped {bad.size} spike sample(s) in column {name!r} at line(s) {where}"
             )
     if not keep.all():
+        samples.keep(keep)
+
+
+def _fill_empty(samples: _Samples, data: ColumnData, channels: Channels, label: Path | str, repair: bool,
+                warnings: list[str]) -> None:  # fmt: skip
+    """Empty cells of time, stroke or force: interpolated, dropped or refused by their pattern.
+
+    The patterns are those of :mod:`bendpam.lab.rates` (a channel sampled at another rate, a column that ends first).
+    """
+    clocks = {}
+    for name, col in data.clocks.items():
+        arr = _column(data, name)
+        clocks[name] = (arr * (unit_factor("time", col.unit or "s") or 1.0), col.source)
+    sources = {role: str(ch["source"] or role) for role, ch in channels.items()}
+    keep = fill_empty_cells(samples.values, samples.lines, sources, clocks, data.empty_first, label, repair,
+                            warnings)  # fmt: skip
+    if not keep.all():
+        samples.keep(keep)
+
+
+def _drop_uncounted(samples: _Samples, counted: tuple[int, str] | None, warnings: list[str]) -> None:
+    """Drop the last rows past the number of samples the metadata declare (end records), when a few."""
+    if counted is None:
+        return
+    k = samples.lines.size - counted[0]
+    if 1 <= k <= MAX_END_RECORDS and counted[0] >= 2:
+        warnings.append(f"the metadata count {counted[0]} samples ({counted[1]}): the last {k} row(s) at "
+                        f"line(s) {_lines_text(samples.lines[-k:].tolist())} are end records, not samples; dropped")
+        keep = np.ones(samples.lines.size, dtype=bool)
+        keep[-k:] = False
         samples.keep(keep)
 
 
@@ -441,7 +472,11 @@ def _samples(parsed: Parsed, rate_hz: float | None, repair: bool, warnings: list
     counter = _column(data, "counter") if ch.counter is not None else None
     sample_rate = _time_from_rate(values, source_units, channels, p, blk, rate_hz, warnings)
     samples = _Samples(values, lines, counter)
+    if data.empty_first:
+        _fill_empty(samples, data, channels, label, repair, warnings)
     _drop_padding(samples, channels, warnings)
+    if not parsed.parser.joined and blk.groups == 1:
+        _drop_uncounted(samples, counted_samples(p.meta_items(blk.header_line)), warnings)
     _drop_spikes(samples, channels, label, repair, warnings)
     segments = _check_time(samples, channels, label, repair, warnings)
     if values["time"].size < 2:

@@ -17,7 +17,7 @@ __all__ = ["c_numbers"]
 
 
 def c_numbers(text: str, *, sep: str, decimal: str, columns: Sequence[int], n_rows: int,
-              skipinitialspace: bool = False) -> list[np.ndarray] | None:  # fmt: skip
+              skipinitialspace: bool = False, empty_nan: bool = False) -> list[np.ndarray] | None:  # fmt: skip
     """Columns ``columns`` (0-based, in that order, repeats allowed) of ``n_rows`` lines of numbers.
 
     Parameters
@@ -34,6 +34,8 @@ def c_numbers(text: str, *, sep: str, decimal: str, columns: Sequence[int], n_ro
         Lines in ``text``; any other count of rows is an irregular block.
     skipinitialspace : bool
         Blanks after a delimiter are not part of the cell.
+    empty_nan : bool
+        An empty or missing cell is NaN instead of irregular (text, ``nan`` and infinities still are).
 
     Returns
     -------
@@ -49,6 +51,8 @@ def c_numbers(text: str, *, sep: str, decimal: str, columns: Sequence[int], n_ro
     ([0.0, 0.5], [1.5, 2.5])
     >>> c_numbers("0,1\\n0.5,x", sep=",", decimal=".", columns=[0, 1], n_rows=2) is None
     True
+    >>> c_numbers("0,1\\n0.5,", sep=",", decimal=".", columns=[0, 1], n_rows=2, empty_nan=True)[1].tolist()
+    [1.0, nan]
     """
     if sep == decimal or not columns:
         return None
@@ -65,7 +69,9 @@ def c_numbers(text: str, *, sep: str, decimal: str, columns: Sequence[int], n_ro
             engine="c",
             skip_blank_lines=False,
             quotechar='"',
-            na_filter=False,
+            na_filter=empty_nan,
+            na_values=[""] if empty_nan else None,
+            keep_default_na=False,
             index_col=False,
             skipinitialspace=skipinitialspace,
         )
@@ -73,6 +79,6 @@ def c_numbers(text: str, *, sep: str, decimal: str, columns: Sequence[int], n_ro
     except Exception:  # any parser trouble: the caller's line-by-line path finds the line
         return None
     del frame
-    if any(len(a) != n_rows or not np.isfinite(a).all() for a in arrs):
+    if any(len(a) != n_rows or (np.isinf(a).any() if empty_nan else not np.isfinite(a).all()) for a in arrs):
         return None
     return arrs

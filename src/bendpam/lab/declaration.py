@@ -74,7 +74,7 @@ DECLARATION_HINT = (
 )
 _DELIMITERS_SHOWN = '"tab", ";", ",", "whitespace" or "fixed"'
 _THOUSANDS = ("", ",", ".", " ", "'")
-_ROLE_KEYS = ("column", "unit")
+_ROLE_KEYS = ("column", "unit", "clock")
 #: Every top-level key of a declaration.
 DECLARATION_KEYS: tuple[str, ...] = (
     "version", "header_line", "units_line", "first_data_line", "last_data_line", "delimiter", "widths",
@@ -96,6 +96,8 @@ class ColumnSpec:
 
     column: str | int
     unit: str | None = None
+    #: The time column this channel is sampled on, when not the one of ``[time]`` (a slower rate group).
+    clock: str | int | None = field(default=None, repr=False)
 
     @property
     def shown(self) -> str:
@@ -207,7 +209,14 @@ class _Checker:
         unit = spec.get("unit")
         if unit is not None and (not isinstance(unit, str) or unit_factor(role, unit) is None):
             raise self.fail(f"{role}.unit", f"{unit!r} is not allowed; expected {UNIT_HINT[role]}")
-        return ColumnSpec(col.strip() if isinstance(col, str) else col, unit.strip() if unit else None)
+        clock = spec.get("clock")
+        if clock is not None and (role == "time" or isinstance(clock, bool) or not isinstance(clock, (str, int))
+                                  or (isinstance(clock, str) and not clock.strip())
+                                  or (isinstance(clock, int) and not 1 <= clock <= 100_000)):
+            raise self.fail(f"{role}.clock", f"{clock!r} is not allowed; expected the name or 1-based position of "
+                                             "the time column this channel is sampled on (stroke and force only)")
+        return ColumnSpec(col.strip() if isinstance(col, str) else col, unit.strip() if unit else None,
+                          clock.strip() if isinstance(clock, str) else clock)
 
 
 def _text_keys(c: _Checker, data: dict[str, Any]) -> dict[str, Any]:
@@ -350,6 +359,10 @@ def _check_columns(c: _Checker, columns: dict[str, ColumnSpec], kw: dict[str, An
     if "time" in columns and kw["rate_hz"] is not None:
         raise c.fail("rate_hz", "given with a time column; expected one of them (rate_hz only when the file has "
                                 "no time column)")
+    if kw["specimen_width"] is not None or "time" not in columns:
+        clocked = [r for r, s in columns.items() if s.clock is not None]
+        if clocked:
+            raise c.fail(f"{clocked[0]}.clock", "needs a [time] column and one specimen (no specimen_width)")
     cols = [s.column for s in columns.values()]
     if len(set(cols)) < len(cols):
         raise c.fail("force", f"one column given for two roles ({', '.join(s.shown for s in columns.values())}); "

@@ -40,6 +40,7 @@ from bendpam.lab.pressure import (
     pressure_from_filename,
     pressure_out_of_range,
 )
+from bendpam.lab.rates import resample_to_time
 from bendpam.lab.rawtest import COLUMNS, RawTest
 from bendpam.lab.read_error import ReadError, show
 
@@ -76,6 +77,7 @@ class _Layout:
     width: int | None
     groups: int = 1
     specimen_names: list[str] = field(default_factory=list)
+    clocks: dict[str, tuple[int, str, str]] = field(default_factory=dict)  # role -> its own time column, name, unit
 
     @property
     def roles(self) -> tuple[str, ...]:
@@ -171,22 +173,24 @@ def _open(path: Path, decl: Declaration) -> _Input:
 # ------------------------------------------------------------------------------------------------
 # the lines above the numbers
 # ------------------------------------------------------------------------------------------------
-def _resolve(role: str, decl: Declaration, names: list[str], inp: _Input) -> int:
-    """0-based position of a role's column."""
+def _resolve(role: str, decl: Declaration, names: list[str], inp: _Input, key: str = "column") -> int:
+    """0-based position of a role's column (``key="clock"``: of its own time column)."""
     spec = decl.columns[role]
+    ref = spec.clock if key == "clock" else spec.column
+    assert ref is not None
     width = decl.specimen_width
-    if isinstance(spec.column, int):
-        return spec.column - 1
-    hits = [i for i, n in enumerate(names) if n.strip() == spec.column]
+    if isinstance(ref, int):
+        return ref - 1
+    hits = [i for i, n in enumerate(names) if n.strip() == ref]
     if width is not None:
         hits = [i for i in hits if i < width]
     if not hits:
         cells = ", ".join(repr(n) for n in names if n.strip())
-        raise decl.error(f"{role}.column", f"{spec.column!r} is not in the names row (line {decl.header_line} of "
+        raise decl.error(f"{role}.{key}", f"{ref!r} is not in the names row (line {decl.header_line} of "
                                            f"{inp.label.name}: {cells}); expected one of its cells or a 1-based "
                                            "position")
     if len(hits) > 1:
-        raise decl.error(f"{role}.column", f"{spec.column!r} appears {len(hits)} times in the names row (positions "
+        raise decl.error(f"{role}.{key}", f"{ref!r} appears {len(hits)} times in the names row (positions "
                                            f"{', '.join(str(i + 1) for i in hits)}); expected its 1-based position")
     return hits[0]
 
@@ -243,6 +247,13 @@ def _read_head(inp: _Input, decl: Declaration, lines: Iterator[tuple[int, str]])
         cell = names[i].strip() if i < len(names) else ""
         sources[role] = cell or f"column {i + 1}"
     layout = _Layout(names, head, pos, units, sources, decl.specimen_width)
+    for role in layout.roles:
+        if decl.columns[role].clock is not None:
+            i = _resolve(role, decl, names, inp, "clock")
+            cell = units_row[i].strip() if units_row is not None and i < len(units_row) else ""
+            unit = cell if cell and unit_factor("time", cell) is not None else units["time"]
+            layout.clocks[role] = (i, names[i].strip() if i < len(names) and names[i].strip() else f"column {i + 1}",
+                                   unit)
     if decl.specimen_names_line:
         layout.specimen_names = inp.split(text[decl.specimen_names_line])
     return layout
@@ -419,7 +430,10 @@ def _convert_chunk(lines: np.ndarray, vals: np.ndarray, status: np.ndarray, cell
         block = _blocks_of(any_num, ~any_num, state, lines, texts, inp, layout, decl)
     nr = len(layout.roles)
     for g in range(layout.groups):
-        st = status[g * nr:(g + 1) * nr]
+        st = status[g * nr:(g + 1) * nr].copy()
+        for k, role in enumerate(layout.clocks):  # a channel on its own clock: empty where its clock is empty
+            j = layout.roles.index(role)
+            st[j][(st[j] == _EMPTY) & (status[layout.groups * nr + k] == _EMPTY)] = _OK
         good = (st == _OK).all(axis=0) & (block >= 0)
         damaged = any_num & (block >= 0) & ~good & ~(st == _EMPTY).all(axis=0)
         if damaged.any() and not repair:
@@ -433,6 +447,8 @@ def _convert_chunk(lines: np.ndarray, vals: np.ndarray, status: np.ndarray, cell
             part = state.parts.setdefault((b, g), _Part())
             for j, role in enumerate(layout.roles):
                 part.values.setdefault(role, []).append(vals[g * nr + j][sel])
+            for k, role in enumerate(layout.clocks):
+                part.values.setdefault(f"clock:{role}", []).append(vals[layout.groups * nr + k][sel])
             part.lines.append(lines[sel])
             part.dropped.extend(lines[damaged & (block == b)].tolist())
             if g == 0:
@@ -491,6 +507,7 @@ def _read_data(inp: _Input, decl: Declaration, layout: _Layout, lines: Iterator[
                 continue
             layout.groups = _groups(inp.split(line), layout)
             needed = [layout.pos[r] + g * (layout.width or 0) for g in range(layout.groups) for r in layout.roles]
+            needed += [c[0] for c in layout.clocks.values()]
             first_ln = ln
         texts.append(line)
         if len(texts) >= _CHUNK:
@@ -601,6 +618,14 @@ def _make_test(inp: _Input, decl: Declaration, layout: _Layout, state: _State, k
                                                                  f"{rate:g} Hz ({why})"}
         source_units["time_s"] = "s"
         warnings.append(f"no time column: time made from {rate:g} Hz ({why})")
+    for role, (_i, clock, unit) in layout.clocks.items():
+        ct = np.concatenate([v for p in parts for v in p.values[f"clock:{role}"]]) * (unit_factor("time", unit) or 1.0)
+        values[role], keep, note = resample_to_time(values[role], ct, values["time"], lines,
+                                                    source=str(layout.sources[role]), clock=clock,
+                                                    time=str(layout.sources["time"]))  # fmt: skip
+        warnings.append(note)
+        values = {r: v[keep] for r, v in values.items()}
+        lines = lines[keep]
     values, lines = check_values(values, lines, {r: channels[r] for r in ROLES}, label, repair, warnings)
     if lines.size < 2:
         raise ReadError(f"only {lines.size} sample(s) left after the checks; expected at least 2", label,

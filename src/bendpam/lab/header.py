@@ -137,6 +137,8 @@ def _between_ok(cells: list[str], names: list[str], width: int) -> str | None:
         return "specimen names"
     if n >= 2 and abs(n - n_names) <= 1 and len(nonempty) >= max(2, n_names - 1):
         return "one cell per column (channel metadata)"
+    if n >= 2 and abs(n - n_names) <= 1 and num == 0 and len(nonempty) >= max(2, (n_names + 1) // 2):
+        return "channel metadata (some channels without)"  # catman: no hardware scaling for its time columns
     return None
 
 

@@ -51,6 +51,7 @@ from bendpam.lab.layout import (
     parse_number,
     split_cells,
 )
+from bendpam.lab.rates import other_clocks
 from bendpam.lab.read_error import ReadError, show
 from bendpam.lab.source import Source, open_source
 
@@ -60,6 +61,7 @@ _CHUNK_LINES = 100_000  # lines looked at at a time when a block is only skipped
 _CHUNK_CHARS = 1 << 21  # characters of data lines handed to the C parser at a time
 _PIECE_LINES = 2_000  # lines per piece of a chunk that has odd lines (the odd piece is read line by line)
 _PEEK_LINES = 200  # data rows inspected for the decimal mark
+_TAIL_PEEK = 50  # lines after an odd row looked at: an end or summary record only if the file ends within them
 _RATE_KEY = re.compile(
     r"sampl|abtast|mess ?rate|data rate|acquisition rate|recording rate|aufzeichnungsrate|"
     r"frequen|taux d.acquisition|échantillon|campionamento|muestreo|próbkowani|採樣|采样|"
@@ -166,6 +168,11 @@ class ColumnData:
         Lines dropped for a non-finite or empty cell (``repair=True``).
     counter_bad_line : int or None
         First line whose cycle-counter cell is not a number.
+    empty_first : dict of str to (int, str)
+        role -> ``(line, message)`` of the first empty cell of that column (its values are NaN
+        there; :mod:`bendpam.lab.rates` decides whether the pattern is a channel sampled slower).
+    clocks : dict of str to ColumnInfo
+        ``"clock1"``, ... -> the block's other time columns, read alongside (NaN where not a number).
 
     Examples
     --------
@@ -181,6 +188,8 @@ class ColumnData:
     lines: list[np.ndarray] = field(default_factory=list)
     dropped_nonfinite: list[int] = field(default_factory=list)
     counter_bad_line: int | None = None
+    empty_first: dict[str, tuple[int, str]] = field(default_factory=dict)
+    clocks: dict[str, ColumnInfo] = field(default_factory=dict)
 
 
 def _is_units_row(cells: list[str], names: list[str]) -> bool:
@@ -347,6 +356,7 @@ class Parser:
         self.joined: list[Block] = []  # blocks after the chosen one that repeat its header, read with it
         self.specimen = specimen
         self.trailing: list[tuple[int, str]] = []
+        self._pending: tuple[int, str, str] | None = None  # a odd row that ends the block unless samples follow
         self._blank_carry = False  # the last chunk of data lines read ended in blank lines
         self._sink = _Sink([])  # the numbers of the block being read
 
@@ -594,6 +604,9 @@ class Parser:
         ch = blk.choice
         assert ch is not None
         out = [(role, ch.chosen[role]) for role in ROLES if role in ch.chosen]
+        if "time" in ch.chosen and self.data is not None:
+            out += [(name, col) for name, col in other_clocks(blk.columns, ch.chosen["time"])]
+            self.data.clocks.update(dict(out[len(ch.chosen):]))
         if ch.counter is not None:
             out.append(("counter", ch.counter))
         return out
@@ -620,7 +633,7 @@ class Parser:
                 if left is not None:
                     self._sink.reserve(self._sink.n + n + int(1.02 * left * n / max(len(text), 1)) + 4096)
                 sized = True
-            arrs = self._fast(text, n, blk, needed, dec, data)
+            arrs = self._fast(text, n, blk, needed, dec, data, start)
             if arrs is not None:
                 self._keep_rows(blk, arrs, np.arange(start, start + n, dtype=np.int32))
                 continue
@@ -629,6 +642,7 @@ class Parser:
             if self._rows_of_lines(lines, start, blk, needed, dec, data):
                 break
         self._sink.into(data)
+        self._end_records(blk)
 
     def _keep_rows(self, blk: Block, arrs: list[np.ndarray], lnos: np.ndarray) -> None:
         self._sink.add(arrs, lnos)
@@ -641,7 +655,7 @@ class Parser:
         for off in range(0, len(lines), _PIECE_LINES):
             piece = lines[off:off + _PIECE_LINES]
             first = start + off
-            arrs = self._fast("\n".join(piece), len(piece), blk, needed, dec, data)
+            arrs = self._fast("\n".join(piece), len(piece), blk, needed, dec, data, first)
             if arrs is not None:
                 self._keep_rows(blk, arrs, np.arange(first, first + len(piece), dtype=np.int32))
                 continue
@@ -651,7 +665,8 @@ class Parser:
                 return True
         return False
 
-    def _fast(self, text: str, n: int, blk: Block, needed, dec: str, data: ColumnData) -> list[np.ndarray] | None:
+    def _fast(self, text: str, n: int, blk: Block, needed, dec: str, data: ColumnData,
+              start: int = 0) -> list[np.ndarray] | None:  # fmt: skip
         """The needed columns of ``n`` lines of numbers by the C parser, or None if any line is odd.
 
         Once the optional cycle counter is known to hold a non-number, it is no longer parsed
@@ -660,10 +675,32 @@ class Parser:
         counter_off = needed[-1][0] == "counter" and data.counter_bad_line is not None
         idx = [col.index for _role, col in (needed[:-1] if counter_off else needed)]
         arrs = c_numbers(text, sep=blk.sep, decimal=dec, columns=idx, n_rows=n)
+        if arrs is None and data.empty_first:  # empty cells seen already (a slower channel): keep them as NaN
+            arrs = self._fast_empty(text, n, blk, needed[:len(idx)], dec, data, start)
         if arrs is None:
             return None
         if counter_off:
             arrs.append(np.full(n, np.nan))
+        return arrs
+
+    def _fast_empty(self, text: str, n: int, blk: Block, needed, dec: str, data: ColumnData,
+                    start: int) -> list[np.ndarray] | None:  # fmt: skip
+        """The C parser with empty cells as NaN (lines from ``start``), when every row has a time, stroke or force."""
+        arrs = c_numbers(text, sep=blk.sep, decimal=dec, columns=[col.index for _r, col in needed], n_rows=n,
+                         empty_nan=True)  # fmt: skip
+        if arrs is None:
+            return None
+        core = [(k, role, col) for k, (role, col) in enumerate(needed) if role in ROLES]
+        if not np.logical_or.reduce([np.isfinite(arrs[k]) for k, _r, _c in core]).all():
+            return None  # a row without any (a blank line): the line-by-line path sees where the block ends
+        for k, role, col in core:
+            bad = np.flatnonzero(np.isnan(arrs[k]))
+            if bad.size and role not in data.empty_first:
+                line = text.split("\n", int(bad[0]) + 1)[int(bad[0])]
+                data.empty_first[role] = (start + int(bad[0]),
+                                          self._row_problem(role, col, "", dec, blk, line))
+        if needed[-1][0] == "counter" and data.counter_bad_line is None and np.isnan(arrs[-1]).any():
+            data.counter_bad_line = start + int(np.flatnonzero(np.isnan(arrs[-1]))[0])
         return arrs
 
     def _row_problem(self, role: str, col: ColumnInfo, cell: str | None, dec: str, blk: Block,
@@ -707,37 +744,24 @@ class Parser:
             if has_control_chars(line):
                 self._binary_line(ln)
             cells = split_cells(line, sep)
-            vals: list[float] = []
-            problem: tuple[str, ColumnInfo, str | None] | None = None
-            for role, col in needed:
-                cell = cells[col.index] if col.index < len(cells) else None
-                if cell is None:
-                    if role == "counter":
-                        vals.append(math.nan)
-                        continue
-                    problem = (role, col, None)
-                    break
-                res = parse_number(cell, dec)
-                if res.value is None:
-                    if role == "counter":
-                        vals.append(math.nan)
-                        if data.counter_bad_line is None:
-                            data.counter_bad_line = ln
-                        continue
-                    problem = (role, col, cell)
-                    break
-                vals.append(res.value)
-            if problem is None:
-                rows.append(vals)
-                lnos.append(ln)
-                blank_run = None
-                continue
-            if blk.groups > 1 and all(col.index >= len(cells) or not cells[col.index] for _r, col in needed):
+            vals, problem, empty = self._cells(cells, ln, needed, dec, data)
+            if blk.groups > 1 and (problem is not None or empty) and all(
+                    col.index >= len(cells) or not cells[col.index] for _r, col in needed):
                 if blank_run is None:  # this specimen's columns have ended (a shorter one side by side)
                     blank_run = k
                 continue
             num, nonempty = numeric_cells(cells)
             datalike = num >= 2 and 2 * num >= nonempty
+            numbers = datalike or 0 < num == nonempty  # a row of numbers, some cells empty
+            if problem is None and (not empty or (numbers and blank_run is None)):
+                for role, col, cell in empty:  # NaN: a channel sampled slower, or an end record (rates.py)
+                    data.empty_first.setdefault(role, (ln, self._row_problem(role, col, cell, dec, blk, line)))
+                rows.append(vals)
+                lnos.append(ln)
+                blank_run = None
+                continue
+            if problem is None:
+                problem = empty[0]
             if not datalike:
                 repeated = [normalize_name(c) for c in cells] == names_norm or any(
                     [normalize_name(c) for c in split_cells(nxt, sep)] == names_norm for nxt in lines[k + 1:k + 3])
@@ -745,6 +769,11 @@ class Parser:
                     end = blank_run if blank_run is not None else k
                     break
             role, col, cell = problem
+            if datalike and cell is not None and parse_number(cell, dec).problem not in ("nonfinite", "thousands") and (
+                    self._pending is None):  # a row of numbers with text: an end or summary record if no sample follows
+                self._pending = (ln, self._row_problem(role, col, cell, dec, blk, line), col.source)
+                end = k
+                break
             if (
                 self.repair
                 and cell is not None
@@ -763,6 +792,57 @@ class Parser:
             blk.last_line = lnos[-1]
         self._blank_carry = end is None and blank_run is not None  # trailing blank lines: the next chunk decides
         return end
+
+    def _cells(self, cells: list[str], ln: int, needed: list[tuple[str, ColumnInfo]], dec: str, data: ColumnData
+               ) -> tuple[list[float], tuple[str, ColumnInfo, str | None] | None,
+                          list[tuple[str, ColumnInfo, str | None]]]:  # fmt: skip
+        """The needed cells of one row as numbers: ``(values, first bad cell, empty cells)``.
+
+        The counter and the other time columns are NaN where they are not numbers; an empty or
+        missing cell of time, stroke or force is NaN and listed; any other bad cell stops the row.
+        """
+        vals: list[float] = []
+        empty: list[tuple[str, ColumnInfo, str | None]] = []
+        for role, col in needed:
+            cell = cells[col.index] if col.index < len(cells) else None
+            res = parse_number(cell, dec) if cell is not None else None
+            if res is not None and res.value is not None:
+                vals.append(res.value)
+                continue
+            if role == "counter" or role.startswith("clock"):
+                vals.append(math.nan)
+                if role == "counter" and cell is not None and data.counter_bad_line is None:
+                    data.counter_bad_line = ln
+                continue
+            if res is None or res.problem == "empty":
+                empty.append((role, col, cell))
+                vals.append(math.nan)
+                continue
+            return vals, (role, col, cell), empty
+        return vals, None, empty
+
+    def _end_records(self, blk: Block) -> None:
+        """After a block ended at an odd row: refuse it if samples follow, else note it as an end record."""
+        if self._pending is None:
+            return
+        ln, message, column = self._pending
+        self._pending = None
+        ahead = self.reader.take(_TAIL_PEEK)
+        self.reader.push_back(ahead)
+        needed = self._needed(blk)[:3] if blk.choice is not None else []
+        dec = blk.decimal or "."
+
+        def sample(line: str) -> bool:
+            cells = split_cells(line, blk.sep)
+            return bool(needed) and all(c.index < len(cells) and parse_number(cells[c.index], dec).value is not None
+                                        for _r, c in needed)
+
+        if len(ahead) >= _TAIL_PEEK or any(sample(x) for x in ahead[1:]):
+            raise ReadError(message, self.label, ln, column)
+        rest = [x for x in ahead if not is_blank(x, blk.sep)]
+        if _data_seps(rest[0]):  # a text line without delimiters is listed with the text after the data
+            self.warnings.append(f"line {ln}: {len(rest)} end or summary record(s) after the samples not read "
+                                 f"(no number in column {column!r}: {show(rest[0].strip())})")
 
     def _skip_rows(self, blk: Block) -> None:
         reader = self.reader

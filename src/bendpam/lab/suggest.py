@@ -11,6 +11,7 @@ to check are marked ``# CHECK``.
 
 from __future__ import annotations
 
+import ast
 import json
 import os
 import re
@@ -48,7 +49,7 @@ def _q(value: Any) -> str:
 
 
 def _render(path: Path, how: str, keys: list[tuple[str, Any, str]], columns: dict[str, tuple[Any, str, str]],
-            notes: list[str]) -> str:
+            notes: list[str], clocks: dict[str, Any] | None = None) -> str:
     out = [f"# bendpam format declaration for {path.name}", f"# {how}"]
     out += [f"# {n}" for n in notes]
     for key, value, comment in keys:
@@ -59,6 +60,8 @@ def _render(path: Path, how: str, keys: list[tuple[str, Any, str]], columns: dic
         column, unit, comment = columns[role]
         out += ["", f"[{role}]", f"column = {_q(column)}" + (f"  # {comment}" if comment else ""),
                 f"unit = {_q(unit)}"]
+        if clocks and role in clocks:
+            out.append(f"clock = {_q(clocks[role])}  # sampled on its own time column")
     return "\n".join(out) + "\n"
 
 
@@ -317,7 +320,18 @@ def _from_detection(path: Path, parsed: Any, raw: Any) -> str:
         comment = "" if col.unit else "no unit in the file: assumed"
         column: Any = col.source if col.source and names.count(col.source) == 1 else col.index + 1
         columns[role] = (column, unit, comment)
-    return _render(path, "filled in with what detection found", keys, columns, [])
+    clocks = {}
+    for role in ("stroke", "force"):  # a channel detection resampled from its own clock (bendpam.lab.rates)
+        src = raw.channels.get(role, {}).get("source")
+        m = next((re.match(r"column (.+?) is sampled on its own clock (.+?) \(every", w) for w in raw.warnings
+                  if w.startswith(f"column {src!r} is sampled on its own clock ")), None)
+        name = ast.literal_eval(m.group(2)) if m else None
+        if name is not None:
+            clocks[role] = name if names.count(name) == 1 else names.index(name) + 1
+    notes = ["CHECK: detection interpolated the empty cells of a channel sampled slower on the same clock; "
+             "a declaration refuses empty cells (except on a channel's own clock)"] if any(
+        "(sampled slower)" in w for w in raw.warnings) else []
+    return _render(path, "filled in with what detection found", keys, columns, notes, clocks)
 
 
 def suggest_declaration(path: str | os.PathLike) -> str:
