@@ -202,3 +202,25 @@ def test_demo_default_output(capsys, tmp_path, monkeypatch):
     fig = tmp_path / "bendpam-demo" / "moment-curvature.png"
     assert fig.read_bytes()[:4] == b"\x89PNG"
     assert "bendpam-demo/moment-curvature.png" in out
+
+
+@pytest.mark.parametrize(("signum", "code"), [(2, 130), (15, 143)])
+def test_a_signal_during_a_compiled_modules_import_is_an_interrupt(monkeypatch, capsys, signum, code):
+    """pybind11 turns an exception inside a module's initialisation into ImportError("initialization failed")
+    raised from it: a Ctrl-C (or SIGTERM) there is still an interrupt, one line and its exit status, not a bug."""
+    import importlib
+
+    from bendpam.infra.signals import Interrupted
+
+    cli_app = importlib.import_module("bendpam.cli.app")  # the module (bendpam.cli.app the name is the Typer app)
+
+    def run(args):
+        try:
+            raise Interrupted(code, signum)
+        except Interrupted as exc:
+            raise ImportError("initialization failed") from exc
+
+    monkeypatch.setattr(cli_app, "_run", run)
+    assert cli_app.main(["predict", "--preset", "be-pam", "--pressure-kpa", "100"]) == code
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "interrupted" in err[0] and "internal error" not in err[0]

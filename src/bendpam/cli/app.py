@@ -343,6 +343,33 @@ def _print_root_help() -> int:
     return 0
 
 
+def _interrupt_behind(exc: BaseException) -> BaseException | None:
+    """The interrupt (Ctrl-C, SIGTERM) an error was raised from, if any.
+
+    A signal that arrives while a compiled module initialises (pybind11's, say) reaches the caller as
+    ``ImportError("initialization failed")`` raised *from* the interrupt: it is the interrupt still.
+
+    >>> try:
+    ...     try:
+    ...         raise KeyboardInterrupt
+    ...     except KeyboardInterrupt as k:
+    ...         raise ImportError("initialization failed") from k
+    ... except ImportError as e:
+    ...     type(_interrupt_behind(e)).__name__, _interrupt_behind(ValueError("x"))
+    ('KeyboardInterrupt', None)
+    """
+    from bendpam.infra.signals import Interrupted
+
+    seen: set[int] = set()
+    e: BaseException | None = exc
+    while e is not None and id(e) not in seen:
+        if isinstance(e, (Interrupted, KeyboardInterrupt)):
+            return e
+        seen.add(id(e))
+        e = e.__cause__ or e.__context__
+    return None
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point: run the app; user errors are one line and exit code 2, bugs exit code 1.
 
@@ -401,6 +428,10 @@ def main(argv: list[str] | None = None) -> int:
     except BaseException as exc:
         if isinstance(exc, SystemExit):
             raise
+        cause = _interrupt_behind(exc)
+        if cause is not None:  # a signal inside an extension module's import comes back as its ImportError
+            typer.echo(interrupted_line(), err=True)
+            return cause.exit_code if isinstance(cause, Interrupted) else 130
         if debug:
             traceback.print_exc()
         typer.echo(f"bendpam: internal error ({type(exc).__name__}: {_one_line(exc)}); this is a bug in bendpam, "
