@@ -1,6 +1,7 @@
 """The calibration study of bendpam's error bars (issue 23): do the fit's standard errors hold?
 
-    python tools/calibration_study.py [--seeds 10] [--set main|holdout|holdout2] [--cases CASE ...] [--jobs 1] [--out FILE]
+    python tools/calibration_study.py [--seeds 10] [--set main|holdout|holdout2] [--cases CASE ...] [--jobs 1]
+                                      [--out FILE]
 
 For every case of :data:`raw_generators.CASES` (or of :data:`raw_generators.HOLDOUT` with ``--set holdout``:
 cases kept out of any tuning) and every seed, raw test files are made by the

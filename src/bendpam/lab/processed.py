@@ -275,7 +275,7 @@ class ProcessedSet:
     >>> round(p0), round(se, 1)
     (68, 0.1)
     >>> processed.to_frame().columns.tolist()
-    ['pressure_kpa', 'cycle', 'branch', 'curvature_per_mm', 'moment_nmm', 'replicate']
+    ['pressure_kpa', 'cycle', 'branch', 'curvature_per_mm', 'moment_nmm', 'replicate', 'time_s']
     """
 
     results: list[PressureResult]
