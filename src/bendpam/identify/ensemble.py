@@ -56,8 +56,8 @@ from bendpam.identify.data import FitData
 from bendpam.identify.result import PARAMETERS, EnsembleMember, UncertaintyBudget, parameter_field
 from bendpam.identify.uncertainty import Uncertainty, lag1_autocorrelation, material_gradients
 
-__all__ = ["MEMBER_EXTRA", "MemberFit", "akaike_weights", "effective_points", "model_average", "played_path",
-           "steady_z", "systematic_covariance", "uncertainty_budget"]
+__all__ = ["MEMBER_EXTRA", "MemberFit", "akaike_weights", "effective_points", "member_weights", "model_average",
+           "played_path", "steady_z", "systematic_covariance", "uncertainty_budget"]
 
 #: The parameters a member of the ensemble adds to the reported fit's: the standard linear solid's second pair
 #: of amplitudes (its Maxwell branch; the first pair weighs the dashpot), the play's gap (deg) and the breakaway
@@ -376,6 +376,22 @@ def model_average(values: np.ndarray, covs: np.ndarray, weights: np.ndarray):
     return v_bar, np.einsum("i,ijk->jk", w, c[ok]), systematic_covariance(v_bar, v[ok], w)
 
 
+def member_weights(fits: dict, r: np.ndarray, groups: np.ndarray) -> tuple[np.ndarray, float]:
+    """The members' Akaike weights (in the order of ``fits``) and the effective points they are counted on.
+
+    ``fits`` as :func:`uncertainty_budget` takes them; ``r``, ``groups``: the reported fit's weighted
+    residuals and their groups (:func:`effective_points`).
+
+    >>> w, m = member_weights({"pi": MemberFit({}, 1.0, n_params=6), "dahl": MemberFit({}, 1.0, n_params=6)},
+    ...                       np.ones(40), np.zeros(40, int))
+    >>> w.tolist(), m
+    ([0.5, 0.5], 40.0)
+    """
+    laws = list(fits)
+    m_eff = effective_points(r, groups)
+    return akaike_weights([fits[k][1] for k in laws], m_eff, _counts(fits, laws)), m_eff
+
+
 def _counts(fits: dict, laws: list[str]) -> list[int] | None:
     """The members' parameter counts (None when any is not known: equal counts)."""
     k = [int(getattr(fits[law], "n_params", 0)) for law in laws]
@@ -432,9 +448,8 @@ def uncertainty_budget(unc: Uncertainty, fitted, fits: dict, r: np.ndarray, grou
     members: list[EnsembleMember] = []
     weighting = ""
     if fits:
-        m_eff = effective_points(r, groups)
         laws = list(fits)
-        w = akaike_weights([fits[k][1] for k in laws], m_eff, _counts(fits, laws))
+        w, m_eff = member_weights(fits, r, groups)
         idx = [j for j, n in enumerate(names) if n in PARAMETERS]
         V = np.array([[fits[k][0].get(names[j], math.nan) for j in idx] for k in laws]).reshape(len(laws), len(idx))
         v_bar, c_stat, c_sys = model_average(V, _member_covariances(unc, fits, laws, idx), w)

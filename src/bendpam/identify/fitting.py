@@ -121,8 +121,7 @@ from bendpam.identify.diagnose import (
 from bendpam.identify.ensemble import (
     MEMBER_EXTRA,
     MemberFit,
-    akaike_weights,
-    effective_points,
+    member_weights,
     played_path,
     steady_z,
     uncertainty_budget,
@@ -596,8 +595,7 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool):
             run.nfev += n
     r = run.prob.residual_full(np.concatenate([[run.nl[p] for p in run.prob.nonlin], run.lin]))
     if fits:  # each member's own statistical covariance, where it has weight (the others add nothing)
-        w = akaike_weights([f.ssr for f in fits.values()], effective_points(r, run.prob.groups),
-                           [f.n_params for f in fits.values()])
+        w, _ = member_weights(fits, r, run.prob.groups)
         for (alt, f), wk in zip(list(fits.items()), w, strict=True):
             if alt in solved and wk > 1e-4:
                 p2, nl2, lin2 = solved[alt]
