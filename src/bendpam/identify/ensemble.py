@@ -3,8 +3,9 @@
 No loop law is known to be the actuator's.  With a loop model the fit is repeated with every law
 of :data:`bendpam.physics.hysteresis.ENSEMBLE` (Prandtl-Ishlinskii, Dahl, Bouc-Wen, Maxwell-slip,
 breakaway stiction, rate-dependent viscous loops, the standard linear solid, friction with a Maxwell
-branch and a fixture with a dead zone), each warm-started from the fit and with the quasi-static
-parameters free as in it.  The reported model parameters are their weighted average.
+branch, a fixture with a dead zone, and Dahl and Bouc-Wen loops that scale with the span), each
+warm-started from the fit and with the quasi-static parameters free as in it.  The reported model
+parameters are their weighted average.
 
 Weights (Akaike weights, AICc, on an effective number of points)
     ``AICc_i = m_eff ln(SSR_i) + 2 k_i + 2 k_i (k_i + 1) / (m_eff - k_i - 1)`` with ``k_i`` the parameters
@@ -28,6 +29,15 @@ Members with parameters of their own (:data:`MEMBER_EXTRA`)
     amplitudes.  ``"pi_maxwell"``: Prandtl-Ishlinskii friction and a Maxwell branch of its own angle.
     ``"pi_play"``: a play operator on the stroke (:func:`played_path`); the quasi-static model and the
     loop are evaluated at the played curvature.  ``"stiction"``: the breakaway law's friction ratio.
+
+Self-similar members (:data:`SPAN_SCALED`)
+    ``"dahl_span"`` and ``"bouc_wen_span"``: the Dahl and Bouc-Wen laws with a characteristic angle in
+    proportion to each test's bending span (:func:`span_scaled_z`), so that every test's loop has the
+    same shape at its own amplitude.  A rate-independent law otherwise has one angle for every test,
+    and its loops are rounder at the small spans of the low pressures; a loop that keeps its shape is
+    what a material with a constant loss factor gives, and what a machine cycling at a fixed period
+    gives a viscous loop (``"viscous_period"``).  With one span (a single test) they are the plain laws
+    and are left out.
 
 The rate-dependent laws
     A viscous loop (a Maxwell element, :class:`~bendpam.physics.hysteresis.ViscousLoop`) needs the
@@ -56,14 +66,20 @@ from bendpam.identify.data import FitData
 from bendpam.identify.result import PARAMETERS, EnsembleMember, UncertaintyBudget, parameter_field
 from bendpam.identify.uncertainty import Uncertainty, lag1_autocorrelation, material_gradients
 
-__all__ = ["MEMBER_EXTRA", "MemberFit", "akaike_weights", "effective_points", "member_weights", "model_average",
-           "played_path", "steady_z", "systematic_covariance", "uncertainty_budget"]
+__all__ = ["MEMBER_EXTRA", "SPAN_SCALED", "MemberFit", "akaike_weights", "effective_points", "member_weights",
+           "model_average", "played_path", "span_scaled_z", "spans_differ", "steady_z", "systematic_covariance",
+           "uncertainty_budget"]
 
 #: The parameters a member of the ensemble adds to the reported fit's: the standard linear solid's second pair
 #: of amplitudes (its Maxwell branch; the first pair weighs the dashpot), the play's gap (deg) and the breakaway
 #: law's static-to-kinetic friction ratio.
 MEMBER_EXTRA: dict[str, tuple[str, ...]] = {"zener": ("a0_2", "a1_2"), "pi_play": ("gap",), "stiction": ("ratio",),
                                              "pi_maxwell": ("theta_2", "a0_2", "a1_2")}
+
+
+#: The self-similar members: a rate-independent law whose characteristic angle is a fixed fraction of each test's
+#: span (:func:`span_scaled_z`), by the name of the law it scales.
+SPAN_SCALED: dict[str, str] = {"dahl_span": "dahl", "bouc_wen_span": "bouc_wen"}
 
 
 class MemberFit(NamedTuple):
@@ -116,6 +132,8 @@ def steady_z(law: str, theta_deg: float, d: FitData, ratio: float | None = None)
         # Maxwell element relaxes over theta_c (the same for every test: the same speed)
         z_away, z_back = make_law("dahl", theta_deg).steady_branches(d.delta, d.span)
         return d.rate * np.where(d.branch < 0, z_away, z_back)
+    if law in SPAN_SCALED:
+        return span_scaled_z(SPAN_SCALED[law], theta_deg, d)
     if law in ("viscous", "viscous_period"):
         period = _periods(d)
         rate = 2.0 * d.span / period
@@ -124,6 +142,46 @@ def steady_z(law: str, theta_deg: float, d: FitData, ratio: float | None = None)
     else:
         z_away, z_back = make_law(law, theta_deg).steady_branches(d.delta, d.span)
     return np.where(d.branch < 0, z_away, z_back)
+
+
+def span_scaled_z(law: str, theta_deg: float, d: FitData) -> np.ndarray:
+    """``z`` of every point of ``d`` on the steady cycle of ``law`` with its angle in proportion to each test's span.
+
+    ``theta_c = theta_deg x span / max(span)``: ``theta_deg`` is the characteristic angle of the widest test, and
+    each test's loop is the widest one's shape scaled to its own span (the loop of a material whose hysteresis
+    follows the amplitude, as a constant loss factor does, rather than a fixed angle).  The laws' steady cycles
+    depend on ``delta / theta_c`` and ``span / theta_c`` alone, so they are evaluated at those ratios.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from types import SimpleNamespace as NS
+    >>> d = NS(branch=np.array([1, 1]), delta=np.array([0.1, 0.05]), span=np.array([0.2, 0.1]))
+    >>> z = span_scaled_z("dahl", 5.0, d)     # the narrower test, at half the angle, is at the same place
+    >>> bool(np.isclose(z[0], z[1])), bool(np.isclose(z[0], steady_z("dahl", 5.0, NS(**{**vars(d), "delta": d.delta[:1],
+    ...     "span": d.span[:1], "branch": d.branch[:1]}))[0]))
+    (True, True)
+    """
+    from bendpam.physics.hysteresis import make_law
+
+    assert d.branch is not None and d.delta is not None and d.span is not None, "a loop fit is built on branch data"
+    span = np.asarray(d.span, dtype=float)
+    theta = math.radians(theta_deg) * span / float(np.max(span))
+    z_away, z_back = make_law(law, math.degrees(1.0)).steady_branches(np.asarray(d.delta, dtype=float) / theta,
+                                                                      span / theta)
+    return np.where(d.branch < 0, z_away, z_back)
+
+
+def spans_differ(d: FitData) -> bool:
+    """Do the tests of ``d`` span different bending angles (by more than 1 %)?  Else the self-similar members
+    (:data:`SPAN_SCALED`) are the plain laws.
+
+    >>> from types import SimpleNamespace as NS
+    >>> spans_differ(NS(span=np.array([0.2, 0.2]))), spans_differ(NS(span=np.array([0.2, 0.1])))
+    (False, True)
+    """
+    span = np.asarray(getattr(d, "span", None) if getattr(d, "span", None) is not None else [], dtype=float)
+    return bool(span.size and np.ptp(span) > 0.01 * float(np.max(np.abs(span))))
 
 
 def _zener(theta_deg: float, d: FitData, with_maxwell: bool = True) -> np.ndarray:

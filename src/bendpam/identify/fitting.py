@@ -120,9 +120,11 @@ from bendpam.identify.diagnose import (
 )
 from bendpam.identify.ensemble import (
     MEMBER_EXTRA,
+    SPAN_SCALED,
     MemberFit,
     member_weights,
     played_path,
+    spans_differ,
     steady_z,
     uncertainty_budget,
 )
@@ -587,7 +589,7 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool):
         fits[run.law] = MemberFit(dict(unc.values), _ssr(run.prob, run.nl, run.lin), tuple(unc.names),
                                   unc.cov_stat.copy(), len(run.prob.free))
         solved = {}
-        for alt in (a for a in ENSEMBLE if a != run.law):
+        for alt in (a for a in ENSEMBLE if a != run.law and (a not in SPAN_SCALED or spans_differ(run.prob.d))):
             try:
                 fits[alt], n, solved[alt] = _law_refit(run.prob, run.bnd, run.nl, alt)
             except FitError:  # this law cannot describe the curves at all: it has no weight

@@ -85,9 +85,10 @@ __all__ = [
 ]
 
 LAWS = ("pi", "dahl")
-#: The loop laws whose fits make the identification's systematic (model-form) uncertainty.
+#: The loop laws whose fits make the identification's systematic (model-form) uncertainty (the members beyond
+#: :func:`make_law`'s laws are :mod:`bendpam.identify.ensemble`'s).
 ENSEMBLE = ("pi", "dahl", "bouc_wen", "maxwell_slip", "stiction", "viscous", "viscous_period", "zener", "pi_play",
-            "pi_maxwell")
+            "pi_maxwell", "dahl_span", "bouc_wen_span")
 
 
 def _segments(theta: np.ndarray):

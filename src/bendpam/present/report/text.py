@@ -46,7 +46,9 @@ LAW_LABEL = {"pi": "Prandtl-Ishlinskii", "dahl": "Dahl", "bouc_wen": "Bouc-Wen",
              "viscous_period": "viscous (constant cycle period)",
              "zener": "standard linear solid (a dashpot and a Maxwell branch)",
              "pi_play": "Prandtl-Ishlinskii after a fixture play (backlash)",
-             "pi_maxwell": "Prandtl-Ishlinskii and a Maxwell branch"}
+             "pi_maxwell": "Prandtl-Ishlinskii and a Maxwell branch",
+             "dahl_span": "Dahl (angle in proportion to the span)",
+             "bouc_wen_span": "Bouc-Wen (angle in proportion to the span)"}
 
 
 def escape(x) -> str:
