@@ -248,3 +248,54 @@ def test_corrected_alpha0_lands_within_two_se_of_the_truth():
     assert sum(r.drift.flagged for r in processed.results) >= 2  # the shortest test (100 kPa, 85 s) is marginal
     assert all(r.drift.corrected for r in processed.results)
     assert abs(alpha0.value - BE.alpha0_deg) <= 2 * alpha0.stderr
+
+
+def test_a_drift_too_small_for_any_test_alone_is_found_in_the_set():
+    """Four tests drifting by 0.15 % of the blocked force each: no test is flagged alone, the set's pooled slope is,
+    and the set says so once (summary, a warning); four tests without a drift say nothing."""
+    from pathlib import Path
+
+    from bendpam.errors import PlausibilityWarning
+    from bendpam.lab.drift import SET_FLAG_SIGMAS, set_drift
+
+    def raws(fraction):
+        out = []
+        for seed in range(4):
+            clean, drifted, _, _ = drifting(seed=40 + seed, fraction=fraction)
+            out.append(RawTest(drifted if fraction else clean, Path(f"be_{seed}.csv"), "csv", pressure_kpa=P_KPA))
+        return out
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        drifts = process_tests(raws(0.0015), keep_series=False)
+    ests = [r.drift for r in drifts.results]
+    assert not any(e.flagged for e in ests)
+    rate, z = set_drift(ests)
+    assert z >= SET_FLAG_SIGMAS and rate > 0
+    found = [f for f in drifts.summary()["warnings"] if f["check"] == "set drift"]
+    assert len(found) == 1 and "4 tests' slopes pooled" in found[0]["message"]
+    assert sum("drifts in the set as a whole" in str(w.message) for w in caught
+               if issubclass(w.category, PlausibilityWarning)) == 1
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        quiet = process_tests(raws(0.0), keep_series=False)
+    assert set_drift([r.drift for r in quiet.results])[1] < SET_FLAG_SIGMAS
+    assert not [f for f in quiet.summary()["warnings"] if f["check"] == "set drift"]
+
+
+def test_an_uncorrected_drift_the_set_shares_is_counted_in_the_fits_error_bars():
+    from types import SimpleNamespace as NS
+
+    from bendpam.identify.data import drift_offsets
+
+    one = DriftEstimate(2e-4, 1e-4, 200.0, 0.0, 0.05, 10.0, 12, blocked_moment_shift_nmm=-2.0)  # 2 SE: not flagged
+    d = NS(seg=np.array([0, 1, 2]))
+    assert not one.flagged
+    assert drift_offsets(NS(results=[NS(drift=one)]), d) == []  # alone: no evidence of a drift
+    many = drift_offsets(NS(results=[NS(drift=one)] * 3), d)  # three alike: 3.5 SE pooled
+    assert [sd for _, sd in many] == pytest.approx([math.hypot(2.0, 1.0)] * 3)
+    # corrected: the rate's own error and half the disagreement of the free and blocked ends' slopes
+    fixed = DriftEstimate(2e-4, 1e-5, 200.0, 0.0, 0.05, 10.0, 12, free_rate_n_per_s=1e-4, blocked_rate_n_per_s=3e-4,
+                          blocked_moment_nmm=300.0, corrected=True)
+    (_, sd), = drift_offsets(NS(results=[NS(drift=fixed)]), NS(seg=np.array([0])))
+    assert sd == pytest.approx(math.hypot(1e-5, 1e-4) * 100.0 * 30.0)

@@ -17,6 +17,7 @@ from functools import cached_property
 import numpy as np
 
 from bendpam.errors import InputError
+from bendpam.lab.drift import set_drifts
 from bendpam.physics.actuator import Actuator
 from bendpam.physics.braid import radius_terms
 
@@ -314,26 +315,44 @@ def drift_offsets(processed, d: FitData) -> list[tuple[np.ndarray, float]]:
     A test whose drift was corrected keeps the error of the estimated rate: an offset growing
     from the test's start, ``rate_se (t - t0)``, common to its cycles on average (``rate_se x
     duration / 2``; resampling the cycles sees only its growth), converted to moment by the
-    blocked state's lever ``M_b / F_b``.  A flagged drift left uncorrected is an offset of the size
-    correcting it would have moved the blocked moment.  Tests without a drift estimate add nothing.
+    blocked state's lever ``M_b / F_b``.  A drift left uncorrected, when it is flagged or the set drifts as a
+    whole (:func:`bendpam.lab.drift.set_drifts`), is an offset of the root mean square size of what correcting
+    it would move the blocked moment by: that shift ``s`` is known to its standard error ``s / z`` (``z`` the
+    drift's size in standard errors), so ``sqrt(s^2 + (s / z)^2)``.  Other tests add nothing.
 
     >>> from types import SimpleNamespace as NS
-    >>> drift = NS(corrected=True, flagged=True, rate_se_n_per_s=1e-4, duration_s=200.0, blocked_moment_nmm=300.0,
-    ...            blocked_force_n=10.0, blocked_moment_shift_nmm=-3.0)
+    >>> drift = NS(corrected=True, flagged=True, rate_n_per_s=1e-3, rate_se_n_per_s=1e-4, duration_s=200.0,
+    ...            blocked_moment_nmm=300.0, blocked_force_n=10.0, blocked_moment_shift_nmm=-3.0,
+    ...            free_rate_n_per_s=1e-3, blocked_rate_n_per_s=1e-3)   # both ends alike
     >>> d = NS(seg=np.array([0, 0, 0]))
     >>> [(rows.tolist(), round(sd, 6)) for rows, sd in drift_offsets(NS(results=[NS(drift=drift)]), d)]  # N*mm
     [([0, 1, 2], 0.3)]
+
+    Two tests that drift by 2 standard errors each, left uncorrected: not flagged alone, but the set drifts
+    (2.8 standard errors pooled), so each adds ``sqrt(s^2 + (s / 2)^2)``:
+
+    >>> from bendpam.lab.drift import DriftEstimate
+    >>> e = DriftEstimate(2e-4, 1e-4, 200.0, 0.0, 0.05, 10.0, 12, blocked_moment_shift_nmm=-2.0)
+    >>> d = NS(seg=np.array([0, 0, 1, 1]))
+    >>> [(rows.tolist(), round(sd, 3)) for rows, sd in drift_offsets(NS(results=[NS(drift=e), NS(drift=e)]), d)]
+    [([0, 1], 2.236), ([2, 3], 2.236)]
     """
     out: list[tuple[np.ndarray, float]] = []
+    drifts = set_drifts([getattr(r, "drift", None) for r in processed.results])
     for i, r in enumerate(processed.results):
         e = getattr(r, "drift", None)
         if e is None:
             continue
         if e.corrected:
             lever = e.blocked_moment_nmm / e.blocked_force_n if e.blocked_force_n else math.nan
-            sd = abs(e.rate_se_n_per_s * e.duration_s / 2.0 * lever)
+            ends = abs(e.free_rate_n_per_s - e.blocked_rate_n_per_s) / 2.0
+            rate_sd = math.hypot(e.rate_se_n_per_s, ends) if math.isfinite(ends) else e.rate_se_n_per_s
+            sd = abs(rate_sd * e.duration_s / 2.0 * lever)
+        elif e.flagged or drifts:  # its own estimate of the shift, known to its standard error shift / sigmas
+            shift, sig = abs(e.blocked_moment_shift_nmm), e.sigmas
+            sd = math.hypot(shift, shift / sig) if math.isfinite(sig) and sig > 0 else shift
         else:
-            sd = abs(e.blocked_moment_shift_nmm) if e.flagged else 0.0
+            sd = 0.0
         if math.isfinite(sd) and sd > 0:
             out.append((np.flatnonzero(d.seg == i), float(sd)))
     return out

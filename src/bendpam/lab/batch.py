@@ -15,7 +15,7 @@ from pathlib import Path
 
 from bendpam.errors import BendpamError, ProcessingError
 from bendpam.lab.processed import ProcessedSet, ProcessingOptions
-from bendpam.lab.processing import NotABendingTest, number_replicates, process_one
+from bendpam.lab.processing import NotABendingTest, number_replicates, process_one, warn_set
 from bendpam.physics.fixture import PAPER_FIXTURE, Fixture
 
 __all__ = ["FilesRefused", "file_line", "process_files"]
@@ -143,5 +143,6 @@ def process_files(paths, *, pressures_kpa: Sequence[float | None] | None = None,
     if not results:
         raise ProcessingError(f"none of the {len(files)} file(s) could be processed"
                               + (": " + "; ".join(str(e["reason"]) for e in bad) if bad else ""))
+    warn_set(results)
     return ProcessedSet(results=number_replicates(results), fixture=fixture, options=options or ProcessingOptions(),
                         files=entries)

@@ -25,6 +25,12 @@ standard errors) and large enough to bias a fit: over the test it reaches ``0.1 
 force (:data:`FLAG_FRACTION`).  On independent test data a drift of 1 % of the blocked force over
 a test moved a fitted ``alpha0`` by about 20 of its standard errors, so 0.1 % is about 2.
 
+A load cell that drifts does so in every test of a set, so the tests' slopes are also pooled
+(:func:`set_drift`, the inverse-variance mean in N/s): a set whose pooled slope reaches
+:data:`SET_FLAG_SIGMAS` of its standard error drifts, even when no single test is long or
+quiet enough to show it (:func:`set_drift_findings`).  Then every test's drift is real to the fit:
+left uncorrected, each adds its doubt (:func:`bendpam.identify.data.drift_offsets`).
+
 The offset is taken as zero at the first sample (the machine is zeroed before the test);
 :meth:`DriftEstimate.offset_n` is the fitted offset ``a (t - t_0)`` that a correction subtracts.
 """
@@ -36,8 +42,8 @@ from dataclasses import asdict, dataclass, fields
 
 import numpy as np
 
-__all__ = ["DRIFT_METHODS", "FLAG_FRACTION", "FLAG_SIGMAS", "DriftEstimate", "check_drift", "drift_findings",
-           "estimate_drift", "moment_shift_nmm"]
+__all__ = ["DRIFT_METHODS", "FLAG_FRACTION", "FLAG_SIGMAS", "SET_FLAG_SIGMAS", "DriftEstimate", "check_drift",
+           "drift_findings", "estimate_drift", "moment_shift_nmm", "set_drift", "set_drift_findings", "set_drifts"]
 
 #: The drift corrections processing knows: ``"none"`` (estimate and report only) and ``"linear"``.
 DRIFT_METHODS = ("none", "linear")
@@ -45,6 +51,10 @@ DRIFT_METHODS = ("none", "linear")
 FLAG_FRACTION = 0.001
 #: ... and this many of its standard errors.
 FLAG_SIGMAS = 3.0
+#: A set drifts when its tests' pooled slope reaches this many standard errors.  On the calibration study's tests
+#: without a drift (six cases, eight seeds) the pooled slope stayed within 2.2 standard errors; with a drift of
+#: 0.8 % of the blocked force over each test that no single test showed, it reached 2.5-3.9 in seven of eight sets.
+SET_FLAG_SIGMAS = 2.5
 #: Use the first cycle's unloading when there are three cycles or more?  No: it starts from the state
 #: before any cycling (a transient of the loop).
 FIRST_UNLOADING = False
@@ -360,3 +370,62 @@ def drift_findings(result) -> list[dict]:
     return [{"test": result.source, "pressure_kpa": float(result.pressure_kpa), "check": "drift",
              "value": float(est.drift_n), "bound": float(est.threshold_n), "unit": "N",
              "message": f"{result.source} ({result.pressure_kpa:g} kPa): {est.message()} ({what})"}]
+
+
+def set_drift(estimates) -> tuple[float, float]:
+    """The tests' drift slopes pooled: their inverse-variance mean (N/s) and its size in standard errors.
+
+    ``estimates``: the tests' :class:`DriftEstimate` (None for a test without one; NaN, NaN when none has a
+    standard error).
+
+    >>> e = [DriftEstimate(1e-4, 5e-5, 300.0, 0.0, 0.05, 10.0, 12),
+    ...      DriftEstimate(2e-4, 1e-4, 300.0, 0.0, 0.05, 10.0, 12)]
+    >>> rate, z = set_drift(e)          # each test 2 SE alone; together 2.68 SE
+    >>> round(rate * 1e4, 3), round(z, 2)
+    (1.2, 2.68)
+    """
+    rates = [(e.rate_n_per_s, e.rate_se_n_per_s) for e in estimates if e is not None]
+    ok = [(a, se) for a, se in rates if math.isfinite(a) and math.isfinite(se) and se > 0]
+    if not ok:
+        return math.nan, math.nan
+    a, se = np.array(ok).T
+    w = 1.0 / se**2
+    rate = float(np.sum(w * a) / np.sum(w))
+    return rate, abs(rate) * math.sqrt(float(np.sum(w)))
+
+
+def set_drifts(estimates) -> bool:
+    """Does the set drift (:func:`set_drift` at :data:`SET_FLAG_SIGMAS` or more, with two tests or more)?
+
+    >>> e = DriftEstimate(2e-4, 1e-4, 300.0, 0.0, 0.05, 10.0, 12)        # 2 SE: not flagged alone
+    >>> set_drifts([e]), set_drifts([e, e]), set_drifts([e, None])      # two alike: 2.8 SE pooled
+    (False, True, False)
+    """
+    n = sum(e is not None for e in estimates)
+    z = set_drift(estimates)[1]
+    return bool(n >= 2 and math.isfinite(z) and z >= SET_FLAG_SIGMAS)
+
+
+def set_drift_findings(results) -> list[dict]:
+    """A finding for the set when its tests drift together (:func:`set_drifts`) and some tests are not flagged
+    on their own (those have their findings already).
+
+    >>> from types import SimpleNamespace as NS
+    >>> e = [DriftEstimate(1e-4, 5e-5, 300.0, 0.0, 0.05, 10.0, 12),
+    ...      DriftEstimate(2e-4, 1e-4, 300.0, 0.0, 0.05, 10.0, 12)]
+    >>> [f["check"] for f in set_drift_findings([NS(drift=x, source="a.csv") for x in e])]
+    ['set drift']
+    """
+    ests = [getattr(r, "drift", None) for r in results]
+    if not set_drifts(ests) or all(e is None or e.flagged for e in ests):
+        return []
+    rate, z = set_drift(ests)
+    n, alone = sum(e is not None for e in ests), sum(e is not None and not e.flagged for e in ests)
+    fixed = all(e is None or e.corrected for e in ests)
+    what = ("corrected (--drift linear)" if fixed else
+            "not corrected: each test's drift is counted in the fit's error bars; --drift linear corrects it")
+    return [{"test": "(the set)", "pressure_kpa": math.nan, "check": "set drift", "value": rate, "bound": z,
+             "unit": "N/s",
+             "message": (f"the load-cell offset drifts in the set as a whole: the {n} tests' slopes pooled are "
+                         f"{rate:+.3g} N/s, {z:.1f} standard errors (a set drifts from {SET_FLAG_SIGMAS:g}), though "
+                         f"{alone} of them are not flagged alone; {what}")}]

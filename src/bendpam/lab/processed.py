@@ -332,8 +332,11 @@ class ProcessedSet:
 
     @property
     def findings(self) -> list[dict]:
-        """Every plausibility finding: of the processed tests, then of the files that were skipped."""
-        out = [f for r in self.results for f in r.findings]
+        """Every plausibility finding: of the processed tests, of the set (a drift the tests share,
+        :func:`bendpam.lab.drift.set_drift_findings`), then of the files that were skipped."""
+        from bendpam.lab.drift import set_drift_findings
+
+        out = [f for r in self.results for f in r.findings] + set_drift_findings(self.results)
         return out + [f for info in self.files for f in info.get("findings", [])]
 
     def replicates(self) -> list[dict]:

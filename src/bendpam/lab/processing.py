@@ -49,7 +49,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from bendpam.errors import InputError, PlausibilityWarning, ProcessingError
-from bendpam.lab.drift import check_drift, drift_findings, moment_shift_nmm
+from bendpam.lab.drift import check_drift, drift_findings, moment_shift_nmm, set_drift_findings
 from bendpam.lab.plausibility import check_result, compression_like
 from bendpam.lab.processed import (
     PressureResult,
@@ -80,6 +80,7 @@ __all__ = [
     "process_series",
     "process_tests",
     "raw_test_name",
+    "warn_set",
     "write_processed",
 ]
 
@@ -661,4 +662,23 @@ def process_tests(tests, *, fixture: Fixture = PAPER_FIXTURE, options: Processin
     results = [process_one(rt, fixture=fixture, options=options, keep_series=keep_series) for rt in tests]
     if not results:
         raise ProcessingError("no tests to process")
+    warn_set(results)
     return ProcessedSet(results=number_replicates(results), fixture=fixture, options=options or ProcessingOptions())
+
+
+def warn_set(results) -> None:
+    """Warn (PlausibilityWarning) the findings of the set as a whole: a drift its tests share
+    (:func:`bendpam.lab.drift.set_drift_findings`).
+
+    >>> import warnings
+    >>> from types import SimpleNamespace as NS
+    >>> from bendpam.lab.drift import DriftEstimate
+    >>> e = DriftEstimate(2e-4, 1e-4, 300.0, 0.0, 0.05, 10.0, 12)
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     warn_set([NS(drift=e, source="a.csv"), NS(drift=e, source="b.csv")])
+    >>> [str(w.message)[:50] for w in caught]
+    ['the load-cell offset drifts in the set as a whole:']
+    """
+    for f in set_drift_findings(results):
+        warnings.warn(f["message"], PlausibilityWarning, stacklevel=3)
