@@ -274,6 +274,7 @@ def test_a_drift_too_small_for_any_test_alone_is_found_in_the_set():
     assert z >= SET_FLAG_SIGMAS and rate > 0
     found = [f for f in drifts.summary()["warnings"] if f["check"] == "set drift"]
     assert len(found) == 1 and "4 tests' slopes pooled" in found[0]["message"]
+    assert [w.kind for w in plausibility_warnings(drifts)] == ["drift"]  # the report: a load-cell fault
     assert sum("drifts in the set as a whole" in str(w.message) for w in caught
                if issubclass(w.category, PlausibilityWarning)) == 1
     with warnings.catch_warnings():

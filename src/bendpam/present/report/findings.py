@@ -215,7 +215,7 @@ def plausibility_warnings(processed) -> list[ReportWarning]:
     """
     out = []
     for f in getattr(processed, "findings", []):
-        if f.get("check") == "drift":  # bendpam.lab.drift: an instrument fault, not an implausible actuator
+        if f.get("check") in ("drift", "set drift"):  # bendpam.lab.drift: an instrument fault, not the actuator
             out.append(ReportWarning(
                 "drift", f"Load-cell drift: {f['message']}",
                 "The force reading drifts across the cycles by more than the fit can tolerate; the blocked moment "
