@@ -491,3 +491,30 @@ def test_a_loop_that_keeps_its_shape_across_spans_is_fitted_by_a_span_scaled_mem
     se = r.parameters["alpha0"].stderr
     assert abs(r.actuator.alpha0_deg - truth["alpha0_deg"]) < 2.0 * se
     assert abs(members["viscous_period"].values["alpha0_deg"] - truth["alpha0_deg"]) > 3.0 * se
+
+
+def test_friction_with_a_dashpot_is_fitted_by_the_pi_dashpot_member():
+    """Raw tests from the independent generators with rounded Coulomb friction and a dashpot: the member with
+    friction and a dashpot carries the weight and lands within 2 SE, and its rows are friction's and the rate's."""
+    import sys
+    import tempfile
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tools"))
+    import raw_generators as gen
+
+    from bendpam.identify.fitting import fit
+    from bendpam.lab import read_test
+    from bendpam.lab.processing import process_tests
+    from bendpam.physics.fixture import Fixture
+
+    case = gen.HOLDOUT3["friction-viscous"]
+    with tempfile.TemporaryDirectory() as folder:
+        truth = gen.generate_set(case, 1, folder)
+        raws = [read_test(Path(folder) / name) for name in truth["files"]]
+    ps = process_tests(raws, fixture=Fixture(L0_mm=truth["fixture_L0_mm"]), keep_series=False)
+    r = fit(ps, gen.start_actuator(case), profile_points=0)
+    members = {m.law: m for m in r.uncertainty.ensemble}
+    assert members["pi_dashpot"].weight > 0.5
+    assert members["pi_dashpot"].nrmse < min(m.nrmse for k, m in members.items() if k != "pi_dashpot")
+    assert abs(r.actuator.alpha0_deg - truth["alpha0_deg"]) < 2.0 * r.parameters["alpha0"].stderr

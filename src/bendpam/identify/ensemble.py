@@ -3,7 +3,7 @@
 No loop law is known to be the actuator's.  With a loop model the fit is repeated with every law
 of :data:`bendpam.physics.hysteresis.ENSEMBLE` (Prandtl-Ishlinskii, Dahl, Bouc-Wen, Maxwell-slip,
 breakaway stiction, rate-dependent viscous loops, the standard linear solid, friction with a Maxwell
-branch, a fixture with a dead zone, and Dahl and Bouc-Wen loops that scale with the span), each
+branch or a dashpot, a fixture with a dead zone, and Dahl and Bouc-Wen loops that scale with the span), each
 warm-started from the fit and with the quasi-static parameters free as in it.  The reported model
 parameters are their weighted average.
 
@@ -27,6 +27,8 @@ Members with parameters of their own (:data:`MEMBER_EXTRA`)
     ``"zener"``, the standard linear solid's loop (:class:`~bendpam.physics.hysteresis.ZenerLoop`): a
     dashpot (the bending rate) and a Maxwell branch (the ``"viscous"`` member's ``z``), each with its own
     amplitudes.  ``"pi_maxwell"``: Prandtl-Ishlinskii friction and a Maxwell branch of its own angle.
+    ``"pi_dashpot"``: Prandtl-Ishlinskii friction and a dashpot (the textbook Coulomb-plus-viscous damping;
+    the dashpot is the standard linear solid's, the bending rate).
     ``"pi_play"``: a play operator on the stroke (:func:`played_path`); the quasi-static model and the
     loop are evaluated at the played curvature.  ``"stiction"``: the breakaway law's friction ratio.
 
@@ -71,10 +73,11 @@ __all__ = ["MEMBER_EXTRA", "SPAN_SCALED", "MemberFit", "akaike_weights", "effect
            "uncertainty_budget"]
 
 #: The parameters a member of the ensemble adds to the reported fit's: the standard linear solid's second pair
-#: of amplitudes (its Maxwell branch; the first pair weighs the dashpot), the play's gap (deg) and the breakaway
-#: law's static-to-kinetic friction ratio.
+#: of amplitudes (its Maxwell branch; the first pair weighs the dashpot), the play's gap (deg), the breakaway
+#: law's static-to-kinetic friction ratio, and the second branch of friction with a Maxwell branch or a dashpot.
 MEMBER_EXTRA: dict[str, tuple[str, ...]] = {"zener": ("a0_2", "a1_2"), "pi_play": ("gap",), "stiction": ("ratio",),
-                                             "pi_maxwell": ("theta_2", "a0_2", "a1_2")}
+                                             "pi_maxwell": ("theta_2", "a0_2", "a1_2"),
+                                             "pi_dashpot": ("a0_2", "a1_2")}
 
 
 #: The self-similar members: a rate-independent law whose characteristic angle is a fixed fraction of each test's

@@ -47,6 +47,7 @@ LAW_LABEL = {"pi": "Prandtl-Ishlinskii", "dahl": "Dahl", "bouc_wen": "Bouc-Wen",
              "zener": "standard linear solid (a dashpot and a Maxwell branch)",
              "pi_play": "Prandtl-Ishlinskii after a fixture play (backlash)",
              "pi_maxwell": "Prandtl-Ishlinskii and a Maxwell branch",
+             "pi_dashpot": "Prandtl-Ishlinskii and a dashpot (Coulomb and viscous damping)",
              "dahl_span": "Dahl (angle in proportion to the span)",
              "bouc_wen_span": "Bouc-Wen (angle in proportion to the span)"}
 
