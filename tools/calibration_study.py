@@ -1,6 +1,6 @@
 """The calibration study of bendpam's error bars (issue 23): do the fit's standard errors hold?
 
-    python tools/calibration_study.py [--seeds 10] [--set main|holdout|holdout2|holdout3] [--cases CASE ...] [--jobs 1]
+    python tools/calibration_study.py [--seeds 10] [--set main|holdout|...|holdout4] [--cases CASE ...] [--jobs 1]
                                       [--out FILE]
 
 For every case of :data:`raw_generators.CASES` (or of :data:`raw_generators.HOLDOUT` with ``--set holdout``:
@@ -51,8 +51,9 @@ from bendpam.version import __version__  # noqa: E402
 START, END = "<!-- calibration-table:start -->", "<!-- calibration-table:end -->"
 #: The case sets: ``main`` (:data:`raw_generators.CASES`, what the error bars are tuned and judged on) and
 #: ``holdout`` (:data:`raw_generators.HOLDOUT`, other parameters and combined faults, kept out of any tuning).
-SETS = {"main": gen.CASES, "holdout": gen.HOLDOUT, "holdout2": gen.HOLDOUT2, "holdout3": gen.HOLDOUT3}
-ALL_CASES = {**gen.CASES, **gen.HOLDOUT, **gen.HOLDOUT2, **gen.HOLDOUT3}
+SETS = {"main": gen.CASES, "holdout": gen.HOLDOUT, "holdout2": gen.HOLDOUT2, "holdout3": gen.HOLDOUT3,
+        "holdout4": gen.HOLDOUT4}
+ALL_CASES = {**gen.CASES, **gen.HOLDOUT, **gen.HOLDOUT2, **gen.HOLDOUT3, **gen.HOLDOUT4}
 
 
 def markers(case_set: str) -> tuple[str, str]:
@@ -377,11 +378,11 @@ def main(argv=None) -> int:
     ap.add_argument("--first-seed", type=int, default=0)
     ap.add_argument("--set", dest="case_set", choices=list(SETS), default="main",
                     help="main (default): the cases the error bars are judged on; holdout: other parameters and "
-                    "combined faults, kept out of any tuning; holdout2, holdout3: further such sets, each scored once")
+                    "combined faults, kept out of any tuning; holdout2-4: further such sets, each scored once")
     ap.add_argument("--cases", nargs="+", choices=list(ALL_CASES), metavar="CASE",
                     help=f"cases to run (default: the whole set; main: {', '.join(gen.CASES)}; holdout: "
                     f"{', '.join(gen.HOLDOUT)}; holdout2: {', '.join(gen.HOLDOUT2)}; "
-                    f"holdout3: {', '.join(gen.HOLDOUT3)})")
+                    f"holdout3: {', '.join(gen.HOLDOUT3)}; holdout4: {', '.join(gen.HOLDOUT4)})")
     ap.add_argument("--jobs", type=int, default=1, help="processes (default 1; the machine may be shared)")
     ap.add_argument("--fit", dest="fit_options", action="append", default=[], metavar="KEY=VALUE",
                     help="a keyword of bendpam.identify.fitting.fit, as a Python literal (law_uncertainty=False, "

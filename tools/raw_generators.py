@@ -53,11 +53,22 @@ Loop laws (all written here from their textbook forms):
 ``friction-viscous``
     A rounded Coulomb friction (``tanh`` of the rate over a small velocity) in parallel with a linear
     dashpot: part of the loop grows with the rate, part does not.
+``lugre``
+    The LuGre friction model (bristles with a Stribeck curve, ``dz/dt = v - sigma0 |v| z / g(v)``,
+    ``F = sigma0 z + sigma1 dz/dt + sigma2 v``), integrated in time: rate-dependent friction.
+``two-maxwell``
+    Two Maxwell branches of different relaxation times (2 s and 40 s by default): a generalised
+    Maxwell (Prony series) solid's loop.
+``preisach``
+    A discrete Preisach model: relays of random switching thresholds on the bending angle,
+    symmetric in the mean; rate-independent, with loops that are not Prandtl-Ishlinskii's.
 ``none``
     No loop (noise and drift only).
 
 Drift shapes: linear (``drift_tau_s = 0``), or a thermal one, ``D (1 - exp(-t / tau)) / (1 - exp(-T / tau))``
 that settles over ``drift_tau_s`` (a load cell warming up): a linear correction leaves part of it.
+Other faults: a step of the offset halfway through a test (``drift_step_fraction``, a knocked cable) and a
+force quantised to ``force_resolution_n`` (a coarse load-cell range).
 """
 
 from __future__ import annotations
@@ -73,10 +84,11 @@ import bendpam
 from bendpam import presets
 from bendpam.infra.atomic import atomic_write_text
 
-__all__ = ["CASES", "HOLDOUT", "HOLDOUT2", "HOLDOUT3", "LOOPS",
+__all__ = ["CASES", "HOLDOUT", "HOLDOUT2", "HOLDOUT3", "HOLDOUT4", "LOOPS",
            "Case", "Truth", "case_truth", "generate_set", "machine_test", "start_actuator"]
 
-LOOPS = ("none", "maxwell-creep", "stiction", "viscous", "backlash", "bouc-wen", "masing", "friction-viscous")
+LOOPS = ("none", "maxwell-creep", "stiction", "viscous", "backlash", "bouc-wen", "masing", "friction-viscous", "lugre",
+         "two-maxwell", "preisach")
 DIALECTS = ("csv", "testxpert", "bluehill")
 SUFFIX = {"csv": ".csv", "testxpert": ".txt", "bluehill": ".csv"}
 DETECTION_LOAD_N = 0.2
@@ -230,6 +242,74 @@ def masing(t, u, A, *, theta_c: float, r: float = 2.0):
     return out
 
 
+def lugre(t, u, A, *, speed_rad_s: float, stribeck: float = 1.5, vs_fraction: float = 0.3, bristle_deg: float = 0.5,
+          damping: float = 0.3, viscous_share: float = 0.3, substeps: int = 8):
+    """LuGre friction of Coulomb level ``(1 - viscous_share) A`` (static ``stribeck`` times that) and a viscous part.
+
+    ``g(v) = Fc + (Fs - Fc) exp(-(v / vs)^2)``; bristle stiffness ``sigma0 = Fs / bristle_deg``; micro-damping
+    ``sigma1 = damping sigma0 / speed``; viscous ``sigma2 = viscous_share A / speed`` (``H`` opposes the motion).
+    """
+    fc = (1.0 - viscous_share) * A
+    fs = stribeck * fc
+    vs = vs_fraction * speed_rad_s
+    s0 = fs / math.radians(bristle_deg)
+    s1 = damping * s0 / speed_rad_s * math.radians(bristle_deg)
+    s2 = viscous_share * A / speed_rad_s
+    v = np.gradient(u, t) if t.size > 1 else np.zeros_like(u)
+    z = fc / s0  # after a motion toward the blocked state (v < 0): bristles at the kinetic deflection, H > 0
+    out = np.empty(u.size)
+    dt = np.diff(t, prepend=t[0])
+    for i in range(u.size):
+        vi = -float(v[i])  # friction's own coordinate: H = +F when u decreases
+        g = fc + (fs - fc) * math.exp(-((vi / vs) ** 2))
+        h = dt[i] / substeps
+        for _ in range(substeps):
+            zdot = vi - s0 * abs(vi) * z / g
+            z += h * zdot
+        zdot = vi - s0 * abs(vi) * z / g
+        out[i] = s0 * z + s1 * zdot + s2 * vi
+    return out
+
+
+def two_maxwell(t, u, A, *, speed_rad_s: float, taus_s: tuple = (2.0, 40.0), shares: tuple = (0.5, 0.5)):
+    """Two Maxwell branches (relaxation times ``taus_s``), each ``share`` of ``A`` in steady motion at ``speed``."""
+    out = np.zeros(u.size)
+    for tau, share in zip(taus_s, shares, strict=True):
+        out += viscous(t, u, share * A, speed_rad_s=speed_rad_s, tau_s=tau, dashpot_share=0.0)
+    return out
+
+
+def preisach(t, u, A, *, n: int = 200, width_deg: float = 4.0, seed: int = 7):
+    """A discrete Preisach model: ``n`` relays (up threshold ``c + w/2``, down ``c - w/2``) of equal weight.
+
+    Centres ``c`` uniform over 0-120 deg, widths exponential of mean ``width_deg`` (a fixed draw: the law is
+    the same in every test).  ``H = A mean(relay)``, less its angle-dependent part: the relays lag the motion, so
+    the loop opposes it as the other laws do.
+    """
+    r = np.random.default_rng(seed)
+    c = np.radians(r.uniform(0.0, 120.0, n))
+    w = np.radians(r.exponential(width_deg, n))
+    up, down = c + w / 2.0, c - w / 2.0
+    state = np.where(u[0] <= down, -1.0, 1.0)  # after a motion toward the blocked state (u decreasing): from above
+    def run(path, state):
+        out = np.empty(path.size)
+        for i in range(path.size):
+            state = np.where(path[i] >= up, 1.0, np.where(path[i] <= down, -1.0, state))
+            out[i] = A * float(state.mean())
+        return out
+
+    # the relays' mean state depends on the angle itself (an elastic part, which would change the quasi-static
+    # curve): remove the mean of the two branches of a steady cycle over the whole range, so that the loop is
+    # centred on the quasi-static moment as every other law's
+    top = float(np.max(u)) * 1.05 + 1e-9
+    grid = np.linspace(0.0, top, 400)
+    k = grid.size - 1
+    h = run(np.concatenate([grid[::-1], grid[1:], grid[::-1][1:], grid[1:]]), np.ones(n))
+    rising, falling = h[-k:], h[-2 * k:-k][::-1]  # on grid[1:] and on grid[:-1]
+    m = 0.5 * (np.interp(grid, grid[1:], rising) + np.interp(grid, grid[:-1], falling))
+    return run(u, state) - np.interp(u, grid, m)
+
+
 def friction_viscous(t, u, A, *, speed_rad_s: float, share: float = 0.5, v0_fraction: float = 0.05):
     """Rounded Coulomb friction (``share`` of ``A``) and a linear dashpot (the rest, at ``speed_rad_s``)."""
     rate = np.gradient(u, t) if t.size > 1 else np.zeros_like(u)
@@ -252,6 +332,8 @@ class Case:
     noise_fraction, noise_ar1 : force noise (fraction of the blocked force) and its lag-one correlation.
     drift_fraction : load-cell offset drift over each test (fraction of the blocked force).
     drift_tau_s : 0: the drift is linear in time; > 0: it settles exponentially with this time constant (s).
+    drift_step_fraction : a step of the offset halfway through each test (fraction of the blocked force).
+    force_resolution_n : the force is rounded to this resolution (N; 0: not).
     """
 
     name: str
@@ -269,6 +351,8 @@ class Case:
     noise_ar1: float = 0.9
     drift_fraction: float = 0.0
     drift_tau_s: float = 0.0
+    drift_step_fraction: float = 0.0
+    force_resolution_n: float = 0.0
     dialect: str = "csv"
     cycles: int = 3
     speed_mm_min: float = 30.0
@@ -366,6 +450,31 @@ HOLDOUT3 = {c.name: c for c in (
 )}
 
 
+#: A fourth held-out set, written on 2026-11-26 after the third was scored and the fit changed for it, to be scored
+#: once when done (``calibration_study.py --set holdout4``): three more loop laws (LuGre friction, two Maxwell
+#: branches, a discrete Preisach model) and other instrument faults (an offset step, a coarse force resolution,
+#: a low sampling rate, heavy coloured noise).
+HOLDOUT4 = {c.name: c for c in (
+    Case("lugre", pressures_kpa=(100.0, 130.0, 160.0, 190.0), d_alpha0_deg=0.5, mu_factor=0.98, loop="lugre",
+         loop_fraction=0.05, noise_fraction=0.01, noise_ar1=0.85, dialect="testxpert"),
+    Case("lugre-bc-fb", preset="bc-pam", model="force_balance", pressures_kpa=(50.0, 75.0, 100.0, 125.0),
+         d_alpha0_deg=-0.6, shape=0.5, loop="lugre", loop_fraction=0.06,
+         loop_options={"stribeck": 2.0, "viscous_share": 0.1}, noise_fraction=0.015, noise_ar1=0.9, dialect="csv"),
+    Case("two-maxwell", pressures_kpa=(110.0, 150.0, 190.0), d_alpha0_deg=-0.4, mu_factor=1.04, loop="two-maxwell",
+         loop_fraction=0.06, noise_fraction=0.01, noise_ar1=0.9, dwell_s=3.0, dialect="bluehill"),
+    Case("preisach-bc", preset="bc-pam", pressures_kpa=(45.0, 65.0, 85.0, 105.0, 125.0), d_alpha0_deg=0.6,
+         loop="preisach", loop_fraction=0.05, noise_fraction=0.01, noise_ar1=0.8, dialect="testxpert"),
+    Case("step+drift", pressures_kpa=(100.0, 140.0, 180.0), d_alpha0_deg=0.3, loop="none", noise_fraction=0.006,
+         noise_ar1=0.9, drift_fraction=0.006, drift_step_fraction=0.004, dialect="csv"),
+    Case("coarse-slow", pressures_kpa=(100.0, 125.0, 150.0, 175.0, 200.0), d_alpha0_deg=-0.5, loop="maxwell-creep",
+         loop_fraction=0.04, loop_options={"creep_tau_s": 30.0}, noise_fraction=0.005, noise_ar1=0.5,
+         force_resolution_n=0.02, rate_hz=5.0, dialect="bluehill"),
+    Case("heavy-noise", pressures_kpa=(90.0, 115.0, 140.0, 165.0, 190.0, 215.0), d_alpha0_deg=0.4, shape=0.45,
+         loop="stiction", loop_fraction=0.04, loop_options={"ratio": 1.5}, noise_fraction=0.03, noise_ar1=0.95,
+         dialect="testxpert"),
+)}
+
+
 @dataclass(frozen=True)
 class Truth:
     """The true actuator of a case and the values a fit should recover (deg, kPa)."""
@@ -420,6 +529,12 @@ def _loop(case: Case, t, u, A, speed_rad_s: float, span_rad: float):
         return masing(t, u, A, theta_c=math.radians(opts.pop("theta_c_deg", 3.0)), **opts)
     if case.loop == "friction-viscous":
         return friction_viscous(t, u, A, speed_rad_s=speed_rad_s, **opts)
+    if case.loop == "lugre":
+        return lugre(t, u, A, speed_rad_s=speed_rad_s, **opts)
+    if case.loop == "two-maxwell":
+        return two_maxwell(t, u, A, speed_rad_s=speed_rad_s, **opts)
+    if case.loop == "preisach":
+        return preisach(t, u, A, **opts)
     raise ValueError(f"unknown loop {case.loop!r}; one of {', '.join(LOOPS)}")
 
 
@@ -483,11 +598,15 @@ def machine_test(case: Case, truth: Truth, pressure_kpa: float, rng: np.random.G
     if case.drift_tau_s > 0:  # a thermal drift that settles
         x = -np.expm1(-(t - t[0]) / case.drift_tau_s) / -math.expm1(-(t[-1] - t[0]) / case.drift_tau_s)
     drift = case.drift_fraction * F_block * x
+    if case.drift_step_fraction:
+        drift = drift + case.drift_step_fraction * F_block * (t >= t[0] + 0.5 * (t[-1] - t[0]))
     force_n = clean + case.noise_fraction * F_block * noise + drift
+    if case.force_resolution_n > 0:
+        force_n = np.round(force_n / case.force_resolution_n) * case.force_resolution_n
     stroke = cross + rng.normal(0.0, 0.002, t.size)
     info = {"pressure_kpa": pressure_kpa, "free_stroke_mm": s_free, "blocked_force_n": F_block,
             "blocked_moment_nmm": Mb, "loop_amplitude_nmm": A, "samples": int(t.size),
-            "duration_s": float(t[-1]), "drift_n": float(drift[-1])}
+            "duration_s": float(t[-1]), "drift_n": float(drift[-1] if np.size(drift) else 0.0)}
     return t, stroke, force_n, info
 
 
