@@ -518,3 +518,32 @@ def test_friction_with_a_dashpot_is_fitted_by_the_pi_dashpot_member():
     assert members["pi_dashpot"].weight > 0.5
     assert members["pi_dashpot"].nrmse < min(m.nrmse for k, m in members.items() if k != "pi_dashpot")
     assert abs(r.actuator.alpha0_deg - truth["alpha0_deg"]) < 2.0 * r.parameters["alpha0"].stderr
+
+
+def test_two_maxwell_branches_are_fitted_by_the_two_term_prony_member():
+    """Raw tests with two Maxwell branches (2 s and 40 s) and dwells: every one-branch law shares a bias of about
+    3 SE; the member with two branches of their own angles carries the weight and lands on the truth."""
+    import sys
+    import tempfile
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tools"))
+    import raw_generators as gen
+
+    from bendpam.identify.ensemble import MEMBER_EXTRA
+    from bendpam.identify.fitting import fit
+    from bendpam.lab import read_test
+    from bendpam.lab.processing import process_tests
+    from bendpam.physics.fixture import Fixture
+
+    assert MEMBER_EXTRA["maxwell2"] == ("theta_2", "a0_2", "a1_2")
+    case = gen.HOLDOUT4["two-maxwell"]
+    with tempfile.TemporaryDirectory() as folder:
+        truth = gen.generate_set(case, 4, folder)
+        raws = [read_test(Path(folder) / name) for name in truth["files"]]
+    ps = process_tests(raws, fixture=Fixture(L0_mm=truth["fixture_L0_mm"]), keep_series=False)
+    r = fit(ps, gen.start_actuator(case), profile_points=0)
+    members = {m.law: m for m in r.uncertainty.ensemble}
+    assert max(members.values(), key=lambda m: m.weight).law == "maxwell2"
+    assert abs(r.actuator.alpha0_deg - truth["alpha0_deg"]) < 2.0 * r.parameters["alpha0"].stderr
+    assert abs(members["pi"].values["alpha0_deg"] - truth["alpha0_deg"]) > 0.2  # deg: the one-branch laws' bias

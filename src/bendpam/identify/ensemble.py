@@ -3,9 +3,9 @@
 No loop law is known to be the actuator's.  With a loop model the fit is repeated with every law
 of :data:`bendpam.physics.hysteresis.ENSEMBLE` (Prandtl-Ishlinskii, Dahl, Bouc-Wen, Maxwell-slip,
 breakaway stiction, rate-dependent viscous loops, the standard linear solid, friction with a Maxwell
-branch or a dashpot, a fixture with a dead zone, and Dahl and Bouc-Wen loops that scale with the span), each
-warm-started from the fit and with the quasi-static parameters free as in it.  The reported model
-parameters are their weighted average.
+branch or a dashpot, two Maxwell branches, a fixture with a dead zone, and Dahl and Bouc-Wen loops that
+scale with the span), each warm-started from the fit and with the quasi-static parameters free as in it.
+The reported model parameters are their weighted average.
 
 Weights (Akaike weights, AICc, on an effective number of points)
     ``AICc_i = m_eff ln(SSR_i) + 2 k_i + 2 k_i (k_i + 1) / (m_eff - k_i - 1)`` with ``k_i`` the parameters
@@ -27,6 +27,7 @@ Members with parameters of their own (:data:`MEMBER_EXTRA`)
     ``"zener"``, the standard linear solid's loop (:class:`~bendpam.physics.hysteresis.ZenerLoop`): a
     dashpot (the bending rate) and a Maxwell branch (the ``"viscous"`` member's ``z``), each with its own
     amplitudes.  ``"pi_maxwell"``: Prandtl-Ishlinskii friction and a Maxwell branch of its own angle.
+    ``"maxwell2"``: two Maxwell branches of their own angles (a two-term Prony series).
     ``"pi_dashpot"``: Prandtl-Ishlinskii friction and a dashpot (the textbook Coulomb-plus-viscous damping;
     the dashpot is the standard linear solid's, the bending rate).
     ``"pi_play"``: a play operator on the stroke (:func:`played_path`); the quasi-static model and the
@@ -77,7 +78,7 @@ __all__ = ["MEMBER_EXTRA", "SPAN_SCALED", "MemberFit", "akaike_weights", "effect
 #: law's static-to-kinetic friction ratio, and the second branch of friction with a Maxwell branch or a dashpot.
 MEMBER_EXTRA: dict[str, tuple[str, ...]] = {"zener": ("a0_2", "a1_2"), "pi_play": ("gap",), "stiction": ("ratio",),
                                              "pi_maxwell": ("theta_2", "a0_2", "a1_2"),
-                                             "pi_dashpot": ("a0_2", "a1_2")}
+                                             "pi_dashpot": ("a0_2", "a1_2"), "maxwell2": ("theta_2", "a0_2", "a1_2")}
 
 
 #: The self-similar members: a rate-independent law whose characteristic angle is a fixed fraction of each test's

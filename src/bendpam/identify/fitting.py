@@ -362,6 +362,8 @@ class _Problem:
                 z = np.column_stack([self._z(0.0, law="dashpot")[:, 0], self._z(theta_deg, law="viscous")])
             elif law == "pi_maxwell":  # friction and a Maxwell branch of its own angle
                 z = np.column_stack([self._z(theta_deg, law="pi"), self._z(float(theta_2 or 1.0), law="viscous")])
+            elif law == "maxwell2":  # two Maxwell branches of their own angles (a two-term Prony series)
+                z = np.column_stack([self._z(theta_deg, law="viscous"), self._z(float(theta_2 or 1.0), law="viscous")])
             elif law == "pi_dashpot":  # friction and a dashpot (Coulomb and viscous damping)
                 z = np.column_stack([self._z(theta_deg, law="pi"), self._z(0.0, law="dashpot")[:, 0]])
             else:

@@ -88,7 +88,7 @@ LAWS = ("pi", "dahl")
 #: The loop laws whose fits make the identification's systematic (model-form) uncertainty (the members beyond
 #: :func:`make_law`'s laws are :mod:`bendpam.identify.ensemble`'s).
 ENSEMBLE = ("pi", "dahl", "bouc_wen", "maxwell_slip", "stiction", "viscous", "viscous_period", "zener", "pi_play",
-            "pi_maxwell", "pi_dashpot", "dahl_span", "bouc_wen_span")
+            "pi_maxwell", "pi_dashpot", "maxwell2", "dahl_span", "bouc_wen_span")
 
 
 def _segments(theta: np.ndarray):

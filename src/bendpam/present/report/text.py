@@ -48,6 +48,7 @@ LAW_LABEL = {"pi": "Prandtl-Ishlinskii", "dahl": "Dahl", "bouc_wen": "Bouc-Wen",
              "pi_play": "Prandtl-Ishlinskii after a fixture play (backlash)",
              "pi_maxwell": "Prandtl-Ishlinskii and a Maxwell branch",
              "pi_dashpot": "Prandtl-Ishlinskii and a dashpot (Coulomb and viscous damping)",
+             "maxwell2": "two Maxwell branches (a two-term Prony series)",
              "dahl_span": "Dahl (angle in proportion to the span)",
              "bouc_wen_span": "Bouc-Wen (angle in proportion to the span)"}
 
