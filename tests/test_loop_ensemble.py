@@ -26,6 +26,37 @@ def loop_area(theta, z):
     return 0.5 * abs(float(np.sum(theta[:-1] * z[1:] - theta[1:] * z[:-1])))
 
 
+def generated_fit(case, seed: int):
+    """Raw tests of a case of the independent generators (``tools/raw_generators.py``), read, processed and
+    fitted with the defaults (no profile): ``(truth, FitResult, members by law)``."""
+    import tempfile
+    from pathlib import Path
+
+    from bendpam.identify.fitting import fit
+    from bendpam.lab import read_test
+    from bendpam.lab.processing import process_tests
+    from bendpam.physics.fixture import Fixture
+
+    gen = generators()
+    with tempfile.TemporaryDirectory() as folder:
+        truth = gen.generate_set(case, seed, folder)
+        raws = [read_test(Path(folder) / name) for name in truth["files"]]
+    ps = process_tests(raws, fixture=Fixture(L0_mm=truth["fixture_L0_mm"]), keep_series=False)
+    r = fit(ps, gen.start_actuator(case), profile_points=0)
+    return truth, r, {m.law: m for m in r.uncertainty.ensemble}
+
+
+def generators():
+    """The independent generators' module (``tools/raw_generators.py``)."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tools"))
+    import raw_generators
+
+    return raw_generators
+
+
 # --------------------------------------------------------------------------------------------
 # Bouc-Wen (exponent 2, beta = gamma = 1/2)
 # --------------------------------------------------------------------------------------------
@@ -396,25 +427,9 @@ def test_a_fixture_with_backlash_is_fitted_by_the_play_member():
     """Raw tests from the independent generators with a 0.3 mm dead zone: the play member carries the weight and
     the model average lands on the truth, where the Prandtl-Ishlinskii fit alone is off by several SE."""
     import dataclasses
-    import sys
-    import tempfile
-    from pathlib import Path
 
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tools"))
-    import raw_generators as gen
-
-    from bendpam.identify.fitting import fit
-    from bendpam.lab import read_test
-    from bendpam.lab.processing import process_tests
-    from bendpam.physics.fixture import Fixture
-
-    case = dataclasses.replace(gen.CASES["backlash"], pressures_kpa=(110.0, 150.0, 190.0))
-    with tempfile.TemporaryDirectory() as folder:
-        truth = gen.generate_set(case, 0, folder)
-        raws = [read_test(Path(folder) / name) for name in truth["files"]]
-    ps = process_tests(raws, fixture=Fixture(L0_mm=truth["fixture_L0_mm"]), keep_series=False)
-    r = fit(ps, gen.start_actuator(case), profile_points=0)
-    members = {m.law: m for m in r.uncertainty.ensemble}
+    case = dataclasses.replace(generators().CASES["backlash"], pressures_kpa=(110.0, 150.0, 190.0))
+    truth, r, members = generated_fit(case, 0)
     assert max(members.values(), key=lambda m: m.weight).law == "pi_play"
     se = r.parameters["alpha0"].stderr
     assert abs(r.actuator.alpha0_deg - truth["alpha0_deg"]) < 2.0 * se
@@ -468,25 +483,9 @@ def test_a_loop_that_keeps_its_shape_across_spans_is_fitted_by_a_span_scaled_mem
     test's span: a span-scaled member carries the weight and the average lands on the truth; without those members
     the constant-period viscous law took all the weight and was off by more than 10 of its SE."""
     import dataclasses
-    import sys
-    import tempfile
-    from pathlib import Path
 
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tools"))
-    import raw_generators as gen
-
-    from bendpam.identify.fitting import fit
-    from bendpam.lab import read_test
-    from bendpam.lab.processing import process_tests
-    from bendpam.physics.fixture import Fixture
-
-    case = dataclasses.replace(gen.HOLDOUT["bouc-wen-n2"], pressures_kpa=(90.0, 140.0, 190.0, 215.0))
-    with tempfile.TemporaryDirectory() as folder:
-        truth = gen.generate_set(case, 0, folder)
-        raws = [read_test(Path(folder) / name) for name in truth["files"]]
-    ps = process_tests(raws, fixture=Fixture(L0_mm=truth["fixture_L0_mm"]), keep_series=False)
-    r = fit(ps, gen.start_actuator(case), profile_points=0)
-    members = {m.law: m for m in r.uncertainty.ensemble}
+    case = dataclasses.replace(generators().HOLDOUT["bouc-wen-n2"], pressures_kpa=(90.0, 140.0, 190.0, 215.0))
+    truth, r, members = generated_fit(case, 0)
     assert max(members.values(), key=lambda m: m.weight).law in ("bouc_wen_span", "dahl_span")
     se = r.parameters["alpha0"].stderr
     assert abs(r.actuator.alpha0_deg - truth["alpha0_deg"]) < 2.0 * se
@@ -495,26 +494,8 @@ def test_a_loop_that_keeps_its_shape_across_spans_is_fitted_by_a_span_scaled_mem
 
 def test_friction_with_a_dashpot_is_fitted_by_the_pi_dashpot_member():
     """Raw tests from the independent generators with rounded Coulomb friction and a dashpot: the member with
-    friction and a dashpot carries the weight and lands within 2 SE, and its rows are friction's and the rate's."""
-    import sys
-    import tempfile
-    from pathlib import Path
-
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tools"))
-    import raw_generators as gen
-
-    from bendpam.identify.fitting import fit
-    from bendpam.lab import read_test
-    from bendpam.lab.processing import process_tests
-    from bendpam.physics.fixture import Fixture
-
-    case = gen.HOLDOUT3["friction-viscous"]
-    with tempfile.TemporaryDirectory() as folder:
-        truth = gen.generate_set(case, 1, folder)
-        raws = [read_test(Path(folder) / name) for name in truth["files"]]
-    ps = process_tests(raws, fixture=Fixture(L0_mm=truth["fixture_L0_mm"]), keep_series=False)
-    r = fit(ps, gen.start_actuator(case), profile_points=0)
-    members = {m.law: m for m in r.uncertainty.ensemble}
+    friction and a dashpot carries the weight and lands within 2 SE, and fits better than any other."""
+    truth, r, members = generated_fit(generators().HOLDOUT3["friction-viscous"], 1)
     assert members["pi_dashpot"].weight > 0.5
     assert members["pi_dashpot"].nrmse < min(m.nrmse for k, m in members.items() if k != "pi_dashpot")
     assert abs(r.actuator.alpha0_deg - truth["alpha0_deg"]) < 2.0 * r.parameters["alpha0"].stderr
@@ -523,27 +504,10 @@ def test_friction_with_a_dashpot_is_fitted_by_the_pi_dashpot_member():
 def test_two_maxwell_branches_are_fitted_by_the_two_term_prony_member():
     """Raw tests with two Maxwell branches (2 s and 40 s) and dwells: every one-branch law shares a bias of about
     3 SE; the member with two branches of their own angles carries the weight and lands on the truth."""
-    import sys
-    import tempfile
-    from pathlib import Path
-
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tools"))
-    import raw_generators as gen
-
     from bendpam.identify.ensemble import MEMBER_EXTRA
-    from bendpam.identify.fitting import fit
-    from bendpam.lab import read_test
-    from bendpam.lab.processing import process_tests
-    from bendpam.physics.fixture import Fixture
 
     assert MEMBER_EXTRA["maxwell2"] == ("theta_2", "a0_2", "a1_2")
-    case = gen.HOLDOUT4["two-maxwell"]
-    with tempfile.TemporaryDirectory() as folder:
-        truth = gen.generate_set(case, 4, folder)
-        raws = [read_test(Path(folder) / name) for name in truth["files"]]
-    ps = process_tests(raws, fixture=Fixture(L0_mm=truth["fixture_L0_mm"]), keep_series=False)
-    r = fit(ps, gen.start_actuator(case), profile_points=0)
-    members = {m.law: m for m in r.uncertainty.ensemble}
+    truth, r, members = generated_fit(generators().HOLDOUT4["two-maxwell"], 4)
     assert max(members.values(), key=lambda m: m.weight).law == "maxwell2"
     assert abs(r.actuator.alpha0_deg - truth["alpha0_deg"]) < 2.0 * r.parameters["alpha0"].stderr
     assert abs(members["pi"].values["alpha0_deg"] - truth["alpha0_deg"]) > 0.2  # deg: the one-branch laws' bias
