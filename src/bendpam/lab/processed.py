@@ -26,7 +26,7 @@ from bendpam.infra.accessors import figure as figure_by_name
 from bendpam.infra.budgets import check_input_file
 from bendpam.infra.display import summary_html, summary_text
 from bendpam.infra.manifest import verify_input
-from bendpam.lab.drift import DRIFT_METHODS, DriftEstimate
+from bendpam.lab.drift import DRIFT_METHODS, DriftEstimate, set_drift_findings
 from bendpam.physics.fixture import Fixture
 
 if TYPE_CHECKING:  # pandas and xarray are imported by the functions that use them (fast start-up of `fit`)
@@ -334,8 +334,6 @@ class ProcessedSet:
     def findings(self) -> list[dict]:
         """Every plausibility finding: of the processed tests, of the set (a drift the tests share,
         :func:`bendpam.lab.drift.set_drift_findings`), then of the files that were skipped."""
-        from bendpam.lab.drift import set_drift_findings
-
         out = [f for r in self.results for f in r.findings] + set_drift_findings(self.results)
         return out + [f for info in self.files for f in info.get("findings", [])]
 
