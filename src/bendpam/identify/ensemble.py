@@ -69,9 +69,9 @@ from bendpam.identify.data import FitData
 from bendpam.identify.result import PARAMETERS, EnsembleMember, UncertaintyBudget, parameter_field
 from bendpam.identify.uncertainty import Uncertainty, lag1_autocorrelation, material_gradients
 
-__all__ = ["MEMBER_EXTRA", "SPAN_SCALED", "MemberFit", "akaike_weights", "effective_points", "member_weights",
-           "model_average", "played_path", "span_scaled_z", "spans_differ", "steady_z", "systematic_covariance",
-           "uncertainty_budget"]
+__all__ = ["MEMBER_EXTRA", "SPAN_SCALED", "TWO_BRANCH", "MemberFit", "akaike_weights", "effective_points",
+           "member_weights", "model_average", "played_path", "span_scaled_z", "spans_differ", "steady_z",
+           "systematic_covariance", "uncertainty_budget"]
 
 #: The parameters a member of the ensemble adds to the reported fit's: the standard linear solid's second pair
 #: of amplitudes (its Maxwell branch; the first pair weighs the dashpot), the play's gap (deg), the breakaway
@@ -79,6 +79,17 @@ __all__ = ["MEMBER_EXTRA", "SPAN_SCALED", "MemberFit", "akaike_weights", "effect
 MEMBER_EXTRA: dict[str, tuple[str, ...]] = {"zener": ("a0_2", "a1_2"), "pi_play": ("gap",), "stiction": ("ratio",),
                                              "pi_maxwell": ("theta_2", "a0_2", "a1_2"),
                                              "pi_dashpot": ("a0_2", "a1_2"), "maxwell2": ("theta_2", "a0_2", "a1_2")}
+
+
+#: The members made of two branches, each another law's ``z`` at an angle: ``(law, angle)`` with the angle the
+#: member's ``"theta"`` (the loop's own), ``"theta_2"`` (its second, :data:`MEMBER_EXTRA`) or None (the dashpot's
+#: rate needs none).  Each branch has its own amplitudes: the first ``a0, a1``, the second ``a0_2, a1_2``.
+TWO_BRANCH: dict[str, tuple[tuple[str, str | None], tuple[str, str | None]]] = {
+    "zener": (("dashpot", None), ("viscous", "theta")),  # the standard linear solid
+    "pi_maxwell": (("pi", "theta"), ("viscous", "theta_2")),  # friction and a Maxwell branch
+    "maxwell2": (("viscous", "theta"), ("viscous", "theta_2")),  # a two-term Prony series
+    "pi_dashpot": (("pi", "theta"), ("dashpot", None)),  # Coulomb and viscous damping
+}
 
 
 #: The self-similar members: a rate-independent law whose characteristic angle is a fixed fraction of each test's

@@ -121,6 +121,7 @@ from bendpam.identify.diagnose import (
 from bendpam.identify.ensemble import (
     MEMBER_EXTRA,
     SPAN_SCALED,
+    TWO_BRANCH,
     MemberFit,
     member_weights,
     played_path,
@@ -358,14 +359,10 @@ class _Problem:
             if len(self._z_cache) > 512:
                 self._z_cache.clear()
             assert law is not None, "a loop fit has a law"
-            if law == "zener":  # the dashpot's part, and the viscous member's Maxwell branch (cached)
-                z = np.column_stack([self._z(0.0, law="dashpot")[:, 0], self._z(theta_deg, law="viscous")])
-            elif law == "pi_maxwell":  # friction and a Maxwell branch of its own angle
-                z = np.column_stack([self._z(theta_deg, law="pi"), self._z(float(theta_2 or 1.0), law="viscous")])
-            elif law == "maxwell2":  # two Maxwell branches of their own angles (a two-term Prony series)
-                z = np.column_stack([self._z(theta_deg, law="viscous"), self._z(float(theta_2 or 1.0), law="viscous")])
-            elif law == "pi_dashpot":  # friction and a dashpot (Coulomb and viscous damping)
-                z = np.column_stack([self._z(theta_deg, law="pi"), self._z(0.0, law="dashpot")[:, 0]])
+            if law in TWO_BRANCH:  # two columns of other laws' z (each cached), at their angles
+                angle = {"theta": theta_deg, "theta_2": float(theta_2 or 1.0), None: 0.0}
+                z = np.column_stack([self._z(angle[a], law=part).reshape(self.d.kc.size, -1)[:, 0]
+                                     for part, a in TWO_BRANCH[law]])
             else:
                 z = steady_z(law, theta_deg, self.d if gap <= 0 else self._played(gap)[2], ratio)
             self._z_cache[key] = z
