@@ -294,9 +294,44 @@ def test_an_uncorrected_drift_the_set_shares_is_counted_in_the_fits_error_bars()
     assert not one.flagged
     assert drift_offsets(NS(results=[NS(drift=one)]), d) == []  # alone: no evidence of a drift
     many = drift_offsets(NS(results=[NS(drift=one)] * 3), d)  # three alike: 3.5 SE pooled
-    assert [sd for _, sd in many] == pytest.approx([math.hypot(2.0, 1.0)] * 3)
+    assert [sd for _, sd, _ in many] == pytest.approx([math.hypot(2.0, 1.0)] * 3)
+    assert [shift for *_, shift in many] == [-2.0] * 3  # what correcting it would move the moments by
     # corrected: the rate's own error and half the disagreement of the free and blocked ends' slopes
     fixed = DriftEstimate(2e-4, 1e-5, 200.0, 0.0, 0.05, 10.0, 12, free_rate_n_per_s=1e-4, blocked_rate_n_per_s=3e-4,
                           blocked_moment_nmm=300.0, corrected=True)
-    (_, sd), = drift_offsets(NS(results=[NS(drift=fixed)]), NS(seg=np.array([0])))
+    (_, sd, shift), = drift_offsets(NS(results=[NS(drift=fixed)]), NS(seg=np.array([0])))
+    assert shift == 0.0
     assert sd == pytest.approx(math.hypot(1e-5, 1e-4) * 100.0 * 30.0)
+
+
+def test_an_uncorrected_drift_says_how_far_correcting_it_would_move_alpha0():
+    """Issue 23 item 1: the fit of a drifting set left uncorrected says by how much alpha0 would move when
+    corrected; the linearised figure has the sign and about the size of an actual refit with --drift linear."""
+    import re
+    import sys
+    import tempfile
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tools"))
+    import raw_generators as gen
+
+    from bendpam.identify.fitting import fit
+    from bendpam.lab import read_test
+    from bendpam.physics.fixture import Fixture
+
+    case = gen.CASES["drift"]
+    with tempfile.TemporaryDirectory() as folder:
+        truth = gen.generate_set(case, 0, folder)
+        raws = [read_test(Path(folder) / name) for name in truth["files"]]
+    fx = Fixture(L0_mm=truth["fixture_L0_mm"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        left = fit(process_tests(raws, fixture=fx, keep_series=False), gen.start_actuator(case), profile_points=0)
+        fixed = fit(process_tests(raws, fixture=fx, keep_series=False, drift="linear"), gen.start_actuator(case),
+                    profile_points=0)
+    note = [f for f in left.flags if "left uncorrected" in f]
+    assert len(note) == 1 and "--drift linear" in note[0]
+    said = float(re.search(r"alpha0 by about ([-+0-9.e]+) deg", note[0]).group(1))
+    moved = fixed.actuator.alpha0_deg - left.actuator.alpha0_deg
+    assert np.sign(said) == np.sign(moved) and 0.6 < said / moved < 1.6
+    assert not [f for f in fixed.flags if "left uncorrected" in f]  # corrected: nothing to say

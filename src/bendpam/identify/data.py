@@ -22,7 +22,7 @@ from bendpam.physics.actuator import Actuator
 from bendpam.physics.braid import radius_terms
 
 __all__ = ["FitData", "bladder_stretch_range", "branch_data", "cycle_deviations", "cycle_period_s", "developed_range",
-           "drift_offsets", "fit_data", "relative_rate"]
+           "drift_note", "drift_offsets", "fit_data", "relative_rate"]
 
 
 @dataclass
@@ -309,8 +309,12 @@ def bladder_stretch_range(actuator: Actuator, curvature_per_mm) -> tuple[float, 
 
 
 
-def drift_offsets(processed, d: FitData) -> list[tuple[np.ndarray, float]]:
-    """The load-cell drift's doubt as a moment offset per test: ``[(rows, sd_nmm)]``.
+def drift_offsets(processed, d: FitData) -> list[tuple[np.ndarray, float, float]]:
+    """The load-cell drift's doubt as a moment offset per test: ``[(rows, sd_nmm, shift_nmm)]``.
+
+    ``shift_nmm`` is how much correcting a drift left uncorrected would move the test's moments (its
+    blocked-moment shift, as a constant offset of its rows; 0 for a corrected test), for the fit to say how
+    far its values would move.
 
     A test whose drift was corrected keeps the error of the estimated rate: an offset growing
     from the test's start, ``rate_se (t - t0)``, common to its cycles on average (``rate_se x
@@ -325,8 +329,8 @@ def drift_offsets(processed, d: FitData) -> list[tuple[np.ndarray, float]]:
     ...            blocked_moment_nmm=300.0, blocked_force_n=10.0, blocked_moment_shift_nmm=-3.0,
     ...            free_rate_n_per_s=1e-3, blocked_rate_n_per_s=1e-3)   # both ends alike
     >>> d = NS(seg=np.array([0, 0, 0]))
-    >>> [(rows.tolist(), round(sd, 6)) for rows, sd in drift_offsets(NS(results=[NS(drift=drift)]), d)]  # N*mm
-    [([0, 1, 2], 0.3)]
+    >>> [(rows.tolist(), round(sd, 6), s) for rows, sd, s in drift_offsets(NS(results=[NS(drift=drift)]), d)]  # N*mm
+    [([0, 1, 2], 0.3, 0.0)]
 
     Two tests that drift by 2 standard errors each, left uncorrected: not flagged alone, but the set drifts
     (2.8 standard errors pooled), so each adds ``sqrt(s^2 + (s / 2)^2)``:
@@ -334,25 +338,46 @@ def drift_offsets(processed, d: FitData) -> list[tuple[np.ndarray, float]]:
     >>> from bendpam.lab.drift import DriftEstimate
     >>> e = DriftEstimate(2e-4, 1e-4, 200.0, 0.0, 0.05, 10.0, 12, blocked_moment_shift_nmm=-2.0)
     >>> d = NS(seg=np.array([0, 0, 1, 1]))
-    >>> [(rows.tolist(), round(sd, 3)) for rows, sd in drift_offsets(NS(results=[NS(drift=e), NS(drift=e)]), d)]
-    [([0, 1], 2.236), ([2, 3], 2.236)]
+    >>> [(rows.tolist(), round(sd, 3), s) for rows, sd, s in drift_offsets(NS(results=[NS(drift=e)] * 2), d)]
+    [([0, 1], 2.236, -2.0), ([2, 3], 2.236, -2.0)]
     """
-    out: list[tuple[np.ndarray, float]] = []
+    out: list[tuple[np.ndarray, float, float]] = []
     drifts = set_drifts([getattr(r, "drift", None) for r in processed.results])
     for i, r in enumerate(processed.results):
         e = getattr(r, "drift", None)
         if e is None:
             continue
+        shift = 0.0
         if e.corrected:
             lever = e.blocked_moment_nmm / e.blocked_force_n if e.blocked_force_n else math.nan
             ends = abs(e.free_rate_n_per_s - e.blocked_rate_n_per_s) / 2.0
             rate_sd = math.hypot(e.rate_se_n_per_s, ends) if math.isfinite(ends) else e.rate_se_n_per_s
             sd = abs(rate_sd * e.duration_s / 2.0 * lever)
         elif e.flagged or drifts:  # its own estimate of the shift, known to its standard error shift / sigmas
-            shift, sig = abs(e.blocked_moment_shift_nmm), e.sigmas
-            sd = math.hypot(shift, shift / sig) if math.isfinite(sig) and sig > 0 else shift
+            shift, sig = float(e.blocked_moment_shift_nmm), e.sigmas
+            sd = math.hypot(shift, shift / sig) if math.isfinite(sig) and sig > 0 else abs(shift)
         else:
             sd = 0.0
         if math.isfinite(sd) and sd > 0:
-            out.append((np.flatnonzero(d.seg == i), float(sd)))
+            out.append((np.flatnonzero(d.seg == i), float(sd), shift if math.isfinite(shift) else 0.0))
     return out
+
+
+def drift_note(shift: dict[str, float], sd: dict[str, float], tests: int) -> list[str]:
+    """The fit's words for a drift left uncorrected: how far correcting it would move alpha0 (and mu), in degrees,
+    kPa and standard errors.  ``shift``, ``sd``: by field name (``alpha0_deg``, ``shear_modulus_kpa``).
+
+    >>> shift, sd = {"alpha0_deg": 0.14, "shear_modulus_kpa": 1.2}, {"alpha0_deg": 0.07, "shear_modulus_kpa": 3.0}
+    >>> drift_note(shift, sd, 2)[0].split("would move ")[1].split(";")[0]
+    'alpha0 by about +0.14 deg (2 SE) and mu by +1.2 kPa (0.4 SE)'
+    """
+    a = shift.get("alpha0_deg")
+    if not tests or a is None or not math.isfinite(a):
+        return []
+    words = [f"alpha0 by about {a:+.2g} deg ({abs(a) / sd['alpha0_deg']:.2g} SE)" if sd.get("alpha0_deg") else
+             f"alpha0 by about {a:+.2g} deg"]
+    mu, mu_sd = shift.get("shear_modulus_kpa"), sd.get("shear_modulus_kpa")
+    if mu is not None and math.isfinite(mu):
+        words.append(f"mu by {mu:+.2g} kPa" + (f" ({abs(mu) / mu_sd:.2g} SE)" if mu_sd else ""))
+    return [f"the load-cell drift of {tests} test(s) was left uncorrected (flagged, or shared by the set): correcting "
+            f"it (--drift linear) would move {' and '.join(words)}; its doubt is in the standard errors"]

@@ -106,6 +106,7 @@ from bendpam.identify.data import (
     bladder_stretch_range,
     branch_data,
     cycle_deviations,
+    drift_note,
     drift_offsets,
     fit_data,
 )
@@ -141,7 +142,7 @@ from bendpam.identify.result import (
     Profile,
     UncertaintyBudget,
 )
-from bendpam.identify.uncertainty import Uncertainty, material_fit, sandwich_covariance
+from bendpam.identify.uncertainty import Uncertainty, material_fit, offset_shift, sandwich_covariance
 from bendpam.lab.processed import as_processed
 from bendpam.physics.actuator import NEUTRAL_ANGLE_DEG, Actuator, FitIdentity
 from bendpam.physics.braid import DEFAULT_ORDER
@@ -513,6 +514,7 @@ def fit(processed, actuator: Actuator, model: str | None = None, free=("alpha0",
                    admissible_range, order, eq19_factor)
     _search_stages(run, grid_alpha, grid_r0, tension_data)
     unc, budget = _uncertainty_stages(run, corr_flag, law_uncertainty)
+    run.notes += drift_note(unc.drift_shift, budget.total, sum(s != 0 for *_, s in run.offsets))
     profile, n = _profile(run.prob, run.bnd, run.nl, unc, profile_points)
     run.nfev += n
     return _result(processed, actuator, run, unc, tension, t0, budget, profile, hysteresis)
@@ -829,15 +831,14 @@ def _uncertainty(prob: _Problem, bnd, nl_best, lin, corr_flag: float, cycles=(),
     if bound_names.get("S_lo", False) or bound_names.get("S_hi", False):
         cycles = ()  # the model cannot follow the curves (shape at an admissibility bound): misfit as noise
     weighted = [(rows, prob.w[rows][None, :] * E) for rows, E in cycles]
-    offs = [(rows, sd * prob.w[rows]) for rows, sd in offsets]
-    cov_int, rho = sandwich_covariance(J, r, prob.groups, weighted, offs)
+    cov_int, rho = sandwich_covariance(J, r, prob.groups, weighted, [(i, sd * prob.w[i]) for i, sd, _ in offsets])
     G = np.zeros((nn + len(prob.lin), x_int.size))
     G[:nn, :nn] = np.eye(nn)
     G[nn:, nn:] = prob.T
-    cov = G @ cov_int @ G.T
-    names = prob.nonlin + prob.lin
-    values = prob.to_user(nl_best, lin)
-    return Uncertainty(values, names, cov, rho, nfev, bound_names, float(r @ r), m, corr_flag)
+    unc = Uncertainty(prob.to_user(nl_best, lin), prob.nonlin + prob.lin, G @ cov_int @ G.T, rho, nfev, bound_names,
+                      float(r @ r), m, corr_flag)
+    unc.set_drift_shift(G @ offset_shift(J, [(i, s * prob.w[i]) for i, _, s in offsets]))  # an uncorrected drift's
+    return unc
 
 
 def _law_refit(prob: _Problem, bnd, nl, alt: str):

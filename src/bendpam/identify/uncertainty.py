@@ -25,7 +25,8 @@ from bendpam.identify.diagnose import shape_identified, study_coverage
 from bendpam.identify.result import MaterialFit
 from bendpam.physics.actuator import Actuator
 
-__all__ = ["Uncertainty", "lag1_autocorrelation", "material_fit", "material_gradients", "sandwich_covariance"]
+__all__ = ["Uncertainty", "lag1_autocorrelation", "material_fit", "material_gradients", "offset_shift",
+           "sandwich_covariance"]
 
 
 class Uncertainty:
@@ -65,6 +66,25 @@ class Uncertainty:
         self.at_bound = at_bound
         self.ssr = ssr
         self.m = m
+        self.drift_shift: dict[str, float] = {}
+
+    def set_drift_shift(self, shift: np.ndarray) -> None:
+        """Keep how far correcting an uncorrected drift would move the parameters (``shift`` in the order of
+        ``names``, :func:`offset_shift`): ``alpha0_deg`` and ``shear_modulus_kpa`` (``2 (C10 + C01)``), by field.
+
+        >>> unc = Uncertainty({}, ["alpha0", "C10", "C01"], np.eye(3), 0.0, 0, {}, 0.0, 40, 0.95)
+        >>> unc.set_drift_shift(np.array([0.1, 2.0, -0.5]))
+        >>> unc.drift_shift
+        {'alpha0_deg': 0.1, 'shear_modulus_kpa': 3.0}
+        """
+        by = dict(zip(self.names, (float(x) for x in shift), strict=True))
+        if not any(by.values()):
+            self.drift_shift = {}
+            return
+        out = {"alpha0_deg": by["alpha0"]} if "alpha0" in by else {}
+        if "C10" in by or "C01" in by:
+            out["shear_modulus_kpa"] = 2.0 * (by.get("C10", 0.0) + by.get("C01", 0.0))
+        self.drift_shift = out
 
     @property
     def sd(self) -> np.ndarray:
@@ -125,6 +145,25 @@ def lag1_autocorrelation(resid: np.ndarray, seg: np.ndarray) -> float:
         num += float(r[1:] @ r[:-1])
         den += float(r @ r)
     return num / den if den > 0 else 0.0
+
+
+def offset_shift(J: np.ndarray, shifts: Sequence[tuple[np.ndarray, float]]) -> np.ndarray:
+    """How far the parameters move when each group of rows of the data moves by a constant (linearised refit).
+
+    With weighted residuals ``r = w (model - y)`` at the optimum (``J^T r = 0``), moving the data by ``dy``
+    moves the optimum by ``dx = (J^T J)^-1 J^T (w dy)``.  ``shifts``: ``(rows, w dy)`` with ``w dy`` the
+    weighted shift of those rows (a scalar times their weights, or an array); zero without any.
+
+    >>> J = np.column_stack([np.ones(4), np.arange(4.0)])   # a line: offset and slope
+    >>> offset_shift(J, [(np.arange(4), np.full(4, 0.5))]).round(12).tolist()   # all rows up by 0.5: offset only
+    [0.5, 0.0]
+    """
+    b = np.zeros(J.shape[0])
+    for rows, dy in shifts:
+        b[rows] += dy
+    if not np.any(b):
+        return np.zeros(J.shape[1])
+    return np.linalg.lstsq(J, b, rcond=None)[0]
 
 
 def sandwich_covariance(J: np.ndarray, r: np.ndarray, groups: np.ndarray,
