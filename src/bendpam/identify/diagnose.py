@@ -388,8 +388,8 @@ def identifiability(mat: MaterialFit | None, free: list[str], unc: Uncertainty, 
         se = float(unc.sd[i])
         sys_ = 0.0 if budget is None else budget.systematic.get("alpha0_deg", 0.0)
         n_laws = 0 if budget is None else len(budget.ensemble)
-        tail = (f"; the loop law alone ({law} among {n_laws} laws, systematic) accounts for ± {2 * sys_:.2g} deg"
-                if law and n_laws and sys_ > 0 else "")
+        tail = (f"; the choice of loop law (the spread of {n_laws} laws about their weighted average, systematic) "
+                f"accounts for ± {2 * sys_:.2g} deg" if law and n_laws and sys_ > 0 else "")
         head = f"alpha0 = {fitted.alpha0_deg:.4g} ± {2 * se:.2g} deg (2 SE{tail})"
         if unc.at_bound.get("alpha0", False):
             out.append(f"{head} sits at a bound of its range: the curves do not determine it there.")

@@ -514,7 +514,6 @@ def fit(processed, actuator: Actuator, model: str | None = None, free=("alpha0",
                    admissible_range, order, eq19_factor)
     _search_stages(run, grid_alpha, grid_r0, tension_data)
     unc, budget = _uncertainty_stages(run, corr_flag, law_uncertainty)
-    run.notes += drift_note(unc.drift_shift, budget.total, sum(s != 0 for *_, s in run.offsets))
     profile, n = _profile(run.prob, run.bnd, run.nl, unc, profile_points)
     run.nfev += n
     return _result(processed, actuator, run, unc, tension, t0, budget, profile, hysteresis)
@@ -615,6 +614,7 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool):
         budget.weighting += ("; the viscous loop driven at the test's own times" if timed else
                              "; the viscous loop's rate approximated at a constant crosshead speed (the processed "
                              "set keeps no time: saved before 0.4)")
+    run.notes += drift_note(unc.drift_shift, budget.total, sum(s != 0 for *_, s in run.offsets))
     return unc, budget
 
 
