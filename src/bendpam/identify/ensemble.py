@@ -195,7 +195,7 @@ def spans_differ(d: FitData) -> bool:
     >>> spans_differ(NS(span=np.array([0.2, 0.2]))), spans_differ(NS(span=np.array([0.2, 0.1])))
     (False, True)
     """
-    span = np.asarray(getattr(d, "span", None) if getattr(d, "span", None) is not None else [], dtype=float)
+    span = np.asarray(d.span if getattr(d, "span", None) is not None else [], dtype=float)
     return bool(span.size and np.ptp(span) > 0.01 * float(np.max(np.abs(span))))
 
 

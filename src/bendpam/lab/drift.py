@@ -401,8 +401,11 @@ def set_drifts(estimates) -> bool:
     >>> set_drifts([e]), set_drifts([e, e]), set_drifts([e, None])      # two alike: 2.8 SE pooled
     (False, True, False)
     """
-    n = sum(e is not None for e in estimates)
-    z = set_drift(estimates)[1]
+    return _drifts(sum(e is not None for e in estimates), set_drift(estimates)[1])
+
+
+def _drifts(n: int, z: float) -> bool:
+    """``n`` tests whose pooled drift is ``z`` standard errors: does the set drift?"""
     return bool(n >= 2 and math.isfinite(z) and z >= SET_FLAG_SIGMAS)
 
 
@@ -417,10 +420,10 @@ def set_drift_findings(results) -> list[dict]:
     ['set drift']
     """
     ests = [getattr(r, "drift", None) for r in results]
-    if not set_drifts(ests) or all(e is None or e.flagged for e in ests):
-        return []
     rate, z = set_drift(ests)
     n, alone = sum(e is not None for e in ests), sum(e is not None and not e.flagged for e in ests)
+    if not _drifts(n, z) or not alone:
+        return []
     fixed = all(e is None or e.corrected for e in ests)
     what = ("corrected (--drift linear)" if fixed else
             "not corrected: each test's drift is counted in the fit's error bars; --drift linear corrects it")
