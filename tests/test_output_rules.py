@@ -111,7 +111,7 @@ def test_a_file_added_to_a_bendpam_set_is_kept(capsys, lab, tmp_path):
     assert tree(out) == before
     # a file of the set changed by hand is the user's too
     (out / "my-notes.txt").unlink()
-    with open(out / "summary.json", "a") as f:
+    with open(out / "summary.json", "a", encoding="utf-8") as f:
         f.write(" ")
     code, _, err = run(capsys, "process", lab / "raw", "--out", out, "--no-figure")
     assert code == 2 and f"'{out}/summary.json' was changed after bendpam wrote it" in one_error(err)

@@ -125,6 +125,33 @@ def test_the_check_sees_a_top_level_import():
     assert [n for _, n in _module_level_imports(tree)] == ["os", "fcntl"]
 
 
+def _text_io_without_encoding(tree: ast.AST) -> list[int]:
+    """Lines that read a file as text with the platform's encoding: ``x.read_text()`` without ``encoding=``, or
+    ``open(...)`` in text mode without it (on Windows that is cp1252, not the UTF-8 bendpam writes)."""
+    found = []
+    for node in ast.walk(tree):
+        if not isinstance(node, ast.Call) or any(k.arg == "encoding" for k in node.keywords):
+            continue
+        f = node.func
+        if isinstance(f, ast.Attribute) and f.attr == "read_text" and not node.args:
+            found.append(node.lineno)
+        elif isinstance(f, ast.Name) and f.id == "open":
+            mode = node.args[1] if len(node.args) > 1 else next((k.value for k in node.keywords if k.arg == "mode"),
+                                                                 None)
+            if not (isinstance(mode, ast.Constant) and "b" in str(mode.value)):
+                found.append(node.lineno)
+    return found
+
+
+def test_text_is_read_and_written_with_a_named_encoding():
+    bad = [f"{path.relative_to(SRC).as_posix()}:{line}" for path in sorted(SRC.rglob("*.py"))
+           for line in _text_io_without_encoding(ast.parse(path.read_text(encoding="utf-8")))]
+    assert bad == [], "name the encoding (utf-8) where text is read:\n" + "\n".join(bad)
+    sample = ("Path('a').read_text()\nopen('b')\nopen('c', 'rb')\nopen('d', encoding='utf-8')\n"
+              "x.read_text(encoding='u')\n")
+    assert _text_io_without_encoding(ast.parse(sample)) == [1, 2]
+
+
 # ----------------------------------------------------------------------------------------------
 # the soft lock (no native lock on this system)
 # ----------------------------------------------------------------------------------------------

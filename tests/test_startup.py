@@ -162,7 +162,7 @@ def test_no_arguments_and_help_print_the_root_help(capsys):
 def test_a_full_stdout_is_one_error_line(args, tmp_path):
     """The short paths (root help, the entry's --version) keep the command line's error handling."""
     code = "import sys, bendpam_entry; sys.argv = ['bendpam', *sys.argv[1:]]; sys.exit(bendpam_entry.main())"
-    with open("/dev/full", "w") as full:
+    with open("/dev/full", "w", encoding="utf-8") as full:
         r = subprocess.run([sys.executable, "-c", code, *args], stdout=full, stderr=subprocess.PIPE, text=True,
                            cwd=tmp_path, timeout=120)
     assert r.returncode == 2 and r.stderr == "bendpam: error: No space left on device\n", r.stderr

@@ -117,7 +117,7 @@ def _set_plus(extra: str | None, edit: str | None, command: str = "process") -> 
             (d / "out" / extra).write_text("my notes\n")
             user.append(f"out/{extra}")
         if edit:
-            with open(d / "out" / edit, "a") as f:
+            with open(d / "out" / edit, "a", encoding="utf-8") as f:
                 f.write("\n")
             user.append(f"out/{edit}")
         if not user:  # another command's set: all of it is not this command's to lose
@@ -135,7 +135,7 @@ def _hand_file(name: str, text: str = "mine\n") -> Callable[[Path, dict[str, Pat
 
 def _edited_own_toml(d: Path, inp: dict[str, Path]) -> list[str]:
     _bendpam(d, "actuator", "--preset", "be-pam", "--out", "a.toml")
-    with open(d / "a.toml", "a") as f:
+    with open(d / "a.toml", "a", encoding="utf-8") as f:
         f.write("# my comment\n")
     return ["a.toml"]
 

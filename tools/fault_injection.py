@@ -310,7 +310,7 @@ def kill_args(command: str, inputs: dict[str, Path], out: Path) -> list[str]:
 def catches(pid: int, signum: int) -> bool | None:
     """Whether process ``pid`` has a handler for ``signum`` (Linux ``/proc``); None where that is unknown."""
     try:
-        status = Path(f"/proc/{pid}/status").read_text()
+        status = Path(f"/proc/{pid}/status").read_text(encoding="utf-8")
     except OSError:
         return None
     mask = next((line.split()[1] for line in status.splitlines() if line.startswith("SigCgt:")), None)

@@ -115,7 +115,7 @@ def fit(
                 save_figure(figure7(data, res), o.path(fig_name))
         bar.advance(0, description="fit")
     if as_json:
-        typer.echo((out / "fit.json").read_text())
+        typer.echo((out / "fit.json").read_text(encoding="utf-8"))
         return
     typer.echo(str(res))
     echo_wrote(f"wrote {out}/ (fit.json, fitted_actuator.toml{', ' + fig_name if figure else ''})")

@@ -201,7 +201,7 @@ def process(
     except ProcessingError as exc:
         raise UserError(_flags(str(exc))) from None
     if as_json:
-        typer.echo((out / "summary.json").read_text())
+        typer.echo((out / "summary.json").read_text(encoding="utf-8"))
         return
     for info in processed.files:
         typer.echo(_flags(file_line(info)))
