@@ -88,6 +88,19 @@ def test_python_m_bendpam(tmp_path):
     assert r.returncode == 0 and (tmp_path / "be.toml").is_file(), r.stderr
 
 
+def test_a_pipe_in_the_windows_code_page_gets_ascii_words_not_a_crash(tmp_path):
+    # on Windows a redirected standard output is cp1252, which has no Greek letters: the table's theta_free, the
+    # limits' sigma and the notes' mu must come out in words (or as cp1252 has them), with exit status 0
+    env = {**os.environ, "PYTHONIOENCODING": "cp1252"}
+    env.pop("PYTHONUTF8", None)
+    r = subprocess.run([sys.executable, "-m", "bendpam", "predict", "--preset", "be-pam", "--pressure-kpa", "200"],
+                       cwd=tmp_path, capture_output=True, timeout=120, env=env)
+    out = r.stdout.decode("cp1252")
+    assert r.returncode == 0, r.stderr.decode("cp1252")
+    assert "theta_free" in out and "sigma_frame" in out and "N·mm" in out
+    assert "internal error" not in r.stderr.decode("cp1252")
+
+
 def _module_level_imports(tree: ast.Module) -> list[tuple[int, str]]:
     """Imports that run when the module is imported: module level, including under if/try (not in functions)."""
     found: list[tuple[int, str]] = []

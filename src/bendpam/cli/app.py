@@ -380,6 +380,9 @@ def main(argv: list[str] | None = None) -> int:
     2
     """
     args = list(sys.argv[1:] if argv is None else argv)
+    from bendpam.infra.console import plain_streams
+
+    plain_streams()  # a pipe on Windows is cp1252: write what it lacks (theta, mu, <=) in ASCII words, not a crash
     if (not args or args == ["--help"]) and "_BENDPAM_COMPLETE" not in os.environ:  # (shell completion: Typer's)
         return _print_root_help()  # nothing runs: no output group, no signal handling (start-up)
     from bendpam.errors import BendpamError

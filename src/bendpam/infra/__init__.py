@@ -11,7 +11,8 @@ layer may use them.  None imports a POSIX-only module at module level.
 * :mod:`.signals`: SIGINT/SIGTERM as :class:`~.signals.Interrupted`, held sections, honest words;
 * :mod:`.locks`: the portable lock of an output target;
 * :mod:`.fsops`: temporaries, flushing, hashing and the folder swap;
-* :mod:`.atomic`, :mod:`.progress`, :mod:`.accessors`, :mod:`.display` (short summaries of results).
+* :mod:`.atomic`, :mod:`.progress`, :mod:`.accessors`, :mod:`.display` (short summaries of results);
+* :mod:`.console`: what a console's encoding lacks (a Windows pipe has no Greek letters) in ASCII words.
 """
 
 
