@@ -152,6 +152,20 @@ def test_a_numeric_metadata_row_between_names_and_data(tmp_path):
     assert raw.header_line == 1 and len(raw) == 5 and raw.data["force_n"].iat[-1] == 6.0
 
 
+def test_a_time_named_with_its_sampling_rate_group_is_the_time(tmp_path):
+    # catman ASCII names the time of a rate group 'Time DEVICE_1 (Sample rate 1) CH=1': the note on the sampling is
+    # not a rate channel, so the time is read (20 ms apart), not made from the sample index (first seen on a real
+    # export from a public repository, round 5 of the corpus)
+    lines = ["HBM_CATMAN_DATAFILE_40", "", "CHANNELS: 3", "",
+             "Time DEVICE_1 (Sample rate 1) CH=1\tLoad CH=2\tStroke CH=3", "s\tkN\tmm",
+             "T0 =10.11.17 16:53:58\tT0 =10.11.17 16:53:58\tT0 =10.11.17 16:53:58", "dt =20 ms\tdt =20 ms\tdt =20 ms"]
+    lines += [f"{0.02 * k:.2f}\t{0.5 * k:.1f}\t{0.1 * k:.1f}" for k in range(6)]
+    raw = read_test(_write(tmp_path / "catman.asc", lines))
+    assert raw.channels["time"]["source"] == "Time DEVICE_1 (Sample rate 1) CH=1"
+    assert len(raw) == 6 and raw.data["time_s"].iat[-1] == pytest.approx(0.1)
+    assert raw.data["force_n"].iat[-1] == pytest.approx(2500.0)  # 2.5 kN
+
+
 def test_specimen_groups_separated_by_an_empty_column(tmp_path):
     lines = ['"C1",,,,"C2",,', '"Temps","Force","Course","","Temps","Force","Course"',
              '"sec","N","mm","","sec","N","mm"']

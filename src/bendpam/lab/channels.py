@@ -417,6 +417,12 @@ class Candidate:
     unit_ok: bool
 
 
+#: A note on the sampling in a channel's name: a group in parentheses, or a tail after ' - ', that speaks of a
+#: sampling (or measuring) rate.
+_SAMPLING_NOTE = re.compile(r"\((?=[^()]*(?:rate|sampl|messrate|abtast))[^()]*\)"
+                            r"|\s-\s(?=.*(?:rate|sampl|messrate|abtast)).*$", re.IGNORECASE)
+
+
 def classify_column(col: ColumnInfo) -> list[Candidate]:
     """The roles (``time``, ``stroke``, ``force``, ``counter``) a column can play.
 
@@ -437,11 +443,13 @@ def classify_column(col: ColumnInfo) -> list[Candidate]:
     [('stroke', 'crosshead position (absolute)')]
     >>> [(c.role, c.kind) for c in classify_column(ColumnInfo(3, "Total Cycles", "Total Cycles", None))]
     [('counter', 'cycle counter')]
+    >>> name = "Time DEVICE_1 (Sample rate 1) CH=1"                  # HBM catman ASCII: the sampling is a note
+    >>> [c.role for c in classify_column(ColumnInfo(0, name, name, "s"))]
+    ['time']
     """
-    name = normalize_name(col.name)
-    head, dash, tail = col.name.partition(" - ")
-    if dash and re.search(r"rate|messrate|abtast", tail, re.IGNORECASE):
-        name = normalize_name(head)  # HBM catman: 'Time  1 - default sample rate' is the time of rate group 1
+    # a note on how the channel is sampled is not what it measures: HBM catman names the time of a rate group
+    # 'Time  1 - default sample rate' (Excel) or 'Time DEVICE_1 (Sample rate 1) CH=1' (ASCII)
+    name = normalize_name(_SAMPLING_NOTE.sub(" ", col.name))
     unit = (col.unit or "").strip()
     if name and re.fullmatch(r"[\d\s.,+-]+", name) and unit and unit_factor("stroke", unit):
         return [Candidate(col, "stroke", 0, "length channel of unknown kind", True)]
