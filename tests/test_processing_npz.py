@@ -136,6 +136,27 @@ def test_an_npz_changed_in_a_set_with_a_manifest_is_refused(written, tmp_path):
         load_processed(folder)
 
 
+def test_a_set_with_a_manifest_hashes_its_curves_nc_once(written, tmp_path, monkeypatch):
+    """The manifest's check of curves.nc gives the sha256 that the npz is compared with (not hashed again)."""
+    import bendpam.infra.fsops as fsops
+    import bendpam.infra.manifest as manifest
+
+    folder = tmp_path / "with-manifest"
+    with OutputSet(folder, command=["test"], producer="process") as out:
+        write_processed(load_processed(written), out.staging, figure=False)
+    seen: list[str] = []
+
+    def counting(path, *args, **kwargs):
+        seen.append(Path(path).name)
+        return real(path, *args, **kwargs)
+
+    real, plain = fsops.hash_file, load_processed(written)
+    monkeypatch.setattr(fsops, "hash_file", counting)
+    monkeypatch.setattr(manifest, "hash_file", counting)
+    assert_same_set(plain, load_processed(folder))
+    assert seen.count("curves.nc") == 1 and seen.count("curves.npz") == 1
+
+
 def test_the_command_line_says_why_in_one_line(capsys):
     """A warning a bendpam function raises about its caller's input is one ``bendpam: warning:`` line."""
     import importlib

@@ -321,11 +321,12 @@ def _mismatch(p: Path, why: str) -> str:
             "changed or damaged after bendpam wrote it)")
 
 
-def verify_file(path: str | os.PathLike[str]) -> None:
+def verify_file(path: str | os.PathLike[str]) -> str | None:
     """Check one file of a set against the manifest of its folder, if the folder has one.
 
     A file that the manifest does not list, or a folder without a manifest, passes (there
-    is nothing to check it against).
+    is nothing to check it against).  Returns the sha256 the file was checked against (None when
+    it was not checked), so that a reader need not hash it again.
 
     Raises
     ------
@@ -351,17 +352,18 @@ def verify_file(path: str | os.PathLike[str]) -> None:
     folder = p.parent
     m = read_manifest(folder)
     if m is None:
-        return
+        return None
     try:
         rel = p.resolve().relative_to(folder.resolve()).as_posix()
     except ValueError:
-        return
+        return None
     for entry in m["files"]:
         if entry["path"] == rel:
             why = _entry_problem(folder, entry)
             if why is not None:
                 raise FileFormatError(_mismatch(p, why))
-            return
+            return str(entry["sha256"])
+    return None
 
 
 # ----------------------------------------------------------------------------------------------
@@ -429,12 +431,13 @@ def ownership_problem(folder: Path, producer: str | None, shown: str | None = No
     return None
 
 
-def verify_input(path: str | os.PathLike[str]) -> None:
+def verify_input(path: str | os.PathLike[str]) -> str | None:
     """Check an input that is (or lies in) a bendpam output set against that set's manifest.
 
     A folder is checked whole (:func:`verify_set`), a file against the manifest of its
-    folder (:func:`verify_file`).  A folder whose ``manifest.json`` is not bendpam's is
-    someone else's data and passes unchecked, as does anything without a manifest.
+    folder (:func:`verify_file`, whose checked sha256 is returned; None otherwise).  A folder whose
+    ``manifest.json`` is not bendpam's is someone else's data and passes unchecked, as does anything
+    without a manifest.
 
     Raises
     ------
@@ -452,10 +455,10 @@ def verify_input(path: str | os.PathLike[str]) -> None:
     folder = p if p.is_dir() else p.parent
     try:
         if read_manifest(folder) is None:
-            return
+            return None
     except FileFormatError:
-        return
+        return None
     if p.is_dir():
         verify_set(p)
-    else:
-        verify_file(p)
+        return None
+    return verify_file(p)

@@ -587,8 +587,10 @@ def _write_npz(ds: xr.Dataset, nc) -> Path:
     return npz
 
 
-def _trusted_npz(nc) -> Path | None:
+def _trusted_npz(nc, nc_sha256: str | None = None) -> Path | None:
     """The ``curves.npz`` beside ``nc`` when it was written with this very ``nc`` (the sha256 it records), else None.
+
+    ``nc_sha256``: the sha256 of ``nc`` when the set's manifest has just checked it (not hashed again).
 
     A set written before 0.4 has none (``nc`` is read, silently).  One that was written with
     another ``curves.nc`` (the set was edited since, e.g. with xarray) or cannot be read is not
@@ -610,7 +612,7 @@ def _trusted_npz(nc) -> Path | None:
     except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as exc:
         why = f"it cannot be read ({type(exc).__name__})"
     else:
-        if recorded == hash_file(nc)[1]:
+        if recorded == (nc_sha256 or hash_file(nc)[1]):
             return npz
         why = f"it was written with another {nc.name} (that file was changed or replaced since)"
     warnings.warn(f"{npz}: not used, {why}; reading {nc} instead", UserWarning, stacklevel=3)
@@ -716,8 +718,8 @@ def load_processed(path) -> ProcessedSet:
     if not nc.exists():
         raise ProcessingError(f"{p}: no curves.nc here; give the output folder of 'bendpam process'")
     check_input_file(nc, "processed curves file")  # a regular file of a sane size (a pipe would hang the read)
-    verify_input(nc)  # a set that bendpam wrote is read only as it wrote it (its manifest's hashes)
-    source = _trusted_npz(nc) or nc  # the same variables, without a NetCDF reader to import
+    nc_sha = verify_input(nc)  # a set that bendpam wrote is read only as it wrote it (its manifest's hashes)
+    source = _trusted_npz(nc, nc_sha) or nc  # the same variables, without a NetCDF reader to import
     try:
         ds = _read_curves(source)
     except Exception as exc:
