@@ -30,7 +30,7 @@ NOT_DATA = {"truth.toml", "README.md", "SOURCES.md", "ATTRIBUTION.md"}
 
 TIME_S = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "min": 60.0}
 LENGTH_MM = {"mm": 1.0, "m": 1e3, "um": 1e-3, "in": 25.4}
-FORCE_N = {"N": 1.0, "kN": 1e3, "mN": 1e-3, "uN": 1e-6, "lbf": 4.4482216152605}
+FORCE_N = {"N": 1.0, "kN": 1e3, "mN": 1e-3, "uN": 1e-6, "lbf": 4.4482216152605, "kgf": 9.80665}
 CONVERT = {"time": TIME_S, "stroke": LENGTH_MM, "force": FORCE_N}
 TRUTH_KEY = {"time": "time_s", "stroke": "stroke_mm", "force": "force_n"}
 
@@ -40,7 +40,7 @@ KEYS = {
     "blocks": int, "specimens": int, "time": dict, "stroke": dict, "force": dict, "first": dict,
     "last": dict, "decimal": str, "delimiter": str, "oddities": list, "notes": str,
 }
-LICENCES = {"MIT", "Apache-2.0", "BSD-3-Clause", "CC0-1.0", "CC-BY-4.0", "GPL-3.0", "LGPL-2.1", "AGPL-3.0"}
+LICENCES = {"MIT", "Apache-2.0", "BSD-3-Clause", "CC0-1.0", "CC-BY-4.0", "GPL-3.0", "LGPL-2.1", "AGPL-3.0", "Unlicense"}
 SPREADSHEETS = {"xlsx", "xls (BIFF8)"}
 DELIMITERS = {"", ",", ";", "\t", " "}
 SOURCE = re.compile(r"^[A-Za-z0-9][\w.-]*/[\w.+-]+:[^@]+(@[0-9a-f]{40})?$")

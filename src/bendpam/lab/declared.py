@@ -457,15 +457,21 @@ def _convert_chunk(lines: np.ndarray, vals: np.ndarray, status: np.ndarray, cell
 
 def _names_rows_as_separators(any_num: np.ndarray, status: np.ndarray, n_roles: int, after_sep: bool
                               ) -> np.ndarray:  # fmt: skip
-    """Rows of numbers, leaving out a row with some numbers but no complete sample between two rows of
-    text (a names row holding a number, such as a sensor's serial number ``1281068``, above a block)."""
+    """Rows of numbers, leaving out rows with some numbers but no complete sample between two rows of
+    text: a names row holding a number (a sensor's serial number ``1281068``) above a block, or a block's
+    heading of several such rows (MTS MPT: ``Parado en: 100 cycle`` then ``Puntos: 51``)."""
     complete = np.zeros(any_num.size, dtype=bool)
     for g in range(status.shape[0] // n_roles):
         complete |= (status[g * n_roles:(g + 1) * n_roles] == _OK).all(axis=0)
     sep = ~any_num
-    before = np.concatenate([[after_sep], sep[:-1]])
-    after = np.concatenate([sep[1:], [False]])
-    return any_num & ~(~complete & before & after)
+    partial = any_num & ~complete
+    keep = any_num.copy()
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], partial.astype(np.int8), [0]])))
+    for a, b in zip(edges[::2].tolist(), edges[1::2].tolist(), strict=True):  # runs [a, b) of partial rows
+        before = sep[a - 1] if a > 0 else after_sep
+        if before and b < sep.size and sep[b]:
+            keep[a:b] = False
+    return keep
 
 
 def _fast_numbers(texts: list[str], needed: list[int], inp: _Input) -> np.ndarray | None:
