@@ -205,3 +205,24 @@ def test_the_study_fits_as_the_commands_do(small_study, tmp_path):
     assert cli["parameters"]["alpha0_deg"]["value"] == pytest.approx(rec["alpha0_deg"], abs=1e-6)
     # the same options: the same SE (to the Monte-Carlo error of a resampling term, should the fit use one)
     assert cli["parameters"]["alpha0_deg"]["stderr"] == pytest.approx(rec["se_alpha0_deg"], rel=0.1)
+
+
+def test_every_holdout5_case_generates_files_that_read_back(tmp_path):
+    """The fifth held-out set (new loop laws and faults): each case writes one file per pressure that reads back."""
+    from bendpam.lab import read_test
+
+    assert set(gen.HOLDOUT5) <= set(study.ALL_CASES) and study.SETS["holdout5"] is gen.HOLDOUT5
+    for name, full in gen.HOLDOUT5.items():
+        case = dataclasses.replace(full, pressures_kpa=full.pressures_kpa[-1:], cycles=2)
+        folder = tmp_path / name.replace("+", "_")
+        folder.mkdir()
+        info = gen.generate_set(case, 1, folder)
+        raw = read_test(folder / info["files"][0])
+        assert raw.pressure_kpa == case.pressures_kpa[0] and raw.dialect == case.dialect
+        assert len(raw.data) == info["tests"][0]["samples"] and np.all(np.isfinite(raw.data["force_n"]))
+    # the new rate-independent laws saturate where their textbook forms say
+    t, u = _triangle(span_deg=20.0)
+    H = gen.iwan_lognormal(t, u, 2.0, median_deg=1.0, sigma_ln=0.5)
+    assert H[999] == pytest.approx(-2.0, abs=1e-9) and H[-1] == pytest.approx(2.0, abs=1e-9)
+    H = gen.asymmetric_stop(t, u, 1.0, up=1.3, down=0.7)
+    assert H[999] == pytest.approx(-0.7, abs=1e-9) and H[-1] == pytest.approx(1.3, abs=1e-9)

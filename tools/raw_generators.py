@@ -62,6 +62,18 @@ Loop laws (all written here from their textbook forms):
 ``preisach``
     A discrete Preisach model: relays of random switching thresholds on the bending angle,
     symmetric in the mean; rate-independent, with loops that are not Prandtl-Ishlinskii's.
+``fractional``
+    A springpot (Scott Blair element), ``H = -c D^q u`` with a Caputo derivative of order ``q``: a power-law
+    relaxation modulus, the limit of a Prony series with log-spread relaxation times (Bagley & Torvik 1983).
+``iwan-lognormal``
+    An Iwan model: Jenkins elements (spring and slider) of equal stiffness with lognormally distributed slip angles.
+``coleman-hodgdon``
+    A Duhem model of Coleman & Hodgdon's form, ``dH/du = alpha sgn(du) (f - H) + g(u)``, with a loop width that
+    changes along the bending angle.
+``asymmetric-stop``
+    Stop operators whose yield differs with the direction: a loop wider on loading than on unloading.
+``rate-state``
+    Dieterich-Ruina rate-and-state friction (aging law) through a spring: healing at reversals and dwells.
 ``none``
     No loop (noise and drift only).
 
@@ -69,6 +81,10 @@ Drift shapes: linear (``drift_tau_s = 0``), or a thermal one, ``D (1 - exp(-t / 
 that settles over ``drift_tau_s`` (a load cell warming up): a linear correction leaves part of it.
 Other faults: a step of the offset halfway through a test (``drift_step_fraction``, a knocked cable) and a
 force quantised to ``force_resolution_n`` (a coarse load-cell range).
+Faults of :data:`HOLDOUT5` (see :class:`Case`; every one off by default, so earlier sets' files are unchanged):
+a pressure leak and regulator ripple, a load cell's gain error and nonlinearity, a compliant frame in series with
+the fixture, a first-order filter on the force channel only, dropped rows, a higher detection load, a force clipped
+at a range limit, and a Mullins-like softening of the bladder (Miehe's continuous damage).
 """
 
 from __future__ import annotations
@@ -84,11 +100,11 @@ import bendpam
 from bendpam import presets
 from bendpam.infra.atomic import atomic_write_text
 
-__all__ = ["CASES", "HOLDOUT", "HOLDOUT2", "HOLDOUT3", "HOLDOUT4", "LOOPS",
+__all__ = ["CASES", "HOLDOUT", "HOLDOUT2", "HOLDOUT3", "HOLDOUT4", "HOLDOUT5", "LOOPS",
            "Case", "Truth", "case_truth", "generate_set", "machine_test", "start_actuator"]
 
 LOOPS = ("none", "maxwell-creep", "stiction", "viscous", "backlash", "bouc-wen", "masing", "friction-viscous", "lugre",
-         "two-maxwell", "preisach")
+         "two-maxwell", "preisach", "fractional", "iwan-lognormal", "coleman-hodgdon", "asymmetric-stop", "rate-state")
 DIALECTS = ("csv", "testxpert", "bluehill")
 SUFFIX = {"csv": ".csv", "testxpert": ".txt", "bluehill": ".csv"}
 DETECTION_LOAD_N = 0.2
@@ -317,6 +333,167 @@ def friction_viscous(t, u, A, *, speed_rad_s: float, share: float = 0.5, v0_frac
     return -A * (share * np.tanh(rate / v0) + (1.0 - share) * rate / speed_rad_s)
 
 
+def _first_ramp_reversed(u):
+    """The path before ``u``: its first ramp (up to the first reversal) run backwards, a loading into ``u[0]``."""
+    du = np.diff(u)
+    moving = np.flatnonzero(du != 0.0)
+    if moving.size == 0:
+        return u[:1]
+    sign = np.sign(du[moving[0]])
+    back = np.flatnonzero(np.sign(du[moving[0]:]) == -sign)
+    end = moving[0] + (int(back[0]) if back.size else du.size - moving[0]) + 1
+    return u[:end][::-1]
+
+
+def fractional(t, u, A, *, speed_rad_s: float, order: float = 0.4, tau_ref_s: float = 20.0):
+    """A springpot (Scott Blair element): ``H = -c D^q u``, the Caputo derivative of order ``q`` of the angle.
+
+    Its relaxation modulus is the power law ``G(t) = c t^-q / Gamma(1 - q)``, the limit of a generalised
+    Maxwell (Prony) series whose relaxation times are spread evenly on a log scale with weights ``tau^-q``
+    (Bagley & Torvik 1983; Mainardi, *Fractional calculus and waves in linear viscoelasticity*, 2010): a
+    viscoelastic bladder with no single relaxation time, relaxed (fully) to the quasi-static moment.  ``c`` is set
+    so that a ramp at ``speed_rad_s`` from rest reaches ``A`` after ``tau_ref_s``: ``c = A Gamma(2 - q) /
+    (v tau^(1 - q))``.  Discretised by the L1 scheme on the (uniform) sampling, with one loading ramp (the path's
+    first ramp run backwards) as the history before the test.
+    """
+    pre = _first_ramp_reversed(u)
+    path = np.concatenate([pre[:-1], u])
+    h = float(np.median(np.diff(t))) if t.size > 1 else 1.0
+    du = np.diff(path, prepend=path[0])
+    m = np.arange(path.size, dtype=float)
+    w = (m + 1.0) ** (1.0 - order) - m ** (1.0 - order)  # L1 weights of the increments, newest first
+    c = A * math.gamma(2.0 - order) / (speed_rad_s * tau_ref_s ** (1.0 - order))
+    d = np.convolve(du, w)[: path.size] * h ** (-order) / math.gamma(2.0 - order)
+    return -c * d[pre.size - 1:]
+
+
+def iwan_lognormal(t, u, A, *, median_deg: float = 1.5, sigma_ln: float = 0.9, n: int = 40):
+    """An Iwan (parallel-series) model: ``n`` Jenkins elements of equal stiffness, slip angles lognormal.
+
+    Each element is a spring ``k`` in series with a Coulomb slider that slips when the spring has stretched by its
+    slip angle ``r_i`` (force ``k r_i``); the ``r_i`` are the ``n`` quantiles of a lognormal of median ``median_deg``
+    and log-standard deviation ``sigma_ln`` (Iwan 1966, *J. Appl. Mech.* 33: 893; Segalman 2005), and ``k`` is such
+    that all of them sliding give ``A``.  Rate-independent; Masing's rules hold.
+    """
+    from scipy.special import ndtri
+
+    r = math.radians(median_deg) * np.exp(sigma_ln * ndtri((np.arange(n) + 0.5) / n))
+    k = A / float(r.sum())
+    lim = k * r
+    h = lim.copy()  # after a loading (u decreasing): every element slipping, H = +A
+    out = np.empty(u.size)
+    du = np.diff(u, prepend=u[0])
+    for i in range(u.size):
+        h = np.clip(h - k * du[i], -lim, lim)
+        out[i] = h.sum()
+    return out
+
+
+def coleman_hodgdon(t, u, A, *, span_rad: float, theta_c_deg: float = 4.0, kappa: float = 0.8):
+    """A Duhem model of Coleman & Hodgdon's form, ``dH/du = alpha sgn(du) (f(u) - H) + g(u)``.
+
+    (Coleman & Hodgdon 1986, *Int. J. Eng. Sci.* 24: 897; Duhem's class of rate-independent models.)  The
+    anhysteretic curve ``f`` is the quasi-static moment itself (so ``f = 0`` here), ``alpha = 1 / theta_c``, and
+    ``g(u) = -alpha A w(u)`` with a width ``w(u) = 1 + kappa (u / span - 1/2)`` that changes along the bending
+    angle (friction that grows, ``kappa > 0``, or falls toward the free state): each branch tends to ``-+A w(u)``
+    exponentially over ``theta_c``.  Integrated by the midpoint rule in ``u``.
+    """
+    alpha = 1.0 / math.radians(theta_c_deg)
+
+    def g(x):
+        return -alpha * A * (1.0 + kappa * (x / span_rad - 0.5))
+
+    y = A * (1.0 + kappa * (float(u[0]) / span_rad - 0.5))  # after a loading: on the upper branch
+    out = np.empty(u.size)
+    out[0] = y
+    for i in range(1, u.size):
+        du = float(u[i] - u[i - 1])
+        if du:
+            s = math.copysign(1.0, du)
+            xm = 0.5 * float(u[i] + u[i - 1])
+            ym = y + 0.5 * du * (alpha * s * -y + g(float(u[i - 1])))
+            y = y + du * (alpha * s * -ym + g(xm))
+        out[i] = y
+    return out
+
+
+def asymmetric_stop(t, u, A, *, up: float = 1.3, down: float = 0.7, n: int = 6, u_min=math.radians(0.4),
+                    u_max=math.radians(4.0)):
+    """Stop operators with direction-dependent yield: a loop wider on loading than on unloading.
+
+    ``n`` elasto-plastic (stop) elements of geometrically spaced yield angles, each of stiffness ``k_i`` and
+    equal share of ``A``; element ``i`` saturates at ``+up A / n`` while the machine straightens the actuator and at
+    ``-down A / n`` while it bends freely (the asymmetric play/stop operators of asymmetric Prandtl-Ishlinskii
+    models, e.g. Janaideh, Rakheja & Su 2009, *Smart Mater. Struct.*, written for McKibben muscles' and
+    piezo actuators' asymmetric loops).  The loop's centre lies ``(up - down) A / 2`` above the quasi-static
+    moment where every element saturates.
+    """
+    r = np.geomspace(u_min, u_max, n)
+    hi, lo = np.full(n, up * A / n), np.full(n, -down * A / n)
+    k = 0.5 * (hi - lo) / r
+    h = hi.copy()  # after a loading (u decreasing)
+    out = np.empty(u.size)
+    du = np.diff(u, prepend=u[0])
+    for i in range(u.size):
+        h = np.clip(h - k * du[i], lo, hi)
+        out[i] = h.sum()
+    return out
+
+
+def rate_state(t, u, A, *, speed_rad_s: float, mu0: float = 0.6, a: float = 0.02, b: float = 0.03,
+               dc_deg: float = 0.2, elastic_deg: float = 0.3, substeps: int = 4):
+    """Dieterich-Ruina rate-and-state friction through a spring (a spring-slider, Ruina 1983's aging law).
+
+    ``mu = a asinh(v / (2 v*) exp((mu0 + b ln(v* theta / Dc)) / a))`` (the regularised form of
+    ``mu0 + a ln(v / v*) + b ln(v* theta / Dc)``, Rice & Ben-Zion 1996), ``dtheta/dt = 1 - |v| theta / Dc``
+    (Dieterich 1979, Ruina 1983), normal load ``A / mu0``; the slider is driven by the bending angle through a
+    spring that takes ``A`` over ``elastic_deg``; ``v*`` is the test's speed.  The contact heals while it is still
+    (reversals, dwells), so friction peaks at breakaway and decays over ``Dc``.  Implicit Euler in time.
+    """
+    N = A / mu0
+    k = A / math.radians(elastic_deg)
+    dc = math.radians(dc_deg)
+    vs = speed_rad_s
+    q = -np.asarray(u, dtype=float)  # friction's own coordinate: H > 0 when u decreases
+    theta = dc / vs  # steady sliding at v* toward the blocked state
+    F = A
+    y = float(q[0]) - F / k
+
+    def rate(F, theta):
+        c = (mu0 + b * math.log(vs * theta / dc)) / a
+        x = F / (a * N)
+        e1, e2 = math.exp(min(x - c, 700.0)), math.exp(min(-x - c, 700.0))
+        return vs * (e1 - e2), vs * (e1 + e2) / (a * N)
+
+    out = np.empty(q.size)
+    out[0] = F
+    dt = np.diff(t, prepend=t[0])
+    for i in range(1, q.size):
+        h = dt[i] / substeps
+        for j in range(substeps):
+            qn = float(q[i - 1] + (q[i] - q[i - 1]) * (j + 1) / substeps)
+            T = k * (qn - y)  # the spring force if the slider did not move
+            lo, hi = min(0.0, T), max(0.0, T)
+            Fn = min(max(F, lo), hi)
+            for _ in range(60):
+                v, dv = rate(Fn, theta)
+                r = Fn + k * h * v - T
+                if abs(r) <= 1e-12 * A:
+                    break
+                if r > 0:
+                    hi = Fn
+                else:
+                    lo = Fn
+                step = Fn - r / (1.0 + k * h * dv)
+                Fn = step if lo < step < hi else 0.5 * (lo + hi)
+            v, _ = rate(Fn, theta)
+            y += h * v
+            F = Fn
+            theta = (theta + h) / (1.0 + h * abs(v) / dc)
+        out[i] = F
+    return out
+
+
 # ------------------------------------------------------------------------------------------------
 # cases and truths
 # ------------------------------------------------------------------------------------------------
@@ -334,6 +511,26 @@ class Case:
     drift_tau_s : 0: the drift is linear in time; > 0: it settles exponentially with this time constant (s).
     drift_step_fraction : a step of the offset halfway through each test (fraction of the blocked force).
     force_resolution_n : the force is rounded to this resolution (N; 0: not).
+
+    The faults below (added for :data:`HOLDOUT5`) are all off by default:
+
+    pressure_leak_fraction : the actuator's pressure falls linearly by this fraction over the cycles (a slow leak
+        of a sealed actuator); the header keeps the nominal pressure.
+    pressure_ripple_fraction, pressure_ripple_period_s : the regulator's pressure oscillates by this fraction
+        (amplitude) with this period, at a random phase per test.
+    load_cell_gain, load_cell_nonlinearity, load_cell_range_n : the load cell reads ``(1 + gain) F`` plus a bow
+        ``nonlinearity * range * 4 x (1 - |x|)``, ``x = F / range`` (a calibration error within a class).
+    frame_compliance_mm_per_n : a spring in series with the fixture (the frame, the load cell, the fixture's
+        rods): the crosshead's stroke, zeroed on the blocked actuator, overstates the plates' travel by the
+        force's fall times this compliance.
+    detection_load_n : the load at which the machine calls the actuator free (default the 0.2 N of every set).
+    force_clip_n : the force saturates at +-this (the amplifier's range; 0: not).
+    force_filter_tau_s : the force channel passes a first-order low-pass of this time constant (an amplifier's
+        filter) that the stroke channel does not: the force lags the stroke.
+    dropped_fraction : about this share of the rows is lost, in bursts of a few samples (a logger's buffer).
+    softening_fraction, softening_cycles : the bladder's moduli soften by up to this fraction as the bending
+        angle accumulates, ``s = s_inf (1 - exp(-arc / (softening_cycles * 2 span)))`` (Miehe's continuous
+        damage, a Mullins-like softening that slows cycle by cycle); the truth is the virgin material.
     """
 
     name: str
@@ -358,6 +555,19 @@ class Case:
     speed_mm_min: float = 30.0
     rate_hz: float = 20.0
     dwell_s: float = 0.0
+    pressure_leak_fraction: float = 0.0
+    pressure_ripple_fraction: float = 0.0
+    pressure_ripple_period_s: float = 6.0
+    load_cell_gain: float = 0.0
+    load_cell_nonlinearity: float = 0.0
+    load_cell_range_n: float = 50.0
+    frame_compliance_mm_per_n: float = 0.0
+    detection_load_n: float = DETECTION_LOAD_N
+    force_clip_n: float = 0.0
+    force_filter_tau_s: float = 0.0
+    dropped_fraction: float = 0.0
+    softening_fraction: float = 0.0
+    softening_cycles: float = 2.0
 
 
 CASES = {c.name: c for c in (
@@ -475,6 +685,44 @@ HOLDOUT4 = {c.name: c for c in (
 )}
 
 
+#: A fifth held-out set, written on 2026-11-26 independently of the fit (its laws and faults chosen from the physics
+#: and instrumentation literature, not from bendpam's ensemble) and scored once (``calibration_study.py --set
+#: holdout5``): five loop laws no earlier set used (a springpot, i.e. a power-law Prony kernel; an Iwan model with
+#: lognormal slip angles; a Coleman-Hodgdon Duhem model with a width that changes along the angle; asymmetric stop
+#: operators; rate-and-state friction), a Mullins-like softening, and instrument and test faults (a pressure leak,
+#: regulator ripple, a load cell's gain and nonlinearity, a compliant frame, a filtered force channel, dropped rows,
+#: a higher detection load, a clipped force, 5-7 cycles, other speeds).
+HOLDOUT5 = {c.name: c for c in (
+    Case("fractional+leak", pressures_kpa=(100.0, 130.0, 160.0, 190.0), d_alpha0_deg=0.6, mu_factor=1.04,
+         loop="fractional", loop_fraction=0.04, loop_options={"order": 0.4, "tau_ref_s": 20.0}, noise_fraction=0.01,
+         noise_ar1=0.85, pressure_leak_fraction=0.02, cycles=5, dialect="bluehill"),
+    Case("iwan-lognormal-bc-fb+frame", preset="bc-pam", model="force_balance",
+         pressures_kpa=(50.0, 70.0, 90.0, 110.0, 130.0), d_alpha0_deg=-0.5, shape=0.5, loop="iwan-lognormal",
+         loop_fraction=0.05, loop_options={"median_deg": 1.5, "sigma_ln": 0.9, "n": 40}, noise_fraction=0.015,
+         noise_ar1=0.8, frame_compliance_mm_per_n=0.01, dialect="csv"),
+    Case("coleman-hodgdon+loadcell", pressures_kpa=(110.0, 140.0, 170.0, 200.0), d_alpha0_deg=0.5, mu_factor=0.97,
+         shape=0.4, loop="coleman-hodgdon", loop_fraction=0.05, loop_options={"theta_c_deg": 4.0, "kappa": 0.8},
+         noise_fraction=0.01, noise_ar1=0.9, load_cell_gain=0.005, load_cell_nonlinearity=0.0015,
+         load_cell_range_n=50.0, dialect="testxpert"),
+    Case("asymmetric-bc+ripple", preset="bc-pam", pressures_kpa=(45.0, 65.0, 85.0, 105.0), d_alpha0_deg=0.6,
+         loop="asymmetric-stop", loop_fraction=0.05, loop_options={"up": 1.3, "down": 0.7}, noise_fraction=0.02,
+         noise_ar1=0.85, pressure_ripple_fraction=0.006, pressure_ripple_period_s=6.0, dialect="bluehill"),
+    Case("rate-state-fb+filter+drops", model="force_balance", pressures_kpa=(100.0, 140.0, 180.0), d_alpha0_deg=-0.6,
+         mu_factor=1.05, shape=0.5, loop="rate-state", loop_fraction=0.05, noise_fraction=0.008, noise_ar1=0.9,
+         dwell_s=2.0, speed_mm_min=45.0, force_filter_tau_s=0.15, dropped_fraction=0.02, dialect="csv"),
+    Case("mullins-bc", preset="bc-pam", pressures_kpa=(50.0, 70.0, 90.0, 110.0, 130.0), d_alpha0_deg=0.4,
+         mu_factor=1.02, loop="iwan-lognormal", loop_fraction=0.03, loop_options={"median_deg": 2.5, "sigma_ln": 0.6},
+         softening_fraction=0.015, softening_cycles=2.0, cycles=6, noise_fraction=0.01, noise_ar1=0.9,
+         dialect="testxpert"),
+    Case("fractional-clip+preload", pressures_kpa=(90.0, 115.0, 140.0, 165.0, 190.0, 215.0), d_alpha0_deg=-0.7,
+         shape=0.45, loop="fractional", loop_fraction=0.04, loop_options={"order": 0.6, "tau_ref_s": 20.0},
+         noise_fraction=0.02, noise_ar1=0.9, detection_load_n=1.0, force_clip_n=20.0, dialect="csv"),
+    Case("coleman-hodgdon-bc-fb-fast+leak", preset="bc-pam", model="force_balance", pressures_kpa=(55.0, 85.0, 115.0),
+         d_alpha0_deg=-0.4, mu_factor=0.98, loop="coleman-hodgdon", loop_fraction=0.06,
+         loop_options={"theta_c_deg": 2.5, "kappa": -0.6}, noise_fraction=0.025, noise_ar1=0.9, cycles=7,
+         speed_mm_min=60.0, rate_hz=50.0, pressure_leak_fraction=0.03, dialect="testxpert"),
+)}
+
 @dataclass(frozen=True)
 class Truth:
     """The true actuator of a case and the values a fit should recover (deg, kPa)."""
@@ -535,6 +783,16 @@ def _loop(case: Case, t, u, A, speed_rad_s: float, span_rad: float):
         return two_maxwell(t, u, A, speed_rad_s=speed_rad_s, **opts)
     if case.loop == "preisach":
         return preisach(t, u, A, **opts)
+    if case.loop == "fractional":
+        return fractional(t, u, A, speed_rad_s=speed_rad_s, **opts)
+    if case.loop == "iwan-lognormal":
+        return iwan_lognormal(t, u, A, **opts)
+    if case.loop == "coleman-hodgdon":
+        return coleman_hodgdon(t, u, A, span_rad=span_rad, **opts)
+    if case.loop == "asymmetric-stop":
+        return asymmetric_stop(t, u, A, **opts)
+    if case.loop == "rate-state":
+        return rate_state(t, u, A, speed_rad_s=speed_rad_s, **opts)
     raise ValueError(f"unknown loop {case.loop!r}; one of {', '.join(LOOPS)}")
 
 
@@ -569,11 +827,44 @@ def machine_test(case: Case, truth: Truth, pressure_kpa: float, rng: np.random.G
     beta_hi = min(MAX_BETA_RAD, 0.5 * k_lim * rig.L0)
     speed_rad_s = 2.0 * (case.speed_mm_min / 60.0) / rig.d  # about, near the blocked state
     gap = float(case.loop_options.get("gap_mm", 0.3)) if case.loop == "backlash" else 0.0
+    varying = bool(case.pressure_leak_fraction or case.pressure_ripple_fraction or case.softening_fraction)
+    phase = float(rng.uniform(0.0, 2.0 * math.pi)) if case.pressure_ripple_fraction else 0.0
+    soft_law = (bendpam.MomentLaw.of(act.replace(C10_kpa=act.C10_kpa * (1.0 - case.softening_fraction),
+                                                 C01_kpa=act.C01_kpa * (1.0 - case.softening_fraction)), case.model)
+                if case.softening_fraction else None)
 
-    def force(t, cross, span_rad):
-        beta = rig.beta(play(cross, gap) if gap else cross)
+    def m_varying(t, u, span_rad, cycle_end_s):
+        """The quasi-static moment with the pressure's leak and ripple and the bladder's softening."""
+        p = np.full(u.size, float(pressure_kpa))
+        if case.pressure_ripple_fraction:
+            p = p * (1.0 + case.pressure_ripple_fraction * np.sin(2.0 * math.pi * t / case.pressure_ripple_period_s
+                                                                   + phase))
+        if case.pressure_leak_fraction and cycle_end_s:  # the cycles (not the release that finds the free state)
+            p = p * (1.0 - case.pressure_leak_fraction * (t - t[0]) / cycle_end_s)
+        k = sign * u / rig.L0
+        m = sign * law.moment(p, k)
+        if soft_law is not None:
+            arc = np.concatenate([[0.0], np.cumsum(np.abs(np.diff(u)))]) + (span_rad if cycle_end_s else 0.0)
+            frac = 1.0 - np.exp(-arc / (case.softening_cycles * 2.0 * span_rad))  # of the full softening
+            m = m + frac * (sign * soft_law.moment(p, k) - m)
+        return m
+
+    def force_at(t, stroke, span_rad, cycle_end_s):
+        beta = rig.beta(play(stroke, gap) if gap else stroke)
         u = 2.0 * beta
-        return rig.force(m_qs(u / rig.L0) + _loop(case, t, u, A, speed_rad_s, span_rad), beta)
+        mq = m_varying(t, u, span_rad, cycle_end_s) if varying else m_qs(u / rig.L0)
+        return rig.force(mq + _loop(case, t, u, A, speed_rad_s, span_rad), beta)
+
+    def force(t, cross, span_rad, cycle_end_s=0.0):
+        f = force_at(t, cross, span_rad, cycle_end_s)
+        if case.frame_compliance_mm_per_n:  # the plates travel the crosshead's stroke plus the frame's relaxation
+            for _ in range(30):
+                g = force_at(t, cross + case.frame_compliance_mm_per_n * (f[0] - f), span_rad, cycle_end_s)
+                done = float(np.max(np.abs(g - f))) < 1e-10
+                f = g
+                if done:
+                    break
+        return f
 
     # 1. the machine releases the actuator from the blocked state until the force falls to the detection load
     s_hi = float(rig.stroke(beta_hi))
@@ -582,15 +873,24 @@ def machine_test(case: Case, truth: Truth, pressure_kpa: float, rng: np.random.G
     mq = m_qs(kk)
     span = float(kk[np.argmax(mq <= 0.0)] * rig.L0) if np.any(mq <= 0.0) else 2.0 * beta_hi  # quasi-static free angle
     f = force(s / (case.speed_mm_min / 60.0), s, span)
-    below = np.flatnonzero(f <= DETECTION_LOAD_N)
+    load = case.detection_load_n
+    below = np.flatnonzero(f <= load)
     if below.size == 0 or below[0] == 0:
         raise ValueError(f"{case.name}: at {pressure_kpa:g} kPa the force never falls to the detection load")
     j = int(below[0])
-    s_free = float(s[j - 1] + (s[j] - s[j - 1]) * (f[j - 1] - DETECTION_LOAD_N) / (f[j - 1] - f[j]))
+    s_free = float(s[j - 1] + (s[j] - s[j - 1]) * (f[j - 1] - load) / (f[j - 1] - f[j]))
     # 2. the cycles
     t, cross = _path(s_free, case)
-    clean = force(t, cross, span)
+    clean = force(t, cross, span, float(t[-1] - t[0]))
     F_block = float(clean[0])
+    measured = clean
+    if case.load_cell_gain or case.load_cell_nonlinearity:  # the load cell's calibration error
+        x = clean / case.load_cell_range_n
+        measured = clean * (1.0 + case.load_cell_gain) + (case.load_cell_nonlinearity * case.load_cell_range_n
+                                                          * 4.0 * x * (1.0 - np.abs(x)))
+    if case.force_filter_tau_s:  # the amplifier's first-order low-pass (exact for a signal linear over each step)
+        a = math.exp(-float(np.median(np.diff(t))) / case.force_filter_tau_s)
+        measured = lfilter([1.0 - a], [1.0, -a], measured, zi=[a * measured[0]])[0]
     w = rng.normal(0.0, 1.0, t.size)
     w[1:] *= math.sqrt(1.0 - case.noise_ar1**2)  # e_0 = w_0, e_n = phi e_(n-1) + sqrt(1 - phi^2) w_n: stationary
     noise = lfilter([1.0], [1.0, -case.noise_ar1], w)
@@ -600,10 +900,20 @@ def machine_test(case: Case, truth: Truth, pressure_kpa: float, rng: np.random.G
     drift = case.drift_fraction * F_block * x
     if case.drift_step_fraction:
         drift = drift + case.drift_step_fraction * F_block * (t >= t[0] + 0.5 * (t[-1] - t[0]))
-    force_n = clean + case.noise_fraction * F_block * noise + drift
+    force_n = measured + case.noise_fraction * F_block * noise + drift
+    if case.force_clip_n > 0:
+        force_n = np.clip(force_n, -case.force_clip_n, case.force_clip_n)
     if case.force_resolution_n > 0:
         force_n = np.round(force_n / case.force_resolution_n) * case.force_resolution_n
     stroke = cross + rng.normal(0.0, 0.002, t.size)
+    if case.dropped_fraction:  # bursts of 1-7 lost rows (4 on average), never the first or the last
+        starts = np.flatnonzero(rng.random(t.size) < case.dropped_fraction / 4.0)
+        lengths = rng.integers(1, 8, starts.size)
+        keep = np.ones(t.size, dtype=bool)
+        for a0, n0 in zip(starts, lengths, strict=True):
+            keep[a0:a0 + n0] = False
+        keep[0] = keep[-1] = True
+        t, stroke, force_n, drift = t[keep], stroke[keep], force_n[keep], drift[keep]
     info = {"pressure_kpa": pressure_kpa, "free_stroke_mm": s_free, "blocked_force_n": F_block,
             "blocked_moment_nmm": Mb, "loop_amplitude_nmm": A, "samples": int(t.size),
             "duration_s": float(t[-1]), "drift_n": float(drift[-1] if np.size(drift) else 0.0)}
