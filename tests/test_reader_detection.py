@@ -240,6 +240,31 @@ def test_one_test_per_values_sheet_of_a_workbook(tmp_path, monkeypatch):
     assert b.data["force_n"].tolist() == [0.0, 3.0, 6.0, 9.0, 12.0]
 
 
+def test_sheets_that_continue_one_test_are_that_test(tmp_path, monkeypatch):
+    # TA Instruments TRIOS writes a sheet per step of the procedure (a ramp, a hold, a ramp...), time running on
+    # from sheet to sheet: one test of its sheets' samples, each sheet a block (a sheet per specimen, whose time
+    # starts again, stays a test of its own; the test above)
+    import bendpam.lab.excel as excel
+
+    def step(k: int, n: int = 4) -> list[str]:
+        return ["Step time\tTime\tDisplacement\tForce", "s\ts\tmm\tN"] + [
+            f"{0.5 * i:.1f}\t{10.0 * k + 0.5 * i:.1f}\t{0.1 * (k + i):.1f}\t{k + 0.25 * i:.2f}" for i in range(n)]
+
+    sheets = [excel.Sheet("Details", ["Procedure\tramp, hold", "Operator\tX"]), excel.Sheet("Ramp - 1", step(0)),
+              excel.Sheet("Hold - 2", step(1)), excel.Sheet("Ramp - 3", step(2, 3))]
+    monkeypatch.setattr(excel, "workbook_sheets", lambda path: sheets)
+    path = tmp_path / "trios.xlsx"
+    path.write_bytes(b"PK\x03\x04" + bytes(60))
+    tests = read_tests(path)
+    assert len(tests) == 1 and tests[0].specimen is None
+    raw = read_test(path)
+    assert len(raw) == 11 and raw.data["time_s"].tolist()[3:6] == [1.5, 10.0, 10.5]
+    assert [b["sheet"] for b in raw.blocks] == ["Ramp - 1", "Hold - 2", "Ramp - 3"]
+    assert [b["start"] for b in raw.blocks] == [0, 4, 8] and raw.metadata["sheets"] == "Ramp - 1; Hold - 2; Ramp - 3"
+    assert any("continue one test" in w for w in raw.warnings)
+    assert raw.data["force_n"].iat[-1] == 2.5
+
+
 def test_channels_found_by_their_units_when_no_name_is_known(tmp_path):
     lines = ["Kanal A (s);Kanal B (mm);Kanal C (kN)"]
     lines += [f"{k};{0.5 * k};{0.25 * k}".replace(".", ",") for k in range(5)]

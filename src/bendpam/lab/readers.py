@@ -347,18 +347,21 @@ def read_test(
         return tests[0]
     raw = _read_one(path, pressure_kpa=pressure_kpa, dialect=dialect, columns=columns, rate_hz=rate_hz,
                     repair=repair)  # fmt: skip
-    _refuse_several(raw, pressure_kpa=pressure_kpa, dialect=dialect, columns=columns, rate_hz=rate_hz, repair=repair)
-    return raw
+    return _the_one(raw, pressure_kpa=pressure_kpa, dialect=dialect, columns=columns, rate_hz=rate_hz, repair=repair)
 
 
-def _refuse_several(raw: RawTest, **kw: Any) -> None:
-    """read_test's refusal of a file that holds several tests (specimens, sheets or blocks), naming them."""
+def _the_one(raw: RawTest, **kw: Any) -> RawTest:
+    """read_test's one test: ``raw``, or its sheets joined when they continue one test; refused, naming them, when
+    the file holds several tests (specimens, sheets or blocks)."""
     labels = _specimen_labels(raw)
     if len(labels) > 1:
         raise ReadError(f"holds {len(labels)} specimens side by side ({', '.join(labels[:4])}"
                         f"{', ...' if len(labels) > 4 else ''}); read them with read_tests",
                         raw.path, raw.header_line)  # fmt: skip
     sheets = _other_sheets(raw, **kw)
+    joined = _join_sheets([raw, *sheets]) if sheets and raw.dialect != "zs2" else []
+    if len(joined) == 1:
+        return joined[0]
     if sheets:
         names = ", ".join(repr(s) for s in [raw.metadata.get("sheet"), *[t.metadata.get("sheet") for t in sheets]])
         where = "specimens of the series" if raw.dialect == "zs2" else "sheets"
@@ -369,6 +372,7 @@ def _refuse_several(raw: RawTest, **kw: Any) -> None:
         lines = ", ".join(str(t.header_line) for t in parts[1:4])
         raise ReadError(f"holds {len(parts)} tests in separate blocks (time restarts in the blocks at line(s) "
                         f"{lines}); read them with read_tests", raw.path, parts[1].header_line)  # fmt: skip
+    return raw
 
 
 def _read_one(path: str | os.PathLike, *, pressure_kpa: float | None, dialect: str | None,
@@ -584,6 +588,51 @@ def _other_sheets(raw: RawTest, **kw: Any) -> list[RawTest]:
     return out
 
 
+def _sheet_continues(a: RawTest, b: RawTest) -> bool:
+    """Does sheet ``b`` continue the test of sheet ``a``: the same channels, and time running on from it (as blocks
+    of a text file continue one test)?  A sheet per specimen (testXpert) starts its time again."""
+    if any(a.channels.get(r, {}).get("source") != b.channels.get(r, {}).get("source") for r in ROLES):
+        return False
+    ta, tb = a.data["time_s"].to_numpy(), b.data["time_s"].to_numpy()
+    return bool(a.channels["time"].get("source") is not None and ta.size and tb.size and tb[0] > ta[-1])
+
+
+def _join_sheets(tests: list[RawTest]) -> list[RawTest]:
+    """The tests of a workbook's sheets with the runs of sheets that continue one test (:func:`_sheet_continues`; a
+    TA Instruments TRIOS export writes a sheet per step of the procedure) joined, each sheet a block of it."""
+    import pandas as pd
+
+    from bendpam.lab.checks import time_structure
+
+    groups: list[list[RawTest]] = [[tests[0]]]
+    for t in tests[1:]:
+        if _sheet_continues(groups[-1][-1], t):
+            groups[-1].append(t)
+        else:
+            groups.append([t])
+    out = []
+    for g in groups:
+        if len(g) == 1:
+            out.append(g[0])
+            continue
+        data = pd.concat([t.data for t in g], ignore_index=True)
+        starts = np.cumsum([0] + [len(t) for t in g[:-1]])
+        counters = [t.cycle_counter for t in g if t.cycle_counter is not None]
+        names = [str(t.metadata.get("sheet")) for t in g]
+        warns = list(dict.fromkeys(w for t in g for w in t.warnings))
+        warns.append(f"the {len(g)} sheets {names[0]!r} to {names[-1]!r} continue one test (the same channels, "
+                     f"time running on): read as one test of {len(data)} samples, each sheet a block")
+        blocks = [{"line": t.header_line, "sheet": n, "columns": list(t.data.columns), "rows": len(t), "read": True,
+                   "start": int(a), "continues": k > 0}
+                  for k, (t, n, a) in enumerate(zip(g, names, starts, strict=True))]
+        out.append(dataclasses.replace(
+            g[0], data=data, warnings=warns, blocks=blocks,
+            segments=time_structure(data["time_s"].to_numpy()).segments(len(data)),
+            cycle_counter=np.concatenate(counters) if len(counters) == len(g) else None,
+            metadata={**g[0].metadata, "sheets": "; ".join(names)}))
+    return out
+
+
 def _specimen_labels(raw: RawTest) -> list[str]:
     for b in raw.blocks:
         if b.get("read") and b.get("specimens"):
@@ -665,7 +714,10 @@ def read_tests(
     if len(labels) <= 1:
         sheets = _other_sheets(raw, **kw)
         if sheets or raw.dialect == "zs2":  # a native Zwick file names its specimens, even a lone one
-            return [dataclasses.replace(t, specimen=t.metadata.get("sheet")) for t in [raw, *sheets]]
+            tests = [raw, *sheets] if raw.dialect == "zs2" else _join_sheets([raw, *sheets])
+            if len(tests) == 1 and raw.dialect != "zs2":  # every sheet continues one test: the workbook is that test
+                return tests
+            return [dataclasses.replace(t, specimen=t.metadata.get("sheet")) for t in tests]
         return _split_blocks(raw)
     out = [dataclasses.replace(raw, specimen=labels[0])]
     for k in range(1, len(labels)):
