@@ -335,3 +335,29 @@ def test_an_uncorrected_drift_says_how_far_correcting_it_would_move_alpha0():
     moved = fixed.actuator.alpha0_deg - left.actuator.alpha0_deg
     assert np.sign(said) == np.sign(moved) and 0.6 < said / moved < 1.6
     assert not [f for f in fixed.flags if "left uncorrected" in f]  # corrected: nothing to say
+
+
+def test_drifts_left_uncorrected_are_one_mode_whose_doubt_is_the_shift_correcting_them_makes():
+    # one load cell: the tests' shifts (with their signs) move the parameters together, by what the linearised
+    # refit says correcting them would; only each shift's own error (s / z) is independent of the others'
+    from bendpam.identify.data import offset_modes
+    from bendpam.identify.uncertainty import offset_shift, sandwich_covariance
+
+    rng = np.random.default_rng(4)
+    J = rng.normal(size=(12, 3))
+    rows = [np.arange(0, 4), np.arange(4, 8), np.arange(8, 12)]
+    w = np.ones(12)
+    groups = np.zeros(12, dtype=int)
+    shifts = [-0.5, -0.8, -1.1]
+    exact = [(r, abs(s), s) for r, s in zip(rows, shifts, strict=True)]  # known exactly (z infinite)
+    cov, _ = sandwich_covariance(J, np.zeros(12), groups, [], offset_modes(exact, w))
+    move = offset_shift(J, [(r, s * w[r]) for r, s in zip(rows, shifts, strict=True)])
+    assert np.sqrt(np.diag(cov)) == pytest.approx(np.abs(move), rel=1e-9)
+    # with an error of its own (z = 2 each), the doubt is the mode plus three independent offsets of s / 2
+    loose = [(r, math.hypot(s, s / 2.0), s) for r, s in zip(rows, shifts, strict=True)]
+    cov2, _ = sandwich_covariance(J, np.zeros(12), groups, [], offset_modes(loose, w))
+    alone = sum(np.outer(g, g) for g in (s / 2.0 * J[r].sum(axis=0) for r, s in zip(rows, shifts, strict=True)))
+    B = np.linalg.inv(J.T @ J)
+    assert cov2 == pytest.approx(cov + B @ alone @ B, rel=1e-9)
+    # a corrected drift (no shift) stays its own test's error
+    assert [u.tolist() for _, u in offset_modes([(rows[0], 0.3, 0.0)], w)] == [[0.3] * 4]

@@ -21,8 +21,19 @@ from bendpam.lab.drift import set_drifts
 from bendpam.physics.actuator import Actuator
 from bendpam.physics.braid import radius_terms
 
-__all__ = ["FitData", "bladder_stretch_range", "branch_data", "cycle_deviations", "cycle_period_s", "developed_range",
-           "drift_note", "drift_offsets", "fit_data", "relative_rate"]
+__all__ = [
+    "FitData",
+    "bladder_stretch_range",
+    "branch_data",
+    "cycle_deviations",
+    "cycle_period_s",
+    "developed_range",
+    "drift_note",
+    "drift_offsets",
+    "fit_data",
+    "offset_modes",
+    "relative_rate",
+]
 
 
 @dataclass
@@ -361,6 +372,34 @@ def drift_offsets(processed, d: FitData) -> list[tuple[np.ndarray, float, float]
         if math.isfinite(sd) and sd > 0:
             out.append((np.flatnonzero(d.seg == i), float(sd), shift if math.isfinite(shift) else 0.0))
     return out
+
+
+def offset_modes(offsets, w: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The drift's doubt as offsets of the weighted data (:func:`sandwich_covariance`'s ``offsets``).
+
+    A corrected drift's error is its own test's (independent of the others').  Drifts left uncorrected are
+    one load cell's: what correcting them would move, every test's shift with its sign, is one mode (its
+    effect on the parameters is the shift the fit's note reports), and only each shift's own error
+    ``s / z`` is independent.  Taken one test at a time, shifts of one sign could add up as though they had
+    any sign, and excite directions the data barely fix (a shape on its bound) far beyond what correcting
+    the drift does.
+
+    >>> rows = [np.array([0, 1]), np.array([2])]
+    >>> modes = offset_modes([(rows[0], 1.25, -1.0), (rows[1], 0.5, 0.0)], np.ones(3))
+    >>> [(r.tolist(), u.tolist()) for r, u in modes]       # 1.25 = hypot(1, 0.75): 0.75 alone, the shift as a mode
+    [([0, 1], [0.75, 0.75]), ([2], [0.5]), ([0, 1], [-1.0, -1.0])]
+    """
+    modes, shift_rows, shift_u = [], [], []
+    for rows, sd, shift in offsets:
+        own = math.sqrt(max(sd * sd - shift * shift, 0.0)) if shift else sd
+        if own > 0:
+            modes.append((rows, own * w[rows]))
+        if shift:
+            shift_rows.append(rows)
+            shift_u.append(shift * w[rows])
+    if shift_rows:
+        modes.append((np.concatenate(shift_rows), np.concatenate(shift_u)))
+    return modes
 
 
 def drift_note(shift: dict[str, float], sd: dict[str, float], tests: int) -> list[str]:

@@ -109,6 +109,7 @@ from bendpam.identify.data import (
     drift_note,
     drift_offsets,
     fit_data,
+    offset_modes,
 )
 from bendpam.identify.diagnose import (
     LIMITS,
@@ -831,7 +832,7 @@ def _uncertainty(prob: _Problem, bnd, nl_best, lin, corr_flag: float, cycles=(),
     if bound_names.get("S_lo", False) or bound_names.get("S_hi", False):
         cycles = ()  # the model cannot follow the curves (shape at an admissibility bound): misfit as noise
     weighted = [(rows, prob.w[rows][None, :] * E) for rows, E in cycles]
-    cov_int, rho = sandwich_covariance(J, r, prob.groups, weighted, [(i, sd * prob.w[i]) for i, sd, _ in offsets])
+    cov_int, rho = sandwich_covariance(J, r, prob.groups, weighted, offset_modes(offsets, prob.w))
     G = np.zeros((nn + len(prob.lin), x_int.size))
     G[:nn, :nn] = np.eye(nn)
     G[nn:, nn:] = prob.T
