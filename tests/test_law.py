@@ -14,6 +14,7 @@ from numpy.testing import assert_allclose
 import bendpam
 from bendpam import MomentLaw, presets
 from bendpam.errors import InputError
+from bendpam.physics.actuator import Actuator
 from bendpam.physics.models import get_model
 from bendpam.sweeps import build_cases
 from strategies import actuators as actuator_strategy
@@ -324,3 +325,17 @@ def test_tangent_stiffness_of_a_block_equals_one_by_one():
     got = law.tangent_stiffness(180.0, k)
     ref = [float(MomentLaw(base.replace(alpha0_deg=a), "energy").tangent_stiffness(180.0, kk)) for a, kk in zip(a0, k)]
     assert_allclose(got, ref, rtol=1e-12)
+
+
+def test_free_curvature_where_the_branch_parametrisation_degenerates():
+    # found by the property above: force balance, C10 = -254 kPa, the first branch ends where A and B of
+    # M = P A - B vanish together, so P_a = B / A jumps near 13.2 kPa without reaching 14 kPa; the root is then
+    # found on the moment's own sign (it had stopped 3.7e-6 1/mm short, M = 0.0017 N*mm of 29.7)
+    r, t, s, c1 = 12.0, 0.17329783081982397, 1.212890625, -254.125
+    act = Actuator(alpha0_deg=58.0, R0_mm=r, t0_mm=t * r, L0_mm=145.0, frame_thickness_mm=0.5, frame_width_mm=5.0,
+                   frame_modulus_mpa=6796.0, C10_kpa=c1, C01_kpa=12.0 - c1 + 20.0, P_start_kpa=0.0, R0_start_mm=r * s)
+    law = MomentLaw(act, "force_balance")
+    P = np.array([10.0, 13.5, 14.0, 20.0])
+    fb = law.free_curvature(P)
+    assert np.all(fb.status == "ok")
+    assert np.all(np.abs(law.moment(P, fb.curvature_per_mm)) <= 1e-9 * np.abs(law.blocked_moment(P)))

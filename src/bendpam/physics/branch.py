@@ -271,15 +271,22 @@ def solve_free(law: MomentLaw, tab: BranchTable, pa: np.ndarray, xtol: float = 1
     # the curvature at the last evaluation and its slope: k' at the root by one Taylor step (the root is
     # within xtol of it, so the step's error is of order xtol^2), without another evaluation of the law
     x_last, k_last, dk_last = np.full(q.size, np.nan), np.zeros(q.size), np.zeros(q.size)
+    g_last = np.zeros(q.size)
 
     def G(x, idx):  # P_a(u) - q, increasing along the branch; past A's sign change (unbounded end) beyond the root
         A, B, kx, dk = ev.coef_k(x, case[idx])
         x_last[idx], k_last[idx], dk_last[idx] = x, kx, dk
         with np.errstate(divide="ignore", invalid="ignore"):
-            return np.where(sgn[idx] * A > 0.0, B / A - q[idx], np.inf)
+            g = np.where(sgn[idx] * A > 0.0, B / A - q[idx], np.inf)
+        g_last[idx] = g
+        return g
 
     tol = xtol * np.abs(tab.x_end[case]) + 1e-300
     x = table_newton(G, x0, s0, a, b, ga, gb, tol)
+    stuck = np.flatnonzero(np.abs(g_last) > 1e-6 * np.maximum(q, 1.0))
+    if stuck.size:  # B and A vanish together near an unbounded end: P_a = B/A never reaches q there
+        x[stuck] = _bisect_moment(ev, case[stuck], sgn[stuck], q[stuck], a[stuck], b[stuck], x[stuck], tol[stuck])
+        x_last[stuck] = np.nan
     near = np.isfinite(x_last) & np.isfinite(k_last) & np.isfinite(dk_last) & (np.abs(x - x_last) <= tol)
     kx = np.where(near, k_last + dk_last * (x - x_last), 0.0)
     if not np.all(near):  # a root on a bracket's end (never evaluated), or one found by the bracket's width
@@ -287,6 +294,32 @@ def solve_free(law: MomentLaw, tab: BranchTable, pa: np.ndarray, xtol: float = 1
     k[case, col] = kx
     u[case, col] = x
     return k, u
+
+
+def _bisect_moment(ev, case, sgn, q, a, b, x, tol, steps: int = 200) -> np.ndarray:
+    """Roots of ``sgn (B - q A) = 0``, the moment's own sign, on ``[a, b]`` by bisection (all points at once).
+
+    ``P_a = B / A`` is the branch's parametrisation of the root; where ``A`` and ``B`` vanish together (an
+    unbounded end whose pole cancels), ``P_a`` jumps without reaching ``q`` and Newton on it stops short,
+    while ``B - q A`` (the moment at ``q``, up to a factor) stays continuous and changes sign at the root.
+    Points whose ends do not bracket a sign change keep ``x``.
+    """
+    def h(xx):
+        A, B = ev.coef(xx, case)
+        return sgn * (B - q * A)
+
+    lo, hi = a.copy(), b.copy()
+    hl, hh = h(lo), h(hi)
+    ok = (hl < 0.0) & (hh > 0.0)
+    for _ in range(steps):
+        if not np.any(ok & (hi - lo > tol)):
+            break
+        mid = 0.5 * (lo + hi)
+        hm = h(mid)
+        up = hm > 0.0
+        hi = np.where(ok & up, mid, hi)
+        lo = np.where(ok & ~up, mid, lo)
+    return np.where(ok, 0.5 * (lo + hi), x)
 
 
 def _bracket_index(pt: np.ndarray, pa: np.ndarray) -> np.ndarray:
