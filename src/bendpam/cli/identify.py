@@ -81,6 +81,12 @@ def fit(
     admissible_range: Annotated[RangeOpt, typer.Option(
         "--admissible-range", help="Stretches LO HI the bladder material must be physical over besides the "
         "tested ones (the range it will predict).")] = (0.6, 1.6),
+    force_uncertainty_pct: Annotated[float, typer.Option(
+        "--force-uncertainty-pct", min=0.0, max=20.0, help="The load cell's calibration, a standard uncertainty in % "
+        "of the reading (ISO 7500-1 class 1: 0.58): added to the error bars as the instrument's part.")] = 0.0,
+    pressure_uncertainty_kpa: Annotated[float, typer.Option(
+        "--pressure-uncertainty-kpa", min=0.0, max=100.0,
+        help="The pressure gauge's calibration, a standard uncertainty in kPa common to every test.")] = 0.0,
     out: Annotated[Optional[Path], typer.Option("--out", help="Output folder.")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print fit.json to stdout.")] = False,
     fig_format: FigureFormatOpt = None,
@@ -89,6 +95,7 @@ def fit(
 ):
     """Identify model parameters (alpha0, C10, C01, ...) from processed cyclic tests (section 3.4)."""
     from bendpam.identify.fitting import fit as run_fit
+    from bendpam.identify.uncertainty import Instrument
     from bendpam.infra.progress import Progress
     from bendpam.lab.processing import load_processed
 
@@ -104,7 +111,8 @@ def fit(
         bar.advance(0, description="fit (identifying)")
         res = run_fit(data, act, model_name(model), free=free, tension=tfit, tension_data=tdata,
                       fit_range=fit_range, hysteresis="auto" if hysteresis else None, hysteresis_law=hysteresis_law,
-                      admissible_range=admissible_range)
+                      admissible_range=admissible_range,
+                      instrument=Instrument(force_uncertainty_pct, pressure_uncertainty_kpa))
         bar.advance(0, description="fit (writing)")
         with output_set(out, [processed_dir, actuator, tension]) as o:
             res.save(o.staging, processed=Path(processed_dir).resolve().name,

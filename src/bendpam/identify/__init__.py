@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from bendpam.identify.data import bladder_stretch_range, developed_range
 from bendpam.identify.diagnose import LOOP_THRESHOLD, has_loop
-from bendpam.identify.fitting import fit, parse_free
+from bendpam.identify.fitting import fit
 from bendpam.identify.metrics import branch_nrmse, predicted_loss_ratios, score
 from bendpam.identify.result import (
     HYST_PARAMETERS,
@@ -32,6 +32,7 @@ from bendpam.identify.result import (
     Metrics,
     Parameter,
     Profile,
+    parse_free,
 )
 
 __all__ = [

@@ -70,7 +70,7 @@ from bendpam.identify.result import PARAMETERS, EnsembleMember, UncertaintyBudge
 from bendpam.identify.uncertainty import Uncertainty, lag1_autocorrelation, material_gradients
 
 __all__ = ["MEMBER_EXTRA", "SPAN_SCALED", "TWO_BRANCH", "MemberFit", "akaike_weights", "effective_points",
-           "member_weights", "model_average", "played_path", "span_scaled_z", "spans_differ", "steady_z",
+           "member_weights", "model_average", "part_sds", "played_path", "span_scaled_z", "spans_differ", "steady_z",
            "systematic_covariance", "uncertainty_budget"]
 
 #: The parameters a member of the ensemble adds to the reported fit's: the standard linear solid's second pair
@@ -487,6 +487,24 @@ def _member_covariances(unc: Uncertainty, fits: dict, laws: list[str], idx: list
     return np.array(out).reshape(len(laws), len(idx), len(idx))
 
 
+def part_sds(cov: np.ndarray, names, fitted) -> dict[str, float]:
+    """The standard errors one part of a covariance (in ``names``' order) gives each field of the budget: the
+    varied parameters, and the shear modulus and shape when a constant varies (at the ``fitted`` actuator).
+
+    >>> import bendpam
+    >>> act = bendpam.physics.presets.be_pam().replace(C10_kpa=100.0, C01_kpa=300.0)
+    >>> sds = part_sds(np.diag([0.01, 4.0, 9.0]), ["alpha0", "C10", "C01"], act)
+    >>> {k: round(v, 4) for k, v in sds.items()}               # mu = 2 (C10 + C01): 2 sqrt(13) kPa
+    {'alpha0_deg': 0.1, 'C10_kpa': 2.0, 'C01_kpa': 3.0, 'shear_modulus_kpa': 7.2111, 'shape': 0.0042}
+    """
+    out = {parameter_field(n): math.sqrt(max(float(v), 0.0)) for n, v in zip(names, np.diag(cov), strict=True)}
+    if "C10" in names or "C01" in names:
+        g_mu, g_b = material_gradients(fitted, names)
+        for key, g in (("shear_modulus_kpa", g_mu), ("shape", g_b)):
+            out[key] = math.sqrt(max(float(g @ cov @ g), 0.0))
+    return out
+
+
 def uncertainty_budget(unc: Uncertainty, fitted, fits: dict, r: np.ndarray, groups: np.ndarray, law: str | None,
                        n_resampled: int) -> UncertaintyBudget:
     """Average the model parameters over the loop laws' fits (in ``unc``) and return the two parts of the errors.
@@ -538,13 +556,7 @@ def uncertainty_budget(unc: Uncertainty, fitted, fits: dict, r: np.ndarray, grou
                      "lag-1 autocorrelation); reported: the weighted average of the laws' values, with Burnham & "
                      "Anderson's unconditional variance (statistical: the laws' own covariances, weighted; "
                      f"systematic: their weighted spread about the average); the loop's parameters are the {law} fit's")
-    stat = {parameter_field(n): float(v) for n, v in zip(names, unc.sd_stat, strict=True)}
-    sys_ = {parameter_field(n): float(v) for n, v in zip(names, unc.sd_sys, strict=True)}
-    if "C10" in names or "C01" in names:
-        g_mu, g_b = material_gradients(fitted, names)
-        for key, g in (("shear_modulus_kpa", g_mu), ("shape", g_b)):
-            stat[key] = math.sqrt(max(float(g @ unc.cov_stat @ g), 0.0))
-            sys_[key] = math.sqrt(max(float(g @ unc.cov_sys @ g), 0.0))
+    stat, sys_ = part_sds(unc.cov_stat, names, fitted), part_sds(unc.cov_sys, names, fitted)
     resampling = (f"the cycles of {n_resampled} test(s) resampled (a block bootstrap over cycles through the "
                   "linearised fit, its covariance computed exactly); the sandwich with its AR(1) inflation for the "
                   "curves of single-cycle tests and a tension test" if n_resampled else

@@ -69,7 +69,9 @@ Uncertainty (both parts are reported separately: ``FitResult.uncertainty``)
        parameters are the average over the laws with Akaike weights (AICc on the residuals' effective
        number of points), their covariance the unconditional one: the laws' own covariances
        (statistical) and their spread about the average (systematic) (:mod:`bendpam.identify.ensemble`).
-    3. The profile of alpha0 (the objective minimised over everything else, against alpha0) is
+    3. Instrument (when declared, :class:`~bendpam.identify.uncertainty.Instrument`): a load cell's and a
+       pressure gauge's calibration, each the linearised refit its error would make; a third part.
+    4. The profile of alpha0 (the objective minimised over everything else, against alpha0) is
        kept in ``FitResult.alpha0_profile``.
     Pairs with ``|corr| > corr_flag`` are flagged, with the combination the data determine and
     their joint 95 % region (``FitResult.joint_intervals``); this and every other judgement of the
@@ -93,6 +95,7 @@ bound can be overridden (``bounds={"shape": (lo, hi)}`` narrows the admissible s
 from __future__ import annotations
 
 import copy
+import dataclasses
 import math
 import time
 from dataclasses import dataclass, field
@@ -126,6 +129,7 @@ from bendpam.identify.ensemble import (
     TWO_BRANCH,
     MemberFit,
     member_weights,
+    part_sds,
     played_path,
     spans_differ,
     steady_z,
@@ -135,6 +139,7 @@ from bendpam.identify.metrics import score
 from bendpam.identify.numerics import bounded_lstsq, chebyshev_interpolation, halfline
 from bendpam.identify.result import (
     HYST_PARAMETERS,
+    PARAMETER_ORDER,
     PARAMETERS,
     FitResult,
     HysteresisFit,
@@ -142,8 +147,16 @@ from bendpam.identify.result import (
     Parameter,
     Profile,
     UncertaintyBudget,
+    parse_free,
 )
-from bendpam.identify.uncertainty import Uncertainty, material_fit, offset_shift, sandwich_covariance
+from bendpam.identify.uncertainty import (
+    Instrument,
+    Uncertainty,
+    instrument_covariance,
+    material_fit,
+    offset_shift,
+    sandwich_covariance,
+)
 from bendpam.lab.processed import as_processed
 from bendpam.physics.actuator import NEUTRAL_ANGLE_DEG, Actuator, FitIdentity
 from bendpam.physics.braid import DEFAULT_ORDER
@@ -153,47 +166,17 @@ from bendpam.physics.models import resolve_model
 from bendpam.validate import PLAUSIBLE
 from bendpam.version import __version__
 
-__all__ = ["PAPER_START", "fit", "parse_free"]
+__all__ = ["PAPER_START", "fit"]
 
-_ALIASES = {
-    "alpha0": "alpha0", "alpha0_deg": "alpha0", "a0": "alpha0", "alpha": "alpha0",
-    "c10": "C10", "c10_kpa": "C10", "c1": "C10",
-    "c01": "C01", "c01_kpa": "C01", "c2": "C01",
-    "p_start": "P_start", "pstart": "P_start", "p_start_kpa": "P_start",
-    "e_f": "E_f", "ef": "E_f", "frame_modulus_mpa": "E_f", "frame_modulus": "E_f",
-    "r0_start": "R0_start", "r0start": "R0_start", "r0_start_mm": "R0_start",
-}
 _NONLINEAR = ("alpha0", "R0_start")
 #: The paper's starting values of the identification (section 3.4, from its tension test), kPa.
 PAPER_START = {"C10": 114.0, "C01": 300.0}
-_ORDER = ("alpha0", "C10", "C01", "P_start", "E_f", "R0_start")
 #: Loop angles (deg) of the global grid.
 _THETA_GRID = np.geomspace(0.5, 40.0, 9)
 #: Chebyshev nodes on which the kinematics are sampled (then interpolated to the data).
 _CHEB_NODES = 32
 #: Stretch margin over the tested curvatures for the admissible shapes.
 _STRETCH_MARGIN = 1.1
-
-
-def parse_free(free) -> list[str]:
-    """Normalise a list (or comma string) of parameter names; unknown names raise InputError.
-
-    >>> parse_free("c01, alpha0_deg")
-    ['alpha0', 'C01']
-    """
-    if isinstance(free, str):
-        free = [f for f in free.replace(" ", ",").split(",") if f]
-    out = []
-    for f in free:
-        key = _ALIASES.get(str(f).strip().lower())
-        if key is None:
-            raise InputError(f"unknown parameter {f!r} to fit; choose from {', '.join(PARAMETERS)}")
-        if key not in out:
-            out.append(key)
-    if not out:
-        raise InputError(f"no parameter to fit; choose from {', '.join(PARAMETERS)}")
-    return sorted(out, key=_ORDER.index)
-
 
 
 def _default_bounds(actuator: Actuator, P_min_kpa: float) -> dict[str, tuple[float, float]]:
@@ -444,7 +427,7 @@ def fit(processed, actuator: Actuator, model: str | None = None, free=("alpha0",
         corr_flag: float = LIMITS.correlation,
         fit_range: str = "developed", hysteresis: str | None = "auto", hysteresis_law: str = "pi",
         law_uncertainty: bool = True, admissible_range: tuple[float, float] | None = (0.6, 1.6),
-        profile_points: int = 13) -> FitResult:
+        profile_points: int = 13, instrument: Instrument | None = None) -> FitResult:
     """Identify ``free`` parameters of ``actuator`` for ``model`` from a processed test set.
 
     The stages (module notes): the data and the admissible shapes, a global grid and a local search
@@ -473,9 +456,9 @@ def fit(processed, actuator: Actuator, model: str | None = None, free=("alpha0",
         free P_start the loop's amplitude ``a0 + a1 (P - P_start)`` uses the nominal P_start (the
         amplitude stays linear in a0, a1); the fitted loop is saved with the fitted one.
     law_uncertainty : with a loop, the ensemble of loop laws' systematic part (:mod:`bendpam.identify.ensemble`).
-    admissible_range : principal stretches (lo, hi) the material must be physical over besides the
-        tested ones (the range it will predict); None: only the tested ones.
+    admissible_range : stretches (lo, hi) the material must be physical over besides the tested ones (or None).
     profile_points : points of the profile of alpha0 (0: none).
+    instrument : a declared calibration of the rig (:class:`~bendpam.identify.uncertainty.Instrument`), or None.
 
     Returns
     -------
@@ -514,7 +497,7 @@ def fit(processed, actuator: Actuator, model: str | None = None, free=("alpha0",
     run = _prepare(processed, actuator, model, free, bounds, tension_data, fit_range, hysteresis, hysteresis_law,
                    admissible_range, order, eq19_factor)
     _search_stages(run, grid_alpha, grid_r0, tension_data)
-    unc, budget = _uncertainty_stages(run, corr_flag, law_uncertainty)
+    unc, budget = _uncertainty_stages(run, corr_flag, law_uncertainty, instrument)
     profile, n = _profile(run.prob, run.bnd, run.nl, unc, profile_points)
     run.nfev += n
     return _result(processed, actuator, run, unc, tension, t0, budget, profile, hysteresis)
@@ -581,11 +564,11 @@ def _search_stages(run: _Run, grid_alpha: int, grid_r0: int, tension_data) -> No
     run.prob, run.nl, run.lin = prob, nl, lin
 
 
-def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool):
-    """The statistical covariance, and the loop laws' systematic part: ``(unc, budget)``."""
+def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool, instrument: Instrument | None = None):
+    """The statistical covariance, the loop laws' systematic part and a declared instrument's: ``(unc, budget)``."""
     from bendpam.physics.hysteresis import ENSEMBLE
 
-    unc = _uncertainty(run.prob, run.bnd, run.nl, run.lin, corr_flag, run.cycles, run.offsets)
+    unc = _uncertainty(run.prob, run.bnd, run.nl, run.lin, corr_flag, run.cycles, run.offsets, instrument)
     run.nfev += unc.nfev
     fits: dict[str, MemberFit] = {}
     if run.law and law_uncertainty:
@@ -616,6 +599,9 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool):
                              "; the viscous loop's rate approximated at a constant crosshead speed (the processed "
                              "set keeps no time: saved before 0.4)")
     run.notes += drift_note(unc.drift_shift, budget.total, sum(s != 0 for *_, s in run.offsets))
+    if instrument is not None and instrument.declared:
+        budget.instrument = part_sds(unc.cov_inst, unc.names, run.prob.actuator(unc.values))
+        budget.resampling += f"; the instrument's declared calibration: {instrument.describe()}"
     return unc, budget
 
 
@@ -799,7 +785,8 @@ def _joint_tension(prob: _Problem, args, bnd, nl, lin, tension_data):
     return p2, nl2, lin2, n, note
 
 
-def _uncertainty(prob: _Problem, bnd, nl_best, lin, corr_flag: float, cycles=(), offsets=()) -> Uncertainty:
+def _uncertainty(prob: _Problem, bnd, nl_best, lin, corr_flag: float, cycles=(), offsets=(),
+                 instrument: Instrument | None = None) -> Uncertainty:
     """Sandwich covariance from the joint Jacobian (nonlinear columns by central differences).
 
     The weights normalise each curve (eq 53), they are not inverse noise variances, so each residual
@@ -839,6 +826,12 @@ def _uncertainty(prob: _Problem, bnd, nl_best, lin, corr_flag: float, cycles=(),
     unc = Uncertainty(prob.to_user(nl_best, lin), prob.nonlin + prob.lin, G @ cov_int @ G.T, rho, nfev, bound_names,
                       float(r @ r), m, corr_flag)
     unc.set_drift_shift(G @ offset_shift(J, [(i, s * prob.w[i]) for i, _, s in offsets]))  # an uncorrected drift's
+    if instrument is not None and instrument.declared:  # the load cell's moments; the residuals' change per kPa
+        p2 = copy.copy(prob)
+        p2.d = dataclasses.replace(prob.d, Pc=prob.d.Pc + 1.0)
+        force = np.where(np.arange(m) < prob.d.kc.size, prob.w * prob.y, 0.0)
+        Jf = np.where(np.asarray(at_bound, dtype=bool)[None, :], 0.0, J)  # a bound held moves nothing (refit)
+        unc.set_instrument(G @ instrument_covariance(Jf, force, p2.residual_full(x_int) - r, instrument) @ G.T)
     return unc
 
 
@@ -955,7 +948,7 @@ def _parameters(prob: _Problem, bnd, unc: Uncertainty, fitted: Actuator, actuato
     """Every parameter of the model: the varied ones with their standard errors and start values."""
     sd = unc.sd
     params = {}
-    for n in _ORDER:
+    for n in PARAMETER_ORDER:
         field_, unit = PARAMETERS[n]
         val = float(getattr(fitted, field_))
         lo, hi = bnd[n]

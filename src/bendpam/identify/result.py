@@ -32,6 +32,7 @@ from bendpam.physics.law import MomentLaw
 __all__ = [
     "HYST_PARAMETERS",
     "PARAMETERS",
+    "PARAMETER_ORDER",
     "Band",
     "EnsembleMember",
     "ExtrapolationWarning",
@@ -46,6 +47,7 @@ __all__ = [
     "UncertaintyBudget",
     "parameter_field",
     "parameter_unit",
+    "parse_free",
 ]
 
 #: Identifiable parameters: short name -> (Actuator field, unit).
@@ -57,6 +59,38 @@ PARAMETERS = {
     "E_f": ("frame_modulus_mpa", "MPa"),
     "R0_start": ("R0_start_mm", "mm"),
 }
+
+#: The identifiable parameters in the order a fit reports them.
+PARAMETER_ORDER = ("alpha0", "C10", "C01", "P_start", "E_f", "R0_start")
+_ALIASES = {
+    "alpha0": "alpha0", "alpha0_deg": "alpha0", "a0": "alpha0", "alpha": "alpha0",
+    "c10": "C10", "c10_kpa": "C10", "c1": "C10",
+    "c01": "C01", "c01_kpa": "C01", "c2": "C01",
+    "p_start": "P_start", "pstart": "P_start", "p_start_kpa": "P_start",
+    "e_f": "E_f", "ef": "E_f", "frame_modulus_mpa": "E_f", "frame_modulus": "E_f",
+    "r0_start": "R0_start", "r0start": "R0_start", "r0_start_mm": "R0_start",
+}
+
+
+def parse_free(free) -> list[str]:
+    """Normalise a list (or comma string) of parameter names; unknown names raise InputError.
+
+    >>> parse_free("c01, alpha0_deg")
+    ['alpha0', 'C01']
+    """
+    if isinstance(free, str):
+        free = [f for f in free.replace(" ", ",").split(",") if f]
+    out = []
+    for f in free:
+        key = _ALIASES.get(str(f).strip().lower())
+        if key is None:
+            raise InputError(f"unknown parameter {f!r} to fit; choose from {', '.join(PARAMETERS)}")
+        if key not in out:
+            out.append(key)
+    if not out:
+        raise InputError(f"no parameter to fit; choose from {', '.join(PARAMETERS)}")
+    return sorted(out, key=PARAMETER_ORDER.index)
+
 
 #: Parameters of the loop model (:mod:`bendpam.physics.hysteresis`): short name -> (field, unit).
 HYST_PARAMETERS = {"theta_h": ("theta_h_deg", "deg"), "a0": ("a0_nmm", "N*mm"), "a1": ("a1_nmm_per_kpa", "N*mm/kPa")}
@@ -398,10 +432,15 @@ class UncertaintyBudget:
     AR(1) inflation elsewhere (``resampling`` says which, in words).  ``systematic`` is the loop
     law's part: the weighted spread over the :class:`EnsembleMember` fits (``ensemble``), weighted by
     ``weighting``.  Both include ``shear_modulus_kpa`` and ``shape`` when the constants vary.
+    ``instrument`` is a declared calibration's part (:class:`~bendpam.identify.uncertainty.Instrument`;
+    empty when none was declared).
 
     >>> b = UncertaintyBudget({"alpha0_deg": 0.03}, {"alpha0_deg": 0.04}, "cycles", "Akaike", [])
     >>> round(b.total["alpha0_deg"], 3), UncertaintyBudget.from_dict(b.to_dict()) == b
     (0.05, True)
+    >>> b.instrument = {"alpha0_deg": 0.12}
+    >>> round(b.total["alpha0_deg"], 3), UncertaintyBudget.from_dict(b.to_dict()) == b
+    (0.13, True)
     """
 
     statistical: dict[str, float]
@@ -409,24 +448,28 @@ class UncertaintyBudget:
     resampling: str
     weighting: str
     ensemble: list[EnsembleMember] = field(default_factory=list)
+    instrument: dict[str, float] = field(default_factory=dict)
 
     @property
     def total(self) -> dict[str, float]:
-        """``sqrt(statistical^2 + systematic^2)`` per quantity."""
-        return {k: math.hypot(v, self.systematic.get(k, 0.0)) for k, v in self.statistical.items()}
+        """``sqrt(statistical^2 + systematic^2 + instrument^2)`` per quantity."""
+        return {k: math.hypot(v, self.systematic.get(k, 0.0), self.instrument.get(k, 0.0))
+                for k, v in self.statistical.items()}
 
     def to_dict(self) -> dict:
-        """The budget as JSON types."""
-        return {"statistical": dict(self.statistical), "systematic": dict(self.systematic), "total": self.total,
-                "resampling": self.resampling, "weighting": self.weighting,
-                "ensemble": [m.to_dict() for m in self.ensemble]}
+        """The budget as JSON types (``instrument`` only when a calibration was declared)."""
+        out = {"statistical": dict(self.statistical), "systematic": dict(self.systematic), "total": self.total,
+               "resampling": self.resampling, "weighting": self.weighting,
+               "ensemble": [m.to_dict() for m in self.ensemble]}
+        return {**out, "instrument": dict(self.instrument)} if self.instrument else out
 
     @classmethod
     def from_dict(cls, d: dict) -> UncertaintyBudget:
         """The budget from :meth:`to_dict`'s dictionary."""
         return cls({k: _num(v) for k, v in d["statistical"].items()}, {k: _num(v) for k, v in d["systematic"].items()},
                    str(d.get("resampling", "")), str(d.get("weighting", "")),
-                   [EnsembleMember.from_dict(m) for m in d.get("ensemble", [])])
+                   [EnsembleMember.from_dict(m) for m in d.get("ensemble", [])],
+                   {k: _num(v) for k, v in (d.get("instrument") or {}).items()})
 
 
 @dataclass
@@ -737,8 +780,10 @@ class FitResult:
         if b is not None:
             keys = [k for k in b.statistical if k in (*(v[0] for v in PARAMETERS.values()), "shear_modulus_kpa",
                                                       "shape")]
-            lines.append("  standard errors, statistical / systematic: " + ", ".join(
-                f"{k} {b.statistical[k]:.2g} / {b.systematic.get(k, 0.0):.2g}" for k in keys))
+            inst = " / instrument" if b.instrument else ""
+            lines.append(f"  standard errors, statistical / systematic{inst}: " + ", ".join(
+                f"{k} {b.statistical[k]:.2g} / {b.systematic.get(k, 0.0):.2g}"
+                + (f" / {b.instrument.get(k, 0.0):.2g}" if b.instrument else "") for k in keys))
             if b.ensemble:
                 lines.append("  loop laws (weight; the model parameters are their weighted average): "
                              + ", ".join(f"{m.law} {m.weight:.2f}" for m in b.ensemble))

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -25,7 +26,8 @@ from bendpam.identify.diagnose import shape_identified, study_coverage
 from bendpam.identify.result import MaterialFit
 from bendpam.physics.actuator import Actuator
 
-__all__ = ["Uncertainty", "lag1_autocorrelation", "material_fit", "material_gradients", "offset_shift",
+__all__ = ["Instrument", "Uncertainty", "instrument_covariance", "lag1_autocorrelation", "material_fit",
+           "material_gradients", "offset_shift",
            "sandwich_covariance"]
 
 
@@ -60,6 +62,7 @@ class Uncertainty:
         self.names = names
         self.cov_stat = cov
         self.cov_sys = np.zeros_like(cov)
+        self.cov_inst = np.zeros_like(cov)
         self.cov = cov.copy()
         self.rho = rho
         self.nfev = nfev
@@ -129,7 +132,86 @@ class Uncertainty:
     def set_systematic(self, cov_sys: np.ndarray) -> None:
         """The systematic covariance (the loop laws' spread, :mod:`bendpam.identify.ensemble`); ``cov`` is the sum."""
         self.cov_sys = np.asarray(cov_sys, dtype=float)
-        self.cov = self.cov_stat + self.cov_sys
+        self.cov = self.cov_stat + self.cov_sys + self.cov_inst
+
+    def set_instrument(self, cov_inst: np.ndarray) -> None:
+        """The instrument's declared calibration (:class:`Instrument`, :func:`instrument_covariance`); ``cov`` is
+        the sum of the three parts.
+
+        >>> unc = Uncertainty({"a": 1.0}, ["a"], np.array([[9.0]]), 0.0, 0, {}, 0.0, 9, 0.95)
+        >>> unc.set_instrument(np.array([[16.0]]))
+        >>> unc.sd.tolist(), unc.sd_stat.tolist()
+        ([5.0], [3.0])
+        """
+        self.cov_inst = np.asarray(cov_inst, dtype=float)
+        self.cov = self.cov_stat + self.cov_sys + self.cov_inst
+
+
+@dataclass(frozen=True)
+class Instrument:
+    """The test rig's calibration, as standard uncertainties common to every test of a set (GUM type B).
+
+    The curves cannot show a load cell that reads a fixed fraction high, or a gauge that reads every
+    pressure a few kPa off: every test moves alike, and a fit takes it for the actuator.  Declared, each
+    adds to the error bars what it would move the fitted parameters by (:func:`instrument_covariance`).
+
+    force_uncertainty_pct : relative standard uncertainty of the force reading (%); a load cell of ISO
+        7500-1 class 1 (within 1 % of the reading) has ``1 / sqrt(3) = 0.58`` %.
+    pressure_uncertainty_kpa : standard uncertainty of the pressure the actuator was held at (kPa); a
+        gauge within 0.5 % of a 600 kPa span has ``3 / sqrt(3) = 1.7`` kPa.
+
+    >>> Instrument(force_uncertainty_pct=0.58).declared, Instrument().declared
+    (True, False)
+    >>> Instrument(0.58, 1.7).describe()
+    'the force reading to 0.58 % and the pressure to 1.7 kPa (standard uncertainties, common to every test)'
+    """
+
+    force_uncertainty_pct: float = 0.0
+    pressure_uncertainty_kpa: float = 0.0
+
+    def __post_init__(self) -> None:
+        from bendpam.validate import number
+
+        object.__setattr__(self, "force_uncertainty_pct",
+                           number("force_uncertainty_pct", self.force_uncertainty_pct, 0.0, 20.0, unit="%"))
+        object.__setattr__(self, "pressure_uncertainty_kpa",
+                           number("pressure_uncertainty_kpa", self.pressure_uncertainty_kpa, 0.0, 100.0, unit="kPa"))
+
+    @property
+    def declared(self) -> bool:
+        """Is any part declared (non-zero)?"""
+        return self.force_uncertainty_pct > 0.0 or self.pressure_uncertainty_kpa > 0.0
+
+    def describe(self) -> str:
+        """The declaration in words."""
+        parts = ([f"the force reading to {self.force_uncertainty_pct:.3g} %"] if self.force_uncertainty_pct else []) + \
+                ([f"the pressure to {self.pressure_uncertainty_kpa:.3g} kPa"] if self.pressure_uncertainty_kpa else [])
+        return " and ".join(parts) + " (standard uncertainties, common to every test)" if parts else "nothing"
+
+
+def instrument_covariance(J: np.ndarray, force_rows: np.ndarray, pressure_rows: np.ndarray,
+                          instrument: Instrument) -> np.ndarray:
+    """The covariance a declared calibration (:class:`Instrument`) adds to the parameters (linearised refits).
+
+    A force reading high by a fraction ``e`` moves the weighted data by ``e * force_rows`` (``w M``, the
+    weighted moments; zero on rows the load cell did not measure), a pressure off by ``p`` kPa moves the
+    weighted residuals by ``p * pressure_rows`` (their change per kPa); each moves the parameters by
+    :func:`offset_shift`'s linearised refit, ``dx``, and adds ``u^2 dx dx^T`` (``u`` its standard uncertainty).
+
+    >>> J = np.column_stack([np.ones(4), np.arange(4.0)])          # a line: offset and slope
+    >>> y = np.array([1.0, 2.0, 3.0, 4.0])                          # data on y = 1 + x
+    >>> cov = instrument_covariance(J, y, np.zeros(4), Instrument(force_uncertainty_pct=1.0))
+    >>> np.sqrt(np.diag(cov)).round(6).tolist()                    # 1 % of the offset 1 and of the slope 1
+    [0.01, 0.01]
+    """
+    n = J.shape[1]
+    cov = np.zeros((n, n))
+    for rows, u in ((np.asarray(force_rows, dtype=float), instrument.force_uncertainty_pct / 100.0),
+                    (-np.asarray(pressure_rows, dtype=float), instrument.pressure_uncertainty_kpa)):
+        if u > 0.0 and np.any(rows):
+            dx = np.linalg.lstsq(J, rows, rcond=None)[0] * u
+            cov += np.outer(dx, dx)
+    return cov
 
 
 def lag1_autocorrelation(resid: np.ndarray, seg: np.ndarray) -> float:

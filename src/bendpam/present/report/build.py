@@ -21,7 +21,8 @@ import numpy as np
 from bendpam.errors import BendpamError, FitError, InputError
 from bendpam.identify.compare import type_comparison
 from bendpam.identify.diagnose import has_loop, needs_type_check
-from bendpam.identify.fitting import fit, parse_free
+from bendpam.identify.fitting import fit
+from bendpam.identify.result import parse_free
 from bendpam.infra.atomic import atomic_write_text
 from bendpam.lab.files import collect_raw_files
 from bendpam.physics.actuator import Actuator

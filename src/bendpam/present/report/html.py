@@ -316,12 +316,13 @@ def _uncertainty_tables(m: str, label: str, res) -> list[_Table]:
     if b is None:
         return []
     rows = []
-    for f, se in b.statistical.items():
-        sys_, tot = b.systematic.get(f, 0.0), b.total[f]
-        rows.append(_Row([_td(fmt_value(se), se), _td(fmt_value(sys_), sys_), _td(fmt_value(tot), tot)],
-                         Markup(symbol(f).heading())))
+    parts = [b.statistical, b.systematic, *([b.instrument] if b.instrument else [])]
+    for f in b.statistical:
+        cells = [part.get(f, 0.0) for part in parts] + [b.total[f]]
+        rows.append(_Row([_td(fmt_value(v), v) for v in cells], Markup(symbol(f).heading())))
     out = [_Table(f"uncertainty-{m}", f"Standard errors of the {label} model fit: statistical ({b.resampling}) and "
-                  "systematic (the loop law)", ["", "Statistical", "Systematic", "Total"], rows)]
+                  "systematic (the loop law)", ["", "Statistical", "Systematic",
+                                                *(["Instrument (declared)"] if b.instrument else []), "Total"], rows)]
     if b.ensemble:
         keys = list(b.ensemble[0].values)
         rows = [_Row([_td(fmt_value(e.weight), e.weight), _td(fmt_pct(e.nrmse), e.nrmse)]

@@ -1,0 +1,106 @@
+"""A declared calibration of the rig (GUM type B): the load cell's and the pressure gauge's standard uncertainties.
+
+The curves cannot show a force reading a fixed fraction high or a pressure a few kPa off (every test moves
+alike); declared, each adds what it would move the fitted parameters by.  Checked against actual refits of
+the same raw tests read by a load cell 1 % high and at pressures 2 kPa off.
+"""
+
+import json
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from bendpam import presets
+from bendpam.cli import main
+from bendpam.errors import InputError
+from bendpam.identify.fitting import fit
+from bendpam.identify.result import FitResult
+from bendpam.identify.uncertainty import Instrument
+from bendpam.lab import RawTest
+from bendpam.lab.processed import write_processed
+from bendpam.lab.processing import process_tests
+from bendpam.lab.simulate import SimulationSettings, simulate_test
+
+BE = presets.be_pam()
+PRESSURES = (100.0, 150.0, 200.0)
+
+
+def raws(force_scale: float = 1.0, pressure_offset_kpa: float = 0.0) -> list[RawTest]:
+    """The same simulated tests (two cycles, a loop), read with a force scaled and pressures said off."""
+    out = []
+    for p in PRESSURES:
+        data, _ = simulate_test(BE, p, settings=SimulationSettings(cycles=2, rate_hz=5.0, seed=int(p)))
+        data = data.assign(force_n=data["force_n"] * force_scale)
+        out.append(RawTest(data, Path(f"be_{p:g}kPa.csv"), "csv", pressure_kpa=p + pressure_offset_kpa))
+    return out
+
+
+def fitted(force_scale=1.0, pressure_offset_kpa=0.0, instrument=None):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ps = process_tests(raws(force_scale, pressure_offset_kpa), keep_series=False)
+        return fit(ps, BE, profile_points=0, law_uncertainty=False, instrument=instrument)
+
+
+@pytest.fixture(scope="module")
+def base():
+    return fitted(instrument=Instrument(force_uncertainty_pct=1.0, pressure_uncertainty_kpa=2.0))
+
+
+def test_the_declared_parts_are_what_refits_with_the_errors_move(base):
+    b = base.uncertainty
+    assert set(b.instrument) >= {"alpha0_deg", "shear_modulus_kpa"}
+    # the load cell 1 % high: one standard uncertainty of the declared 1 %
+    high = fitted(force_scale=1.01)
+    for key, moved in (("alpha0_deg", high.actuator.alpha0_deg - base.actuator.alpha0_deg),
+                       ("shear_modulus_kpa", high.material.shear_modulus_kpa - base.material.shear_modulus_kpa)):
+        alone = Instrument(force_uncertainty_pct=1.0)
+        part = fitted(instrument=alone).uncertainty.instrument[key]
+        assert part == pytest.approx(abs(moved), rel=0.15), key
+    # the pressures 2 kPa off: one standard uncertainty of the declared 2 kPa
+    off = fitted(pressure_offset_kpa=2.0)
+    part = fitted(instrument=Instrument(pressure_uncertainty_kpa=2.0)).uncertainty.instrument["alpha0_deg"]
+    assert part == pytest.approx(abs(off.actuator.alpha0_deg - base.actuator.alpha0_deg), rel=0.15)
+
+
+def test_the_total_and_the_parameters_include_it(base):
+    b = base.uncertainty
+    plain = fitted()
+    assert plain.uncertainty.instrument == {}
+    for key in ("alpha0_deg", "shear_modulus_kpa"):
+        assert b.total[key] == pytest.approx(np.sqrt(b.statistical[key] ** 2 + b.systematic.get(key, 0.0) ** 2
+                                                     + b.instrument[key] ** 2))
+        assert b.total[key] > plain.uncertainty.total[key]
+    assert base.parameters["alpha0"].stderr == pytest.approx(b.total["alpha0_deg"], rel=1e-6)
+    assert base.material.se_shear_modulus_kpa == pytest.approx(b.total["shear_modulus_kpa"], rel=1e-6)
+    assert "declared calibration" in b.resampling and "/ instrument" in str(base)
+
+
+def test_it_survives_the_saved_fit(base, tmp_path):
+    base.save(tmp_path / "fit")
+    back = FitResult.load(tmp_path / "fit")
+    assert back.uncertainty.instrument == pytest.approx(base.uncertainty.instrument)
+    assert "instrument" in json.loads((tmp_path / "fit" / "fit.json").read_text(encoding="utf-8"))["uncertainty"]
+
+
+def test_bad_declarations_are_refused():
+    with pytest.raises(InputError, match="force_uncertainty_pct"):
+        Instrument(force_uncertainty_pct=-1.0)
+    with pytest.raises(InputError, match="pressure_uncertainty_kpa"):
+        Instrument(pressure_uncertainty_kpa=float("nan"))
+
+
+def test_the_command_line_declares_it(tmp_path, capsys):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        write_processed(process_tests(raws(), keep_series=False), tmp_path / "proc", figure=False)
+    assert main(["fit", str(tmp_path / "proc"), "--preset", "be-pam", "--out", str(tmp_path / "fit"), "--no-figure",
+                 "--force-uncertainty-pct", "0.58", "--pressure-uncertainty-kpa", "1.7", "--json"]) == 0
+    unc = json.loads(capsys.readouterr().out)["uncertainty"]
+    assert unc["instrument"]["alpha0_deg"] > 0
+    assert main(["fit", str(tmp_path / "proc"), "--preset", "be-pam", "--out", str(tmp_path / "fit2"),
+                 "--force-uncertainty-pct", "-1"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--force-uncertainty-pct" in err[0]
