@@ -104,3 +104,14 @@ def test_the_command_line_declares_it(tmp_path, capsys):
                  "--force-uncertainty-pct", "-1"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--force-uncertainty-pct" in err[0]
+
+
+def test_the_report_declares_it_too(tmp_path):
+    from bendpam.lab.simulate import simulate_tests
+    from bendpam.present.report import build_report
+
+    raw = simulate_tests(BE, [100, 200], tmp_path / "raw", settings=SimulationSettings(cycles=2, rate_hz=2.0, seed=3))
+    rep = build_report(tmp_path / "raw", BE, tmp_path / "report.html", models=["energy"], progress=False,
+                       processing_options={"grid_points": 21}, instrument=Instrument(force_uncertainty_pct=0.58))
+    assert raw and "Instrument (declared)" in (tmp_path / "report.html").read_text(encoding="utf-8")
+    assert rep.html.name == "report.html"

@@ -12,8 +12,10 @@ from bendpam.cli.app import app
 from bendpam.cli.options import (
     ActuatorOpt,
     FigureFormatOpt,
+    ForceUncertaintyOpt,
     ModelOpt,
     PresetOpt,
+    PressureUncertaintyOpt,
     QuietOpt,
     UserError,
     echo_wrote,
@@ -81,12 +83,8 @@ def fit(
     admissible_range: Annotated[RangeOpt, typer.Option(
         "--admissible-range", help="Stretches LO HI the bladder material must be physical over besides the "
         "tested ones (the range it will predict).")] = (0.6, 1.6),
-    force_uncertainty_pct: Annotated[float, typer.Option(
-        "--force-uncertainty-pct", min=0.0, max=20.0, help="The load cell's calibration, a standard uncertainty in % "
-        "of the reading (ISO 7500-1 class 1: 0.58): added to the error bars as the instrument's part.")] = 0.0,
-    pressure_uncertainty_kpa: Annotated[float, typer.Option(
-        "--pressure-uncertainty-kpa", min=0.0, max=100.0,
-        help="The pressure gauge's calibration, a standard uncertainty in kPa common to every test.")] = 0.0,
+    force_uncertainty_pct: ForceUncertaintyOpt = 0.0,
+    pressure_uncertainty_kpa: PressureUncertaintyOpt = 0.0,
     out: Annotated[Optional[Path], typer.Option("--out", help="Output folder.")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print fit.json to stdout.")] = False,
     fig_format: FigureFormatOpt = None,

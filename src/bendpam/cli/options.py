@@ -42,6 +42,7 @@ __all__ = [
     "BendpamCommand",
     "FigureFormat",
     "FigureFormatOpt",
+    "ForceUncertaintyOpt",
     "Format",
     "Model",
     "ModelOpt",
@@ -49,6 +50,7 @@ __all__ = [
     "Preset",
     "PresetOpt",
     "PressureOpt",
+    "PressureUncertaintyOpt",
     "QuietOpt",
     "UserError",
     "as_given",
@@ -706,6 +708,12 @@ FigureFormatOpt = Annotated[
     Optional[FigureFormat],
     typer.Option("--format", help="Figure format: png, pdf or svg (default: from the file name, else png)."),
 ]
+ForceUncertaintyOpt = Annotated[float, typer.Option(
+    "--force-uncertainty-pct", min=0.0, max=20.0, help="The load cell's calibration, a standard uncertainty in % of "
+    "the reading (ISO 7500-1 class 1: 0.58): added to the error bars as the instrument's part.")]
+PressureUncertaintyOpt = Annotated[float, typer.Option(
+    "--pressure-uncertainty-kpa", min=0.0, max=100.0,
+    help="The pressure gauge's calibration, a standard uncertainty in kPa common to every test.")]
 QuietOpt = Annotated[
     bool, typer.Option("--quiet", "-q", help="No progress on stderr (neither the bar nor the progress lines).")
 ]

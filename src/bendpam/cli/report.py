@@ -26,7 +26,14 @@ def register(app: typer.Typer) -> None:
     """
     if any(getattr(c, "name", None) == "report" for c in app.registered_commands):
         return
-    from bendpam.cli.options import RANGE_HELP, ActuatorOpt, PresetOpt, QuietOpt
+    from bendpam.cli.options import (
+        RANGE_HELP,
+        ActuatorOpt,
+        ForceUncertaintyOpt,
+        PresetOpt,
+        PressureUncertaintyOpt,
+        QuietOpt,
+    )
 
     @app.command("report")
     def report(
@@ -53,6 +60,8 @@ def register(app: typer.Typer) -> None:
             typer.Option("--model", help="Model(s) to fit: energy, force-balance ('energy force-balance', "
                          "'energy,force-balance' or repeated; default both)."),
         ] = None,
+        force_uncertainty_pct: ForceUncertaintyOpt = 0.0,
+        pressure_uncertainty_kpa: PressureUncertaintyOpt = 0.0,
         quiet: QuietOpt = False,
         as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object (Table 2, the deadband, each "
                                               "model's parameters and NRMSEs, the warnings) instead of lines.")]
@@ -66,11 +75,11 @@ def register(app: typer.Typer) -> None:
         prints cleanly to PDF from a browser.
         """
         _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, model, progress and not quiet,
-                as_json)
+                as_json, (force_uncertainty_pct, pressure_uncertainty_kpa))
 
 
 def _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, model, progress,
-            as_json=False) -> None:
+            as_json=False, instrument=(0.0, 0.0)) -> None:
     from bendpam.cli.options import (
         Model,
         UserError,
@@ -80,6 +89,7 @@ def _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, m
         output_file,
         parse_values,
     )
+    from bendpam.identify.uncertainty import Instrument
     from bendpam.physics.fixture import Fixture
     from bendpam.present.report import build_report, fmt_value
 
@@ -111,7 +121,7 @@ def _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, m
     fx = Fixture.from_string(fixture, L0_mm=act.L0_mm if l0_mm is None else l0_mm, name="--fixture")
     with output_file(out, [*files, actuator]) as f:
         res = build_report(files, act, f.path, models=[m.value for m in models], free=free, pressure_kpa=pressures,
-                           fixture=fx, progress=progress, shown_as=str(out))
+                           fixture=fx, progress=progress, shown_as=str(out), instrument=Instrument(*instrument))
 
     summ = res.summary
     if as_json:

@@ -92,7 +92,7 @@ def build_report(
     models: Sequence[str] = ("energy", "force_balance"), free=("alpha0", "C10", "C01"), pressure_kpa=None,
     fixture: Fixture | str | None = None,
     processing_options=None,
-    progress: bool = True, shown_as: str | None = None,
+    progress: bool = True, shown_as: str | None = None, instrument=None,
 ) -> Report:
     """Raw test files -> processing -> fits -> checks -> ONE self-contained HTML page at ``out_html``.
 
@@ -112,6 +112,7 @@ def build_report(
     processing_options : a :class:`~bendpam.lab.processing.ProcessingOptions`, a dict of its fields, or None.
     progress : report progress on stderr (:class:`bendpam.infra.progress.Progress`); False writes nothing.
     shown_as : the page's name in the progress lines (default ``out_html``'s; a temporary file's caller: the target).
+    instrument : a declared calibration of the rig for the fits (:class:`~bendpam.identify.uncertainty.Instrument`).
 
     Returns
     -------
@@ -141,7 +142,7 @@ def build_report(
     with Progress(_steps(len(files), len(model_names)), "report", quiet=not progress) as bar:
         tests, processed = _read_and_process(files, pressures, fx, opts, bar)
         summary = processed.summary()
-        fits, failed = _fit_models(processed, actuator, model_names, free_names, bar)
+        fits, failed = _fit_models(processed, actuator, model_names, free_names, bar, instrument)
         warnings = plausibility_warnings(processed) + _judge(processed, actuator, fits, failed, tests, model_names[0],
                                                               free_names, bar)
         loops = has_loop(processed)
@@ -218,14 +219,14 @@ def _read_and_process(files, pressures, fx: Fixture, opts, bar):
     return tests, processed
 
 
-def _fit_models(processed, actuator: Actuator, model_names, free_names, bar):
+def _fit_models(processed, actuator: Actuator, model_names, free_names, bar, instrument=None):
     """Fit each model (one step each): ``(fits, failed)``; a model that cannot be fitted goes to ``failed``."""
     fits: dict = {}
     failed: dict[str, str] = {}
     for m in model_names:
         bar.advance(0, description=f"report: fitting the {MODEL_LABEL[m]} model")
         try:
-            fits[m] = fit(processed, actuator, m, free=free_names)
+            fits[m] = fit(processed, actuator, m, free=free_names, instrument=instrument)
         except (FitError, InputError) as exc:  # these tests cannot be fitted with this actuator
             failed[m] = plain_text(str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
         bar.advance()
