@@ -83,10 +83,15 @@ def _fit_record(result) -> dict:
 def run_one(case_name: str, seed: int, case: gen.Case | None = None, fit_options: dict | None = None) -> list[dict]:
     """Generate, read, process and fit one case and seed: one record per processing variant.
 
-    ``fit_options`` are keywords of :func:`bendpam.identify.fitting.fit` (default: those of ``bendpam fit``).
+    ``fit_options`` are keywords of :func:`bendpam.identify.fitting.fit` (default: those of ``bendpam fit``); an
+    ``instrument`` given as ``(force %, pressure kPa)`` is the :class:`~bendpam.identify.uncertainty.Instrument`.
     """
     fit_kw = dict(fit_options or {})
     from bendpam.identify.fitting import fit
+    from bendpam.identify.uncertainty import Instrument
+
+    if isinstance(fit_kw.get("instrument"), tuple | list):
+        fit_kw["instrument"] = Instrument(*fit_kw["instrument"])
     from bendpam.lab import read_test
     from bendpam.lab.processing import process_tests
     from bendpam.physics.fixture import Fixture
