@@ -761,12 +761,14 @@ def _loop(case: Case, t, u, A, speed_rad_s: float, span_rad: float):
     opts.pop("gap_mm", None)
     if case.loop == "none" or A == 0.0:
         return np.zeros(u.size)
-    if case.loop == "maxwell-creep":
-        return maxwell_slip(t, u, A, **opts)
-    if case.loop == "stiction":
-        return stiction(t, u, A, **opts)
-    if case.loop == "viscous":
-        return viscous(t, u, A, speed_rad_s=speed_rad_s, **opts)
+    rate_laws = {"viscous": viscous, "friction-viscous": friction_viscous, "lugre": lugre, "two-maxwell": two_maxwell,
+                 "fractional": fractional, "rate-state": rate_state}  # f(t, u, A, speed_rad_s=..., **options)
+    plain_laws = {"maxwell-creep": maxwell_slip, "stiction": stiction, "preisach": preisach,
+                  "iwan-lognormal": iwan_lognormal, "asymmetric-stop": asymmetric_stop}  # f(t, u, A, **options)
+    if case.loop in rate_laws:
+        return rate_laws[case.loop](t, u, A, speed_rad_s=speed_rad_s, **opts)
+    if case.loop in plain_laws:
+        return plain_laws[case.loop](t, u, A, **opts)
     if case.loop == "backlash":
         return maxwell_slip(t, u, A, **{"creep_tau_s": None, "u_min": math.radians(0.5), "u_max": math.radians(4.0),
                                         **opts})
@@ -775,24 +777,8 @@ def _loop(case: Case, t, u, A, speed_rad_s: float, span_rad: float):
         return bouc_wen(t, u, A, theta_c=span * span_rad, **opts)
     if case.loop == "masing":
         return masing(t, u, A, theta_c=math.radians(opts.pop("theta_c_deg", 3.0)), **opts)
-    if case.loop == "friction-viscous":
-        return friction_viscous(t, u, A, speed_rad_s=speed_rad_s, **opts)
-    if case.loop == "lugre":
-        return lugre(t, u, A, speed_rad_s=speed_rad_s, **opts)
-    if case.loop == "two-maxwell":
-        return two_maxwell(t, u, A, speed_rad_s=speed_rad_s, **opts)
-    if case.loop == "preisach":
-        return preisach(t, u, A, **opts)
-    if case.loop == "fractional":
-        return fractional(t, u, A, speed_rad_s=speed_rad_s, **opts)
-    if case.loop == "iwan-lognormal":
-        return iwan_lognormal(t, u, A, **opts)
     if case.loop == "coleman-hodgdon":
         return coleman_hodgdon(t, u, A, span_rad=span_rad, **opts)
-    if case.loop == "asymmetric-stop":
-        return asymmetric_stop(t, u, A, **opts)
-    if case.loop == "rate-state":
-        return rate_state(t, u, A, speed_rad_s=speed_rad_s, **opts)
     raise ValueError(f"unknown loop {case.loop!r}; one of {', '.join(LOOPS)}")
 
 
