@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from bendpam.errors import InputTypeError
-from bendpam.physics.roots import table_newton
+from bendpam.physics.roots import illinois, table_newton
 from bendpam.physics.sections import branch_path
 from bendpam.validate import float_array, instance, integer
 
@@ -285,7 +285,7 @@ def solve_free(law: MomentLaw, tab: BranchTable, pa: np.ndarray, xtol: float = 1
     x = table_newton(G, x0, s0, a, b, ga, gb, tol)
     stuck = np.flatnonzero(np.abs(g_last) > 1e-6 * np.maximum(q, 1.0))
     if stuck.size:  # B and A vanish together near an unbounded end: P_a = B/A never reaches q there
-        x[stuck] = _bisect_moment(ev, case[stuck], sgn[stuck], q[stuck], a[stuck], b[stuck], x[stuck], tol[stuck])
+        x[stuck] = _moment_root(ev, case[stuck], sgn[stuck], q[stuck], a[stuck], b[stuck], x[stuck], tol[stuck])
         x_last[stuck] = np.nan
     near = np.isfinite(x_last) & np.isfinite(k_last) & np.isfinite(dk_last) & (np.abs(x - x_last) <= tol)
     kx = np.where(near, k_last + dk_last * (x - x_last), 0.0)
@@ -296,30 +296,25 @@ def solve_free(law: MomentLaw, tab: BranchTable, pa: np.ndarray, xtol: float = 1
     return k, u
 
 
-def _bisect_moment(ev, case, sgn, q, a, b, x, tol, steps: int = 200) -> np.ndarray:
-    """Roots of ``sgn (B - q A) = 0``, the moment's own sign, on ``[a, b]`` by bisection (all points at once).
+def _moment_root(ev, case, sgn, q, a, b, x, tol) -> np.ndarray:
+    """Roots of ``sgn (B - q A) = 0``, the moment's own sign, on ``[a, b]`` (:func:`~bendpam.physics.roots.illinois`).
 
     ``P_a = B / A`` is the branch's parametrisation of the root; where ``A`` and ``B`` vanish together (an
     unbounded end whose pole cancels), ``P_a`` jumps without reaching ``q`` and Newton on it stops short,
     while ``B - q A`` (the moment at ``q``, up to a factor) stays continuous and changes sign at the root.
     Points whose ends do not bracket a sign change keep ``x``.
     """
-    def h(xx):
-        A, B = ev.coef(xx, case)
-        return sgn * (B - q * A)
+    def F(xx, idx):  # decreasing through the root: illinois's F(a) >= 0 >= F(b)
+        A, B = ev.coef(xx, case[idx])
+        return sgn[idx] * (q[idx] * A - B)
 
-    lo, hi = a.copy(), b.copy()
-    hl, hh = h(lo), h(hi)
-    ok = (hl < 0.0) & (hh > 0.0)
-    for _ in range(steps):
-        if not np.any(ok & (hi - lo > tol)):
-            break
-        mid = 0.5 * (lo + hi)
-        hm = h(mid)
-        up = hm > 0.0
-        hi = np.where(ok & up, mid, hi)
-        lo = np.where(ok & ~up, mid, lo)
-    return np.where(ok, 0.5 * (lo + hi), x)
+    every = np.arange(q.size)
+    ok = (F(a, every) > 0.0) & (F(b, every) < 0.0)
+    if not ok.any():
+        return x
+    out = x.copy()
+    out[ok] = illinois(lambda xx, idx: F(xx, np.flatnonzero(ok)[idx]), a[ok], b[ok], tol[ok])
+    return out
 
 
 def _bracket_index(pt: np.ndarray, pa: np.ndarray) -> np.ndarray:
