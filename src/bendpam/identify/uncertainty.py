@@ -204,14 +204,11 @@ def instrument_covariance(J: np.ndarray, force_rows: np.ndarray, pressure_rows: 
     >>> np.sqrt(np.diag(cov)).round(6).tolist()                    # 1 % of the offset 1 and of the slope 1
     [0.01, 0.01]
     """
-    n = J.shape[1]
-    cov = np.zeros((n, n))
-    for rows, u in ((np.asarray(force_rows, dtype=float), instrument.force_uncertainty_pct / 100.0),
-                    (-np.asarray(pressure_rows, dtype=float), instrument.pressure_uncertainty_kpa)):
-        if u > 0.0 and np.any(rows):
-            dx = np.linalg.lstsq(J, rows, rcond=None)[0] * u
-            cov += np.outer(dx, dx)
-    return cov
+    every = np.arange(J.shape[0])
+    dxs = [offset_shift(J, [(every, u * np.asarray(rows, dtype=float))])
+           for rows, u in ((force_rows, instrument.force_uncertainty_pct / 100.0),
+                           (pressure_rows, instrument.pressure_uncertainty_kpa)) if u > 0.0]
+    return sum((np.outer(dx, dx) for dx in dxs), np.zeros((J.shape[1], J.shape[1])))
 
 
 def lag1_autocorrelation(resid: np.ndarray, seg: np.ndarray) -> float:
@@ -229,7 +226,7 @@ def lag1_autocorrelation(resid: np.ndarray, seg: np.ndarray) -> float:
     return num / den if den > 0 else 0.0
 
 
-def offset_shift(J: np.ndarray, shifts: Sequence[tuple[np.ndarray, float]]) -> np.ndarray:
+def offset_shift(J: np.ndarray, shifts: Sequence[tuple[np.ndarray, float | np.ndarray]]) -> np.ndarray:
     """How far the parameters move when each group of rows of the data moves by a constant (linearised refit).
 
     With weighted residuals ``r = w (model - y)`` at the optimum (``J^T r = 0``), moving the data by ``dy``
