@@ -465,13 +465,14 @@ def _names_rows_as_separators(any_num: np.ndarray, status: np.ndarray, n_roles: 
         complete |= (status[g * n_roles:(g + 1) * n_roles] == _OK).all(axis=0)
     sep = ~any_num
     partial = any_num & ~complete
-    keep = any_num.copy()
     edges = np.flatnonzero(np.diff(np.concatenate([[0], partial.astype(np.int8), [0]])))
-    for a, b in zip(edges[::2].tolist(), edges[1::2].tolist(), strict=True):  # runs [a, b) of partial rows
-        before = sep[a - 1] if a > 0 else after_sep
-        if before and b < sep.size and sep[b]:
-            keep[a:b] = False
-    return keep
+    a, b = edges[::2], edges[1::2]  # the runs [a, b) of partial rows
+    before = np.where(a > 0, sep[np.maximum(a - 1, 0)], after_sep)
+    after = (b < sep.size) & sep[np.minimum(b, sep.size - 1)]
+    marks = np.zeros(sep.size + 1, dtype=np.int64)
+    np.add.at(marks, a[before & after], 1)
+    np.add.at(marks, b[before & after], -1)
+    return any_num & ~(np.cumsum(marks[:-1]) > 0)
 
 
 def _fast_numbers(texts: list[str], needed: list[int], inp: _Input) -> np.ndarray | None:
