@@ -190,16 +190,16 @@ class _Output:
         if self._state != "new":
             raise RuntimeError(f"an {type(self).__name__} can be entered only once")
         self._prepare()
-        try:
+        try:  # everything after the lock is taken: a signal anywhere here still releases it (no __exit__ yet)
             self._lock.acquire(self.lock_timeout_s)
             self._open()
+            self._state = "open"
+            self._group = current_group()
+            if self._group is not None:
+                self._group._join(self)
         except BaseException as exc:
             self._abort(exc)
             raise
-        self._state = "open"
-        self._group = current_group()
-        if self._group is not None:
-            self._group._join(self)
         return self
 
     def _exit(self, exc: BaseException | None) -> Literal[False]:
