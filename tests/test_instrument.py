@@ -75,7 +75,8 @@ def test_the_total_and_the_parameters_include_it(base):
         assert b.total[key] > plain.uncertainty.total[key]
     assert base.parameters["alpha0"].stderr == pytest.approx(b.total["alpha0_deg"], rel=1e-6)
     assert base.material.se_shear_modulus_kpa == pytest.approx(b.total["shear_modulus_kpa"], rel=1e-6)
-    assert "declared calibration" in b.resampling and "/ instrument" in str(base)
+    assert "the force reading to 1 %" in b.declared and "2 kPa" in b.declared and "declared" not in b.resampling
+    assert "/ instrument" in str(base) and b.declared in str(base)
 
 
 def test_it_survives_the_saved_fit(base, tmp_path):
@@ -115,3 +116,19 @@ def test_the_report_declares_it_too(tmp_path):
                        processing_options={"grid_points": 21}, instrument=Instrument(force_uncertainty_pct=0.58))
     assert raw and "Instrument (declared)" in (tmp_path / "report.html").read_text(encoding="utf-8")
     assert rep.html.name == "report.html"
+
+
+def test_the_report_names_the_declaration(tmp_path):
+    from bendpam.lab.simulate import SimulationSettings, simulate_tests
+    from bendpam.present.report import build_report
+
+    simulate_tests(BE, [100, 200], tmp_path / "raw", settings=SimulationSettings(cycles=1, rate_hz=2.0, hysteresis=0.0,
+                                                                                  seed=1))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        build_report(tmp_path / "raw", BE, tmp_path / "r.html", models=["energy"], progress=False,
+                     processing_options={"grid_points": 21}, instrument=Instrument(force_uncertainty_pct=0.5))
+    page = (tmp_path / "r.html").read_text(encoding="utf-8")
+    assert "Instrument (declared)" in page
+    assert "its declared calibration: the force reading to 0.5 %" in page
+    assert "statistical (" in page and "calibration: the force reading to 0.5 %)" not in page

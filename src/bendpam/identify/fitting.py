@@ -601,7 +601,7 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool, inst
     run.notes += drift_note(unc.drift_shift, budget.total, sum(s != 0 for *_, s in run.offsets))
     if instrument is not None and instrument.declared:
         budget.instrument = part_sds(unc.cov_inst, unc.names, run.prob.actuator(unc.values))
-        budget.resampling += f"; the instrument's declared calibration: {instrument.describe()}"
+        budget.declared = instrument.describe()
     return unc, budget
 
 

@@ -433,12 +433,12 @@ class UncertaintyBudget:
     law's part: the weighted spread over the :class:`EnsembleMember` fits (``ensemble``), weighted by
     ``weighting``.  Both include ``shear_modulus_kpa`` and ``shape`` when the constants vary.
     ``instrument`` is a declared calibration's part (:class:`~bendpam.identify.uncertainty.Instrument`;
-    empty when none was declared).
+    empty when none was declared) and ``declared`` that declaration in words.
 
     >>> b = UncertaintyBudget({"alpha0_deg": 0.03}, {"alpha0_deg": 0.04}, "cycles", "Akaike", [])
     >>> round(b.total["alpha0_deg"], 3), UncertaintyBudget.from_dict(b.to_dict()) == b
     (0.05, True)
-    >>> b.instrument = {"alpha0_deg": 0.12}
+    >>> b.instrument, b.declared = {"alpha0_deg": 0.12}, "the force reading to 0.29 %"
     >>> round(b.total["alpha0_deg"], 3), UncertaintyBudget.from_dict(b.to_dict()) == b
     (0.13, True)
     """
@@ -449,6 +449,7 @@ class UncertaintyBudget:
     weighting: str
     ensemble: list[EnsembleMember] = field(default_factory=list)
     instrument: dict[str, float] = field(default_factory=dict)
+    declared: str = ""
 
     @property
     def total(self) -> dict[str, float]:
@@ -457,11 +458,11 @@ class UncertaintyBudget:
                 for k, v in self.statistical.items()}
 
     def to_dict(self) -> dict:
-        """The budget as JSON types (``instrument`` only when a calibration was declared)."""
+        """The budget as JSON types (``instrument`` and ``declared`` only when a calibration was declared)."""
         out = {"statistical": dict(self.statistical), "systematic": dict(self.systematic), "total": self.total,
                "resampling": self.resampling, "weighting": self.weighting,
                "ensemble": [m.to_dict() for m in self.ensemble]}
-        return {**out, "instrument": dict(self.instrument)} if self.instrument else out
+        return {**out, "instrument": dict(self.instrument), "declared": self.declared} if self.instrument else out
 
     @classmethod
     def from_dict(cls, d: dict) -> UncertaintyBudget:
@@ -469,7 +470,7 @@ class UncertaintyBudget:
         return cls({k: _num(v) for k, v in d["statistical"].items()}, {k: _num(v) for k, v in d["systematic"].items()},
                    str(d.get("resampling", "")), str(d.get("weighting", "")),
                    [EnsembleMember.from_dict(m) for m in d.get("ensemble", [])],
-                   {k: _num(v) for k, v in (d.get("instrument") or {}).items()})
+                   {k: _num(v) for k, v in (d.get("instrument") or {}).items()}, str(d.get("declared", "")))
 
 
 @dataclass
@@ -784,6 +785,8 @@ class FitResult:
             lines.append(f"  standard errors, statistical / systematic{inst}: " + ", ".join(
                 f"{k} {b.statistical[k]:.2g} / {b.systematic.get(k, 0.0):.2g}"
                 + (f" / {b.instrument.get(k, 0.0):.2g}" if b.instrument else "") for k in keys))
+            if b.instrument:
+                lines.append(f"  instrument, its declared calibration: {b.declared}")
             if b.ensemble:
                 lines.append("  loop laws (weight; the model parameters are their weighted average): "
                              + ", ".join(f"{m.law} {m.weight:.2f}" for m in b.ensemble))

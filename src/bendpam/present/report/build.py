@@ -146,7 +146,7 @@ def build_report(
         warnings = plausibility_warnings(processed) + _judge(processed, actuator, fits, failed, tests, model_names[0],
                                                               free_names, bar)
         loops = has_loop(processed)
-        hyst, separate, hyst_error = _loop_fit(processed, actuator, fits, free_names, loops, bar)
+        hyst, separate, hyst_error = _loop_fit(processed, actuator, fits, free_names, loops, bar, instrument)
         figures, notes, stresses = draw_figures(processed, actuator, fits, model_names, hyst, separate, bar)
         bar.advance(0, description=f"report: writing {shown_as or out.name}")
         inputs_info = [_input_info(t) for t in tests]
@@ -242,11 +242,12 @@ def _judge(processed, actuator: Actuator, fits, failed, tests, model: str, free_
     return report_warnings(processed, actuator, fits, metadata=metadata, comparison=comparison, failed=failed)
 
 
-def _loop_fit(processed, actuator: Actuator, fits, free_names, loops: bool, bar):
+def _loop_fit(processed, actuator: Actuator, fits, free_names, loops: bool, bar, instrument=None):
     """The loop fits shown in the hysteresis section (one step): ``(hyst, separate, error)``.
 
     The fits' own when they modelled the loop; otherwise, when the tests show loops, a loop fit of
-    its own (``separate``) of the first model, or why it could not be made (``error``).
+    its own (``separate``) of the first model, with the same declared ``instrument`` as the main fits,
+    or why it could not be made (``error``).
     """
     hyst = {m: r for m, r in fits.items() if getattr(r, "hysteresis", None) is not None}
     separate = None  # a loop fit of its own, when the fits above did not model the loop
@@ -255,7 +256,7 @@ def _loop_fit(processed, actuator: Actuator, fits, free_names, loops: bool, bar)
     if loops and not hyst and fits:
         m0 = next(iter(fits))
         try:
-            separate = fit(processed, actuator, m0, free=free_names, hysteresis="pi")
+            separate = fit(processed, actuator, m0, free=free_names, hysteresis="pi", instrument=instrument)
             hyst = {m0: separate}
         except (BendpamError, ValueError, ArithmeticError) as exc:
             hyst_error = plain_text(str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
