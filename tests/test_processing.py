@@ -291,3 +291,32 @@ def test_branch_times_are_kept_and_an_old_set_loads_without_them(simulated, tmp_
     with xr.open_dataset(tmp_path / "out" / "curves.nc") as ds:
         ds.drop_vars("time_s").load().to_netcdf(old, format="NETCDF3_64BIT")
     assert all(r.branch_times_s is None for r in load_processed(old).results)
+
+
+def test_isolated_spikes_are_replaced_and_noted():
+    data, _ = simulate_test(presets.be_pam(), 150.0, settings=SimulationSettings(cycles=2, rate_hz=10.0, seed=3))
+    t, s, f = (data[c].to_numpy() for c in ("time_s", "stroke_mm", "force_n"))
+    clean = process_series(t, s, f, 150.0, keep_series=False)
+    spiked = f.copy()
+    top = int(np.argmax(f))
+    spiked[[top + 3, 400, 401, 900]] += [60.0, -8.0, -8.5, 5.0]  # N: a glitch near the blocked state, a pair, one
+    res = process_series(t, s, spiked, 150.0, keep_series=False)
+    assert any("4 isolated spike(s) in the force (N)" in n and "+59.9 at" in n for n in res.notes), res.notes
+    assert res.blocked_moment[0] == pytest.approx(clean.blocked_moment[0], rel=1e-3)
+    kept = process_series(t, s, spiked, 150.0, keep_series=False, options=ProcessingOptions(despike_sigmas=0))
+    assert not any("spike" in n for n in kept.notes)
+    assert abs(kept.blocked_moment[0] / clean.blocked_moment[0] - 1.0) > 0.01  # the glitch moves it when kept
+    with pytest.raises(bendpam.errors.InputError, match="despike_sigmas"):
+        ProcessingOptions(despike_sigmas=2.0)
+
+
+def test_steps_and_sharp_reversals_are_not_spikes():
+    from bendpam.lab.checks import noise_spikes
+
+    rng = np.random.default_rng(5)
+    tri = np.abs(((np.arange(400) / 20.0) % 2.0) - 1.0) * 10.0  # a reversal every 20 samples: steps of 0.5
+    assert noise_spikes(tri + rng.normal(0.0, 0.01, 400), 8.0)[0].size == 0
+    saw = (np.arange(600) % 50) * 0.2  # stick-slip: ramps, then a drop of 9.8 in one sample
+    assert noise_spikes(saw + rng.normal(0.0, 0.01, 600), 8.0)[0].size == 0
+    coarse = np.round(np.sin(np.linspace(0.0, 20.0, 2000)) * 5.0) / 5.0  # quantised to 0.2, mostly repeated samples
+    assert noise_spikes(coarse, 8.0)[0].size == 0

@@ -156,6 +156,9 @@ def process(
     repair: RepairOpt = False,
     format_file: FormatFileOpt = None,
     drift: DriftOpt = DriftMethod.none,
+    despike_sigmas: Annotated[float, typer.Option(
+        "--despike-sigmas", help="Replace isolated spikes of 1-2 samples this many noise SDs off both neighbours "
+                                 "(noted per test); 0 = keep them; else 4 to 1e6.")] = 8.0,
     as_json: Annotated[bool, typer.Option("--json", help="Print summary.json to stdout.")] = False,
     keep_going: Annotated[bool, typer.Option(
         "--keep-going", help="Skip the files that cannot be read or processed (each reported) instead of refusing.")]
@@ -175,7 +178,7 @@ def process(
     pressures = _file_pressures(pressure_kpa, files)
     fx = Fixture.from_string(fixture, L0_mm=l0_mm, name="--fixture")
     opts = ProcessingOptions(cutoff_hz=cutoff_hz, reversal_fraction=reversal_fraction, grid_points=grid_points,
-                             tare_n=tare_n, drift=DriftMethod(drift).value)
+                             tare_n=tare_n, drift=DriftMethod(drift).value, despike_sigmas=despike_sigmas)
     fig_name = f"figure4.{fig_format.value if fig_format is not None else 'png'}"
     if fig_format is not None and not figure:
         raise UserError(f"--format {fig_format.value}: there is no figure with --no-figure")

@@ -2,9 +2,10 @@
 
 Nothing read from a file reaches a result unchecked.  :func:`find_spikes` finds isolated
 samples that lie orders of magnitude off their neighbours (a glitch such as ``2,451502E9`` in a
-column of ``2,45``); :func:`time_structure` finds samples out of order, clock restarts, repeated stamps and
-gaps in the sampling; :func:`padding_rows` the padding after the samples.  They work on whole
-columns with NumPy (linear time, a few temporary arrays).
+column of ``2,45``); :func:`noise_spikes` the smaller ones processing removes, samples many times
+the noise (:func:`white_noise`) off both neighbours; :func:`time_structure` finds samples out of
+order, clock restarts, repeated stamps and gaps in the sampling; :func:`padding_rows` the padding
+after the samples.  They work on whole columns with NumPy (linear time, a few temporary arrays).
 """
 
 from __future__ import annotations
@@ -18,15 +19,21 @@ __all__ = [
     "GAP_FACTOR",
     "GAP_MIN_S",
     "SPIKE_FACTOR",
+    "SPIKE_STEPS",
     "TimeStructure",
     "find_spikes",
+    "noise_spikes",
     "padding_rows",
     "time_structure",
+    "white_noise",
 ]
 
 #: A sample is a spike when it lies this many robust column ranges off the median of its
 #: neighbourhood (5 samples).
 SPIKE_FACTOR = 10.0
+#: ... and (:func:`noise_spikes`) this many times the steps between the samples beside it: a sharp
+#: reversal sampled coarsely rises one step above its neighbours, a glitch many.
+SPIKE_STEPS = 4.0
 #: A time step is a gap when it exceeds this many median steps and :data:`GAP_MIN_S`.
 GAP_FACTOR = 50.0
 #: Shortest gap reported (s).
@@ -112,6 +119,84 @@ def _off_median5(x: np.ndarray, limit: float, scratch: np.ndarray | None = None)
     window = np.clip(cand[:, None] + np.arange(-2, 3), 0, n - 1)
     med = np.sort(x[window], axis=1)[:, 2]
     return cand[np.abs(x[cand] - med) > limit].astype(np.int64)
+
+
+def white_noise(x: np.ndarray) -> float:
+    """The white noise of one sample of a column, from the median absolute difference of successive samples.
+
+    ``1.4826 MAD(diff(x)) / sqrt(2)``: robust to a few outliers; a signal's own slope (the differences'
+    spread about their median) adds to it, so on a moving signal it errs high.  NaN below three samples.
+
+    >>> rng = np.random.default_rng(1)
+    >>> round(white_noise(np.linspace(0.0, 10.0, 20000) + rng.normal(0.0, 0.05, 20000)), 2)
+    0.05
+    """
+    d = np.diff(np.asarray(x, dtype=float))
+    if d.size < 2:
+        return float("nan")
+    return float(1.4826 * np.median(np.abs(d - np.median(d))) / np.sqrt(2.0))
+
+
+def noise_spikes(x: np.ndarray, sigmas: float) -> tuple[np.ndarray, np.ndarray, float]:
+    """Isolated spikes of one or two samples many times the noise off the samples on both sides.
+
+    A sample (or two adjacent ones) is a spike when it lies more than ``sigmas`` noise standard
+    deviations (:func:`white_noise`; for a coarse column whose samples mostly repeat, the noise its 90th
+    percentile of steps gives, at least its quantum, its smallest step) from the median
+    of the five samples around it *and* from both samples beside it (beside the pair), on the same
+    side, by more than :data:`SPIKE_STEPS` times the steps between those samples and the next ones
+    out: a glitch of the load cell or the logger, not a step (stick-slip, a dropped load, whose samples
+    on one side follow) nor a reversal sampled coarsely (one step above its neighbours).
+
+    Parameters
+    ----------
+    x : the column (finite values).
+    sigmas : the threshold in noise standard deviations (> 0).
+
+    Returns
+    -------
+    (indices of the spikes, the values to put in their place: the medians of five around them, the noise SD)
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(2)
+    >>> f = 10.0 * np.sin(np.linspace(0.0, 6.0, 600)) + rng.normal(0.0, 0.05, 600)
+    >>> f[100] += 2.0; f[300:302] -= 1.5; f[450:] += 3.0          # two spikes and a step
+    >>> idx, fill, noise = noise_spikes(f, 8.0)
+    >>> idx.tolist(), round(noise, 2)
+    ([100, 300, 301], 0.07)
+    """
+    x = np.asarray(x, dtype=float)
+    n = x.size
+    noise = white_noise(x)
+    steps = np.abs(np.diff(x))
+    quantum = float(steps[steps > 0].min()) if np.any(steps > 0) else 0.0
+    # a coarse column has mostly equal samples (no noise by the median difference): its tenth largest steps
+    # then say more of its noise (for Gaussian noise the 90th percentile of |N(0, 2 s^2)| is 1.645 sqrt(2) s)
+    noise = noise if np.isfinite(noise) else 0.0
+    if noise <= quantum and steps.size >= 10:
+        noise = max(quantum, float(np.quantile(steps, 0.9)) / (1.645 * np.sqrt(2.0)))
+    empty = np.empty(0, dtype=np.int64)
+    if n < 5 or noise <= 0.0:
+        return empty, np.empty(0), noise
+    limit = sigmas * noise
+    cand = _off_median5(x, limit)
+    if cand.size == 0:
+        return empty, np.empty(0), noise
+    # runs of one or two candidates, with the samples on both sides of the run off by more than the limit
+    first = np.flatnonzero(np.diff(np.concatenate([[-2], cand])) > 1)
+    a, b = cand[first], cand[np.concatenate([first[1:], [cand.size]]) - 1]
+    ok = (b - a <= 1) & (a > 1) & (b < n - 2)
+    a, b = a[ok], b[ok]
+    lo, hi = np.minimum(x[a], x[b]), np.maximum(x[a], x[b])
+    side_hi, side_lo = np.maximum(x[a - 1], x[b + 1]), np.minimum(x[a - 1], x[b + 1])
+    height = np.maximum(lo - side_hi, side_lo - hi)
+    local = np.maximum(np.abs(x[a - 1] - x[a - 2]), np.abs(x[b + 2] - x[b + 1]))  # the steps beside it
+    spike = (height > limit) & (height > SPIKE_STEPS * local)
+    a, b = a[spike], b[spike]
+    idx = np.unique(np.concatenate([a, b])).astype(np.int64)
+    window = np.clip(idx[:, None] + np.arange(-2, 3), 0, n - 1)
+    return idx, np.sort(x[window], axis=1)[:, 2], noise
 
 
 @dataclass(frozen=True)

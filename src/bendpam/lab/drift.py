@@ -42,6 +42,8 @@ from dataclasses import asdict, dataclass, fields
 
 import numpy as np
 
+from bendpam.lab.checks import white_noise
+
 __all__ = ["DRIFT_METHODS", "FLAG_FRACTION", "FLAG_SIGMAS", "SET_FLAG_SIGMAS", "DriftEstimate", "check_drift",
            "drift_findings", "estimate_drift", "moment_shift_nmm", "set_drift", "set_drift_findings", "set_drifts"]
 
@@ -180,14 +182,6 @@ class DriftEstimate:
         return out
 
 
-def _noise_n(force: np.ndarray) -> float:
-    """The white noise of one sample (N), from the median absolute difference of successive samples."""
-    d = np.diff(force)
-    if d.size < 2:
-        return math.nan
-    return float(1.4826 * np.median(np.abs(d - np.median(d))) / math.sqrt(2.0))
-
-
 def _end_windows(time: np.ndarray, stroke: np.ndarray, force: np.ndarray, cycles, band_mm: float,
                  first_unloading: bool) -> tuple[np.ndarray, ...]:
     """The end windows of every cycle ``(blocked, free, blocked)``: ``(end, mean time, mean force, samples)``.
@@ -293,7 +287,7 @@ def estimate_drift(time_s, stroke_mm, force_n, cycles, *, band_fraction: float =
     end, tw, fw, nw = _end_windows(t, s, f, cycles, band_fraction * float(np.ptp(s)), FIRST_UNLOADING)
     if end.size == 0:
         return None
-    noise = _noise_n(f)
+    noise = white_noise(f)
     a, se = _slope(tw, fw, nw, end, noise, np.ones(end.size, dtype=bool))
     if not math.isfinite(a):
         return None

@@ -63,6 +63,9 @@ class ProcessingOptions:
     zero_stroke : count the stroke from the blocked turning points (True) or use it as recorded.
     drift : the load-cell offset drift (:mod:`bendpam.lab.drift`): ``"none"`` estimates and reports it,
     ``"linear"`` also subtracts the fitted linear offset before the conversion.
+    despike_sigmas : isolated spikes of one or two samples, this many noise standard deviations off the
+    samples on both sides (:func:`bendpam.lab.checks.noise_spikes`), are replaced by the median of the five
+    samples around them before filtering, and the test's notes say so; 0 keeps them (allowed: 0, or 4 to 1e6).
 
     Examples
     --------
@@ -81,6 +84,7 @@ class ProcessingOptions:
     tare_n: float = 0.0
     zero_stroke: bool = True
     drift: str = "none"
+    despike_sigmas: float = 8.0
 
     def __post_init__(self) -> None:
         if self.drift not in DRIFT_METHODS:
@@ -95,6 +99,9 @@ class ProcessingOptions:
             raise InputError(f"grid_points = {self.grid_points!r} is outside the allowed range [5, 100000]")
         if not math.isfinite(self.tare_n):
             raise InputError(f"tare_n = {self.tare_n!r} N is not finite")
+        if not (self.despike_sigmas == 0 or 4.0 <= self.despike_sigmas <= 1e6):
+            raise InputError(f"despike_sigmas = {self.despike_sigmas!r} is outside the allowed values: 0 (off) or "
+                             "4 to 1e6 noise standard deviations")
 
 
 @dataclass

@@ -5,10 +5,13 @@ One raw test (time, stroke, force) at one pressure becomes:
 1. **Orientation.**  Force is made positive at the blocked state (compression exports are often
    negative) and stroke is oriented so that it grows toward the free state (force falls as the
    actuator is released); both flips are recorded.
-2. **Filtering.**  A zero-phase low-pass filter, ``scipy.signal.sosfiltfilt`` with a 4th-order
-   Butterworth design.  The default cutoff is 1 Hz, limited to 40 % of the Nyquist frequency;
-   the paper's tests run at about 30 mm/min, so a cycle lasts minutes and the filter only
-   removes measurement noise.  Set ``cutoff_hz`` to change it, or ``cutoff_hz=0`` to switch it off.
+2. **Filtering.**  Isolated spikes of one or two samples, ``despike_sigmas`` (8) noise standard
+   deviations off the samples on both sides, are first replaced by the median of the five samples
+   around them and noted (:func:`bendpam.lab.checks.noise_spikes`).  Then a zero-phase low-pass
+   filter, ``scipy.signal.sosfiltfilt`` with a 4th-order Butterworth design.  The default cutoff is
+   1 Hz, limited to 40 % of the Nyquist frequency; the paper's tests run at about 30 mm/min, so a
+   cycle lasts minutes and the filter only removes measurement noise.  Set ``cutoff_hz`` to change
+   it, or ``cutoff_hz=0`` to switch it off.
 3. **Segmentation.**  Turning points of the filtered stroke, found with a hysteresis (zig-zag)
    threshold of ``reversal_fraction`` of the stroke range, so noise, dwell at the ends and small
    back-steps do not create false reversals.  A cycle is blocked -> free -> blocked; a partial
@@ -49,6 +52,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from bendpam.errors import InputError, PlausibilityWarning, ProcessingError
+from bendpam.lab.checks import noise_spikes
 from bendpam.lab.drift import check_drift, drift_findings, moment_shift_nmm, set_drift_findings
 from bendpam.lab.plausibility import check_result, compression_like
 from bendpam.lab.processed import (
@@ -422,6 +426,9 @@ def process_series(
     t, s_raw, f_raw = _checked_arrays(time_s, stroke_mm, force_n, source)
     notes: list[str] = []
     fs, cutoff = _sampling(t, opt, source, notes)
+    if opt.despike_sigmas:
+        s_raw, f_raw = (_despike(x, opt.despike_sigmas, t, what, notes)
+                        for x, what in ((s_raw, "stroke (mm)"), (f_raw, "force (N)")))
     s_f, f_f = (_lowpass(x, fs, cutoff, int(opt.filter_order)) for x in (s_raw, f_raw))
     rng = float(np.ptp(s_f))
     if rng <= 0:
@@ -450,6 +457,28 @@ def process_series(
     )
     _judge(result, fixture, cycles, k, (t, s_z, f_f, M), opt.tare_n)
     return result
+
+
+def _despike(x: np.ndarray, sigmas: float, t: np.ndarray, what: str, notes: list[str]) -> np.ndarray:
+    """``x`` with its isolated spikes (:func:`~bendpam.lab.checks.noise_spikes`) replaced, and a note of them.
+
+    >>> x = np.r_[np.zeros(50), 5.0, np.zeros(49)] + 0.01 * np.sin(np.arange(100.0))
+    >>> notes = []
+    >>> float(_despike(x, 8.0, np.arange(100.0), "force (N)", notes).max()) < 0.1, notes[0][:48]
+    (True, '1 isolated spike(s) in the force (N) replaced by')
+    """
+    idx, fill, noise = noise_spikes(x, sigmas)
+    if idx.size == 0:
+        return x
+    out = x.copy()
+    dev = x[idx] - fill
+    j = int(np.argmax(np.abs(dev)))
+    out[idx] = fill
+    notes.append(f"{idx.size} isolated spike(s) in the {what} replaced by the median of the samples around them "
+                 f"(the largest {dev[j]:+.3g} at t = {t[idx[j]]:.6g} s, {abs(dev[j]) / noise:.0f} times the noise "
+                 f"{noise:.2g}; a spike is {sigmas:g} times the noise off both neighbours; despike_sigmas = 0 keeps "
+                 "them)")
+    return out
 
 
 def _refuse_compression(s_raw: np.ndarray, f_raw: np.ndarray, threshold_mm: float, source: str) -> None:
