@@ -128,6 +128,7 @@ from bendpam.identify.ensemble import (
     SPAN_SCALED,
     TWO_BRANCH,
     MemberFit,
+    group_ssr,
     member_weights,
     part_sds,
     played_path,
@@ -571,9 +572,10 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool, inst
     unc = _uncertainty(run.prob, run.bnd, run.nl, run.lin, corr_flag, run.cycles, run.offsets, instrument)
     run.nfev += unc.nfev
     fits: dict[str, MemberFit] = {}
+    r = run.prob.residual_full(np.concatenate([[run.nl[p] for p in run.prob.nonlin], run.lin]))
     if run.law and law_uncertainty:
-        fits[run.law] = MemberFit(dict(unc.values), _ssr(run.prob, run.nl, run.lin), tuple(unc.names),
-                                  unc.cov_stat.copy(), len(run.prob.free))
+        fits[run.law] = MemberFit(dict(unc.values), float(r @ r), tuple(unc.names), unc.cov_stat.copy(),
+                                  len(run.prob.free), group_ssr(r, run.prob.groups))
         solved = {}
         for alt in (a for a in ENSEMBLE if a != run.law and (a not in SPAN_SCALED or spans_differ(run.prob.d))):
             try:
@@ -581,7 +583,6 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool, inst
             except FitError:  # this law cannot describe the curves at all: it has no weight
                 continue
             run.nfev += n
-    r = run.prob.residual_full(np.concatenate([[run.nl[p] for p in run.prob.nonlin], run.lin]))
     if fits:  # each member's own statistical covariance, where it has weight (the others add nothing)
         w, _ = member_weights(fits, r, run.prob.groups)
         for (alt, f), wk in zip(list(fits.items()), w, strict=True):
@@ -858,7 +859,10 @@ def _law_refit(prob: _Problem, bnd, nl, alt: str):
             if float(r @ r) < best[0]:
                 best = (float(r @ r), trial)
     nl2, lin2, _, _, n = _search(p2, bnd, best, tol=1e-5)
-    return MemberFit(p2.to_user(nl2, lin2), _ssr(p2, nl2, lin2), n_params=len(p2.free)), nfev + n, (p2, nl2, lin2)
+    r2 = p2.residual_full(np.concatenate([[nl2[p] for p in p2.nonlin], lin2]))
+    member = MemberFit(p2.to_user(nl2, lin2), float(r2 @ r2), n_params=len(p2.free),
+                       group_ssr=group_ssr(r2, p2.groups))
+    return member, nfev + n, (p2, nl2, lin2)
 
 
 def _profile(prob: _Problem, bnd, nl, unc: Uncertainty, n_points: int):
