@@ -1,6 +1,6 @@
 """The calibration study of bendpam's error bars (issue 23): do the fit's standard errors hold?
 
-    python tools/calibration_study.py [--seeds 10] [--set main|holdout|...|holdout5] [--cases CASE ...] [--jobs 1]
+    python tools/calibration_study.py [--seeds 10] [--set main|holdout|...|holdout6] [--cases CASE ...] [--jobs 1]
                                       [--out FILE]
 
 For every case of :data:`raw_generators.CASES` (or of :data:`raw_generators.HOLDOUT` with ``--set holdout``:
@@ -43,6 +43,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+import holdout6_generator as gen6  # noqa: E402
 import raw_generators as gen  # noqa: E402
 
 from bendpam.infra.atomic import atomic_write_text, json_safe  # noqa: E402
@@ -52,8 +53,15 @@ START, END = "<!-- calibration-table:start -->", "<!-- calibration-table:end -->
 #: The case sets: ``main`` (:data:`raw_generators.CASES`, what the error bars are tuned and judged on) and
 #: ``holdout`` (:data:`raw_generators.HOLDOUT`, other parameters and combined faults, kept out of any tuning).
 SETS = {"main": gen.CASES, "holdout": gen.HOLDOUT, "holdout2": gen.HOLDOUT2, "holdout3": gen.HOLDOUT3,
-        "holdout4": gen.HOLDOUT4, "holdout5": gen.HOLDOUT5}
-ALL_CASES = {**gen.CASES, **gen.HOLDOUT, **gen.HOLDOUT2, **gen.HOLDOUT3, **gen.HOLDOUT4, **gen.HOLDOUT5}
+        "holdout4": gen.HOLDOUT4, "holdout5": gen.HOLDOUT5, "holdout6": gen6.CASES}
+ALL_CASES = {**gen.CASES, **gen.HOLDOUT, **gen.HOLDOUT2, **gen.HOLDOUT3, **gen.HOLDOUT4, **gen.HOLDOUT5,
+             **gen6.CASES}
+
+
+def generator(case):
+    """The module that makes ``case``'s raw tests: :mod:`holdout6_generator` for its cases (its own machine,
+    written independently), :mod:`raw_generators` for the others; each has ``generate_set`` and ``start_actuator``."""
+    return gen6 if isinstance(case, gen6.Case6) else gen
 
 
 def markers(case_set: str) -> tuple[str, str]:
@@ -80,7 +88,8 @@ def _fit_record(result) -> dict:
             "converged": bool(result.converged), "loop": result.metrics.curves}
 
 
-def run_one(case_name: str, seed: int, case: gen.Case | None = None, fit_options: dict | None = None) -> list[dict]:
+def run_one(case_name: str, seed: int, case: gen.Case | gen6.Case6 | None = None,
+            fit_options: dict | None = None) -> list[dict]:
     """Generate, read, process and fit one case and seed: one record per processing variant.
 
     ``fit_options`` are keywords of :func:`bendpam.identify.fitting.fit` (default: those of ``bendpam fit``); an
@@ -103,7 +112,7 @@ def run_one(case_name: str, seed: int, case: gen.Case | None = None, fit_options
         warnings.simplefilter("ignore")
         t0 = time.perf_counter()
         try:
-            truth = gen.generate_set(case, seed, folder)
+            truth = generator(case).generate_set(case, seed, folder)
             raws = [read_test(Path(folder) / name) for name in truth["files"]]
         except Exception as exc:  # a failed run is counted, with its reason
             return [{"case": case_name, "variant": v, "seed": seed, "case_info": _case_info(case),
@@ -118,7 +127,7 @@ def run_one(case_name: str, seed: int, case: gen.Case | None = None, fit_options
                                    drift=drift)
                 rec["drift_flagged"] = sum(bool(r.drift is not None and r.drift.flagged) for r in ps.results)
                 rec["tests"] = len(ps.results)
-                rec.update(_fit_record(fit(ps, gen.start_actuator(case), **fit_kw)))
+                rec.update(_fit_record(fit(ps, generator(case).start_actuator(case), **fit_kw)))
                 if drift == "linear":
                     rec.update(_drift_propagation(raws, ps, Fixture(L0_mm=truth["fixture_L0_mm"]), case, fit_kw))
             except Exception as exc:
@@ -128,7 +137,7 @@ def run_one(case_name: str, seed: int, case: gen.Case | None = None, fit_options
     return records
 
 
-def _drift_propagation(raws, processed, fixture, case: gen.Case, fit_kw: dict) -> dict:
+def _drift_propagation(raws, processed, fixture, case: gen.Case | gen6.Case6, fit_kw: dict) -> dict:
     """What the drift corrections' own uncertainty adds to alpha0's and mu's SE (a diagnostic the fit lacks).
 
     Each test's force is corrected by its fitted drift rate, once as estimated and once with one test's rate moved
@@ -150,8 +159,8 @@ def _drift_propagation(raws, processed, fixture, case: gen.Case, fit_kw: dict) -
             d = raw.data
             force = d["force_n"] - rate * (d["time_s"] - e.t0_s)
             shifted.append(dataclasses.replace(raw, data=d.assign(force_n=force)))
-        r = fit(process_tests(shifted, fixture=fixture, keep_series=False, drift="none"), gen.start_actuator(case),
-                **fit_kw)
+        r = fit(process_tests(shifted, fixture=fixture, keep_series=False, drift="none"),
+                generator(case).start_actuator(case), **fit_kw)
         return r.parameters["alpha0"].value, r.material.shear_modulus_kpa
 
     a0, m0 = refit(None)
@@ -160,7 +169,7 @@ def _drift_propagation(raws, processed, fixture, case: gen.Case, fit_kw: dict) -
             "se_mu_drift_kpa": float(np.sqrt(np.sum(shifts[:, 1] ** 2)))}
 
 
-def _case_info(case: gen.Case) -> dict:
+def _case_info(case: gen.Case | gen6.Case6) -> dict:
     """What the table says of a case (its actuator, pressures, loop, noise, drift, truth of the shape)."""
     keys = ("loop", "loop_fraction", "preset", "model", "pressures_kpa", "noise_fraction", "noise_ar1",
             "drift_fraction", "dialect", "cycles", "rate_hz")
@@ -388,12 +397,14 @@ def main(argv=None) -> int:
                     "combined faults, kept out of any tuning; holdout2-4: further such sets, each scored once; "
                     "holdout5: loop laws and instrument faults chosen independently of the fit (a springpot, Iwan, "
                     "Coleman-Hodgdon, asymmetric stops, rate-and-state friction, softening; pressure leak and "
-                    "ripple, load-cell error, frame compliance, filtered force, dropped rows, clipping), scored once")
+                    "ripple, load-cell error, frame compliance, filtered force, dropped rows, clipping), scored once; "
+                    "holdout6: an independent machine (tools/holdout6_generator.py: its own fixture, waveforms, "
+                    "loop laws, faults and export layouts), scored once")
     ap.add_argument("--cases", nargs="+", choices=list(ALL_CASES), metavar="CASE",
                     help=f"cases to run (default: the whole set; main: {', '.join(gen.CASES)}; holdout: "
                     f"{', '.join(gen.HOLDOUT)}; holdout2: {', '.join(gen.HOLDOUT2)}; "
                     f"holdout3: {', '.join(gen.HOLDOUT3)}; holdout4: {', '.join(gen.HOLDOUT4)}; "
-                    f"holdout5: {', '.join(gen.HOLDOUT5)})")
+                    f"holdout5: {', '.join(gen.HOLDOUT5)}; holdout6: {', '.join(gen6.CASES)})")
     ap.add_argument("--jobs", type=int, default=1, help="processes (default 1; the machine may be shared)")
     ap.add_argument("--fit", dest="fit_options", action="append", default=[], metavar="KEY=VALUE",
                     help="a keyword of bendpam.identify.fitting.fit, as a Python literal (law_uncertainty=False, "
