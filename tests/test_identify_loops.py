@@ -21,7 +21,8 @@ import bendpam
 from bendpam import presets
 from bendpam.cli import main
 from bendpam.identify.diagnose import study_coverage
-from bendpam.identify.fitting import _fold_rule, _Problem, fit
+from bendpam.identify.fitting import _fold_rule, fit
+from bendpam.identify.problem import Problem
 from bendpam.identify.result import ExtrapolationWarning, FitResult
 from bendpam.identify.tension import TensionData
 from bendpam.lab import write_test
@@ -258,7 +259,7 @@ def test_fold_rule_holds_the_shape_where_the_model_does_not_fold():
     d = fit_data(noisy_set(lt, seed=1))
     bnd = ident._bounds(base, d, None)
     args = (base, d, "energy", ["alpha0", "C10", "C01"], bnd, 32, True, None, (-4.2, 1.0))
-    prob = _Problem(*args)
+    prob = Problem(*args)
     nl, lin, *_ = ident._solve(prob, bnd, 21, 3)
     assert ident._fold_kpa(prob, nl, lin, 150.0) is not None  # the best fit folds below 150 kPa
     p2, nl2, lin2, _, note, held = _fold_rule(prob, args, bnd, nl, lin, 150.0)
@@ -266,7 +267,7 @@ def test_fold_rule_holds_the_shape_where_the_model_does_not_fold():
     assert p2.shape_fixed is not None and "fold rejected" in note and "held at" in held
     # with no admissible way out the fit is marked as rejected
     args_bad = (*args[:8], (-4.2, -3.9))
-    p3 = _Problem(*args_bad)
+    p3 = Problem(*args_bad)
     nl3, lin3, *_ = ident._solve(p3, bnd, 21, 3)
     _, _, _, _, note3, _ = _fold_rule(p3, args_bad, bnd, nl3, lin3, 150.0)
     assert note3.startswith("REJECTED")

@@ -126,18 +126,15 @@ from bendpam.identify.diagnose import (
 from bendpam.identify.ensemble import (
     MEMBER_EXTRA,
     SPAN_SCALED,
-    TWO_BRANCH,
     MemberFit,
     group_ssr,
     member_weights,
     part_sds,
-    played_path,
     spans_differ,
-    steady_z,
     uncertainty_budget,
 )
 from bendpam.identify.metrics import score
-from bendpam.identify.numerics import bounded_lstsq, chebyshev_interpolation, halfline
+from bendpam.identify.problem import Problem, Tension
 from bendpam.identify.result import (
     HYST_PARAMETERS,
     PARAMETER_ORDER,
@@ -169,13 +166,10 @@ from bendpam.version import __version__
 
 __all__ = ["PAPER_START", "fit"]
 
-_NONLINEAR = ("alpha0", "R0_start")
 #: The paper's starting values of the identification (section 3.4, from its tension test), kPa.
 PAPER_START = {"C10": 114.0, "C01": 300.0}
 #: Loop angles (deg) of the global grid.
 _THETA_GRID = np.geomspace(0.5, 40.0, 9)
-#: Chebyshev nodes on which the kinematics are sampled (then interpolated to the data).
-_CHEB_NODES = 32
 #: Stretch margin over the tested curvatures for the admissible shapes.
 _STRETCH_MARGIN = 1.1
 
@@ -197,210 +191,6 @@ def _default_bounds(actuator: Actuator, P_min_kpa: float) -> dict[str, tuple[flo
         "R0_start": (actuator.R0_mm, 1.5 * actuator.R0_mm),
     }
 
-
-
-@dataclass
-class _Tension:
-    """Tension-test rows of a joint fit: stretches, nominal stresses (kPa) and their weight."""
-
-    stretch: np.ndarray
-    stress_kpa: np.ndarray
-    weight: float
-
-
-class _Problem:
-    """Residuals of the weighted problem for a given set of free parameters (variable projection)."""
-
-    def __init__(self, actuator: Actuator, data: FitData, model: str, free: list[str], bounds, order: int,
-                 eq19_factor: bool, law: str | None, shape_bounds: tuple[float, float], *,
-                 shape_fixed: float | None = None, tension: _Tension | None = None):
-        self.base = actuator
-        self.d = data
-        self.model = model
-        self.order = order
-        self.eq19 = eq19_factor
-        self.law = law
-        self.bounds = bounds
-        self.shape_bounds = shape_bounds
-        self.shape_fixed = shape_fixed
-        self.tension = tension
-        self.sign = actuator.bend_sign or 1
-        self.set_free([*free, "theta_h", "a0", "a1"] if law else list(free))
-        w, y, grp = data.w, data.Mc, data.group
-        if tension is not None:
-            n = tension.stretch.size
-            w = np.concatenate([w, np.full(n, tension.weight)])
-            y = np.concatenate([y, tension.stress_kpa])
-            grp = np.concatenate([grp, np.full(n, int(grp.max()) + 1)])
-        self.w, self.y, self.groups = w, y, grp
-        self.W: np.ndarray | None
-        self.nodes, self.W = chebyshev_interpolation(data.kc, float(data.kc.max()) or 1e-9, _CHEB_NODES)
-        self._qs_cache: dict = {}
-        self._z_cache: dict = {}
-        if not self._interpolation_ok():
-            self.W = None
-
-    def set_free(self, free: list[str]) -> None:
-        """The varied parameters: the nonlinear ones (searched) and the linear ones (projected)."""
-        self.free = list(free)
-        self.nonlin = [p for p in self.free if p in _NONLINEAR or p in ("theta_h", "theta_2", "gap", "ratio")]
-        self.lin = [p for p in self.free if p not in self.nonlin]
-        self.cone = "C10" in self.lin and "C01" in self.lin
-        self.int_names, self.T, self.lo, self.hi = self._internal()
-
-    # -- linear parameters: internal coordinates -> user values (user = T @ internal) ---------
-    def _internal(self):
-        blocks = []  # (internal name, {user name: coefficient}, lo, hi)
-        hiS = max(self.bounds["C10"][1] + self.bounds["C01"][1], 1.0)
-        for p in self.lin:
-            if p == "C01" and self.cone:
-                continue
-            if p == "C10" and self.cone:
-                if self.shape_fixed is not None:
-                    b = self.shape_fixed
-                    blocks.append(("S", {"C10": 1.0 - b, "C01": b}, 0.0, hiS))
-                else:
-                    b_lo, b_hi = self.shape_bounds
-                    blocks.append(("S_lo", {"C10": 1.0 - b_lo, "C01": b_lo}, 0.0, hiS))
-                    blocks.append(("S_hi", {"C10": 1.0 - b_hi, "C01": b_hi}, 0.0, hiS))
-            elif p in ("C10", "C01"):
-                blocks.append((p, {p: 1.0}, *self._single_constant_bounds(p)))
-            else:
-                blocks.append((p, {p: 1.0}, *self.bounds[p]))
-        T = np.zeros((len(self.lin), len(blocks)))
-        for j, (_, coef, _, _) in enumerate(blocks):
-            for name, c in coef.items():
-                T[self.lin.index(name), j] = c
-        return [b[0] for b in blocks], T, np.array([b[2] for b in blocks]), np.array([b[3] for b in blocks])
-
-    def _single_constant_bounds(self, p: str) -> tuple[float, float]:
-        """Bounds of one free constant with the other fixed: its box, C10 + C01 >= 1 kPa, the cone."""
-        b_lo, b_hi = self.shape_bounds if self.shape_fixed is None else (self.shape_fixed, self.shape_fixed)
-        other = "C01" if p == "C10" else "C10"
-        c = float(getattr(self.base, PARAMETERS[other][0]))
-        if p == "C10":  # x = C10: C01 - b_lo S >= 0, b_hi S - C01 >= 0
-            conds = [(-b_lo, -(1.0 - b_lo) * c), (b_hi, -(b_hi - 1.0) * c), (1.0, 1.0 - c)]
-        else:  # x = C01
-            conds = [(1.0 - b_lo, b_lo * c), (b_hi - 1.0, -b_hi * c), (1.0, 1.0 - c)]
-        lo, hi = self.bounds[p]
-        for a, b in conds:
-            l_, h_ = halfline(a, b)
-            lo, hi = max(lo, l_), min(hi, h_)
-        if not lo <= hi:
-            raise InputError(
-                f"with {PARAMETERS[other][0]} = {c:g} kPa held fixed no {PARAMETERS[p][0]} gives an admissible "
-                f"material (shape C01/(C10 + C01) in [{b_lo:.4g}, {b_hi:.4g}]); free both constants")
-        return lo, hi
-
-    def actuator(self, values: dict[str, float]) -> Actuator:
-        ch = {PARAMETERS[p][0]: v for p, v in values.items() if p in PARAMETERS}
-        return self.base.replace(**ch)
-
-    # -- the model's columns --------------------------------------------------------------------
-    def _interpolation_ok(self) -> bool:
-        if self.W is None or self.d.kc.size <= 3 * _CHEB_NODES:
-            return False
-        law = MomentLaw(self.base, self.model, eq19_factor=self.eq19, order=self.order)
-        k = float(self.d.kc.max()) * np.array([1.0, 0.37, 0.81])
-        idx = [int(np.argmin(np.abs(self.d.kc - x))) for x in k]
-        nodes = np.column_stack(law.basis(self.sign * self.nodes))
-        approx = self.W[idx] @ nodes
-        exact = np.column_stack(law.basis(self.sign * self.d.kc[idx]))
-        scale = np.maximum(np.abs(exact).max(axis=0), 1e-300)
-        return bool(np.all(np.abs(approx - exact) <= 1e-9 * scale))
-
-    def _qs(self, nl: dict[str, float]):
-        """The actuator, ``(A, b10, b01)`` (per kPa) and the frame's curvature column at the data's curvatures
-        for the kinematics in ``nl`` (with a ``gap``: at the played curvatures, as the fixture converts them)."""
-        gap = float(nl.get("gap", 0.0))
-        key = (tuple(sorted((p, float(v)) for p, v in nl.items() if p in PARAMETERS)), gap)
-        hit = self._qs_cache.get(key)
-        if hit is None:
-            if len(self._qs_cache) > 256:
-                self._qs_cache.clear()
-            a = self.base.replace(**{PARAMETERS[p][0]: v for p, v in key[0]})
-            law = MomentLaw(a, self.model, eq19_factor=self.eq19, order=self.order)
-            kq, fac = (self.d.kc, 1.0) if gap <= 0 else self._played(gap)[:2]
-            if self.W is not None:
-                W = self.W if gap <= 0 else chebyshev_interpolation(kq, float(self.d.kc.max()) or 1e-9, _CHEB_NODES)[1]
-                cols = W @ np.column_stack(law.basis(self.sign * self.nodes))
-                hit = (a, cols[:, 0] * fac, cols[:, 1] * fac, cols[:, 2] * fac, kq * fac)
-            else:
-                A, b10, b01 = law.basis(self.sign * kq)
-                hit = (a, A * fac, b10 * fac, b01 * fac, kq * fac)
-            self._qs_cache[key] = hit
-        return hit
-
-    def _played(self, gap: float):
-        if ("played", gap) not in self._z_cache:
-            self._z_cache[("played", gap)] = played_path(self.d, gap)
-        return self._z_cache[("played", gap)]
-
-    def _z(self, theta_deg: float, gap: float = 0.0, ratio: float | None = None, law: str | None = None,
-           theta_2: float | None = None):
-        law = law or self.law
-        key = (law, theta_deg, gap, ratio, theta_2)  # the cache is shared by the ensemble's members
-        z = self._z_cache.get(key)
-        if z is None:
-            if len(self._z_cache) > 512:
-                self._z_cache.clear()
-            assert law is not None, "a loop fit has a law"
-            if law in TWO_BRANCH:  # two columns of other laws' z (each cached), at their angles
-                angle = {"theta": theta_deg, "theta_2": float(theta_2 or 1.0), None: 0.0}
-                z = np.column_stack([self._z(angle[a], law=part).reshape(self.d.kc.size, -1)[:, 0]
-                                     for part, a in TWO_BRANCH[law]])
-            else:
-                z = steady_z(law, theta_deg, self.d if gap <= 0 else self._played(gap)[2], ratio)
-            self._z_cache[key] = z
-        return z
-
-    def design(self, nl: dict[str, float]):
-        """Fixed part ``c0`` and columns ``X`` (per internal linear unit) of every row of the model."""
-        a, A, b10, b01, k_frame = self._qs(nl)
-        s, d = self.sign, self.d
-        cols = {"C10": -s * b10, "C01": -s * b01, "P_start": -s * A, "E_f": -a.frame_inertia_mm4 * k_frame}
-        c0 = s * d.Pc * A
-        fixed = {"C10": a.C10_kpa, "C01": a.C01_kpa, "P_start": a.P_start_kpa, "E_f": a.frame_modulus_mpa}
-        for p, col in cols.items():
-            if p not in self.lin:
-                c0 = c0 + col * fixed[p]
-        if self.law:
-            z = self._z(float(nl["theta_h"]), float(nl.get("gap", 0.0)), nl.get("ratio"),
-                        theta_2=nl.get("theta_2")).reshape(d.kc.size, -1)
-            pa = np.maximum(d.Pc - a.P_start_kpa, 0.0)
-            for j, (n0, n1) in enumerate((("a0", "a1"), ("a0_2", "a1_2"))[: z.shape[1]]):
-                cols[n0], cols[n1] = -z[:, j], -z[:, j] * pa
-        X = np.column_stack([cols[p] for p in self.lin]) if self.lin else np.zeros((c0.size, 0))
-        if self.tension is not None:
-            lam = self.tension.stretch
-            g1 = lam - lam**-2
-            tcols = {"C10": 2.0 * g1, "C01": 2.0 * g1 / lam}
-            ct = np.zeros(lam.size)
-            for p, col in tcols.items():
-                if p not in self.lin:
-                    ct = ct + col * fixed[p]
-            Xt = np.column_stack([tcols.get(p, np.zeros(lam.size)) for p in self.lin])
-            c0 = np.concatenate([c0, ct])
-            X = np.vstack([X, Xt])
-        return c0, X @ self.T
-
-    def to_user(self, nl: dict[str, float], lin_int: np.ndarray) -> dict[str, float]:
-        out = {p: float(v) for p, v in nl.items()}
-        out.update({p: float(v) for p, v in zip(self.lin, self.T @ lin_int, strict=True)})
-        return out
-
-    def project(self, nl: dict[str, float]):
-        """Best linear parameters for the nonlinear ones; returns (weighted residuals, internal linear values)."""
-        c0, X = self.design(nl)
-        Aw = self.w[:, None] * X
-        yw = self.w * (self.y - c0)
-        x = bounded_lstsq(Aw, yw, self.lo, self.hi)
-        return Aw @ x - yw, x
-
-    def residual_full(self, x_int: np.ndarray) -> np.ndarray:
-        nl = dict(zip(self.nonlin, x_int[: len(self.nonlin)], strict=True))
-        c0, X = self.design(nl)
-        return self.w * (c0 + X @ x_int[len(self.nonlin):] - self.y)
 
 
 def _loop_law(hysteresis, hysteresis_law: str, processed) -> str | None:
@@ -508,9 +298,9 @@ def fit(processed, actuator: Actuator, model: str | None = None, free=("alpha0",
 class _Run:
     """One identification as its stages go (:func:`fit`): the problem, the solution so far, the notes."""
 
-    args: tuple  # _Problem's: actuator, data, model, free, bounds, order, eq19_factor, law, shape bounds
+    args: tuple  # Problem's: actuator, data, model, free, bounds, order, eq19_factor, law, shape bounds
     stretch: tuple[float, float]  # the stretches the admissible shapes hold over
-    prob: _Problem
+    prob: Problem
     nl: dict[str, float] = field(default_factory=dict)  # the nonlinear parameters
     lin: np.ndarray = field(default_factory=lambda: np.zeros(0))  # the linear ones (internal coordinates)
     converged: bool = True
@@ -542,7 +332,7 @@ def _prepare(processed, actuator: Actuator, model: str, free: list[str], bounds,
     stretch = _stretch_range(actuator, d, admissible_range, tension_data)
     shape_bounds = _shape_bounds(stretch, bounds)
     args = (actuator, d, model, free, bnd, order, eq19_factor, law, shape_bounds)
-    return _Run(args, stretch, _Problem(*args), cycles=cycle_deviations(processed, d),
+    return _Run(args, stretch, Problem(*args), cycles=cycle_deviations(processed, d),
                 offsets=drift_offsets(processed, d))
 
 
@@ -550,7 +340,7 @@ def _search_stages(run: _Run, grid_alpha: int, grid_r0: int, tension_data) -> No
     """The global grid, the local search, the fold rule and the joint fit with a tension test."""
     prob, d, bnd = run.prob, run.args[1], run.bnd
     step = max(1, d.kc.size // 400)  # the grid only has to find the basin: about 400 points suffice
-    coarse = _Problem(run.args[0], d.thin(step), *run.args[2:]) if step > 1 else prob
+    coarse = Problem(run.args[0], d.thin(step), *run.args[2:]) if step > 1 else prob
     best, nfev = _start(coarse, bnd, grid_alpha, grid_r0)
     nl, lin, run.converged, run.message, n = _solve(prob, bnd, 0, 0, start=best[1])
     run.nfev += nfev + n
@@ -650,7 +440,7 @@ def _shape_bounds(stretch: tuple[float, float], bounds) -> tuple[float, float]:
     return lo, hi
 
 
-def _solve(prob: _Problem, bnd, grid_alpha: int, grid_r0: int, start: dict[str, float] | None = None):
+def _solve(prob: Problem, bnd, grid_alpha: int, grid_r0: int, start: dict[str, float] | None = None):
     """Global grid (unless ``start`` is given) and local search; returns (nl, lin, converged, message, nfev)."""
     nfev = 0
     if start is None:
@@ -661,7 +451,7 @@ def _solve(prob: _Problem, bnd, grid_alpha: int, grid_r0: int, start: dict[str, 
     return nl, lin, converged, message, nfev + n
 
 
-def _start(prob: _Problem, bnd, grid_alpha: int, grid_r0: int):
+def _start(prob: Problem, bnd, grid_alpha: int, grid_r0: int):
     """A global grid over the nonlinear parameters, the linear ones projected exactly."""
     nfev = 0
     grids = []
@@ -686,7 +476,7 @@ def _start(prob: _Problem, bnd, grid_alpha: int, grid_r0: int):
     return best, nfev
 
 
-def _search(prob: _Problem, bnd, best, tol: float = 1e-10):
+def _search(prob: Problem, bnd, best, tol: float = 1e-10):
     """A bounded trust-region search on the projected problem (``xtol = tol``); the final linear solve."""
     from scipy.optimize import least_squares
 
@@ -717,19 +507,19 @@ def _search(prob: _Problem, bnd, best, tol: float = 1e-10):
     return nl_best, lin, converged, message, nfev + 1
 
 
-def _ssr(prob: _Problem, nl, lin) -> float:
+def _ssr(prob: Problem, nl, lin) -> float:
     r = prob.residual_full(np.concatenate([[nl[p] for p in prob.nonlin], lin]))
     return float(r @ r)
 
 
-def _fold_kpa(prob: _Problem, nl, lin, p_max: float) -> float | None:
+def _fold_kpa(prob: Problem, nl, lin, p_max: float) -> float | None:
     """The fold pressure of the fitted quasi-static model if its free-bending branch ends below ``p_max``."""
     act = prob.actuator(prob.to_user(nl, lin))
     br = MomentLaw.of(act, prob.model, order=prob.order, eq19_factor=prob.eq19).free_branch()
     return float(br.max_pressure_kpa) if br.max_pressure_kpa < p_max else None
 
 
-def _fold_rule(prob: _Problem, args, bnd, nl, lin, p_max: float):
+def _fold_rule(prob: Problem, args, bnd, nl, lin, p_max: float):
     """Reject a fit whose model has no free-bending equilibrium inside the tested pressures.
 
     Returns ``(prob, nl, lin, nfev, note, shape_held)``.
@@ -744,7 +534,7 @@ def _fold_rule(prob: _Problem, args, bnd, nl, lin, p_max: float):
     nfev = 0
     best = None
     for beta in np.linspace(*prob.shape_bounds, 9):
-        p2 = _Problem(*args, shape_fixed=float(beta))
+        p2 = Problem(*args, shape_fixed=float(beta))
         nl2, lin2, _, _, n = _solve(p2, bnd, 0, 0, start=nl)
         nfev += n
         if _fold_kpa(p2, nl2, lin2, p_max) is None:
@@ -764,7 +554,7 @@ def _fold_rule(prob: _Problem, args, bnd, nl, lin, p_max: float):
         f"held at {beta:.4g} because {why}"
 
 
-def _joint_tension(prob: _Problem, args, bnd, nl, lin, tension_data):
+def _joint_tension(prob: Problem, args, bnd, nl, lin, tension_data):
     """Refit with the tension test's rows, each data set weighted by its own residual noise."""
     from bendpam.identify.tension import fit_tension
 
@@ -777,8 +567,8 @@ def _joint_tension(prob: _Problem, args, bnd, nl, lin, tension_data):
     s_t = tf.rmse_kpa * math.sqrt(tf.n_points / max(tf.n_points - 2, 1))
     if not (s_t > 0 and math.isfinite(s_t)):
         s_t = 1e-6 * max(float(np.max(np.abs(stress))), 1.0)
-    ten = _Tension(lam, stress, s_b / s_t)
-    p2 = _Problem(*args, shape_fixed=prob.shape_fixed, tension=ten)
+    ten = Tension(lam, stress, s_b / s_t)
+    p2 = Problem(*args, shape_fixed=prob.shape_fixed, tension=ten)
     nl2, lin2, _, _, n = _solve(p2, bnd, 0, 0, start=nl)
     note = (f"joint fit with the tension test{' ' + tf.source if tf.source else ''} ({lam.size} points, stretch "
             f"{lam.min():.3g} to {lam.max():.3g}): each data set weighted by its own residual noise (bending "
@@ -786,7 +576,7 @@ def _joint_tension(prob: _Problem, args, bnd, nl, lin, tension_data):
     return p2, nl2, lin2, n, note
 
 
-def _uncertainty(prob: _Problem, bnd, nl_best, lin, corr_flag: float, cycles=(), offsets=(),
+def _uncertainty(prob: Problem, bnd, nl_best, lin, corr_flag: float, cycles=(), offsets=(),
                  instrument: Instrument | None = None) -> Uncertainty:
     """Sandwich covariance from the joint Jacobian (nonlinear columns by central differences).
 
@@ -836,7 +626,7 @@ def _uncertainty(prob: _Problem, bnd, nl_best, lin, corr_flag: float, cycles=(),
     return unc
 
 
-def _law_refit(prob: _Problem, bnd, nl, alt: str):
+def _law_refit(prob: Problem, bnd, nl, alt: str):
     """The fit with another loop law ``alt`` (warm start, angle grid; a member's own parameters from short grids):
     ``(MemberFit without its covariance, nfev, (problem, nonlinear, linear values))``.  The search stops at
     ``xtol = 1e-5`` (alpha0 to about 1e-3 deg): well within the standard errors the values serve."""
@@ -865,7 +655,7 @@ def _law_refit(prob: _Problem, bnd, nl, alt: str):
     return member, nfev + n, (p2, nl2, lin2)
 
 
-def _profile(prob: _Problem, bnd, nl, unc: Uncertainty, n_points: int):
+def _profile(prob: Problem, bnd, nl, unc: Uncertainty, n_points: int):
     """The reported loop law's objective minimised over everything else against alpha0, around its optimum."""
     if "alpha0" not in prob.nonlin or n_points < 3:
         return None, 0
@@ -947,7 +737,7 @@ def _result(processed, actuator: Actuator, run: _Run, unc: Uncertainty, tension,
     )
 
 
-def _parameters(prob: _Problem, bnd, unc: Uncertainty, fitted: Actuator, actuator: Actuator,
+def _parameters(prob: Problem, bnd, unc: Uncertainty, fitted: Actuator, actuator: Actuator,
                 tension) -> dict[str, Parameter]:
     """Every parameter of the model: the varied ones with their standard errors and start values."""
     sd = unc.sd

@@ -375,9 +375,7 @@ def _labelled_series(t: np.ndarray, s_z: np.ndarray, f_f: np.ndarray, beta: np.n
 
 
 def process_series(
-    time_s,
-    stroke_mm,
-    force_n,
+    time_s, stroke_mm, force_n,
     pressure_kpa: float,
     *,
     fixture: Fixture = PAPER_FIXTURE,
@@ -426,9 +424,8 @@ def process_series(
     t, s_raw, f_raw = _checked_arrays(time_s, stroke_mm, force_n, source)
     notes: list[str] = []
     fs, cutoff = _sampling(t, opt, source, notes)
-    if opt.despike_sigmas:
-        s_raw, f_raw = (_despike(x, opt.despike_sigmas, t, what, notes)
-                        for x, what in ((s_raw, "stroke (mm)"), (f_raw, "force (N)")))
+    s_raw, f_raw = (_despike(x, opt.despike_sigmas, t, what, notes) for x, what in ((s_raw, "stroke (mm)"),
+                                                                                   (f_raw, "force (N)")))
     s_f, f_f = (_lowpass(x, fs, cutoff, int(opt.filter_order)) for x in (s_raw, f_raw))
     rng = float(np.ptp(s_f))
     if rng <= 0:
@@ -467,6 +464,8 @@ def _despike(x: np.ndarray, sigmas: float, t: np.ndarray, what: str, notes: list
     >>> float(_despike(x, 8.0, np.arange(100.0), "force (N)", notes).max()) < 0.1, notes[0][:48]
     (True, '1 isolated spike(s) in the force (N) replaced by')
     """
+    if not sigmas:
+        return x
     idx, fill, noise = noise_spikes(x, sigmas)
     if idx.size == 0:
         return x
