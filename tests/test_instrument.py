@@ -132,3 +132,8 @@ def test_the_report_names_the_declaration(tmp_path):
     assert "Instrument (declared)" in page
     assert "its declared calibration: the force reading to 0.5 %" in page
     assert "statistical (" in page and "calibration: the force reading to 0.5 %)" not in page
+
+
+def test_without_a_declaration_the_fit_says_what_its_bars_leave_out():
+    text = str(fitted())
+    assert "not included: the rig's calibration" in text and "--force-uncertainty-pct" in text

@@ -785,8 +785,10 @@ class FitResult:
             lines.append(f"  standard errors, statistical / systematic{inst}: " + ", ".join(
                 f"{k} {b.statistical[k]:.2g} / {b.systematic.get(k, 0.0):.2g}"
                 + (f" / {b.instrument.get(k, 0.0):.2g}" if b.instrument else "") for k in keys))
-            if b.instrument:
-                lines.append(f"  instrument, its declared calibration: {b.declared}")
+            lines.append(f"  instrument, its declared calibration: {b.declared}" if b.instrument else
+                         "  not included: the rig's calibration (a load cell or pressure gauge off, an untared "
+                         "self-weight: every test moved alike, unseen in the curves); declare it with "
+                         "--force-uncertainty-pct, --pressure-uncertainty-kpa (fit(instrument=...))")
             if b.ensemble:
                 lines.append("  loop laws (weight; the model parameters are their weighted average): "
                              + ", ".join(f"{m.law} {m.weight:.2f}" for m in b.ensemble))

@@ -320,7 +320,8 @@ def _uncertainty_tables(m: str, label: str, res) -> list[_Table]:
     for f in b.statistical:
         cells = [part.get(f, 0.0) for part in parts] + [b.total[f]]
         rows.append(_Row([_td(fmt_value(v), v) for v in cells], Markup(symbol(f).heading())))
-    inst = f"; instrument, its declared calibration: {b.declared}" if b.instrument else ""
+    inst = (f"; instrument, its declared calibration: {b.declared}" if b.instrument else
+            "; the rig's calibration (load cell, pressure gauge) is not included: none was declared")
     out = [_Table(f"uncertainty-{m}", f"Standard errors of the {label} model fit: statistical ({b.resampling}) and "
                   f"systematic (the loop law){inst}", ["", "Statistical", "Systematic",
                                                 *(["Instrument (declared)"] if b.instrument else []), "Total"], rows)]
