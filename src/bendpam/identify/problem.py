@@ -33,7 +33,11 @@ CHEB_NODES = 32
 
 @dataclass
 class Tension:
-    """Tension-test rows of a joint fit: stretches, nominal stresses (kPa) and their weight."""
+    """Tension-test rows of a joint fit: stretches, nominal stresses (kPa) and their weight.
+
+    >>> Tension(np.array([1.0, 1.2, 1.4]), np.array([0.0, 95.0, 170.0]), 0.5).stretch.size
+    3
+    """
 
     stretch: np.ndarray
     stress_kpa: np.ndarray
@@ -41,7 +45,37 @@ class Tension:
 
 
 class Problem:
-    """Residuals of the weighted problem for a given set of free parameters (variable projection)."""
+    """Residuals of the weighted problem for a given set of free parameters (variable projection).
+
+    ``Problem(actuator, data, model, free, bounds, order, eq19_factor, law, shape_bounds)``: the nominal
+    actuator, the curves (:class:`~bendpam.identify.data.FitData`), the model, the free parameters, their
+    bounds, the braid's series order, eq 19's factor, the loop law (None: mean curves) and the admissible
+    shapes.  :meth:`project` solves the linear parameters exactly for the nonlinear ones.
+
+    Examples
+    --------
+    Two virtual tests of the paper's BE-PAM; with alpha0 at its nominal value, the constants that fit best:
+
+    >>> import warnings
+    >>> from pathlib import Path
+    >>> import bendpam
+    >>> from bendpam.identify.data import fit_data
+    >>> from bendpam.lab import RawTest
+    >>> from bendpam.lab.processing import process_tests
+    >>> from bendpam.lab.simulate import SimulationSettings, simulate_test
+    >>> be = bendpam.physics.presets.be_pam()
+    >>> raws = [RawTest(simulate_test(be, p, settings=SimulationSettings(cycles=1, rate_hz=2.0, hysteresis=0.0,
+    ...                                                                  seed=1))[0], Path(f"{p}.csv"), "csv",
+    ...                 pressure_kpa=p) for p in (100.0, 200.0)]
+    >>> with warnings.catch_warnings():
+    ...     warnings.simplefilter("ignore")
+    ...     d = fit_data(process_tests(raws, keep_series=False))
+    >>> prob = Problem(be, d, "energy", ["alpha0", "C10", "C01"], {"C10": (-5e3, 5e3), "C01": (-5e3, 5e3)}, 8,
+    ...                True, None, (0.0, 1.0))
+    >>> r, lin = prob.project({"alpha0": be.alpha0_deg})
+    >>> prob.nonlin, prob.int_names, round(prob.to_user({"alpha0": be.alpha0_deg}, lin)["C01"])   # kPa
+    (['alpha0'], ['S_lo', 'S_hi'], 185)
+    """
 
     def __init__(self, actuator: Actuator, data: FitData, model: str, free: list[str], bounds, order: int,
                  eq19_factor: bool, law: str | None, shape_bounds: tuple[float, float], *,
