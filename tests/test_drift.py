@@ -294,12 +294,13 @@ def test_an_uncorrected_drift_the_set_shares_is_counted_in_the_fits_error_bars()
     assert not one.flagged
     assert drift_offsets(NS(results=[NS(drift=one)]), d) == []  # alone: no evidence of a drift
     many = drift_offsets(NS(results=[NS(drift=one)] * 3), d)  # three alike: 3.5 SE pooled
-    assert [sd for _, sd, _ in many] == pytest.approx([math.hypot(2.0, 1.0)] * 3)
-    assert [shift for *_, shift in many] == [-2.0] * 3  # what correcting it would move the moments by
+    assert [o.sd for o in many] == pytest.approx([math.hypot(2.0, 1.0)] * 3)
+    assert [o.shift for o in many] == [-2.0] * 3  # what correcting it would move the moments by
     # corrected: the rate's own error and half the disagreement of the free and blocked ends' slopes
     fixed = DriftEstimate(2e-4, 1e-5, 200.0, 0.0, 0.05, 10.0, 12, free_rate_n_per_s=1e-4, blocked_rate_n_per_s=3e-4,
                           blocked_moment_nmm=300.0, corrected=True)
-    (_, sd, shift), = drift_offsets(NS(results=[NS(drift=fixed)]), NS(seg=np.array([0])))
+    (_, sd, shift, common), = drift_offsets(NS(results=[NS(drift=fixed)]), NS(seg=np.array([0])))
+    assert common == 0.0  # a log from t = 0: zeroed there
     assert shift == 0.0
     assert sd == pytest.approx(math.hypot(1e-5, 1e-4) * 100.0 * 30.0)
 
@@ -340,7 +341,7 @@ def test_an_uncorrected_drift_says_how_far_correcting_it_would_move_alpha0():
 def test_drifts_left_uncorrected_are_one_mode_whose_doubt_is_the_shift_correcting_them_makes():
     # one load cell: the tests' shifts (with their signs) move the parameters together, by what the linearised
     # refit says correcting them would; only each shift's own error (s / z) is independent of the others'
-    from bendpam.identify.data import offset_modes
+    from bendpam.identify.data import DriftOffset, offset_modes
     from bendpam.identify.uncertainty import offset_shift, sandwich_covariance
 
     rng = np.random.default_rng(4)
@@ -349,15 +350,35 @@ def test_drifts_left_uncorrected_are_one_mode_whose_doubt_is_the_shift_correctin
     w = np.ones(12)
     groups = np.zeros(12, dtype=int)
     shifts = [-0.5, -0.8, -1.1]
-    exact = [(r, abs(s), s) for r, s in zip(rows, shifts, strict=True)]  # known exactly (z infinite)
+    exact = [DriftOffset(r, abs(s), s) for r, s in zip(rows, shifts, strict=True)]  # known exactly (z infinite)
     cov, _ = sandwich_covariance(J, np.zeros(12), groups, [], offset_modes(exact, w))
     move = offset_shift(J, [(r, s * w[r]) for r, s in zip(rows, shifts, strict=True)])
     assert np.sqrt(np.diag(cov)) == pytest.approx(np.abs(move), rel=1e-9)
     # with an error of its own (z = 2 each), the doubt is the mode plus three independent offsets of s / 2
-    loose = [(r, math.hypot(s, s / 2.0), s) for r, s in zip(rows, shifts, strict=True)]
+    loose = [DriftOffset(r, math.hypot(s, s / 2.0), s) for r, s in zip(rows, shifts, strict=True)]
     cov2, _ = sandwich_covariance(J, np.zeros(12), groups, [], offset_modes(loose, w))
     alone = sum(np.outer(g, g) for g in (s / 2.0 * J[r].sum(axis=0) for r, s in zip(rows, shifts, strict=True)))
     B = np.linalg.inv(J.T @ J)
     assert cov2 == pytest.approx(cov + B @ alone @ B, rel=1e-9)
     # a corrected drift (no shift) stays its own test's error
-    assert [u.tolist() for _, u in offset_modes([(rows[0], 0.3, 0.0)], w)] == [[0.3] * 4]
+    assert [u.tolist() for _, u in offset_modes([DriftOffset(rows[0], 0.3, 0.0)], w)] == [[0.3] * 4]
+    # when the load cell was zeroed (a log after its clock) is one procedure's doubt: one mode, as the shifts
+    zeroed = [DriftOffset(r, 0.0, 0.0, s) for r, s in zip(rows, shifts, strict=True)]
+    cov3, _ = sandwich_covariance(J, np.zeros(12), groups, [], offset_modes(zeroed, w))
+    assert cov3 == pytest.approx(cov, rel=1e-9)
+
+
+def test_a_log_that_starts_after_its_clock_is_taken_as_zeroed_halfway():
+    rate = 1e-3  # N/s, from the clock's zero
+    t, s, f, cyc = triangle_test(rate, lambda x: 10.0 - 0.9 * x)
+    late = t + 150.0  # the log starts 150 s after the clock: the offset has grown by rate * 150 N already
+    est = estimate_drift(late, s, f + rate * 150.0, cyc)
+    assert est.zero_s == pytest.approx(0.5 * late[0])
+    assert est.zero_sd_n == pytest.approx(rate * 0.5 * late[0] / math.sqrt(3.0), rel=0.02)
+    left = (f + rate * 150.0 - est.offset_n(late)) - (f - rate * t)  # what the correction leaves: constant
+    assert float(np.ptp(left)) < 2e-3 and abs(left[0]) <= math.sqrt(3.0) * est.zero_sd_n * 1.05
+    assert "taken as zero at" in est.message() and DriftEstimate.from_dict(est.to_dict()) == est
+    day = estimate_drift(t + 36000.0, s, f, cyc)  # a clock of the day: zeroed at the first sample
+    assert day.zero_time_s == day.t0_s and day.zero_sd_n == 0.0
+    zero = estimate_drift(t - t[0], s, f, cyc)  # a log from t = 0
+    assert zero.zero_sd_n == 0.0

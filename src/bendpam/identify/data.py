@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import cached_property
+from typing import NamedTuple
 
 import numpy as np
 
@@ -22,6 +23,7 @@ from bendpam.physics.actuator import Actuator
 from bendpam.physics.braid import radius_terms
 
 __all__ = [
+    "DriftOffset",
     "FitData",
     "bladder_stretch_range",
     "branch_data",
@@ -320,28 +322,49 @@ def bladder_stretch_range(actuator: Actuator, curvature_per_mm) -> tuple[float, 
 
 
 
-def drift_offsets(processed, d: FitData) -> list[tuple[np.ndarray, float, float]]:
-    """The load-cell drift's doubt as a moment offset per test: ``[(rows, sd_nmm, shift_nmm)]``.
+class DriftOffset(NamedTuple):
+    """One test's load-cell drift doubt as a moment offset of its rows (N*mm): see :func:`drift_offsets`.
 
-    ``shift_nmm`` is how much correcting a drift left uncorrected would move the test's moments (its
+    rows : the test's rows of the fit's data.  sd : the doubt of the test's own (independent of the others').
+    shift : what correcting a drift left uncorrected would move its moments (0 for a corrected test).
+    common : a doubt shared by every test, with its sign (one load cell: when it was zeroed).
+
+    >>> DriftOffset(np.array([0, 1]), 0.3, 0.0).common
+    0.0
+    """
+
+    rows: np.ndarray
+    sd: float
+    shift: float
+    common: float = 0.0
+
+
+def drift_offsets(processed, d: FitData) -> list[DriftOffset]:
+    """The load-cell drift's doubt as a moment offset per test (:class:`DriftOffset`, N*mm).
+
+    ``shift`` is how much correcting a drift left uncorrected would move the test's moments (its
     blocked-moment shift, as a constant offset of its rows; 0 for a corrected test), for the fit to say how
     far its values would move.
 
-    A test whose drift was corrected keeps the error of the estimated rate: an offset growing
-    from the test's start, ``rate_se (t - t0)``, common to its cycles on average (``rate_se x
-    duration / 2``; resampling the cycles sees only its growth), converted to moment by the
-    blocked state's lever ``M_b / F_b``.  A drift left uncorrected, when it is flagged or the set drifts as a
-    whole (:func:`bendpam.lab.drift.set_drifts`), is an offset of the root mean square size of what correcting
-    it would move the blocked moment by: that shift ``s`` is known to its standard error ``s / z`` (``z`` the
-    drift's size in standard errors), so ``sqrt(s^2 + (s / z)^2)``.  Other tests add nothing.
+    A test whose drift was corrected keeps the error of the estimated rate: an offset growing from the
+    test's start, ``rate_se (t - t0)``, common to its cycles on average (``rate_se x duration / 2``;
+    resampling the cycles sees only its growth), converted to moment by the blocked state's lever
+    ``M_b / F_b``; and, for a log that starts after its clock, the doubt of when the load cell was zeroed
+    (:attr:`bendpam.lab.drift.DriftEstimate.zero_sd_n`, with the drift's sign), which is the same
+    procedure's for every test: ``common``.  A drift left uncorrected, when it is flagged or the set drifts
+    as a whole (:func:`bendpam.lab.drift.set_drifts`), is an offset of the root mean square size of what
+    correcting it would move the blocked moment by: that shift ``s`` is known to its standard error
+    ``s / z`` (``z`` the drift's size in standard errors), so ``sqrt(s^2 + (s / z)^2)``.  Other tests add
+    nothing.
 
     >>> from types import SimpleNamespace as NS
     >>> drift = NS(corrected=True, flagged=True, rate_n_per_s=1e-3, rate_se_n_per_s=1e-4, duration_s=200.0,
     ...            blocked_moment_nmm=300.0, blocked_force_n=10.0, blocked_moment_shift_nmm=-3.0,
-    ...            free_rate_n_per_s=1e-3, blocked_rate_n_per_s=1e-3)   # both ends alike
+    ...            free_rate_n_per_s=1e-3, blocked_rate_n_per_s=1e-3, zero_sd_n=0.02)   # both ends alike
     >>> d = NS(seg=np.array([0, 0, 0]))
-    >>> [(rows.tolist(), round(sd, 6), s) for rows, sd, s in drift_offsets(NS(results=[NS(drift=drift)]), d)]  # N*mm
-    [([0, 1, 2], 0.3, 0.0)]
+    >>> [(o.rows.tolist(), round(o.sd, 6), o.shift, round(o.common, 6))
+    ...  for o in drift_offsets(NS(results=[NS(drift=drift)]), d)]  # N*mm
+    [([0, 1, 2], 0.3, 0.0, 0.6)]
 
     Two tests that drift by 2 standard errors each, left uncorrected: not flagged alone, but the set drifts
     (2.8 standard errors pooled), so each adds ``sqrt(s^2 + (s / 2)^2)``:
@@ -349,28 +372,31 @@ def drift_offsets(processed, d: FitData) -> list[tuple[np.ndarray, float, float]
     >>> from bendpam.lab.drift import DriftEstimate
     >>> e = DriftEstimate(2e-4, 1e-4, 200.0, 0.0, 0.05, 10.0, 12, blocked_moment_shift_nmm=-2.0)
     >>> d = NS(seg=np.array([0, 0, 1, 1]))
-    >>> [(rows.tolist(), round(sd, 3), s) for rows, sd, s in drift_offsets(NS(results=[NS(drift=e)] * 2), d)]
+    >>> [(o.rows.tolist(), round(o.sd, 3), o.shift) for o in drift_offsets(NS(results=[NS(drift=e)] * 2), d)]
     [([0, 1], 2.236, -2.0), ([2, 3], 2.236, -2.0)]
     """
-    out: list[tuple[np.ndarray, float, float]] = []
+    out: list[DriftOffset] = []
     drifts = set_drifts([getattr(r, "drift", None) for r in processed.results])
     for i, r in enumerate(processed.results):
         e = getattr(r, "drift", None)
         if e is None:
             continue
-        shift = 0.0
+        shift, common = 0.0, 0.0
         if e.corrected:
-            lever = e.blocked_moment_nmm / e.blocked_force_n if e.blocked_force_n else math.nan
+            lever = abs(e.blocked_moment_nmm / e.blocked_force_n) if e.blocked_force_n else math.nan
             ends = abs(e.free_rate_n_per_s - e.blocked_rate_n_per_s) / 2.0
             rate_sd = math.hypot(e.rate_se_n_per_s, ends) if math.isfinite(ends) else e.rate_se_n_per_s
             sd = abs(rate_sd * e.duration_s / 2.0 * lever)
+            common = math.copysign(getattr(e, "zero_sd_n", 0.0) * lever, e.rate_n_per_s)
         elif e.flagged or drifts:  # its own estimate of the shift, known to its standard error shift / sigmas
             shift, sig = float(e.blocked_moment_shift_nmm), e.sigmas
             sd = math.hypot(shift, shift / sig) if math.isfinite(sig) and sig > 0 else abs(shift)
         else:
             sd = 0.0
-        if math.isfinite(sd) and sd > 0:
-            out.append((np.flatnonzero(d.seg == i), float(sd), shift if math.isfinite(shift) else 0.0))
+        sd, common = (x if math.isfinite(x) else 0.0 for x in (sd, common))
+        if sd > 0 or common:
+            out.append(DriftOffset(np.flatnonzero(d.seg == i), float(sd), shift if math.isfinite(shift) else 0.0,
+                                   float(common)))
     return out
 
 
@@ -384,21 +410,25 @@ def offset_modes(offsets, w: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
     any sign, and excite directions the data barely fix (a shape on its bound) far beyond what correcting
     the drift does.
 
+    The doubt of when a corrected drift was zeroed (``common``) is one mode too: the same procedure zeroed
+    every test.
+
     >>> rows = [np.array([0, 1]), np.array([2])]
-    >>> modes = offset_modes([(rows[0], 1.25, -1.0), (rows[1], 0.5, 0.0)], np.ones(3))
+    >>> modes = offset_modes([DriftOffset(rows[0], 1.25, -1.0), DriftOffset(rows[1], 0.5, 0.0)], np.ones(3))
     >>> [(r.tolist(), u.tolist()) for r, u in modes]       # 1.25 = hypot(1, 0.75): 0.75 alone, the shift as a mode
     [([0, 1], [0.75, 0.75]), ([2], [0.5]), ([0, 1], [-1.0, -1.0])]
     """
-    modes, shift_rows, shift_u = [], [], []
-    for rows, sd, shift in offsets:
-        own = math.sqrt(max(sd * sd - shift * shift, 0.0)) if shift else sd
+    modes = []
+    shared: dict[str, tuple[list, list]] = {"shift": ([], []), "common": ([], [])}
+    for o in offsets:
+        own = math.sqrt(max(o.sd * o.sd - o.shift * o.shift, 0.0)) if o.shift else o.sd
         if own > 0:
-            modes.append((rows, own * w[rows]))
-        if shift:
-            shift_rows.append(rows)
-            shift_u.append(shift * w[rows])
-    if shift_rows:
-        modes.append((np.concatenate(shift_rows), np.concatenate(shift_u)))
+            modes.append((o.rows, own * w[o.rows]))
+        for key, value in (("shift", o.shift), ("common", o.common)):
+            if value:
+                shared[key][0].append(o.rows)
+                shared[key][1].append(value * w[o.rows])
+    modes += [(np.concatenate(r), np.concatenate(u)) for r, u in shared.values() if r]
     return modes
 
 

@@ -389,7 +389,7 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool, inst
         budget.weighting += ("; the viscous loop driven at the test's own times" if timed else
                              "; the viscous loop's rate approximated at a constant crosshead speed (the processed "
                              "set keeps no time: saved before 0.4)")
-    run.notes += drift_note(unc.drift_shift, budget.total, sum(s != 0 for *_, s in run.offsets))
+    run.notes += drift_note(unc.drift_shift, budget.total, sum(o.shift != 0 for o in run.offsets))
     if instrument is not None and instrument.declared:
         budget.instrument = part_sds(unc.cov_inst, unc.names, run.prob.actuator(unc.values))
         budget.declared = instrument.describe()
@@ -616,7 +616,8 @@ def _uncertainty(prob: Problem, bnd, nl_best, lin, corr_flag: float, cycles=(), 
     G[nn:, nn:] = prob.T
     unc = Uncertainty(prob.to_user(nl_best, lin), prob.nonlin + prob.lin, G @ cov_int @ G.T, rho, nfev, bound_names,
                       float(r @ r), m, corr_flag)
-    unc.set_drift_shift(G @ offset_shift(J, [(i, s * prob.w[i]) for i, _, s in offsets]))  # an uncorrected drift's
+    moved = [(o.rows, o.shift * prob.w[o.rows]) for o in offsets]
+    unc.set_drift_shift(G @ offset_shift(J, moved))  # an uncorrected drift's
     if instrument is not None and instrument.declared:  # the load cell's moments; the residuals' change per kPa
         p2 = copy.copy(prob)
         p2.d = dataclasses.replace(prob.d, Pc=prob.d.Pc + 1.0)

@@ -31,8 +31,18 @@ A load cell that drifts does so in every test of a set, so the tests' slopes are
 quiet enough to show it (:func:`set_drift_findings`).  Then every test's drift is real to the fit:
 left uncorrected, each adds its doubt (:func:`bendpam.identify.data.drift_offsets`).
 
-The offset is taken as zero at the first sample (the machine is zeroed before the test);
-:meth:`DriftEstimate.offset_n` is the fitted offset ``a (t - t_0)`` that a correction subtracts.
+When the offset was zeroed the data do not say.  A log that starts at ``t = 0`` was zeroed there (the
+machine is zeroed before the test).  A log whose clock starts later, ``0 < t_0 <= duration`` (a testing
+machine's test time counts from the start of the test, and the log often begins at a pre-load, after a
+pre-cycle or a step before: 43 of the 88 real exports of ``tests/data/real`` that are read start at a
+time ``0 < t_0 <= duration``, 43 at 0 and 2 later),
+was zeroed at some instant between the clock's zero and its first sample: the offset is taken as zero
+halfway (:attr:`DriftEstimate.zero_s`, ``t_0 / 2``), and the two ends being equally likely, the rest of
+the offset at the first sample is doubt: a rectangular distribution of half-width ``|a| t_0 / 2``,
+standard deviation ``|a| t_0 / (2 sqrt 3)`` (:attr:`DriftEstimate.zero_sd_n`, GUM 4.3.7), which the fit
+counts with a corrected drift.  A clock that starts later still (a time of day) is taken as zeroed at the
+first sample.  :meth:`DriftEstimate.offset_n` is the fitted offset ``a (t - zero_s)`` that a correction
+subtracts.
 """
 
 from __future__ import annotations
@@ -73,6 +83,7 @@ class DriftEstimate:
 
     rate_n_per_s, rate_se_n_per_s : the drift ``a`` (N/s) and its standard error.
     duration_s, t0_s : the test's duration and first time (s).  drift_n : ``a * duration_s`` (N).
+    zero_s : the time at which the offset is taken as zero (s; NaN: ``t0_s``, the first sample; see the module).
     noise_n : the force noise (standard deviation of one sample, N).
     blocked_force_n : the mean force at the blocked ends (N).  points : the end windows used.
     free_rate_n_per_s, blocked_rate_n_per_s : the slopes of the free ends alone and of the blocked ends alone.
@@ -103,6 +114,7 @@ class DriftEstimate:
     blocked_moment_shift_nmm: float = math.nan
     blocked_moment_nmm: float = math.nan
     corrected: bool = False
+    zero_s: float = math.nan
 
     @property
     def drift_n(self) -> float:
@@ -148,9 +160,26 @@ class DriftEstimate:
         except TypeError:
             return None
 
+    @property
+    def zero_time_s(self) -> float:
+        """The time at which the offset is taken as zero (s): :attr:`zero_s`, or the first sample's."""
+        return self.zero_s if math.isfinite(self.zero_s) else self.t0_s
+
+    @property
+    def zero_sd_n(self) -> float:
+        """The offset's doubt at the first sample from not knowing when the load cell was zeroed (N).
+
+        ``|a| (t_0 - zero_s) / sqrt 3``: zero when the offset is taken as zero at the first sample.
+
+        >>> e = DriftEstimate(1e-3, 1e-4, 300.0, 100.0, 0.05, 10.0, 12, zero_s=50.0)
+        >>> round(e.zero_sd_n, 4), round(float(e.offset_n(np.array([100.0]))[0]), 3)   # N
+        (0.0289, 0.05)
+        """
+        return abs(self.rate_n_per_s) * max(self.t0_s - self.zero_time_s, 0.0) / math.sqrt(3.0)
+
     def offset_n(self, time_s) -> np.ndarray:
-        """The fitted offset ``a (t - t_0)`` at ``time_s`` (N), zero at the first sample."""
-        return self.rate_n_per_s * (np.asarray(time_s, dtype=float) - self.t0_s)
+        """The fitted offset ``a (t - zero_s)`` at ``time_s`` (N), zero at :attr:`zero_time_s`."""
+        return self.rate_n_per_s * (np.asarray(time_s, dtype=float) - self.zero_time_s)
 
     def message(self) -> str:
         """The drift in words: its size against the noise and the blocked force, and what correcting it does."""
@@ -164,6 +193,9 @@ class DriftEstimate:
             rel = 100.0 * shift / self.blocked_moment_nmm if self.blocked_moment_nmm else math.nan
             verb = "moved" if self.corrected else "would move"
             text += f"; correcting it {verb} the blocked moment by {shift:+.3g} N*mm ({rel:+.2g} %)"
+        if self.zero_time_s < self.t0_s:
+            text += (f"; the log starts at {self.t0_s:.4g} s, so the offset is taken as zero at {self.zero_time_s:.4g} "
+                     f"s, halfway to the clock's start (± {self.zero_sd_n:.2g} N at the first sample)")
         if self.differs:
             text += (f"; the free ends ({self.free_rate_n_per_s:+.3g} N/s) and the blocked ends "
                      f"({self.blocked_rate_n_per_s:+.3g} N/s) drift differently, so part of it is creep or a "
@@ -295,8 +327,10 @@ def estimate_drift(time_s, stroke_mm, force_n, cycles, *, band_fraction: float =
     blocked = ~free
     a_free, se_free = _slope(tw, fw, nw, end, noise, free)
     a_blocked, se_blocked = _slope(tw, fw, nw, end, noise, blocked)
+    duration = float(t[-1] - t[0])
+    zero = 0.5 * float(t[0]) if 0.0 < float(t[0]) <= duration else float(t[0])  # zeroed between 0 and t0
     return DriftEstimate(
-        rate_n_per_s=a, rate_se_n_per_s=se, duration_s=float(t[-1] - t[0]), t0_s=float(t[0]), noise_n=noise,
+        rate_n_per_s=a, rate_se_n_per_s=se, duration_s=duration, t0_s=float(t[0]), noise_n=noise, zero_s=zero,
         blocked_force_n=_blocked_force_n(s, f, cycles, band_fraction), points=int(end.size),
         free_rate_n_per_s=a_free, blocked_rate_n_per_s=a_blocked,
         difference_se_n_per_s=math.hypot(se_free, se_blocked),
