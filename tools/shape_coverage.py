@@ -69,7 +69,8 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     results = ROOT / "benchmarks" / "results"
     ap.add_argument("study", nargs="*", type=Path,
-                    default=[results / "calibration.json", *sorted(results.glob("calibration-holdout*.json"))])
+                    default=[results / "calibration.json", *sorted(p for p in results.glob("calibration-holdout*.json")
+                                                                    if p.stem.removeprefix("calibration-").isalnum())])
     ap.add_argument("--out", type=Path, default=ROOT / "src" / "bendpam" / "identify" / "shape_coverage.json")
     a = ap.parse_args(argv)
     rec = coverage_record(*(json.loads(p.read_text(encoding="utf-8")) for p in a.study))
