@@ -320,3 +320,7 @@ def test_steps_and_sharp_reversals_are_not_spikes():
     assert noise_spikes(saw + rng.normal(0.0, 0.01, 600), 8.0)[0].size == 0
     coarse = np.round(np.sin(np.linspace(0.0, 20.0, 2000)) * 5.0) / 5.0  # quantised to 0.2, mostly repeated samples
     assert noise_spikes(coarse, 8.0)[0].size == 0
+    # noise that grows with the force (a gain's): large near the peaks, where the column's own median noise is small
+    base = 10.0 * np.abs(np.sin(np.linspace(0.0, 12.0, 40000))) ** 4
+    hetero = base + rng.normal(0.0, 1.0, base.size) * (0.002 + 0.02 * base)
+    assert noise_spikes(hetero, 8.0)[0].size == 0

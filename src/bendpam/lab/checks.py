@@ -34,6 +34,8 @@ SPIKE_FACTOR = 10.0
 #: ... and (:func:`noise_spikes`) this many times the steps between the samples beside it: a sharp
 #: reversal sampled coarsely rises one step above its neighbours, a glitch many.
 SPIKE_STEPS = 4.0
+#: Samples on each side whose differences give a spike's local noise (:func:`noise_spikes`).
+_NEAR = 64
 #: A time step is a gap when it exceeds this many median steps and :data:`GAP_MIN_S`.
 GAP_FACTOR = 50.0
 #: Shortest gap reported (s).
@@ -140,13 +142,14 @@ def white_noise(x: np.ndarray) -> float:
 def noise_spikes(x: np.ndarray, sigmas: float) -> tuple[np.ndarray, np.ndarray, float]:
     """Isolated spikes of one or two samples many times the noise off the samples on both sides.
 
-    A sample (or two adjacent ones) is a spike when it lies more than ``sigmas`` noise standard
-    deviations (:func:`white_noise`; for a coarse column whose samples mostly repeat, the noise its 90th
-    percentile of steps gives, at least its quantum, its smallest step) from the median
-    of the five samples around it *and* from both samples beside it (beside the pair), on the same
-    side, by more than :data:`SPIKE_STEPS` times the steps between those samples and the next ones
-    out: a glitch of the load cell or the logger, not a step (stick-slip, a dropped load, whose samples
-    on one side follow) nor a reversal sampled coarsely (one step above its neighbours).
+    A sample (or two adjacent ones) is a spike when it lies more than ``sigmas`` noise standard deviations
+    (:func:`white_noise`; for a coarse column whose samples mostly repeat, the noise its 90th percentile of
+    steps gives, at least its quantum, its smallest step) from the median of the five samples around it
+    *and* from both samples beside it (beside the pair), on the same side, by more than :data:`SPIKE_STEPS`
+    times the steps between those samples and the next ones out, and by ``sigmas`` times the noise of the
+    128 samples around it too (noise that grows with the force, as a gain's does, is larger near the blocked
+    state than over the column): a glitch of the load cell or the logger, not a step (stick-slip, a dropped
+    load, whose samples on one side follow) nor a reversal sampled coarsely (one step above its neighbours).
 
     Parameters
     ----------
@@ -194,6 +197,11 @@ def noise_spikes(x: np.ndarray, sigmas: float) -> tuple[np.ndarray, np.ndarray, 
     local = np.maximum(np.abs(x[a - 1] - x[a - 2]), np.abs(x[b + 2] - x[b + 1]))  # the steps beside it
     spike = (height > limit) & (height > SPIKE_STEPS * local)
     a, b = a[spike], b[spike]
+    if a.size:  # the noise around it: a force's noise may grow with the force (a gain's noise)
+        near = np.diff(x[np.clip(a[:, None] + np.arange(-_NEAR, _NEAR + 1), 0, n - 1)], axis=1)
+        mad = np.median(np.abs(near - np.median(near, axis=1, keepdims=True)), axis=1)
+        keep = height[spike] > sigmas * 1.4826 * mad / np.sqrt(2.0)
+        a, b = a[keep], b[keep]
     idx = np.unique(np.concatenate([a, b])).astype(np.int64)
     window = np.clip(idx[:, None] + np.arange(-2, 3), 0, n - 1)
     return idx, np.sort(x[window], axis=1)[:, 2], noise
