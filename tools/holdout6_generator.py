@@ -898,20 +898,25 @@ def check_clean_machine(case: Case6, seed: int = 0) -> float:
     return worst
 
 
-def main(argv=None) -> int:
-    argv = sys.argv[1:] if argv is None else argv
+def write_all(cases: dict, generate, argv, script: str) -> int:
+    """``script OUT_FOLDER [SEED]``: one seed of every case of ``cases`` (``generate(case, seed, folder)``) and
+    ``truth.json``; the command line of this generator and of those built on its machine."""
     if not argv:
-        print("usage: python tools/holdout6_generator.py OUT_FOLDER [SEED]")
+        print(f"usage: python tools/{script} OUT_FOLDER [SEED]")
         return 2
     out = Path(argv[0])
     seed = int(argv[1]) if len(argv) > 1 else 0
     truths = {}
-    for name, case in CASES.items():
+    for name, case in cases.items():
         t0 = _time.perf_counter()
-        truths[name] = generate_set(case, seed, out / name)
+        truths[name] = generate(case, seed, out / name)
         print(f"{name}: {len(truths[name]['files'])} files in {_time.perf_counter() - t0:.2f} s")
     (out / "truth.json").write_text(json.dumps(truths, indent=1), encoding="utf-8")
     return 0
+
+
+def main(argv=None) -> int:
+    return write_all(CASES, generate_set, sys.argv[1:] if argv is None else argv, "holdout6_generator.py")
 
 
 if __name__ == "__main__":

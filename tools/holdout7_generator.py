@@ -89,10 +89,8 @@ rubbers and textile braids do.  Every law dissipates on every cycle.
 from __future__ import annotations
 
 import importlib.util
-import json
 import math
 import sys
-import time as _time
 from dataclasses import dataclass
 from pathlib import Path
 from unittest import mock
@@ -445,19 +443,7 @@ def check_laws(n_cycles: int = 4, points: int = 2000) -> dict:
 
 
 def main(argv=None) -> int:
-    argv = sys.argv[1:] if argv is None else argv
-    if not argv:
-        print("usage: python tools/holdout7_generator.py OUT_FOLDER [SEED]")
-        return 2
-    out = Path(argv[0])
-    seed = int(argv[1]) if len(argv) > 1 else 0
-    truths = {}
-    for name, case in CASES.items():
-        t0 = _time.perf_counter()
-        truths[name] = generate_set(case, seed, out / name)
-        print(f"{name}: {len(truths[name]['files'])} files in {_time.perf_counter() - t0:.2f} s")
-    (out / "truth.json").write_text(json.dumps(truths, indent=1), encoding="utf-8")
-    return 0
+    return h6.write_all(CASES, generate_set, sys.argv[1:] if argv is None else argv, "holdout7_generator.py")
 
 
 if __name__ == "__main__":

@@ -1,0 +1,64 @@
+"""The independent held-out generators (tools/holdout6_generator.py, tools/holdout7_generator.py), checked alone.
+
+The sixth set's machine: its fixture against a bracketed root of eq 6 and its clean machine (no loop, noise or
+fault) against the truth's moment.  The seventh set's loop laws (on that machine): each dissipates on every
+cycle.  Both: deterministic, and every file read by bendpam with the pressure and sample count written.
+"""
+
+import hashlib
+import sys
+import warnings
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "tools"))
+
+import holdout6_generator as gen6  # noqa: E402
+import holdout7_generator as gen7  # noqa: E402
+
+from bendpam.lab import read_test  # noqa: E402
+
+
+def test_the_sixth_sets_fixture_solves_eq_6():
+    assert gen6.check_fixture(400) < 1e-9  # rad
+
+
+@pytest.mark.parametrize("name", list(gen6.CASES))
+def test_the_sixth_sets_clean_machine_gives_the_truths_moment(name):
+    assert gen6.check_clean_machine(gen6.CASES[name]) < 1e-6  # of the blocked moment
+
+
+def test_every_seventh_set_law_dissipates_on_every_cycle():
+    for law, found in gen7.check_laws().items():
+        assert min(found["areas"]) > 0.0, law  # loop area over max |z|: positive, each cycle
+
+
+def _digest(folder: Path) -> str:
+    h = hashlib.sha256()
+    for p in sorted(folder.iterdir()):
+        h.update(p.name.encode() + p.read_bytes())
+    return h.hexdigest()
+
+
+@pytest.mark.parametrize(("gen", "name"), [(gen6, "h6-chaboche-drift"), (gen6, "h6-ja-gauge"),
+                                           (gen7, "h7-eyring-drift"), (gen7, "h7-dupont-ep")])
+def test_it_is_deterministic_and_bendpam_reads_every_file(gen, name, tmp_path):
+    case = gen.CASES[name]
+    truth = gen.generate_set(case, 1, tmp_path / "a")
+    gen.generate_set(case, 1, tmp_path / "b")
+    assert _digest(tmp_path / "a") == _digest(tmp_path / "b")
+    assert len(truth["files"]) == len(case.pressures_kpa)
+    for fname, test in zip(truth["files"], truth["tests"], strict=True):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            rt = read_test(tmp_path / "a" / fname)
+        assert rt.pressure_kpa == pytest.approx(test["pressure_kpa"], rel=1e-6)
+        assert len(rt) == test["samples"]
+
+
+def test_their_command_lines_write_a_seed_of_every_case(tmp_path, capsys):
+    assert gen7.main([]) == 2 and "usage" in capsys.readouterr().out
+    assert gen7.main([str(tmp_path), "3"]) == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([*gen7.CASES, "truth.json"])
