@@ -63,7 +63,6 @@ class Uncertainty:
         self.cov_stat = cov
         self.cov_sys = np.zeros_like(cov)
         self.cov_inst = np.zeros_like(cov)
-        self.cov = cov.copy()
         self.rho = rho
         self.nfev = nfev
         self.at_bound = at_bound
@@ -88,6 +87,11 @@ class Uncertainty:
         if "C10" in by or "C01" in by:
             out["shear_modulus_kpa"] = 2.0 * (by.get("C10", 0.0) + by.get("C01", 0.0))
         self.drift_shift = out
+
+    @property
+    def cov(self) -> np.ndarray:
+        """The covariance of the varied parameters: the statistical, systematic and instrument parts summed."""
+        return self.cov_stat + self.cov_sys + self.cov_inst
 
     @property
     def sd(self) -> np.ndarray:
@@ -132,7 +136,6 @@ class Uncertainty:
     def set_systematic(self, cov_sys: np.ndarray) -> None:
         """The systematic covariance (the loop laws' spread, :mod:`bendpam.identify.ensemble`); ``cov`` is the sum."""
         self.cov_sys = np.asarray(cov_sys, dtype=float)
-        self.cov = self.cov_stat + self.cov_sys + self.cov_inst
 
     def set_instrument(self, cov_inst: np.ndarray) -> None:
         """The instrument's declared calibration (:class:`Instrument`, :func:`instrument_covariance`); ``cov`` is
@@ -144,7 +147,6 @@ class Uncertainty:
         ([5.0], [3.0])
         """
         self.cov_inst = np.asarray(cov_inst, dtype=float)
-        self.cov = self.cov_stat + self.cov_sys + self.cov_inst
 
 
 @dataclass(frozen=True)
