@@ -1,8 +1,9 @@
-"""The independent held-out generators (tools/holdout6_generator.py, tools/holdout7_generator.py), checked alone.
+"""The independent held-out generators (tools/holdout6_generator.py, holdout7_generator.py, holdout8_generator.py),
+checked alone.
 
 The sixth set's machine: its fixture against a bracketed root of eq 6 and its clean machine (no loop, noise or
-fault) against the truth's moment.  The seventh set's loop laws (on that machine): each dissipates on every
-cycle.  Both: deterministic, and every file read by bendpam with the pressure and sample count written.
+fault) against the truth's moment.  The seventh and eighth sets' loop laws (on that machine): each dissipates on
+every cycle.  All: deterministic, and every file read by bendpam with the pressure and sample count written.
 """
 
 import hashlib
@@ -17,6 +18,7 @@ sys.path.insert(0, str(ROOT / "tools"))
 
 import holdout6_generator as gen6  # noqa: E402
 import holdout7_generator as gen7  # noqa: E402
+import holdout8_generator as gen8  # noqa: E402
 
 from bendpam.lab import read_test  # noqa: E402
 
@@ -30,8 +32,9 @@ def test_the_sixth_sets_clean_machine_gives_the_truths_moment(name):
     assert gen6.check_clean_machine(gen6.CASES[name]) < 1e-6  # of the blocked moment
 
 
-def test_every_seventh_set_law_dissipates_on_every_cycle():
-    for law, found in gen7.check_laws().items():
+@pytest.mark.parametrize("gen", [gen7, gen8])
+def test_every_seventh_and_eighth_set_law_dissipates_on_every_cycle(gen):
+    for law, found in gen.check_laws().items():
         assert min(found["areas"]) > 0.0, law  # loop area over max |z|: positive, each cycle
 
 
@@ -43,7 +46,9 @@ def _digest(folder: Path) -> str:
 
 
 @pytest.mark.parametrize(("gen", "name"), [(gen6, "h6-chaboche-drift"), (gen6, "h6-ja-gauge"),
-                                           (gen7, "h7-eyring-drift"), (gen7, "h7-dupont-ep")])
+                                           (gen7, "h7-eyring-drift"), (gen7, "h7-dupont-ep"),
+                                           (gen8, "h8-maxwellslip-tare"), (gen8, "h8-preisach-quant"),
+                                           (gen8, "h8-boucwen-zero")])
 def test_it_is_deterministic_and_bendpam_reads_every_file(gen, name, tmp_path):
     case = gen.CASES[name]
     truth = gen.generate_set(case, 1, tmp_path / "a")

@@ -45,7 +45,8 @@ class FitData:
     Per test ``P``, ``k``, ``M`` (pressure, curvatures, mean curve), ``BM``/``BM_se`` and ``K``/``K_se``
     (blocked moment, free curvature and their standard errors); per point ``kc``, ``Mc``, ``Pc``,
     the weight ``w`` and the test ``seg``; with a loop ``branch`` (+1 loading, -1 unloading),
-    ``delta`` (bending angle from the branch's start, rad) and ``span`` (between the loop's ends).
+    ``delta`` (bending angle from the branch's start, rad) and ``span`` (between the loop's ends); ``lever``
+    the moment per newton of machine force at each point (eq 7, mm: a load-cell offset's moment).
 
     Examples
     --------
@@ -80,6 +81,7 @@ class FitData:
     period_s: np.ndarray | None = None  # (n,) each test's mean cycle period, s (NaN: not known)
     rate: np.ndarray | None = None  # each point's bending rate at a constant crosshead speed, relative to k' = 0
     time_s: np.ndarray | None = None  # each point's time since its branch began (cycle mean, s); None: not kept
+    lever: np.ndarray | None = None  # each point's moment per newton of machine force (eq 7, mm); None: no fixture
 
     @cached_property
     def branch_rows(self) -> dict[int, np.ndarray]:
@@ -97,7 +99,7 @@ class FitData:
         """Every ``step``-th point (weights scaled so the objective keeps its scale): for the grid stage."""
         keep = np.arange(self.kc.size) % step == 0
         opt = {n: None if getattr(self, n) is None else getattr(self, n)[keep]
-               for n in ("branch", "delta", "span", "grid_index", "rate", "time_s")}
+               for n in ("branch", "delta", "span", "grid_index", "rate", "time_s", "lever")}
         return FitData(self.P, self.k, self.M, self.BM, self.BM_se, self.K, self.K_se,
                      self.w[keep] * math.sqrt(self.kc.size / keep.sum()), self.kc[keep], self.Mc[keep], self.Pc[keep],
                      self.seg[keep], **opt, period_s=self.period_s)
@@ -176,9 +178,11 @@ def branch_data(processed, L0: float) -> FitData:
     gi = cat([np.tile(np.arange(np.asarray(r.curvature_grid).size), 2) for r in res])
     fixture = getattr(processed, "fixture", None)
     t = cat(times)
-    return FitData(d.P, d.k, d.M, d.BM, d.BM_se, d.K, d.K_se, cat(w), cat(k), cat(M), cat(Pc), cat(seg), cat(br),
-                 cat(delta), cat(span), gi, d.period_s, None if fixture is None else relative_rate(fixture, cat(k)),
-                 t if np.all(np.isfinite(t)) else None)
+    kk = cat(k)
+    return FitData(d.P, d.k, d.M, d.BM, d.BM_se, d.K, d.K_se, cat(w), kk, cat(M), cat(Pc), cat(seg), cat(br),
+                 cat(delta), cat(span), gi, d.period_s, None if fixture is None else relative_rate(fixture, kk),
+                 t if np.all(np.isfinite(t)) else None,
+                 None if fixture is None else np.asarray(fixture.lever(fixture.curvature_to_beta(kk)), dtype=float))
 
 
 def relative_rate(fixture, curvature_per_mm) -> np.ndarray:

@@ -65,10 +65,12 @@ Uncertainty (both parts are reported separately: ``FitResult.uncertainty``)
        residuals; a drift correction adds its own doubt as an offset.
     2. Systematic (the loop law): no law is known to be the actuator's.  The fit is repeated with
        every law of :data:`bendpam.physics.hysteresis.ENSEMBLE` (warm-started, the quasi-static
-       parameters free as in the fit, some laws with parameters of their own); the reported model
-       parameters are the average over the laws with Akaike weights (AICc on the residuals' effective
-       number of points), their covariance the unconditional one: the laws' own covariances
-       (statistical) and their spread about the average (systematic) (:mod:`bendpam.identify.ensemble`).
+       parameters free as in the fit, some laws with parameters of their own), and once more the law of
+       most weight with a load-cell zero offset (N) fitted too; the reported model parameters are the
+       average over the members with Akaike weights (AICc on the residuals' effective number of points,
+       bootstrapped over the residual groups), their covariance the unconditional one: the members' own
+       covariances (statistical) and their spread about the average (systematic)
+       (:mod:`bendpam.identify.ensemble`).
     3. Instrument (when declared, :class:`~bendpam.identify.uncertainty.Instrument`): a load cell's and a
        pressure gauge's calibration, each the linearised refit its error would make; a third part.
     4. The profile of alpha0 (the objective minimised over everything else, against alpha0) is
@@ -125,10 +127,12 @@ from bendpam.identify.diagnose import (
 )
 from bendpam.identify.ensemble import (
     MEMBER_EXTRA,
+    OFFSET_SUFFIX,
     SPAN_SCALED,
     MemberFit,
     group_ssr,
     member_weights,
+    offset_note,
     part_sds,
     spans_differ,
     uncertainty_budget,
@@ -373,6 +377,14 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool, inst
             except FitError:  # this law cannot describe the curves at all: it has no weight
                 continue
             run.nfev += n
+        if "F_off" in run.bnd:  # the law of most weight again, with a load-cell zero offset
+            top = list(fits)[int(np.argmax(member_weights(fits, r, run.prob.groups)[0]))]
+            prob_top, nl_top = solved[top][:2] if top in solved else (run.prob, run.nl)
+            try:
+                fits[top + OFFSET_SUFFIX], n, solved[top + OFFSET_SUFFIX] = _offset_refit(prob_top, run.bnd, nl_top)
+                run.nfev += n
+            except FitError:  # no offset describes the curves: the member has no weight
+                pass
     if fits:  # each member's own statistical covariance, where it has weight (the others add nothing)
         w, _ = member_weights(fits, r, run.prob.groups)
         for (alt, f), wk in zip(list(fits.items()), w, strict=True):
@@ -381,6 +393,8 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool, inst
                 u2 = _uncertainty(p2, run.bnd, nl2, lin2, corr_flag, run.cycles, run.offsets)
                 fits[alt] = f._replace(names=tuple(u2.names), cov=u2.cov_stat)
                 run.nfev += u2.nfev
+                if "F_off" in u2.names and wk >= 0.5:
+                    run.notes.append(offset_note(u2.values["F_off"], float(u2.sd[u2.names.index("F_off")]), wk))
     shape_bound = unc.at_bound.get("S_lo", False) or unc.at_bound.get("S_hi", False)
     budget = uncertainty_budget(unc, run.prob.actuator(unc.values), fits, r, run.prob.groups, run.law,
                                 0 if shape_bound else len(run.cycles))
@@ -399,6 +413,9 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool, inst
 def _bounds(actuator: Actuator, d: FitData, bounds) -> dict[str, tuple[float, float]]:
     bnd = _default_bounds(actuator, float(d.P.min()))
     bnd.update({"theta_h": (0.2, 90.0), "a0": (0.0, 10.0 * float(d.BM.max())), "a1": (0.0, 100.0), "gap": (0.0, 5.0)})
+    if d.lever is not None:  # a load-cell zero offset (N), the ensemble's offset member: up to half the blocked force
+        f_b = 0.5 * float(np.max(d.BM / d.lever.min()))
+        bnd["F_off"] = (-f_b, f_b)
     bnd.update({"a0_2": bnd["a0"], "a1_2": bnd["a1"], "ratio": (1.0, 3.0), "theta_2": bnd["theta_h"]})  # members' own
     for k, v in (bounds or {}).items():
         key = "shape" if str(k).strip().lower() in ("shape", "beta") else parse_free([k])[0]
@@ -654,6 +671,25 @@ def _law_refit(prob: Problem, bnd, nl, alt: str):
     member = MemberFit(p2.to_user(nl2, lin2), float(r2 @ r2), n_params=len(p2.free),
                        group_ssr=group_ssr(r2, p2.groups))
     return member, nfev + n, (p2, nl2, lin2)
+
+
+def _offset_refit(prob: Problem, bnd, nl):
+    """A member's fit (``prob`` at ``nl``) with a load-cell zero offset ``F_off`` (N) as well: the ensemble's offset
+    member (:data:`~bendpam.identify.ensemble.OFFSET_SUFFIX`).  The offset is linear (its moment at each point is
+    eq 7's lever times it), so the search only refines the kinematics from the member's.  Where its shape still sits
+    on an admissibility bound the model cannot follow the curves even so, and the offset would only absorb their
+    misfit: FitError (the member is left out)."""
+    p2 = copy.copy(prob)
+    p2.set_free([*prob.free, "F_off"])
+    r0, _ = p2.project(nl)
+    nl2, lin2, _, _, n = _search(p2, bnd, (float(r0 @ r0), dict(nl)), tol=1e-5)
+    held = dict(zip(p2.int_names, at_bounds(lin2, p2.lo, p2.hi), strict=True))
+    if held.get("S_lo", False) or held.get("S_hi", False):
+        raise FitError("with the offset too the shape sits on its bound: the offset would absorb the model's misfit")
+    r2 = p2.residual_full(np.concatenate([[nl2[p] for p in p2.nonlin], lin2]))
+    member = MemberFit(p2.to_user(nl2, lin2), float(r2 @ r2), n_params=len(p2.free),
+                       group_ssr=group_ssr(r2, p2.groups))
+    return member, n + 1, (p2, nl2, lin2)
 
 
 def _profile(prob: Problem, bnd, nl, unc: Uncertainty, n_points: int):

@@ -230,6 +230,9 @@ class Problem:
         for p, col in cols.items():
             if p not in self.lin:
                 c0 = c0 + col * fixed[p]
+        if "F_off" in self.lin:  # a load-cell zero offset (N): the moment it adds at each row, eq 7's lever times it
+            assert d.lever is not None, "an offset is fitted only where the fixture's lever is known"
+            cols["F_off"] = d.lever
         if self.law:
             z = self._z(float(nl["theta_h"]), float(nl.get("gap", 0.0)), nl.get("ratio"),
                         theta_2=nl.get("theta_2")).reshape(d.kc.size, -1)

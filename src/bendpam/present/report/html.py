@@ -36,6 +36,7 @@ from bendpam.present.report.text import (
     finite,
     fmt_pct,
     fmt_value,
+    law_label,
     plain_html,
     symbol,
 )
@@ -329,7 +330,7 @@ def _uncertainty_tables(m: str, label: str, res) -> list[_Table]:
         keys = list(b.ensemble[0].values)
         rows = [_Row([_td(fmt_value(e.weight), e.weight), _td(fmt_pct(e.nrmse), e.nrmse)]
                      + [_td(fmt_value(e.values.get(k)), e.values.get(k)) for k in keys],
-                     LAW_LABEL.get(e.law, e.law)) for e in b.ensemble]
+                     law_label(e.law)) for e in b.ensemble]
         out.append(_Table(f"ensemble-{m}", f"The loop laws fitted to the same data ({b.weighting})",
                           ["Loop law", "Weight", "NRMSE of both branches (%)",
                            *(Markup(symbol(k).heading()) for k in keys)], rows))

@@ -21,6 +21,7 @@ import numpy as np
 
 from bendpam.errors import InputError
 from bendpam.identify.diagnose import search_state
+from bendpam.identify.ensemble import OFFSET_SUFFIX
 
 __all__ = [
     "LAW_LABEL",
@@ -33,6 +34,7 @@ __all__ = [
     "finite",
     "fmt_pct",
     "fmt_value",
+    "law_label",
     "plain_html",
     "plain_text",
     "symbol",
@@ -51,6 +53,17 @@ LAW_LABEL = {"pi": "Prandtl-Ishlinskii", "dahl": "Dahl", "bouc_wen": "Bouc-Wen",
              "maxwell2": "two Maxwell branches (a two-term Prony series)",
              "dahl_span": "Dahl (angle in proportion to the span)",
              "bouc_wen_span": "Bouc-Wen (angle in proportion to the span)"}
+
+
+def law_label(law: str) -> str:
+    """A loop law's name in words (:data:`LAW_LABEL`), the ensemble's offset member's too
+    (:data:`bendpam.identify.ensemble.OFFSET_SUFFIX`).
+
+    >>> law_label("stiction+offset")
+    'breakaway (stiction) with a load-cell zero offset'
+    """
+    base = law.removesuffix(OFFSET_SUFFIX)
+    return LAW_LABEL.get(base, base) + (" with a load-cell zero offset" if base != law else "")
 
 
 def escape(x) -> str:
