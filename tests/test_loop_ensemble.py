@@ -519,7 +519,7 @@ def test_two_maxwell_branches_are_fitted_by_the_two_term_prony_member():
 
 def test_a_load_cell_zero_offset_is_fitted_by_the_offset_member():
     """Raw tests from the independent generators with 0.3 N added to every force reading (a tare taken otherwise):
-    the offset member carries the weight, finds the offset, and the fit says so; the laws without it are biased."""
+    the offset members carry the weight, find the offset, and the fit says so; the laws without it are biased."""
     import dataclasses
     import tempfile
     from pathlib import Path
@@ -539,8 +539,9 @@ def test_a_load_cell_zero_offset_is_fitted_by_the_offset_member():
     ps = process_tests(raws, fixture=Fixture(L0_mm=truth["fixture_L0_mm"]), keep_series=False)
     r = fit(ps, gen.start_actuator(case), profile_points=0)
     members = {m.law: m for m in r.uncertainty.ensemble}
-    assert members["stiction+offset"].weight > 0.9
-    assert abs(members["stiction+offset"].values["force_offset_n"] - 0.3) < 0.01  # N
+    offset = [m for k, m in members.items() if k.endswith("+offset")]
+    assert sum(m.weight for m in offset) > 0.9 and len(offset) > 5  # the offset taken, every law refitted with it
+    assert all(abs(m.values["force_offset_n"] - 0.3) < 0.01 for m in offset if m.weight > 0.05)  # N
     assert any("load-cell zero offset (0.3 +-" in f for f in r.flags)
     mu, se = r.material.shear_modulus_kpa, r.material.se_shear_modulus_kpa
     assert abs(mu - truth["shear_modulus_kpa"]) < 2.0 * se

@@ -49,7 +49,7 @@ Self-similar members (:data:`SPAN_SCALED`)
     gives a viscous loop (``"viscous_period"``).  With one span (a single test) they are the plain laws
     and are left out.
 
-The offset member (:data:`OFFSET_SUFFIX`)
+The offset members (:data:`OFFSET_SUFFIX`)
     The law of most weight again, with a load-cell zero offset ``F_off`` (N) fitted too: a constant force the load
     cell reads besides the actuator's (a tare taken with the fixture hanging otherwise, the plates' weight),
     whose moment at each point is eq 7's lever times it.  The curves tell it from the actuator's constants only
@@ -59,7 +59,9 @@ The offset member (:data:`OFFSET_SUFFIX`)
     its own shape sits on an admissibility bound the model cannot follow the curves even with the offset, which
     would then absorb their misfit (the README's walkthrough, whose Table 3 bladder is not admissible: weight
     0.94 for -0.11 N that the simulated tests do not have, the cycles' NRMSE 0.88 -> 1.29 %): there the member
-    is left out.
+    is left out.  When this member takes most of the weight, every other law is refitted with the offset too:
+    the offset is then part of the model, and the laws' spread is the systematic part again (with one offset
+    member the eighth held-out set's tare took all the weight and its bars lost the laws' spread).
 The rate-dependent laws
     A viscous loop (a Maxwell element, :class:`~bendpam.physics.hysteresis.ViscousLoop`) needs the
     bending rate.  A processed set keeps each branch point's time (the cycle mean of
@@ -89,8 +91,8 @@ from bendpam.identify.uncertainty import Uncertainty, lag1_autocorrelation, mate
 
 __all__ = ["MEMBER_EXTRA", "OFFSET_SUFFIX", "SPAN_SCALED", "TWO_BRANCH", "WEIGHT_DRAWS", "MemberFit",
            "akaike_weights", "bootstrap_weights", "effective_points", "group_points", "group_ssr", "member_weights",
-           "model_average", "offset_note", "part_sds", "played_path", "span_scaled_z", "spans_differ", "steady_z",
-           "systematic_covariance", "uncertainty_budget"]
+           "model_average", "offset_average", "offset_note", "part_sds", "played_path", "span_scaled_z",
+           "spans_differ", "steady_z", "systematic_covariance", "uncertainty_budget"]
 
 #: The parameters a member of the ensemble adds to the reported fit's: the standard linear solid's second pair
 #: of amplitudes (its Maxwell branch; the first pair weighs the dashpot), the play's gap (deg), the breakaway
@@ -666,13 +668,34 @@ def uncertainty_budget(unc: Uncertainty, fitted, fits: dict, r: np.ndarray, grou
     return UncertaintyBudget(stat, sys_, resampling, weighting, members)
 
 
-def offset_note(offset_n: float, sd_n: float, weight: float) -> str:
-    """The fit's words when the offset member (:data:`OFFSET_SUFFIX`) takes most of the weight.
+def offset_average(members) -> tuple[float, float, float]:
+    """The offset members' load-cell zero offset, model-averaged: ``(offset, its standard error, their weight)`` (N).
 
-    >>> offset_note(-0.234, 0.019, 0.97)[:96]
-    'the ensemble's member with a load-cell zero offset (-0.23 +- 0.019 N) has weight 0.97: the curves'
+    ``members``: ``(weight, offset, standard error)`` of each offset member (:data:`OFFSET_SUFFIX`) with weight.
+    The offset is their weighted average, its variance the unconditional one (each member's own variance and
+    its offset's spread about the average, weighted as :func:`model_average` weighs them), among the offset
+    members; the weight is theirs in the whole ensemble.
+
+    >>> [round(x, 4) for x in offset_average([(0.5, -0.30, 0.01), (0.3, -0.28, 0.01)])]   # N: sqrt(1e-4 + 9.4e-5)
+    [-0.2925, 0.0139, 0.8]
     """
-    return (f"the ensemble's member with a load-cell zero offset ({offset_n:.2g} +- {sd_n:.2g} N) has weight "
+    w = np.array([m[0] for m in members], dtype=float)
+    v = np.array([m[1] for m in members], dtype=float)
+    sd = np.array([m[2] for m in members], dtype=float)
+    total = float(w.sum())
+    wn = w / total
+    mean = float(wn @ v)
+    return mean, math.sqrt(float(wn @ (sd**2 + (v - mean) ** 2))), total
+
+
+def offset_note(offset_n: float, sd_n: float, weight: float) -> str:
+    """The fit's words when the offset members (:data:`OFFSET_SUFFIX`) take most of the weight
+    (:func:`offset_average`).
+
+    >>> offset_note(-0.234, 0.019, 0.97).split(":")[0]
+    "the ensemble's members with a load-cell zero offset (-0.23 +- 0.019 N) have weight 0.97"
+    """
+    return (f"the ensemble's members with a load-cell zero offset ({offset_n:.2g} +- {sd_n:.2g} N) have weight "
             f"{weight:.2f}: the curves are described better with it, as they are when the load cell was not zeroed "
             "with the fixture mounted and the actuator unpressurised, or when the model misfits them in a way an "
             "offset absorbs (a shape at its bound, a loop no member has); the values reported are averaged with it")

@@ -132,6 +132,7 @@ from bendpam.identify.ensemble import (
     MemberFit,
     group_ssr,
     member_weights,
+    offset_average,
     offset_note,
     part_sds,
     spans_differ,
@@ -377,24 +378,21 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool, inst
             except FitError:  # this law cannot describe the curves at all: it has no weight
                 continue
             run.nfev += n
-        if "F_off" in run.bnd:  # the law of most weight again, with a load-cell zero offset
-            top = list(fits)[int(np.argmax(member_weights(fits, r, run.prob.groups)[0]))]
-            prob_top, nl_top = solved[top][:2] if top in solved else (run.prob, run.nl)
-            try:
-                fits[top + OFFSET_SUFFIX], n, solved[top + OFFSET_SUFFIX] = _offset_refit(prob_top, run.bnd, nl_top)
-                run.nfev += n
-            except FitError:  # no offset describes the curves: the member has no weight
-                pass
+        if "F_off" in run.bnd:
+            _offset_members(run, fits, solved, r)
     if fits:  # each member's own statistical covariance, where it has weight (the others add nothing)
         w, _ = member_weights(fits, r, run.prob.groups)
+        offsets = []  # (weight, offset, its standard error) of the offset members with weight
         for (alt, f), wk in zip(list(fits.items()), w, strict=True):
             if alt in solved and wk > 1e-4:
                 p2, nl2, lin2 = solved[alt]
                 u2 = _uncertainty(p2, run.bnd, nl2, lin2, corr_flag, run.cycles, run.offsets)
                 fits[alt] = f._replace(names=tuple(u2.names), cov=u2.cov_stat)
                 run.nfev += u2.nfev
-                if "F_off" in u2.names and wk >= 0.5:
-                    run.notes.append(offset_note(u2.values["F_off"], float(u2.sd[u2.names.index("F_off")]), wk))
+                if "F_off" in u2.names:
+                    offsets.append((float(wk), u2.values["F_off"], float(u2.sd[u2.names.index("F_off")])))
+        if offsets and sum(o[0] for o in offsets) >= 0.5:
+            run.notes.append(offset_note(*offset_average(offsets)))
     shape_bound = unc.at_bound.get("S_lo", False) or unc.at_bound.get("S_hi", False)
     budget = uncertainty_budget(unc, run.prob.actuator(unc.values), fits, r, run.prob.groups, run.law,
                                 0 if shape_bound else len(run.cycles))
@@ -671,6 +669,29 @@ def _law_refit(prob: Problem, bnd, nl, alt: str):
     member = MemberFit(p2.to_user(nl2, lin2), float(r2 @ r2), n_params=len(p2.free),
                        group_ssr=group_ssr(r2, p2.groups))
     return member, nfev + n, (p2, nl2, lin2)
+
+
+def _offset_members(run: _Run, fits: dict, solved: dict, r: np.ndarray) -> None:
+    """Add the offset members to ``fits`` (and their problems to ``solved``): the law of most weight refitted with a
+    load-cell zero offset (:func:`_offset_refit`); when that member takes most of the weight, every other law too,
+    so that the offset is part of every member and the laws' spread is the systematic part again."""
+    def add(law: str) -> None:
+        prob, nl = solved[law][:2] if law in solved else (run.prob, run.nl)
+        try:
+            fits[law + OFFSET_SUFFIX], n, solved[law + OFFSET_SUFFIX] = _offset_refit(prob, run.bnd, nl)
+            run.nfev += n
+        except FitError:  # no offset describes the curves with this law: the member has no weight
+            pass
+
+    laws = list(fits)
+    top = laws[int(np.argmax(member_weights(fits, r, run.prob.groups)[0]))]
+    add(top)
+    if top + OFFSET_SUFFIX in fits:
+        w = member_weights(fits, r, run.prob.groups)[0]
+        if w[list(fits).index(top + OFFSET_SUFFIX)] >= 0.5:
+            for law in laws:
+                if law != top:
+                    add(law)
 
 
 def _offset_refit(prob: Problem, bnd, nl):
