@@ -224,3 +224,13 @@ def test_a_signal_during_a_compiled_modules_import_is_an_interrupt(monkeypatch, 
     assert cli_app.main(["predict", "--preset", "be-pam", "--pressure-kpa", "100"]) == code
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "interrupted" in err[0] and "internal error" not in err[0]
+
+
+@pytest.mark.parametrize(("option", "value"), [("--despike-sigmas", "2"), ("--reversal-fraction", "0.7")])
+def test_a_processing_option_out_of_range_is_named_as_the_option(capsys, tmp_path, option, value):
+    """The refusal names the command line's option, not the API's field, and nothing is written."""
+    raw = tmp_path / "t_150kPa.csv"
+    raw.write_text("time_s,stroke_mm,force_n\n0,0,1\n0.1,0.1,0.9\n", encoding="utf-8")
+    code, _, err = run(capsys, "process", str(raw), option, value, "--out", str(tmp_path / "out"))
+    assert code == 2 and err.startswith(f"bendpam: error: {option} {float(value)} is outside the allowed")
+    assert not (tmp_path / "out").exists()

@@ -112,7 +112,8 @@ def _load_holdout6():
 
 h6 = _load_holdout6()
 
-__all__ = ["CASES", "Case7", "check_laws", "generate_set", "start_actuator", "truth_actuator"]
+__all__ = ["CASES", "Case7", "check_laws", "generate_set", "midpoint_in_u", "reference_cycles",
+           "start_actuator", "truth_actuator"]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -267,7 +268,7 @@ def _law_dupont(t, k, ctx, p):
     zss, zba = p["z_ss"], p["z_ba"] * p["z_ss"]
     hmax = 0.01 * zss
 
-    def slope(z, s):
+    def slope(z, x, s):
         sz = s * z
         if sz <= zba:
             al = 0.0
@@ -277,6 +278,12 @@ def _law_dupont(t, k, ctx, p):
             al = 0.5 * math.sin(math.pi * (sz - 0.5 * (zss + zba)) / (zss - zba)) + 0.5
         return 1.0 - al * sz / zss
 
+    return midpoint_in_u(u, slope, hmax)
+
+
+def midpoint_in_u(u, rate, hmax):
+    """``dz/du = rate(z, u, sign du)`` integrated by the midpoint rule in substeps of at most ``hmax`` in ``u``
+    (``u`` a list; ``z`` starts at 0)."""
     out = np.zeros(len(u))
     z = 0.0
     for i in range(1, len(u)):
@@ -285,9 +292,10 @@ def _law_dupont(t, k, ctx, p):
             nsub = 1 + int(abs(du) / hmax)
             h = du / nsub
             s = 1.0 if h > 0 else -1.0
+            x = u[i - 1]
             for _ in range(nsub):
-                zm = z + 0.5 * h * slope(z, s)
-                z += h * slope(zm, s)
+                z += h * rate(z + 0.5 * h * rate(z, x, s), x + 0.5 * h, s)
+                x += h
         out[i] = z
     return out
 
@@ -417,6 +425,15 @@ def generate_set(case: Case7, seed: int, folder) -> dict:
 # ---------------------------------------------------------------------------------------------
 # check 1: each law alone on a reference cycle
 # ---------------------------------------------------------------------------------------------
+def reference_cycles(law, params, n_cycles: int, points: int):
+    """A law ``z(t, k, ctx, params)`` alone on the triangle u: 0 -> 1 -> 0, ``n_cycles`` times, half-cycle time 1,
+    ``points`` samples a half-cycle: ``(t, u, z)``."""
+    t = np.linspace(0.0, 2.0 * n_cycles, 2 * n_cycles * points + 1)
+    u = 1.0 - np.abs((t % 2.0) - 1.0)
+    ctx = {"k_ref": 1.0, "k_free": 1.0, "dt": float(t[1] - t[0]), "t_half": 1.0}
+    return t, u, law(t, u, ctx, params)
+
+
 def check_laws(n_cycles: int = 4, points: int = 2000) -> dict:
     """Each case's law on a triangle u: 0 -> 1 -> 0, ``n_cycles`` times, half-cycle time 1.
 
@@ -425,10 +442,7 @@ def check_laws(n_cycles: int = 4, points: int = 2000) -> dict:
     """
     res = {}
     for case in CASES.values():
-        t = np.linspace(0.0, 2.0 * n_cycles, 2 * n_cycles * points + 1)
-        u = 1.0 - np.abs((t % 2.0) - 1.0)
-        ctx = {"k_ref": 1.0, "k_free": 1.0, "dt": float(t[1] - t[0]), "t_half": 1.0}
-        z = _LAWS[case.loop](t, u, ctx, case.params)
+        _, u, z = reference_cycles(_LAWS[case.loop], case.params, n_cycles, points)
         zmax = float(np.max(np.abs(z)))
         m = 2 * points
         areas, changes = [], []
