@@ -66,7 +66,8 @@ Uncertainty (both parts are reported separately: ``FitResult.uncertainty``)
     2. Systematic (the loop law): no law is known to be the actuator's.  The fit is repeated with
        every law of :data:`bendpam.physics.hysteresis.ENSEMBLE` (warm-started, the quasi-static
        parameters free as in the fit, some laws with parameters of their own), and once more the law of
-       most weight with a load-cell zero offset (N) fitted too; the reported model parameters are the
+       most weight with a load-cell zero offset (N) fitted too (every law, when that member takes most
+       of the weight; not where its shape sits on a bound); the reported model parameters are the
        average over the members with Akaike weights (AICc on the residuals' effective number of points,
        bootstrapped over the residual groups), their covariance the unconditional one: the members' own
        covariances (statistical) and their spread about the average (systematic)
