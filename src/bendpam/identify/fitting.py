@@ -128,6 +128,7 @@ from bendpam.identify.diagnose import (
 )
 from bendpam.identify.ensemble import (
     MEMBER_EXTRA,
+    OFFSET_NOTE_WEIGHT,
     OFFSET_SUFFIX,
     SPAN_SCALED,
     MemberFit,
@@ -392,8 +393,10 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool, inst
                 run.nfev += u2.nfev
                 if "F_off" in u2.names:
                     offsets.append((float(wk), u2.values["F_off"], float(u2.sd[u2.names.index("F_off")])))
-        if offsets and sum(o[0] for o in offsets) >= 0.5:
-            run.notes.append(offset_note(*offset_average(offsets)))
+        if offsets and sum(o[0] for o in offsets) >= OFFSET_NOTE_WEIGHT:
+            mean, sd, weight = offset_average(offsets)
+            if abs(mean) >= 3.0 * sd:  # an offset the curves show, not the members' share of a misfit
+                run.notes.append(offset_note(mean, sd, weight))
     shape_bound = unc.at_bound.get("S_lo", False) or unc.at_bound.get("S_hi", False)
     budget = uncertainty_budget(unc, run.prob.actuator(unc.values), fits, r, run.prob.groups, run.law,
                                 0 if shape_bound else len(run.cycles))
