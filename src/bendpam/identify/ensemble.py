@@ -677,20 +677,16 @@ def offset_average(members) -> tuple[float, float, float]:
     """The offset members' load-cell zero offset, model-averaged: ``(offset, its standard error, their weight)`` (N).
 
     ``members``: ``(weight, offset, standard error)`` of each offset member (:data:`OFFSET_SUFFIX`) with weight.
-    The offset is their weighted average, its variance the unconditional one (each member's own variance and
-    its offset's spread about the average, weighted as :func:`model_average` weighs them), among the offset
-    members; the weight is theirs in the whole ensemble.
+    The offset is their :func:`model_average` (the weighted average among the offset members, with the
+    unconditional variance: each member's own variance and its offset's spread about the average); the weight
+    is theirs in the whole ensemble.
 
     >>> [round(x, 4) for x in offset_average([(0.5, -0.30, 0.01), (0.3, -0.28, 0.01)])]   # N: sqrt(1e-4 + 9.4e-5)
     [-0.2925, 0.0139, 0.8]
     """
-    w = np.array([m[0] for m in members], dtype=float)
-    v = np.array([m[1] for m in members], dtype=float)
-    sd = np.array([m[2] for m in members], dtype=float)
-    total = float(w.sum())
-    wn = w / total
-    mean = float(wn @ v)
-    return mean, math.sqrt(float(wn @ (sd**2 + (v - mean) ** 2))), total
+    w, v, sd = (np.array([m[i] for m in members], dtype=float) for i in range(3))
+    mean, stat, sys_ = model_average(v[:, None], (sd**2)[:, None, None], w)
+    return float(mean[0]), math.sqrt(float(stat[0, 0] + sys_[0, 0])), float(w.sum())
 
 
 def offset_note(offset_n: float, sd_n: float, weight: float) -> str:
