@@ -1,6 +1,6 @@
 """The calibration study of bendpam's error bars (issue 23): do the fit's standard errors hold?
 
-    python tools/calibration_study.py [--seeds 10] [--set main|holdout|...|holdout8] [--cases CASE ...] [--jobs 1]
+    python tools/calibration_study.py [--seeds 10] [--set main|holdout|...|holdout9] [--cases CASE ...] [--jobs 1]
                                       [--out FILE]
 
 For every case of :data:`raw_generators.CASES` (or of :data:`raw_generators.HOLDOUT` with ``--set holdout``:
@@ -46,6 +46,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import holdout6_generator as gen6  # noqa: E402
 import holdout7_generator as gen7  # noqa: E402
 import holdout8_generator as gen8  # noqa: E402
+import holdout9_generator as gen9  # noqa: E402
 import raw_generators as gen  # noqa: E402
 
 from bendpam.infra.atomic import atomic_write_text, json_safe  # noqa: E402
@@ -56,16 +57,19 @@ START, END = "<!-- calibration-table:start -->", "<!-- calibration-table:end -->
 #: ``holdout`` (:data:`raw_generators.HOLDOUT`, other parameters and combined faults, kept out of any tuning).
 SETS = {"main": gen.CASES, "holdout": gen.HOLDOUT, "holdout2": gen.HOLDOUT2, "holdout3": gen.HOLDOUT3,
         "holdout4": gen.HOLDOUT4, "holdout5": gen.HOLDOUT5, "holdout6": gen6.CASES, "holdout7": gen7.CASES,
-        "holdout8": gen8.CASES}
+        "holdout8": gen8.CASES, "holdout9": gen9.CASES}
 ALL_CASES = {**gen.CASES, **gen.HOLDOUT, **gen.HOLDOUT2, **gen.HOLDOUT3, **gen.HOLDOUT4, **gen.HOLDOUT5,
-             **gen6.CASES, **gen7.CASES, **gen8.CASES}
+             **gen6.CASES, **gen7.CASES, **gen8.CASES, **gen9.CASES}
 
 
 def generator(case):
-    """The module that makes ``case``'s raw tests: :mod:`holdout8_generator`, :mod:`holdout7_generator` and
+    """The module that makes ``case``'s raw tests: :mod:`holdout9_generator`, :mod:`holdout8_generator`,
+    :mod:`holdout7_generator` and
     :mod:`holdout6_generator` for
     theirs (a machine written independently), :mod:`raw_generators` for the others; each has ``generate_set``
     and ``start_actuator``."""
+    if isinstance(case, gen9.Case9):
+        return gen9
     if isinstance(case, gen8.Case8):
         return gen8
     if isinstance(case, gen7.Case7):
@@ -411,13 +415,16 @@ def main(argv=None) -> int:
                     "loop laws, faults and export layouts), scored once; holdout7: eight more loop laws on that "
                     "machine with a careful lab's instrument (tools/holdout7_generator.py), scored once; holdout8: "
                     "common loop laws with a lab's instrument faults on that machine (a tare offset, a warm-up drift, "
-                    "a wandering offset, a stroke zero error, a quantised force; tools/holdout8_generator.py)")
+                    "a wandering offset, a stroke zero error, a quantised force; tools/holdout8_generator.py); "
+                    "holdout9: further loop laws and faults on that machine (a channel skew, pressure crosstalk, a "
+                    "clock error, spikes, a slipping clamp, a pressure droop; tools/holdout9_generator.py)")
     ap.add_argument("--cases", nargs="+", choices=list(ALL_CASES), metavar="CASE",
                     help=f"cases to run (default: the whole set; main: {', '.join(gen.CASES)}; holdout: "
                     f"{', '.join(gen.HOLDOUT)}; holdout2: {', '.join(gen.HOLDOUT2)}; "
                     f"holdout3: {', '.join(gen.HOLDOUT3)}; holdout4: {', '.join(gen.HOLDOUT4)}; "
                     f"holdout5: {', '.join(gen.HOLDOUT5)}; holdout6: {', '.join(gen6.CASES)}; "
-                    f"holdout7: {', '.join(gen7.CASES)}; holdout8: {', '.join(gen8.CASES)})")
+                    f"holdout7: {', '.join(gen7.CASES)}; holdout8: {', '.join(gen8.CASES)}; "
+                    f"holdout9: {', '.join(gen9.CASES)})")
     ap.add_argument("--jobs", type=int, default=1, help="processes (default 1; the machine may be shared)")
     ap.add_argument("--fit", dest="fit_options", action="append", default=[], metavar="KEY=VALUE",
                     help="a keyword of bendpam.identify.fitting.fit, as a Python literal (law_uncertainty=False, "
