@@ -87,10 +87,11 @@ def test_loop_aware_fit_recovers_alpha0_and_mu_from_an_independent_loop(name, mo
     da, se_a, dmu, z_mu = errors(r, truth, lt)
     assert abs(da) < 0.2 and abs(da) < 2 * se_a
     assert abs(dmu) < 0.05 and abs(z_mu) < 2
-    # the mean-curve fit (the paper's way, --no-hysteresis) is biased by the loop several times more
+    # the mean-curve fit (the paper's way, --no-hysteresis) is biased by the loop more than twice as much (three
+    # times before the pressure-offset member, which takes 0.09-0.18 of the weight here with its alpha0 0.2 deg up)
     r0 = fit(ps, base, model, hysteresis=None)
     assert r0.hysteresis is None and r0.metrics.curves == "mean curves"
-    assert abs(r0.parameters["alpha0"].value - truth.alpha0_deg) > 3 * abs(da)
+    assert abs(r0.parameters["alpha0"].value - truth.alpha0_deg) > 2 * abs(da)
     assert any("the tests show a loop" in f for f in r0.flags)
 
 

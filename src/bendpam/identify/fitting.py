@@ -129,7 +129,7 @@ from bendpam.identify.diagnose import (
 from bendpam.identify.ensemble import (
     MEMBER_EXTRA,
     OFFSET_NOTE_WEIGHT,
-    OFFSET_SUFFIX,
+    OFFSETS,
     SPAN_SCALED,
     MemberFit,
     group_ssr,
@@ -384,19 +384,21 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool, inst
             _offset_members(run, fits, solved, r)
     if fits:  # each member's own statistical covariance, where it has weight (the others add nothing)
         w, _ = member_weights(fits, r, run.prob.groups)
-        offsets = []  # (weight, offset, its standard error) of the offset members with weight
+        offsets: dict[str, list] = {s: [] for s in OFFSETS}  # each kind's (weight, offset, its SE) with weight
         for (alt, f), wk in zip(list(fits.items()), w, strict=True):
             if alt in solved and wk > 1e-4:
                 p2, nl2, lin2 = solved[alt]
                 u2 = _uncertainty(p2, run.bnd, nl2, lin2, corr_flag, run.cycles, run.offsets)
                 fits[alt] = f._replace(names=tuple(u2.names), cov=u2.cov_stat)
                 run.nfev += u2.nfev
-                if "F_off" in u2.names:
-                    offsets.append((float(wk), u2.values["F_off"], float(u2.sd[u2.names.index("F_off")])))
-        if offsets and sum(o[0] for o in offsets) >= OFFSET_NOTE_WEIGHT:
-            mean, sd, weight = offset_average(offsets)
-            if abs(mean) >= 3.0 * sd:  # an offset the curves show, not the members' share of a misfit
-                run.notes.append(offset_note(mean, sd, weight))
+                for suffix, (name, _, _) in OFFSETS.items():
+                    if name in u2.names:
+                        offsets[suffix].append((float(wk), u2.values[name], float(u2.sd[u2.names.index(name)])))
+        for suffix, found in offsets.items():
+            if found and sum(o[0] for o in found) >= OFFSET_NOTE_WEIGHT:
+                mean, sd, weight = offset_average(found)
+                if abs(mean) >= 3.0 * sd:  # an offset the curves show, not the members' share of a misfit
+                    run.notes.append(offset_note(mean, sd, weight, suffix))
     shape_bound = unc.at_bound.get("S_lo", False) or unc.at_bound.get("S_hi", False)
     budget = uncertainty_budget(unc, run.prob.actuator(unc.values), fits, r, run.prob.groups, run.law,
                                 0 if shape_bound else len(run.cycles))
@@ -418,6 +420,7 @@ def _bounds(actuator: Actuator, d: FitData, bounds) -> dict[str, tuple[float, fl
     if d.lever is not None:  # a load-cell zero offset (N), the ensemble's offset member: up to half the blocked force
         f_b = 0.5 * float(np.max(d.BM / d.lever.min()))
         bnd["F_off"] = (-f_b, f_b)
+        bnd["F_P"] = (-f_b / float(d.P.max()), f_b / float(d.P.max()))  # N/kPa: as much at the highest pressure
     bnd.update({"a0_2": bnd["a0"], "a1_2": bnd["a1"], "ratio": (1.0, 3.0), "theta_2": bnd["theta_h"]})  # members' own
     for k, v in (bounds or {}).items():
         key = "shape" if str(k).strip().lower() in ("shape", "beta") else parse_free([k])[0]
@@ -676,36 +679,38 @@ def _law_refit(prob: Problem, bnd, nl, alt: str):
 
 
 def _offset_members(run: _Run, fits: dict, solved: dict, r: np.ndarray) -> None:
-    """Add the offset members to ``fits`` (and their problems to ``solved``): the law of most weight refitted with a
-    load-cell zero offset (:func:`_offset_refit`); when that member takes most of the weight, every other law too,
-    so that the offset is part of every member and the laws' spread is the systematic part again."""
+    """Add the offset members to ``fits`` (and their problems to ``solved``): the law of most weight refitted with
+    each offset of :data:`~bendpam.identify.ensemble.OFFSETS` (:func:`_offset_refit`); when those members take most
+    of the weight, every other law too, so that the offsets are part of every member and the laws' spread is the
+    systematic part again."""
     def add(law: str) -> None:
         prob, nl = solved[law][:2] if law in solved else (run.prob, run.nl)
-        try:
-            fits[law + OFFSET_SUFFIX], n, solved[law + OFFSET_SUFFIX] = _offset_refit(prob, run.bnd, nl)
-            run.nfev += n
-        except FitError:  # no offset describes the curves with this law: the member has no weight
-            pass
+        for suffix, (name, _, _) in OFFSETS.items():
+            try:
+                fits[law + suffix], n, solved[law + suffix] = _offset_refit(prob, run.bnd, nl, name)
+                run.nfev += n
+            except FitError:  # no such offset describes the curves with this law: the member has no weight
+                pass
 
     laws = list(fits)
     top = laws[int(np.argmax(member_weights(fits, r, run.prob.groups)[0]))]
     add(top)
-    if top + OFFSET_SUFFIX in fits:
-        w = member_weights(fits, r, run.prob.groups)[0]
-        if w[list(fits).index(top + OFFSET_SUFFIX)] >= 0.5:
-            for law in laws:
-                if law != top:
-                    add(law)
+    w = dict(zip(fits, member_weights(fits, r, run.prob.groups)[0], strict=True))
+    if sum(w.get(top + suffix, 0.0) for suffix in OFFSETS) >= 0.5:
+        for law in laws:
+            if law != top:
+                add(law)
 
 
-def _offset_refit(prob: Problem, bnd, nl):
-    """A member's fit (``prob`` at ``nl``) with a load-cell zero offset ``F_off`` (N) as well: the ensemble's offset
-    member (:data:`~bendpam.identify.ensemble.OFFSET_SUFFIX`).  The offset is linear (its moment at each point is
-    eq 7's lever times it), so the search only refines the kinematics from the member's.  Where its shape still sits
-    on an admissibility bound the model cannot follow the curves even so, and the offset would only absorb their
-    misfit: FitError (the member is left out)."""
+def _offset_refit(prob: Problem, bnd, nl, name: str = "F_off"):
+    """A member's fit (``prob`` at ``nl``) with an offset force as well: ``name`` is ``"F_off"``, a load-cell zero
+    offset (N), or ``"F_P"``, a force in proportion to the pressure (N/kPa): the ensemble's offset members
+    (:data:`~bendpam.identify.ensemble.OFFSETS`).  The offset is linear (its moment at each point is eq 7's lever
+    times it), so the search only refines the kinematics from the member's.  Where its shape still sits on an
+    admissibility bound the model cannot follow the curves even so, and the offset would only absorb their misfit:
+    FitError (the member is left out)."""
     p2 = copy.copy(prob)
-    p2.set_free([*prob.free, "F_off"])
+    p2.set_free([*prob.free, name])
     r0, _ = p2.project(nl)
     nl2, lin2, _, _, n = _search(p2, bnd, (float(r0 @ r0), dict(nl)), tol=1e-5)
     held = dict(zip(p2.int_names, at_bounds(lin2, p2.lo, p2.hi), strict=True))

@@ -230,9 +230,10 @@ class Problem:
         for p, col in cols.items():
             if p not in self.lin:
                 c0 = c0 + col * fixed[p]
-        if "F_off" in self.lin:  # a load-cell zero offset (N): the moment it adds at each row, eq 7's lever times it
+        if "F_off" in self.lin or "F_P" in self.lin:  # an offset force: its moment at each row is eq 7's lever times it
             assert d.lever is not None, "an offset is fitted only where the fixture's lever is known"
-            cols["F_off"] = d.lever
+            cols["F_off"] = d.lever  # a load-cell zero offset (N)
+            cols["F_P"] = d.lever * d.Pc  # a force in proportion to the pressure (N/kPa)
         if self.law:
             z = self._z(float(nl["theta_h"]), float(nl.get("gap", 0.0)), nl.get("ratio"),
                         theta_2=nl.get("theta_2")).reshape(d.kc.size, -1)

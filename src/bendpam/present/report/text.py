@@ -21,7 +21,7 @@ import numpy as np
 
 from bendpam.errors import InputError
 from bendpam.identify.diagnose import search_state
-from bendpam.identify.ensemble import OFFSET_SUFFIX
+from bendpam.identify.ensemble import OFFSETS
 
 __all__ = [
     "LAW_LABEL",
@@ -56,14 +56,19 @@ LAW_LABEL = {"pi": "Prandtl-Ishlinskii", "dahl": "Dahl", "bouc_wen": "Bouc-Wen",
 
 
 def law_label(law: str) -> str:
-    """A loop law's name in words (:data:`LAW_LABEL`), the ensemble's offset member's too
-    (:data:`bendpam.identify.ensemble.OFFSET_SUFFIX`).
+    """A loop law's name in words (:data:`LAW_LABEL`), the ensemble's offset members' too
+    (:data:`bendpam.identify.ensemble.OFFSETS`).
 
     >>> law_label("stiction+offset")
     'breakaway (stiction) with a load-cell zero offset'
+    >>> law_label("dahl+pressure_offset")
+    'Dahl with a force offset in proportion to the pressure'
     """
-    base = law.removesuffix(OFFSET_SUFFIX)
-    return LAW_LABEL.get(base, base) + (" with a load-cell zero offset" if base != law else "")
+    for suffix, (_, _, words) in OFFSETS.items():
+        if law.endswith(suffix):
+            base = law.removesuffix(suffix)
+            return f"{LAW_LABEL.get(base, base)} with {words}"
+    return LAW_LABEL.get(law, law)
 
 
 def escape(x) -> str:
