@@ -205,12 +205,13 @@ def test_fit_reports_the_ensemble_and_both_parts(loop_fit, tmp_path):
     r, truth = loop_fit
     b = r.uncertainty
     assert b.ensemble[0].law == "pi"
-    # the law of most weight with a load-cell offset, and with a force in proportion to the pressure
-    offset = [m for m in b.ensemble if m.law.endswith(("+offset", "+pressure_offset"))]
+    # the law of most weight with a load-cell offset, with a force in proportion to the pressure, and with both
+    offset = [m for m in b.ensemble if m.law.endswith(("+offset", "+pressure_offset", "+both_offsets"))]
     assert sorted(m.law for m in b.ensemble if m not in offset) == sorted(ENSEMBLE)
     plain = max((m for m in b.ensemble if m not in offset), key=lambda m: m.weight)
-    assert [m.law for m in offset] == [plain.law + "+offset", plain.law + "+pressure_offset"]
-    assert "force_offset_n" in offset[0].values and "force_offset_n_per_kpa" in offset[1].values
+    assert [m.law for m in offset] == [plain.law + s for s in ("+offset", "+pressure_offset", "+both_offsets")]
+    assert [sorted(k for k in m.values if k.startswith("force_offset")) for m in offset] == [
+        ["force_offset_n"], ["force_offset_n_per_kpa"], ["force_offset_n", "force_offset_n_per_kpa"]]
     assert sum(m.weight for m in b.ensemble) == pytest.approx(1.0)
     # a law that fits worse gets less weight
     by_fit = sorted(b.ensemble, key=lambda m: m.nrmse)
@@ -550,9 +551,10 @@ def test_a_load_cell_zero_offset_is_fitted_by_the_offset_member():
     the offset members carry the weight, find the offset, and the fit says so; the laws without it are biased."""
     truth, r, members = _fit_with_added_force(lambda p: 0.3)
     offset = [m for k, m in members.items() if k.endswith("+offset")]
-    assert sum(m.weight for m in offset) > 0.9 and len(offset) > 5  # the offset taken, every law refitted with it
+    with_it = [m for m in members.values() if "force_offset_n" in m.values]  # with the pressure's offset too
+    assert sum(m.weight for m in with_it) > 0.9 and len(offset) > 5  # the offset taken, every law refitted with it
     assert all(abs(m.values["force_offset_n"] - 0.3) < 0.01 for m in offset if m.weight > 0.05)  # N
-    assert any("load-cell zero offset (0.3 +-" in f for f in r.flags)
+    assert any("load-cell zero offset (0.3" in f for f in r.flags)
     mu, se = r.material.shear_modulus_kpa, r.material.se_shear_modulus_kpa
     assert abs(mu - truth["shear_modulus_kpa"]) < 2.0 * se
     assert abs(r.actuator.alpha0_deg - truth["alpha0_deg"]) < 2.0 * r.parameters["alpha0"].stderr
@@ -564,12 +566,14 @@ def test_a_force_in_proportion_to_the_pressure_is_fitted_by_the_pressure_offset_
     """The same tests with 0.004 N/kPa times the pressure added (0.4-0.8 N: a supply hose pulling on the fixture):
     the pressure-offset members carry the weight and find it, the fit says so, and the values cover the truth;
     the laws without it are biased.  With half of it (0.2-0.4 N over 100-200 kPa) a constant offset describes the
-    curves nearly as well: the two kinds share the weight, and the bars carry both."""
+    curves nearly as well: the three offset members share the weight, and the bars carry them all."""
     truth, r, members = _fit_with_added_force(lambda p: 0.004 * p)
     found = [m for k, m in members.items() if k.endswith("+pressure_offset")]
-    assert sum(m.weight for m in found) > 0.9 and len(found) > 5
+    with_it = [m for m in members.values() if "force_offset_n_per_kpa" in m.values]  # with a zero offset too
+    assert sum(m.weight for m in with_it) > 0.9 and len(found) > 5
     assert all(abs(m.values["force_offset_n_per_kpa"] - 0.004) < 1e-4 for m in found if m.weight > 0.05)  # N/kPa
-    assert any("in proportion to the pressure (0.004 +-" in f for f in r.flags)
+    note = next(f for f in r.flags if "in proportion to the pressure (" in f)
+    assert abs(float(note.split("in proportion to the pressure (")[1].split(" ")[0]) - 0.004) < 2.5e-4
     mu, se = r.material.shear_modulus_kpa, r.material.se_shear_modulus_kpa
     assert abs(mu - truth["shear_modulus_kpa"]) < 2.0 * se
     assert abs(r.actuator.alpha0_deg - truth["alpha0_deg"]) < 2.0 * r.parameters["alpha0"].stderr
@@ -577,10 +581,27 @@ def test_a_force_in_proportion_to_the_pressure_is_fitted_by_the_pressure_offset_
     assert abs(plain["shear_modulus_kpa"] - truth["shear_modulus_kpa"]) > 3.0 * se
 
     truth, r, members = _fit_with_added_force(lambda p: 0.002 * p)
-    shares = {s: sum(m.weight for k, m in members.items() if k.endswith(s)) for s in ("+offset", "+pressure_offset")}
-    assert min(shares.values()) > 0.2 and sum(shares.values()) > 0.9
+    shares = {s: sum(m.weight for k, m in members.items() if k.endswith(s))
+              for s in ("+offset", "+pressure_offset", "+both_offsets")}
+    assert min(shares.values()) > 0.1 and sum(shares.values()) > 0.9
     assert abs(r.material.shear_modulus_kpa - truth["shear_modulus_kpa"]) < 2.0 * r.material.se_shear_modulus_kpa
     assert abs(r.actuator.alpha0_deg - truth["alpha0_deg"]) < 2.0 * r.parameters["alpha0"].stderr
+
+
+def test_a_zero_offset_and_a_force_in_proportion_to_the_pressure_are_fitted_together():
+    """The same tests with -0.3 N + 0.004 N/kPa times the pressure added (a tare and a hose's pull): the member with
+    both offsets takes the weight, finds both within 2 SE, the fit names both, and the values cover the truth,
+    where the law without them is more than 5 SE off."""
+    truth, r, members = _fit_with_added_force(lambda p: -0.3 + 0.004 * p)
+    both = [m for k, m in members.items() if k.endswith("+both_offsets")]
+    assert sum(m.weight for m in both) > 0.9
+    notes = [f for f in r.flags if "the ensemble's members with" in f]
+    assert any("load-cell zero offset (-0.2" in f or "load-cell zero offset (-0.3" in f for f in notes)
+    assert any("in proportion to the pressure (0.00" in f for f in notes)
+    se = r.parameters["alpha0"].stderr
+    assert abs(r.actuator.alpha0_deg - truth["alpha0_deg"]) < 2.0 * se
+    assert abs(r.material.shear_modulus_kpa - truth["shear_modulus_kpa"]) < 2.0 * r.material.se_shear_modulus_kpa
+    assert abs(members["stiction"].values["alpha0_deg"] - truth["alpha0_deg"]) > 5.0 * se
 
 
 def test_the_offset_member_is_named_in_words():
@@ -589,3 +610,5 @@ def test_the_offset_member_is_named_in_words():
     assert law_label("pi_play+offset") == ("Prandtl-Ishlinskii after a fixture play (backlash) with a load-cell "
                                            "zero offset")
     assert law_label("pi+pressure_offset").endswith(" with a force offset in proportion to the pressure")
+    assert law_label("pi+both_offsets").endswith(" with a load-cell zero offset and a force offset in proportion to "
+                                                 "the pressure")

@@ -98,8 +98,8 @@ from bendpam.identify.data import FitData
 from bendpam.identify.result import PARAMETERS, EnsembleMember, UncertaintyBudget, parameter_field
 from bendpam.identify.uncertainty import Uncertainty, lag1_autocorrelation, material_gradients
 
-__all__ = ["MEMBER_EXTRA", "OFFSETS", "OFFSET_NOTE_WEIGHT", "OFFSET_SUFFIX", "PRESSURE_OFFSET_SUFFIX", "SPAN_SCALED",
-           "TWO_BRANCH", "WEIGHT_DRAWS",
+__all__ = ["BOTH_OFFSETS_SUFFIX", "MEMBER_EXTRA", "OFFSETS", "OFFSET_NOTE_WEIGHT", "OFFSET_PARAMETERS",
+           "OFFSET_SUFFIX", "PRESSURE_OFFSET_SUFFIX", "SPAN_SCALED", "TWO_BRANCH", "WEIGHT_DRAWS",
            "MemberFit", "akaike_weights", "bootstrap_weights", "effective_points", "group_points", "group_ssr",
            "member_weights", "model_average", "offset_average", "offset_note", "part_sds", "played_path",
            "span_scaled_z", "spans_differ", "steady_z", "systematic_covariance", "uncertainty_budget"]
@@ -127,12 +127,18 @@ TWO_BRANCH: dict[str, tuple[tuple[str, str | None], tuple[str, str | None]]] = {
 OFFSET_SUFFIX = "+offset"
 #: The pressure-offset member's name: the law of most weight's with this suffix (``"stiction+pressure_offset"``).
 PRESSURE_OFFSET_SUFFIX = "+pressure_offset"
-#: The offset members by suffix: ``(parameter, unit, words)``.  ``F_off`` is a load-cell zero offset (N), the same
-#: in every test; ``F_P`` a force in proportion to each test's pressure (N/kPa: ``F_P * P`` at ``P``).
-OFFSETS: dict[str, tuple[str, str, str]] = {
-    OFFSET_SUFFIX: ("F_off", "N", "a load-cell zero offset"),
-    PRESSURE_OFFSET_SUFFIX: ("F_P", "N/kPa", "a force offset in proportion to the pressure"),
+#: The member with both offsets: the law of most weight's with this suffix (``"stiction+both_offsets"``).
+BOTH_OFFSETS_SUFFIX = "+both_offsets"
+#: The offset forces a member may fit: ``(unit, words, key among the member's values)``.  ``F_off`` is a load-cell
+#: zero offset (N), the same in every test; ``F_P`` a force in proportion to each test's pressure (N/kPa: ``F_P * P``
+#: at ``P``).
+OFFSET_PARAMETERS: dict[str, tuple[str, str, str]] = {
+    "F_off": ("N", "a load-cell zero offset", "force_offset_n"),
+    "F_P": ("N/kPa", "a force offset in proportion to the pressure", "force_offset_n_per_kpa"),
 }
+#: The offset members by suffix: the offsets each fits.
+OFFSETS: dict[str, tuple[str, ...]] = {OFFSET_SUFFIX: ("F_off",), PRESSURE_OFFSET_SUFFIX: ("F_P",),
+                                      BOTH_OFFSETS_SUFFIX: ("F_off", "F_P")}
 #: The offset members' weight from which the fit speaks of an offset (with the offset at least 3 of its standard
 #: errors): on the main calibration set's clean tests (six cases, three seeds) a threshold of 0.5 spoke in 2 of 18
 #: fits (0.50 and 0.70, offsets of 0.014 and -0.13 N); a tare of 0.3 N gives them 1.00.
@@ -672,10 +678,9 @@ def uncertainty_budget(unc: Uncertainty, fitted, fits: dict, r: np.ndarray, grou
             vals = {parameter_field(n): float(fits[k][0][n]) for n in names if n in PARAMETERS}
             if "C10" in names or "C01" in names:
                 vals["shear_modulus_kpa"], vals["shape"] = _material(fits[k][0], fitted)
-            if "F_off" in fits[k][0]:  # the offset member's load-cell zero offset, N
-                vals["force_offset_n"] = float(fits[k][0]["F_off"])
-            if "F_P" in fits[k][0]:  # the pressure-offset member's force per pressure, N/kPa
-                vals["force_offset_n_per_kpa"] = float(fits[k][0]["F_P"])
+            for name, (_, _, key) in OFFSET_PARAMETERS.items():  # an offset member's offsets (N, N/kPa)
+                if name in fits[k][0]:
+                    vals[key] = float(fits[k][0][name])
             members.append(EnsembleMember(k, float(wk), math.sqrt(max(fits[k][1], 0.0)), vals))
         boot = (f", averaged over a Bayesian bootstrap of the {np.unique(groups).size} residual groups (pseudo-BMA+)"
                 if all(getattr(fits[k], "group_ssr", None) is not None for k in laws) else "")
@@ -708,19 +713,19 @@ def offset_average(members) -> tuple[float, float, float]:
     return float(mean[0]), math.sqrt(float(stat[0, 0] + sys_[0, 0])), float(w.sum())
 
 
-def offset_note(offset: float, sd: float, weight: float, suffix: str = OFFSET_SUFFIX) -> str:
-    """The fit's words when one kind of offset member (:data:`OFFSETS`, by its ``suffix``) takes nearly all the
-    weight (:data:`OFFSET_NOTE_WEIGHT`) and its offset (:func:`offset_average`, in the kind's unit) is at least 3
+def offset_note(offset: float, sd: float, weight: float, name: str = "F_off") -> str:
+    """The fit's words when the offset members that fit the offset ``name`` (:data:`OFFSET_PARAMETERS`) take nearly
+    all the weight (:data:`OFFSET_NOTE_WEIGHT`) and their offset (:func:`offset_average`, in its unit) is at least 3
     standard errors.
 
     >>> offset_note(-0.234, 0.019, 0.97).split(":")[0]
     "the ensemble's members with a load-cell zero offset (-0.23 +- 0.019 N) have weight 0.97"
-    >>> offset_note(0.0021, 0.0002, 0.95, PRESSURE_OFFSET_SUFFIX).split(":")[0]
+    >>> offset_note(0.0021, 0.0002, 0.95, "F_P").split(":")[0]
     "the ensemble's members with a force offset in proportion to the pressure (0.0021 +- 0.0002 N/kPa) have weight 0.95"
     """
-    _, unit, words = OFFSETS[suffix]
+    unit, words, _ = OFFSET_PARAMETERS[name]
     cause = ("the load cell was not zeroed with the fixture mounted and the actuator unpressurised"
-             if suffix == OFFSET_SUFFIX else
+             if name == "F_off" else
              "the supply hose or the fitting's thrust reads on the load cell, or the loop's middle is off the "
              "actuator's own curve in proportion to the loop")
     return (f"the ensemble's members with {words} ({offset:.2g} +- {sd:.2g} {unit}) have weight "

@@ -129,6 +129,7 @@ from bendpam.identify.diagnose import (
 from bendpam.identify.ensemble import (
     MEMBER_EXTRA,
     OFFSET_NOTE_WEIGHT,
+    OFFSET_PARAMETERS,
     OFFSETS,
     SPAN_SCALED,
     MemberFit,
@@ -384,21 +385,20 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool, inst
             _offset_members(run, fits, solved, r)
     if fits:  # each member's own statistical covariance, where it has weight (the others add nothing)
         w, _ = member_weights(fits, r, run.prob.groups)
-        offsets: dict[str, list] = {s: [] for s in OFFSETS}  # each kind's (weight, offset, its SE) with weight
+        offsets: dict[str, list] = {n: [] for n in OFFSET_PARAMETERS}  # each offset's (weight, value, SE)
         for (alt, f), wk in zip(list(fits.items()), w, strict=True):
             if alt in solved and wk > 1e-4:
                 p2, nl2, lin2 = solved[alt]
                 u2 = _uncertainty(p2, run.bnd, nl2, lin2, corr_flag, run.cycles, run.offsets)
                 fits[alt] = f._replace(names=tuple(u2.names), cov=u2.cov_stat)
                 run.nfev += u2.nfev
-                for suffix, (name, _, _) in OFFSETS.items():
-                    if name in u2.names:
-                        offsets[suffix].append((float(wk), u2.values[name], float(u2.sd[u2.names.index(name)])))
-        for suffix, found in offsets.items():
+                for name in (n for n in OFFSET_PARAMETERS if n in u2.names):
+                    offsets[name].append((float(wk), u2.values[name], float(u2.sd[u2.names.index(name)])))
+        for name, found in offsets.items():
             if found and sum(o[0] for o in found) >= OFFSET_NOTE_WEIGHT:
                 mean, sd, weight = offset_average(found)
                 if abs(mean) >= 3.0 * sd:  # an offset the curves show, not the members' share of a misfit
-                    run.notes.append(offset_note(mean, sd, weight, suffix))
+                    run.notes.append(offset_note(mean, sd, weight, name))
     shape_bound = unc.at_bound.get("S_lo", False) or unc.at_bound.get("S_hi", False)
     budget = uncertainty_budget(unc, run.prob.actuator(unc.values), fits, r, run.prob.groups, run.law,
                                 0 if shape_bound else len(run.cycles))
@@ -685,9 +685,9 @@ def _offset_members(run: _Run, fits: dict, solved: dict, r: np.ndarray) -> None:
     systematic part again."""
     def add(law: str) -> None:
         prob, nl = solved[law][:2] if law in solved else (run.prob, run.nl)
-        for suffix, (name, _, _) in OFFSETS.items():
+        for suffix, names in OFFSETS.items():
             try:
-                fits[law + suffix], n, solved[law + suffix] = _offset_refit(prob, run.bnd, nl, name)
+                fits[law + suffix], n, solved[law + suffix] = _offset_refit(prob, run.bnd, nl, names)
                 run.nfev += n
             except FitError:  # no such offset describes the curves with this law: the member has no weight
                 pass
@@ -702,15 +702,15 @@ def _offset_members(run: _Run, fits: dict, solved: dict, r: np.ndarray) -> None:
                 add(law)
 
 
-def _offset_refit(prob: Problem, bnd, nl, name: str = "F_off"):
-    """A member's fit (``prob`` at ``nl``) with an offset force as well: ``name`` is ``"F_off"``, a load-cell zero
-    offset (N), or ``"F_P"``, a force in proportion to the pressure (N/kPa): the ensemble's offset members
-    (:data:`~bendpam.identify.ensemble.OFFSETS`).  The offset is linear (its moment at each point is eq 7's lever
-    times it), so the search only refines the kinematics from the member's.  Where its shape still sits on an
-    admissibility bound the model cannot follow the curves even so, and the offset would only absorb their misfit:
+def _offset_refit(prob: Problem, bnd, nl, names: tuple[str, ...] = ("F_off",)):
+    """A member's fit (``prob`` at ``nl``) with offset forces as well: ``names`` among ``"F_off"``, a load-cell zero
+    offset (N), and ``"F_P"``, a force in proportion to the pressure (N/kPa): the ensemble's offset members
+    (:data:`~bendpam.identify.ensemble.OFFSETS`).  The offsets are linear (their moment at each point is eq 7's lever
+    times them), so the search only refines the kinematics from the member's.  Where its shape still sits on an
+    admissibility bound the model cannot follow the curves even so, and the offsets would only absorb their misfit:
     FitError (the member is left out)."""
     p2 = copy.copy(prob)
-    p2.set_free([*prob.free, name])
+    p2.set_free([*prob.free, *names])
     r0, _ = p2.project(nl)
     nl2, lin2, _, _, n = _search(p2, bnd, (float(r0 @ r0), dict(nl)), tol=1e-5)
     held = dict(zip(p2.int_names, at_bounds(lin2, p2.lo, p2.hi), strict=True))

@@ -21,7 +21,7 @@ import numpy as np
 
 from bendpam.errors import InputError
 from bendpam.identify.diagnose import search_state
-from bendpam.identify.ensemble import OFFSETS
+from bendpam.identify.ensemble import OFFSET_PARAMETERS, OFFSETS
 
 __all__ = [
     "LAW_LABEL",
@@ -63,11 +63,13 @@ def law_label(law: str) -> str:
     'breakaway (stiction) with a load-cell zero offset'
     >>> law_label("dahl+pressure_offset")
     'Dahl with a force offset in proportion to the pressure'
+    >>> law_label("dahl+both_offsets")
+    'Dahl with a load-cell zero offset and a force offset in proportion to the pressure'
     """
-    for suffix, (_, _, words) in OFFSETS.items():
+    for suffix, names in OFFSETS.items():
         if law.endswith(suffix):
             base = law.removesuffix(suffix)
-            return f"{LAW_LABEL.get(base, base)} with {words}"
+            return f"{LAW_LABEL.get(base, base)} with " + " and ".join(OFFSET_PARAMETERS[n][1] for n in names)
     return LAW_LABEL.get(law, law)
 
 
