@@ -369,6 +369,8 @@ class Actuator:
         The fit that wrote these constants (``fit.json``'s SHA-256, the processed set, date, version);
         a dict of those keys is accepted.
 
+    Notes
+    -----
     Every numeric field must also lie in its physical plausibility range
     (:data:`bendpam.validate.PLAUSIBLE`, docs/plausibility.md): a braid angle of 10 to 88 deg,
     ``R0_start_mm`` at most 3 ``R0_mm``, a frame modulus from rubber to steel, and so on.

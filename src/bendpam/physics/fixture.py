@@ -45,6 +45,8 @@ class Fixture:
     t_mm : connecting plate thickness (paper: 4 mm).
     L0_mm : active length of the actuator, for k' = 2 beta / L0 (paper: 145 mm).
 
+    Notes
+    -----
     Each dimension must be a finite number in its physical plausibility range
     (:data:`bendpam.validate.PLAUSIBLE`: ``d`` 1 mm to 2 m, ``r`` and ``t`` up to 200 mm, ``L0`` as an
     actuator's, 1 mm to 5 m), else one :class:`~bendpam.errors.InputError` line names it.
