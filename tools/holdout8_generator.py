@@ -309,8 +309,9 @@ class Case8(h6.Case6):
 
 def _c(name, preset, model, pressures, loop, loop_fraction, noise_fraction, noise_ar1, dialect, cycles, rate_hz,
        shape, case_id, alpha_shift, s_scale, waveform, speed, return_speed, detect_speed, detect_load, noise_kind,
-       params, faults=(), fault_params=None, **kw):
-    return Case8(name, preset, model, tuple(float(x) for x in pressures), loop, loop_fraction, noise_fraction,
+       params, faults=(), fault_params=None, cls=None, **kw):
+    """One case of ``cls`` (default :class:`Case8`; hold-out 9 builds its own cases with it)."""
+    return (cls or Case8)(name, preset, model, tuple(float(x) for x in pressures), loop, loop_fraction, noise_fraction,
                  noise_ar1, 0.0, dialect, cycles, rate_hz, shape, case_id, alpha_shift, s_scale, waveform, speed,
                  return_speed, detect_speed, detect_load, noise_kind, faults=tuple(faults),
                  loop_params=tuple(params.items()), fault_params=tuple((fault_params or {}).items()), **kw)
@@ -441,8 +442,8 @@ def _patched(case, spans):
             mock.patch.object(h6, "_physics", _physics), mock.patch.object(h6, "_write", write)]
 
 
-def _run(case, fn, *args, spans=None):
-    patches = _patched(case, [] if spans is None else spans)
+def call_patched(patches, fn, *args):
+    """``fn(*args)`` with the ``mock`` patches started, and stopped again whatever happens."""
     for pt in patches:
         pt.start()
     try:
@@ -452,18 +453,27 @@ def _run(case, fn, *args, spans=None):
             pt.stop()
 
 
+def _run(case, fn, *args, spans=None):
+    return call_patched(_patched(case, [] if spans is None else spans), fn, *args)
+
+
+def described(out: dict, case, sources: dict, fault_sources: dict) -> dict:
+    """``out`` (hold-out 6's truth of a set) with the case's loop law, faults and their sources."""
+    out["loop"] = case.loop
+    out["loop_source"] = sources[case.loop]
+    out["faults"] = list(case.faults)
+    out["fault_params"] = case.fault_sizes
+    out["fault_sources"] = [fault_sources[f] for f in case.faults]
+    return out
+
+
 def generate_set(case: Case8, seed: int, folder) -> dict:
     """Write one raw machine file per pressure into ``folder``; returns the truth and the file names.
 
     Runs hold-out 6's machine with this module's laws, faults and shut-off filter, for the call only.
     """
     spans = []
-    out = _run(case, h6.generate_set, case, seed, folder, spans=spans)
-    out["loop"] = case.loop
-    out["loop_source"] = SOURCES[case.loop]
-    out["faults"] = list(case.faults)
-    out["fault_params"] = case.fault_sizes
-    out["fault_sources"] = [FAULT_SOURCES[f] for f in case.faults]
+    out = described(_run(case, h6.generate_set, case, seed, folder, spans=spans), case, SOURCES, FAULT_SOURCES)
     tr = h6._Truth(case)
     for test, span in zip(out["tests"], spans, strict=True):
         F_b = _blocked_force(tr, test["pressure_kpa"])
@@ -488,17 +498,20 @@ def generate_set(case: Case8, seed: int, folder) -> dict:
 # ---------------------------------------------------------------------------------------------
 # checks
 # ---------------------------------------------------------------------------------------------
-def check_laws(n_cycles: int = 4, points: int = 2000) -> dict:
+def check_laws(n_cycles: int = 4, points: int = 2000, cases=None, laws=None) -> dict:
     """Each case's law alone on a triangle u: 0 -> 1 -> 0, ``n_cycles`` times, half-cycle time 1.
 
-    Per law: the loop areas (integral of z du per cycle, over max|z|), the largest change of z between
-    consecutive cycles (over max|z|; cycle 2 vs 1, 3 vs 2, ...), and the last cycle's half-width (half
-    the gap between the branches, mean and max over u in [0.1, 0.9]) as a fraction of the blocked moment
-    (``loop_fraction`` x half-width / max|z| of the first two cycles, as the machine scales it).
+    Per law: the loop areas (integral of z du per cycle, over max|z|), ``dissipates`` (every area > 0), the
+    largest change of z between consecutive cycles (over max|z|; cycle 2 vs 1, 3 vs 2, ...), and the last
+    cycle's half-width (half the gap between the branches, mean and max over u in [0.1, 0.9]) as a fraction of
+    the blocked moment (``loop_fraction`` x half-width / max|z| of the first two cycles, as the machine scales
+    it), with ``half_width_ok`` (the mean in 2-6 %).  ``cases`` and ``laws`` default to this module's (hold-out
+    9 passes its own).
     """
     res = {}
-    for case in CASES.values():
-        _, u, z = reference_cycles(_LAWS[case.loop], case.params, n_cycles, points)
+    laws = _LAWS if laws is None else laws
+    for case in (CASES if cases is None else cases).values():
+        _, u, z = reference_cycles(laws[case.loop], case.params, n_cycles, points)
         m = 2 * points
         zmax = float(np.max(np.abs(z[: 2 * m])))
         areas, changes = [], []
@@ -512,24 +525,28 @@ def check_laws(n_cycles: int = 4, points: int = 2000) -> dict:
         c = n_cycles - 1
         i = np.arange(points // 10, points - points // 10 + 1)
         gap = 0.5 * (z[c * m + i] - z[c * m + 2 * points - i]) / zmax * case.loop_fraction
-        res[case.loop] = {"areas": areas, "changes": changes, "half_width_mean": float(np.mean(gap)),
-                          "half_width_max": float(np.max(gap))}
+        hw = float(np.mean(gap))
+        res[case.loop] = {"areas": areas, "dissipates": min(areas) > 0.0, "changes": changes,
+                          "half_width_mean": hw, "half_width_max": float(np.max(gap)),
+                          "half_width_ok": 0.02 <= hw <= 0.06}
     return res
 
 
-def check_machine(case: Case8, seed: int = 0) -> dict:
+def check_machine(case: Case8, seed: int = 0, run=None) -> dict:
     """The machine with the loop but no noise and no fault: per test, per logged cycle, the loop's mean
     half-width ``(closed integral of (M_law - M_back) dk') / (2 range of k') / M_blocked``.
 
-    Cycles are cut at the stroke's minima between releases.  Returns per pressure the list.
+    Cycles are cut at the stroke's minima between releases.  Returns per pressure the list, and the detected
+    stroke over the quasi-static free stroke.  ``run`` is the module's ``_run`` (hold-out 9 passes its own).
     """
+    run = run or _run
     clean = dataclasses.replace(case, noise_fraction=0.0, faults=(), stroke_noise_mm=0.0, fault_params=())
     tr = h6._Truth(clean)
     k_ref = h6._k_ref(clean, tr)
     rng = np.random.default_rng([seed, case.case_id])
     out = {}
     for P in clean.pressures_kpa:
-        sim = _run(clean, h6._simulate, clean, tr, float(P), k_ref, rng)
+        sim = run(clean, h6._simulate, clean, tr, float(P), k_ref, rng)
         x = sim["stroke_mm"]
         beta = h6.beta_from_stroke(x)
         k = 2.0 * beta / tr.L0
@@ -557,9 +574,14 @@ def _print_checks() -> None:
         c = " ".join(f"{v:6.3f}" for v in r["changes"])
         print(f"{law:16s} {a:34s} {c:26s} {r['half_width_mean']:.4f} / {r['half_width_max']:.4f}")
     print()
+    print_machine(CASES, check_machine)
+
+
+def print_machine(cases, check) -> None:
+    """Print ``check(case)`` (:func:`check_machine`) of every case: the clean machine's loops, test by test."""
     print(f"{'case':22s} {'P kPa':>6s} {'det/free':>8s}  mean half-width / M_b per logged cycle")
-    for case in CASES.values():
-        for P, r in check_machine(case).items():
+    for case in cases.values():
+        for P, r in check(case).items():
             hw = " ".join(f"{v:.4f}" for v in r["half_widths"])
             print(f"{case.name:22s} {P:6.0f} {r['detected_over_free']:8.3f}  {hw}")
 

@@ -167,10 +167,8 @@ periodicity and half-width table and the clean machine's loop table.
 from __future__ import annotations
 
 import dataclasses
-import itertools
 import math
 import sys
-from dataclasses import dataclass, field
 from pathlib import Path
 from unittest import mock
 
@@ -179,7 +177,8 @@ from scipy import signal, special
 
 if str(Path(__file__).resolve().parent) not in sys.path:
     sys.path.insert(0, str(Path(__file__).resolve().parent))
-from holdout7_generator import h6, reference_cycles
+import holdout8_generator as gen8
+from holdout7_generator import h6
 
 __all__ = ["CASES", "Case9", "check_laws", "check_machine", "generate_set", "start_actuator", "truth_actuator"]
 
@@ -467,25 +466,14 @@ FAULT_SOURCES = {
 # ---------------------------------------------------------------------------------------------
 # cases
 # ---------------------------------------------------------------------------------------------
-@dataclass(frozen=True)
-class Case9(h6.Case6):
+class Case9(gen8.Case8):
     """A hold-out-6 case (same attributes) whose ``loop`` names one of this module's laws and whose
-    ``faults`` name this module's instrument faults, sized by ``fault_params``."""
-
-    fault_params: tuple = field(default_factory=tuple)
-
-    @property
-    def fault_sizes(self) -> dict:
-        return dict(self.fault_params)
+    ``faults`` name this module's instrument faults, sized by ``fault_params`` (hold-out 8's case, whose
+    builder it shares)."""
 
 
-def _c(name, preset, model, pressures, loop, loop_fraction, noise_fraction, noise_ar1, dialect, cycles, rate_hz,
-       shape, case_id, alpha_shift, s_scale, waveform, speed, return_speed, detect_speed, detect_load, noise_kind,
-       params, faults=(), fault_params=None, **kw):
-    return Case9(name, preset, model, tuple(float(x) for x in pressures), loop, loop_fraction, noise_fraction,
-                 noise_ar1, 0.0, dialect, cycles, rate_hz, shape, case_id, alpha_shift, s_scale, waveform, speed,
-                 return_speed, detect_speed, detect_load, noise_kind, faults=tuple(faults),
-                 loop_params=tuple(params.items()), fault_params=tuple((fault_params or {}).items()), **kw)
+def _c(*args, **kw) -> Case9:
+    return gen8._c(*args, cls=Case9, **kw)
 
 
 CASES: dict[str, Case9] = {c.name: c for c in [
@@ -524,20 +512,14 @@ CASES: dict[str, Case9] = {c.name: c for c in [
 ]}
 
 
-def start_actuator(case: Case9):
-    """The preset with the case's geometry changes (not the truth's constants)."""
-    return h6.start_actuator(case)
-
-
-def truth_actuator(case: Case9):
-    return h6.truth_actuator(case)
+#: The preset with the case's geometry changes (not the truth's constants), and the truth: hold-out 8's.
+start_actuator, truth_actuator = gen8.start_actuator, gen8.truth_actuator
 
 
 # ---------------------------------------------------------------------------------------------
 # instrument faults (hold-out 6's machine, patched for the call)
 # ---------------------------------------------------------------------------------------------
-def _blocked_force(tr, P) -> float:
-    return float(tr.m(P, 0.0)) / float(h6.lever_mm(0.0))
+_blocked_force = gen8._blocked_force
 
 
 def _xtalk_n_per_kpa(case, tr) -> float:
@@ -614,14 +596,7 @@ def _patched(case, seed, log):
 
 
 def _run(case, fn, *args, seed=0, log=None):
-    patches = _patched(case, seed, [] if log is None else log)
-    for pt in patches:
-        pt.start()
-    try:
-        return fn(*args)
-    finally:
-        for pt in reversed(patches):
-            pt.stop()
+    return gen8.call_patched(_patched(case, seed, [] if log is None else log), fn, *args)
 
 
 def _fault_record(case, tr, test, rec) -> dict:
@@ -652,12 +627,8 @@ def generate_set(case: Case9, seed: int, folder) -> dict:
     Runs hold-out 6's machine with this module's laws, faults and shut-off filter, for the call only.
     """
     log = []
-    out = _run(case, h6.generate_set, case, seed, folder, seed=seed, log=log)
-    out["loop"] = case.loop
-    out["loop_source"] = SOURCES[case.loop]
-    out["faults"] = list(case.faults)
-    out["fault_params"] = case.fault_sizes
-    out["fault_sources"] = [FAULT_SOURCES[f] for f in case.faults]
+    out = gen8.described(_run(case, h6.generate_set, case, seed, folder, seed=seed, log=log), case, SOURCES,
+                         FAULT_SOURCES)
     tr = h6._Truth(case)
     for test, rec in zip(out["tests"], log, strict=True):
         test.update(_fault_record(case, tr, test, rec))
@@ -668,66 +639,16 @@ def generate_set(case: Case9, seed: int, folder) -> dict:
 # checks
 # ---------------------------------------------------------------------------------------------
 def check_laws(n_cycles: int = 4, points: int = 2000) -> dict:
-    """Each case's law alone on a triangle u: 0 -> 1 -> 0, ``n_cycles`` times, half-cycle time 1.
-
-    Per law: the loop areas (integral of z du per cycle, over max|z|), ``dissipates`` (every area > 0), the largest
-    change of z between consecutive cycles (over max|z|; cycle 2 vs 1, 3 vs 2, ...), and the last cycle's half-width
-    (half the gap between the branches, mean and max over u in [0.1, 0.9]) as a fraction of the blocked moment
-    (``loop_fraction`` x half-width / max|z| of the first two cycles, as the machine scales it), with
-    ``half_width_ok`` (the mean in 2-6 %).
-    """
-    res = {}
-    for case in CASES.values():
-        _, u, z = reference_cycles(_LAWS[case.loop], case.params, n_cycles, points)
-        m = 2 * points
-        zmax = float(np.max(np.abs(z[: 2 * m])))
-        areas, changes = [], []
-        for c in range(n_cycles):
-            seg = slice(c * m, (c + 1) * m + 1)
-            zz, uu = z[seg], u[seg]
-            areas.append(float(np.sum(0.5 * (zz[1:] + zz[:-1]) * np.diff(uu))) / zmax)
-            if c:  # interior samples: the shared end points carry the virgin start and one-sided rates
-                prev = z[(c - 1) * m: c * m + 1]
-                changes.append(float(np.max(np.abs(zz[1:-1] - prev[1:-1]))) / zmax)
-        c = n_cycles - 1
-        i = np.arange(points // 10, points - points // 10 + 1)
-        gap = 0.5 * (z[c * m + i] - z[c * m + 2 * points - i]) / zmax * case.loop_fraction
-        hw = float(np.mean(gap))
-        res[case.loop] = {"areas": areas, "dissipates": min(areas) > 0.0, "changes": changes,
-                          "half_width_mean": hw, "half_width_max": float(np.max(gap)),
-                          "half_width_ok": 0.02 <= hw <= 0.06}
-    return res
+    """Hold-out 8's check of each case's law alone (:func:`holdout8_generator.check_laws`: loop areas, whether
+    it dissipates on every cycle, the change between cycles, the half-width and whether it is 2-6 % of the
+    blocked moment), run with this module's cases and laws."""
+    return gen8.check_laws(n_cycles, points, CASES, _LAWS)
 
 
 def check_machine(case: Case9, seed: int = 0) -> dict:
-    """The machine with the loop but no noise and no fault: per test, per logged cycle, the loop's mean
-    half-width ``(closed integral of (M_law - M_back) dk') / (2 range of k') / M_blocked``.
-
-    Cycles are cut at the stroke's minima between releases.  Returns per pressure the list and the detected
-    stroke over the quasi-static free stroke.
-    """
-    clean = dataclasses.replace(case, noise_fraction=0.0, faults=(), stroke_noise_mm=0.0, fault_params=())
-    tr = h6._Truth(clean)
-    k_ref = h6._k_ref(clean, tr)
-    rng = np.random.default_rng([seed, case.case_id])
-    out = {}
-    for P in clean.pressures_kpa:
-        sim = _run(clean, h6._simulate, clean, tr, float(P), k_ref, rng)
-        x = sim["stroke_mm"]
-        k = 2.0 * h6.beta_from_stroke(x) / tr.L0
-        z = (tr.m(float(P), k) - sim["force_n"] * h6.lever_mm(0.5 * k * tr.L0)) / sim["M_b"]
-        low = x <= 0.02 * sim["s_amp"]  # near the blocked state; each run's lowest sample ends a cycle
-        edges = np.flatnonzero(np.diff(low.astype(int))) + 1
-        ends = [int(r[np.argmin(x[r])]) for r in np.split(np.arange(x.size), edges) if low[r[0]]]
-        hw = []
-        for a, b in itertools.pairwise(ends):
-            if np.max(x[a:b]) < 0.5 * sim["s_amp"]:
-                continue
-            kk, zz = k[a: b + 1], z[a: b + 1]
-            hw.append(float(np.sum(0.5 * (zz[1:] + zz[:-1]) * np.diff(kk))) / (2.0 * float(np.max(kk) - np.min(kk))))
-        s_free = float(h6.stroke_from_beta(0.5 * sim["k_free"] * tr.L0))
-        out[float(P)] = {"half_widths": hw, "detected_over_free": sim["s_det"] / s_free}
-    return out
+    """Hold-out 8's check of the clean machine's loops (:func:`holdout8_generator.check_machine`), run with this
+    module's laws."""
+    return gen8.check_machine(case, seed, run=_run)
 
 
 def _print_checks() -> None:
@@ -738,11 +659,7 @@ def _print_checks() -> None:
         ok = "yes" if r["dissipates"] and r["half_width_ok"] else "NO"
         print(f"{law:16s} {a:30s} {c:24s} {r['half_width_mean']:.4f} / {r['half_width_max']:.4f}    {ok}")
     print()
-    print(f"{'case':20s} {'P kPa':>6s} {'det/free':>8s}  mean half-width / M_b per logged cycle")
-    for case in CASES.values():
-        for P, r in check_machine(case).items():
-            hw = " ".join(f"{v:.4f}" for v in r["half_widths"])
-            print(f"{case.name:20s} {P:6.0f} {r['detected_over_free']:8.3f}  {hw}")
+    gen8.print_machine(CASES, check_machine)
 
 
 def main(argv=None) -> int:
