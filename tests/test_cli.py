@@ -226,6 +226,17 @@ def test_a_signal_during_a_compiled_modules_import_is_an_interrupt(monkeypatch, 
     assert len(err) == 1 and "interrupted" in err[0] and "internal error" not in err[0]
 
 
+@pytest.mark.parametrize(("given", "named"), [(["--rate-hz", "-5"], "--rate-hz -5.0"),
+                                              (["--speed-mm-min=0"], "--speed-mm-min 0.0"),
+                                              (["--hysteresis-angle-deg", "-3"], "--hysteresis-angle-deg -3.0")])
+def test_a_simulation_setting_out_of_range_is_named_as_the_option(capsys, tmp_path, given, named):
+    """The library's refusal (``rate_hz = -5.0 ...``) in the command line's words, ``=`` form included, exit 2."""
+    code, _, err = run(capsys, "simulate-test", "--preset", "be-pam", "--pressure-kpa", "100", *given,
+                       "--out", str(tmp_path / "raw"))
+    assert code == 2 and err.startswith(f"bendpam: error: {named} is outside the allowed range")
+    assert len(err.strip().splitlines()) == 1 and not (tmp_path / "raw").exists()
+
+
 @pytest.mark.parametrize(("option", "value"), [("--despike-sigmas", "2"), ("--reversal-fraction", "0.7")])
 def test_a_processing_option_out_of_range_is_named_as_the_option(capsys, tmp_path, option, value):
     """The refusal names the command line's option, not the API's field, and nothing is written."""

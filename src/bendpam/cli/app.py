@@ -18,6 +18,7 @@ it returns with status 0, or all rolled back.
 # no ``from __future__ import annotations``: Typer reads the annotations of the commands as objects (start-up)
 
 import os
+import re
 import sys
 import traceback
 import warnings
@@ -293,6 +294,23 @@ DECLARATION_HINT_CLI = (
 )
 
 
+def option_words(text: str, args: list[str]) -> str:
+    """A library refusal that opens with the field it checked (``rate_hz = -5.0 is outside ...``) in the command
+    line's words, when the user gave that field as an option: ``--rate-hz -5.0 is outside ...``.
+
+    >>> option_words("rate_hz = -5.0 is outside the allowed range [0.001, 1e+06]", ["simulate-test", "--rate-hz=-5"])
+    '--rate-hz -5.0 is outside the allowed range [0.001, 1e+06]'
+    >>> option_words("rate_hz = -5.0 is outside the allowed range [0.001, 1e+06]", ["simulate-test"])
+    'rate_hz = -5.0 is outside the allowed range [0.001, 1e+06]'
+    """
+    m = re.match(r"([a-z][a-z0-9_]*) = ", text)
+    if m is None:
+        return text
+    option = "--" + m.group(1).replace("_", "-")
+    given = any(a == option or a.startswith(option + "=") for a in args)
+    return f"{option} {text[m.end():]}" if given else text
+
+
 def cli_words(text: str) -> str:
     """A library message in the command line's words (its options instead of the library's functions).
 
@@ -411,8 +429,8 @@ def main(argv: list[str] | None = None) -> int:
     except _ClickException as exc:
         typer.echo(f"bendpam: error: {exc.format_message()}", err=True)
         return 2
-    except BendpamError as exc:
-        text = cli_words(_one_line(exc))
+    except BendpamError as exc:  # in the command line's words: its options (given), not the library's fields
+        text = option_words(cli_words(_one_line(exc)), args)
         typer.echo(f"bendpam: error: {text}{_MAX_PRESSURE_HINT if 'max_pressure_kpa to go higher' in text else ''}",
                    err=True)
         return 2

@@ -180,8 +180,8 @@ def process(
     try:
         opts = ProcessingOptions(cutoff_hz=cutoff_hz, reversal_fraction=reversal_fraction, grid_points=grid_points,
                                  tare_n=tare_n, drift=DriftMethod(drift).value, despike_sigmas=despike_sigmas)
-    except InputError as exc:  # the API's words name the field: the command line's name the option
-        raise UserError(_option_words(str(exc))) from None
+    except InputError as exc:  # the API's words name the field: the CLI's handler names the option (option_words)
+        raise UserError(str(exc)) from None
     fig_name = f"figure4.{fig_format.value if fig_format is not None else 'png'}"
     if fig_format is not None and not figure:
         raise UserError(f"--format {fig_format.value}: there is no figure with --no-figure")
@@ -213,17 +213,6 @@ def process(
         typer.echo(_flags(file_line(info)))
     _print_table2(processed.summary())
     echo_wrote(f"wrote {out}/ (curves.nc, curves.npz, curves.csv, summary.json{', ' + fig_name if figure else ''})")
-
-
-def _option_words(message: str) -> str:
-    """A :class:`~bendpam.lab.processed.ProcessingOptions` refusal in the command line's words: the field that
-    opens it (``despike_sigmas = 2.0 ...``) named as its option (``--despike-sigmas 2.0 ...``).
-
-    >>> _option_words("reversal_fraction = 0.7 is outside the allowed range (0, 0.5)")
-    '--reversal-fraction 0.7 is outside the allowed range (0, 0.5)'
-    """
-    m = re.match(r"([a-z][a-z0-9_]*) = ", message)
-    return f"--{m.group(1).replace('_', '-')} {message[m.end():]}" if m else message
 
 
 def _check_process_inputs(out: Path | None, l0_mm: float, format_file: Path | None) -> Path:
