@@ -499,7 +499,7 @@ def test_cli_wrist(capsys):
     (["grasp", "--preset", "be-pam", "--pressure-kpa", "100"], "--diameter-mm"),
     (["grasp", "--preset", "be-pam", "--diameter-mm", "0", "--pressure-kpa", "100"], "positive"),
     (["grasp", "--preset", "be-pam", "--diameter-mm", "80", "--pressure-kpa", "100", "--fingers", "1"], "fingers"),
-    (["wrist", "--preset", "bc-pam", "--pressure-kpa", "100", "--direction-deg", "30"], "direction_deg"),
+    (["wrist", "--preset", "bc-pam", "--pressure-kpa", "100", "--direction-deg", "30"], "--direction-deg 30"),
     (["finger", "--preset", "be-pam", "--pressure-kpa", "100", "--plot", "x.txt"], "--plot"),
 ])
 def test_cli_errors_are_one_line(capsys, args, word):

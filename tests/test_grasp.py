@@ -319,7 +319,7 @@ def test_cli_grasp_table(capsys):
 
 @pytest.mark.parametrize("args,word", [
     (["--mu", "-1"], "mu"),
-    (["--splay-deg", "80"], "splay_deg"),
+    (["--splay-deg", "80"], "--splay-deg 80"),
     (["--fingers", "1"], "fingers"),
 ])
 def test_cli_grasp_bad_option_is_one_line(capsys, args, word):

@@ -432,7 +432,7 @@ def test_cli_shows_a_plausibility_warning_as_one_line(tmp_path, capsys):
 def test_cli_refuses_a_pressure_above_the_burst_limit_and_says_where_to_raise_it(capsys):
     assert main(["predict", "--preset", "be-pam", "--pressure-kpa", "3000"]) == 2
     err = capsys.readouterr().err.strip()
-    assert "\n" not in err and err.startswith("bendpam: error: pressure_kpa = 3000 kPa")
+    assert "\n" not in err and err.startswith("bendpam: error: --pressure-kpa 3000 kPa")
     assert "--actuator" in err and "max_pressure_kpa" in err
 
 

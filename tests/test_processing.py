@@ -233,7 +233,7 @@ def test_cli_simulate_and_process(capsys, tmp_path):
         (["process", "raw", "--out", "o", "--cutoff-hz", "100"], ["Nyquist"]),
         (["simulate-test", "--preset", "bc-pam", "--pressure-kpa", "10", "--out", "s"], ["P_start"]),
         (["simulate-test", "--preset", "be-pam", "--pressure-kpa", "100", "--out", "s", "--rate-hz", "-1"],
-         ["rate_hz"]),
+         ["--rate-hz -1.0"]),
         (["simulate-test", "--preset", "be-pam", "--pressure-kpa", "100", "--out", "s", "--format", "xls"], ["xls"]),
     ],
 )
