@@ -361,31 +361,20 @@ def _print_root_help() -> int:
     return 0
 
 
-def _interrupt_behind(exc: BaseException) -> BaseException | None:
-    """The interrupt (Ctrl-C, SIGTERM) an error was raised from, if any.
+def _unexpected(exc: BaseException, debug: bool) -> int:
+    """An exception no other branch of :func:`main` took: an interrupt behind it (a signal during a module's import
+    comes back wrapped, :func:`~bendpam.infra.signals.interrupt_behind`), or a bug (exit 1, one line)."""
+    from bendpam.infra.signals import Interrupted, interrupt_behind, interrupted_line
 
-    A signal that arrives while a compiled module initialises (pybind11's, say) reaches the caller as
-    ``ImportError("initialization failed")`` raised *from* the interrupt: it is the interrupt still.
-
-    >>> try:
-    ...     try:
-    ...         raise KeyboardInterrupt
-    ...     except KeyboardInterrupt as k:
-    ...         raise ImportError("initialization failed") from k
-    ... except ImportError as e:
-    ...     type(_interrupt_behind(e)).__name__, _interrupt_behind(ValueError("x"))
-    ('KeyboardInterrupt', None)
-    """
-    from bendpam.infra.signals import Interrupted
-
-    seen: set[int] = set()
-    e: BaseException | None = exc
-    while e is not None and id(e) not in seen:
-        if isinstance(e, (Interrupted, KeyboardInterrupt)):
-            return e
-        seen.add(id(e))
-        e = e.__cause__ or e.__context__
-    return None
+    cause = interrupt_behind(exc)
+    if cause is not None:
+        typer.echo(interrupted_line(), err=True)
+        return cause.exit_code if isinstance(cause, Interrupted) else 130
+    if debug:
+        traceback.print_exc()
+    typer.echo(f"bendpam: internal error ({type(exc).__name__}: {_one_line(exc)}); this is a bug in bendpam, "
+               f"please report it to {ISSUES_URL}" + ("" if debug else "; --debug shows the traceback"), err=True)
+    return 1
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -449,16 +438,7 @@ def main(argv: list[str] | None = None) -> int:
     except BaseException as exc:
         if isinstance(exc, SystemExit):
             raise
-        cause = _interrupt_behind(exc)
-        if cause is not None:  # a signal inside an extension module's import comes back as its ImportError
-            typer.echo(interrupted_line(), err=True)
-            return cause.exit_code if isinstance(cause, Interrupted) else 130
-        if debug:
-            traceback.print_exc()
-        typer.echo(f"bendpam: internal error ({type(exc).__name__}: {_one_line(exc)}); this is a bug in bendpam, "
-                   f"please report it to {ISSUES_URL}" + ("" if debug else "; --debug shows the traceback"),
-                   err=True)
-        return 1
+        return _unexpected(exc, debug)
     finally:
         import logging
 

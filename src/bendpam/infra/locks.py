@@ -30,7 +30,7 @@ from pathlib import Path
 
 from bendpam.errors import InputError
 from bendpam.infra.atomic import UMASK
-from bendpam.infra.signals import HeldSignals
+from bendpam.infra.signals import HeldSignals, interrupt_behind
 
 __all__ = ["OutputBusy", "TargetLock", "native_locking"]
 
@@ -57,8 +57,13 @@ def _filelock_fns() -> _LockFns | None:
         with warnings.catch_warnings():  # filelock warns when it has only soft locks
             warnings.simplefilter("ignore")
             from filelock import lock_descriptor, unlock_descriptor
-    except ImportError:
-        return None
+    except Exception as exc:  # a signal during the import comes back wrapped (a dataclass's RuntimeError): raise it
+        cause = interrupt_behind(exc)
+        if cause is not None:
+            raise cause from None
+        if isinstance(exc, ImportError):
+            return None
+        raise
 
     def lock(fd: int) -> bool:
         return bool(lock_descriptor(fd, blocking=False))

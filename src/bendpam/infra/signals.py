@@ -31,6 +31,7 @@ __all__ = [
     "HeldSignals",
     "Interrupted",
     "forget_written",
+    "interrupt_behind",
     "interrupted_line",
     "interrupts",
     "is_interruption",
@@ -95,6 +96,32 @@ def is_interruption(exc: BaseException | None) -> bool:
     (True, False, False)
     """
     return isinstance(exc, Interrupted | KeyboardInterrupt)
+
+
+def interrupt_behind(exc: BaseException) -> BaseException | None:
+    """The interrupt (Ctrl-C, SIGTERM) an error was raised from, if any.
+
+    A signal that arrives while a module initialises reaches the caller wrapped: a compiled module's
+    (pybind11's, say) as ``ImportError("initialization failed")`` raised *from* the interrupt, a dataclass's
+    field being set up as ``RuntimeError("Error calling __set_name__ ...")``.  It is the interrupt still.
+
+    >>> try:
+    ...     try:
+    ...         raise KeyboardInterrupt
+    ...     except KeyboardInterrupt as k:
+    ...         raise ImportError("initialization failed") from k
+    ... except ImportError as e:
+    ...     type(interrupt_behind(e)).__name__, interrupt_behind(ValueError("x"))
+    ('KeyboardInterrupt', None)
+    """
+    seen: set[int] = set()
+    e: BaseException | None = exc
+    while e is not None and id(e) not in seen:
+        if is_interruption(e):
+            return e
+        seen.add(id(e))
+        e = e.__cause__ or e.__context__
+    return None
 
 
 def _in_main_thread() -> bool:
