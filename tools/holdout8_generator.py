@@ -115,7 +115,6 @@ from pathlib import Path
 from unittest import mock
 
 import numpy as np
-from scipy import signal
 
 if str(Path(__file__).resolve().parent) not in sys.path:
     sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -166,14 +165,7 @@ def _law_lugre(t, k, ctx, p):
 def _law_wiechert(t, k, ctx, p):
     u = k / ctx["k_ref"]
     du = np.diff(u, prepend=u[0])
-    dt = ctx["dt"]
-    z = np.zeros_like(u)
-    for w, c in zip(p["weights"], p["taus"], strict=True):
-        tau = c * ctx["t_half"]
-        a = math.exp(-dt / tau)
-        b = tau / dt * (1.0 - a)  # exact for a linear input within a step
-        z += w * signal.lfilter([b], [1.0, -a], du)
-    return z
+    return h6.prony(du, p["weights"], [c * ctx["t_half"] for c in p["taus"]], ctx["dt"])
 
 
 def _law_bouc_wen(t, k, ctx, p):
