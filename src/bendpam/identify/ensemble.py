@@ -702,9 +702,10 @@ def uncertainty_budget(unc: Uncertainty, fitted, fits: dict, r: np.ndarray, grou
 
 
 def offset_average(members) -> tuple[float, float, float]:
-    """The offset members' load-cell zero offset, model-averaged: ``(offset, its standard error, their weight)`` (N).
+    """One offset of the offset members, model-averaged: ``(offset, its standard error, their weight)`` (in the
+    offset's unit, :data:`OFFSET_PARAMETERS`).
 
-    ``members``: ``(weight, offset, standard error)`` of each offset member (:data:`OFFSET_SUFFIX`) with weight.
+    ``members``: ``(weight, offset, standard error)`` of each offset member with weight that fits it (:data:`OFFSETS`).
     The offset is their :func:`model_average` (the weighted average among the offset members, with the
     unconditional variance: each member's own variance and its offset's spread about the average); the weight
     is theirs in the whole ensemble.
