@@ -46,13 +46,12 @@ TRUTH = _truth(REAL, REAL / "dev")  # the development set (detection and drafts 
 #: The holdout (scored once, 2026-11-25; its declarations were written after that, from --suggest drafts)
 HOLDOUT = _truth(REAL / "holdout")
 EVERY = {**TRUTH, **HOLDOUT}
-# The time checks shared with detection (bendpam.lab.assemble) still refuse these files on this branch;
-# issue 22 item 3 (leniency) makes gaps and repeated time stamps warnings instead.
+# Files with gaps in the sampling: the declared read is checked with repair=True (which keeps every sample).
+# Repeated time stamps (the WaveMatrix Test6.Stop and CellScale MicroSquisher files) are spread evenly and read as
+# they are (bendpam.lab.checks.spread_repeats).
 GAPS = {"hilhorst_ZwickTXII_EN_Invar_LT_05_01.TRA", "pymechtest_Bluehill3_Tens_No_Yield_Specimen_RawData_1.csv",
         "pymechtest_Bluehill3_Tens_No_Yield_Specimen_RawData_6.csv",
         "pymechtest_Bluehill3_Tens_Yield_Specimen_RawData_6.csv"}
-REPEATED_TIME = {"whiterabbit_WaveMatrix_latexglove_Test6.Stop.csv",
-                 "pyphasic_CellScaleMicroSquisher_20200204-t5-PC500-TestData.csv"}
 
 
 def close(got: float, want: float) -> bool:
@@ -109,8 +108,6 @@ def test_declaration_reads_the_file_as_its_truth_entry(name):
     try:
         tests = read_declared(path, decl)
     except ReadError as exc:
-        if name in REPEATED_TIME and "time does not increase" in str(exc):
-            pytest.xfail("repeated time stamps are refused by the shared time check until issue 22 item 3 lands")
         if name not in GAPS or "gap in the sampling" not in str(exc):
             raise
         tests = read_declared(path, decl, repair=True)  # repair accepts gaps and keeps every sample

@@ -9,6 +9,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from bendpam.lab import ReadError, read_test, read_tests
 
@@ -62,6 +64,43 @@ def test_repeated_time_is_kept_and_reported(tmp_path):
     raw = read_test(_write(tmp_path, body))
     assert len(raw) == 11 and raw.segments == [(0, 11)]
     assert any("repeats" in w and "line(s) 7" in w for w in raw.warnings)
+    t = raw.data["time_s"].to_numpy()
+    # the run 0.4, 0.4 (lines 6-7) is spread between its neighbours' stamps: centres at rows 3, 4.5, 6
+    assert np.all(np.diff(t) > 0) and t[4] == pytest.approx(0.4 - 0.1 / 3) and t[5] == pytest.approx(0.4 + 0.1 / 3)
+
+
+def test_packet_time_stamps_are_spread_and_the_curves_do_not_change(tmp_path):
+    """Samples sent in packets of five, each row stamped with its packet's arrival (its last row's time): the
+    reader spreads each run evenly, says so, and processing gives what the evenly stamped file gives."""
+    from bendpam.lab.processing import process_tests
+    from bendpam.lab.simulate import SimulationSettings, simulate_test
+    from bendpam.physics import presets
+
+    df, _ = simulate_test(presets.be_pam(), 150.0, settings=SimulationSettings(cycles=2, rate_hz=10.0, seed=3))
+    plain = tmp_path / "plain.csv"
+    df.to_csv(plain, index=False)
+    t = df["time_s"].to_numpy()
+    packed = df.copy()
+    packed["time_s"] = t[np.minimum((np.arange(t.size) // 5) * 5 + 4, t.size - 1)]
+    p = tmp_path / "packets.csv"
+    packed.to_csv(p, index=False)
+    raw = read_test(p, pressure_kpa=150.0)
+    (w,) = [w for w in raw.warnings if "repeats" in w]
+    assert "packets" in w and "(up to 5)" in w
+    tr = raw.data["time_s"].to_numpy()
+    assert np.all(np.diff(tr) > 0) and np.ptp(tr - t) < 5 * 0.1 + 1e-9  # s: one packet at most, a constant
+    a, b = (process_tests([read_test(f, pressure_kpa=150.0)], keep_series=False).results[0] for f in (plain, p))
+    assert b.blocked_moment == pytest.approx(a.blocked_moment, rel=2e-3)  # N*mm
+    assert b.free_curvature == pytest.approx(a.free_curvature, rel=2e-3)
+
+
+def test_a_row_that_repeats_the_previous_row_exactly_is_kept_and_spread(tmp_path):
+    """A coarse clock during a hold with a quantised force writes rows equal in every column: they are samples, kept
+    (leaving them out would space the run's other samples wrongly)."""
+    body = _ramp(0.0, 5) + "0.4,0.04,3.0\n" + _ramp(0.5, 5)  # line 7 = line 6
+    raw = read_test(_write(tmp_path, body))
+    assert len(raw) == 11 and np.all(np.diff(raw.data["time_s"].to_numpy()) > 0)
+    assert any("repeats the previous sample's value at 1 sample(s), line(s) 7" in w for w in raw.warnings)
 
 
 def test_padding_rows_at_the_end_are_dropped(tmp_path):
@@ -104,3 +143,20 @@ def test_two_end_records_back_at_time_zero_are_dropped(tmp_path):
     raw = read_test(_write(tmp_path, _ramp(0.0, 30) + "0.0,0.5,0.1\n0.0,0.6,0.2\n"))
     assert len(raw) == 30 and raw.data["time_s"].iat[-1] == pytest.approx(2.9)
     assert any("padding" in w and "32, 33" in w for w in raw.warnings)
+
+
+@settings(max_examples=200, deadline=None)
+@given(step=st.floats(1e-3, 0.1), per=st.integers(2, 10), n=st.integers(30, 400), start=st.floats(0.0, 100.0),
+       coarse=st.floats(0.5, 1.5))
+def test_spread_stamps_increase_and_stay_within_one_clock_step_of_the_truth(step, per, n, start, coarse):
+    """Evenly taken samples (``step`` s apart) stamped by a clock that ticks every ``per * step * coarse`` s
+    (truncated): the spread times increase strictly and differ from the true ones by a constant within less than
+    one tick."""
+    from bendpam.lab.checks import spread_repeats
+
+    truth = start + np.arange(n) * step
+    tick = per * step * coarse
+    stamped = np.floor(truth / tick) * tick
+    out, longest = spread_repeats(stamped)
+    assert np.all(np.diff(out) > 0) and longest >= 1
+    assert np.ptp(out - truth) < tick * (1.0 + 1e-9)

@@ -38,7 +38,7 @@ from bendpam.lab.channels import (
     classify_column,
     unit_factor,
 )
-from bendpam.lab.checks import find_spikes, padding_rows, time_structure
+from bendpam.lab.checks import find_spikes, padding_rows, spread_repeats, time_structure
 from bendpam.lab.parser import Block, ColumnData, Parsed, Parser
 from bendpam.lab.pressure import (
     PRESSURE_RANGE_TEXT,
@@ -289,10 +289,9 @@ def _check_time(samples: _Samples, channels: Channels, label: Path | str, repair
         samples.keep(k2)
         t = samples.values["time"]
         ts = time_structure(t)
-    lines = samples.lines
     if ts.repeats.size:
-        warnings.append(f"time {tname!r} repeats the previous sample's value at {ts.repeats.size} sample(s), "
-                        f"line(s) {_lines_text(lines[ts.repeats].tolist())}; kept")  # fmt: skip
+        t, ts = _spread_time(samples, ts, tname, warnings)
+    lines = samples.lines
     if ts.resets.size:
         i = int(ts.resets[0])
         warnings.append(
@@ -308,6 +307,21 @@ def _check_time(samples: _Samples, channels: Channels, label: Path | str, repair
             f"at line(s) {_lines_text(lines[ts.gaps].tolist())}); the series is split there"
         )
     return ts.segments(t.size)
+
+
+def _spread_time(samples: _Samples, ts, tname: str, warnings: list[str]):
+    """Repeated time stamps, spread evenly over each run of equal stamps (:func:`~bendpam.lab.checks.spread_repeats`)
+    with a warning; returns the new times and their :func:`~bendpam.lab.checks.time_structure`.  A row equal to the
+    one before in every column is kept too: a coarse clock during a hold, with a quantised force, writes such rows,
+    and leaving them out would space the run's other samples wrongly."""
+    t, longest = spread_repeats(samples.values["time"])
+    warnings.append(
+        f"time {tname!r} repeats the previous sample's value at {ts.repeats.size} sample(s), line(s) "
+        f"{_lines_text(samples.lines[ts.repeats].tolist())}: a clock coarser than the sampling, or samples sent in "
+        f"packets; the samples of each run of equal stamps (up to {longest}) are spread evenly between the runs, so "
+        "the times move by at most half a run")
+    samples.values["time"] = t
+    return t, time_structure(t)
 
 
 def _check_counter(samples: _Samples, ch: ChannelChoice, data: ColumnData, warnings: list[str]) -> str | None:

@@ -24,6 +24,7 @@ __all__ = [
     "find_spikes",
     "noise_spikes",
     "padding_rows",
+    "spread_repeats",
     "time_structure",
     "white_noise",
 ]
@@ -281,6 +282,62 @@ def time_structure(t: np.ndarray) -> TimeStructure:
     repeats = np.flatnonzero(dt == 0) + 1
     return TimeStructure(back[glitch].astype(np.int64), back[~glitch].astype(np.int64),
                          repeats.astype(np.int64), gaps.astype(np.int64), med)  # fmt: skip
+
+
+def spread_repeats(t: np.ndarray) -> tuple[np.ndarray, int]:
+    """Times with every run of repeated stamps spread evenly: ``(times, longest run)``.
+
+    A clock coarser than the sampling (time logged to 0.1 s at 50 Hz), or samples sent in packets that
+    each carry one arrival time, writes runs of equal stamps.  The samples were taken evenly, so each
+    sample's time is interpolated over its index between the runs' centres (a run of ``m`` equal stamps
+    becomes ``m`` times one step apart) and extrapolated at the ends with the nearest runs' step.  The
+    times move by at most half a run, and as all channels share the clock the curves do not change;
+    a run at a reset of the clock (time going back) keeps to its own side.
+
+    Parameters
+    ----------
+    t : numpy.ndarray
+        Time in s, finite, with no sample out of order (resets allowed).
+
+    Returns
+    -------
+    times : numpy.ndarray
+        Strictly increasing within each run between resets (a copy).
+    longest : int
+        The longest run of equal stamps (1: none repeated, ``t`` returned as it is).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> spread_repeats(np.array([0.0, 0.0, 0.2, 0.2, 0.4, 0.4]))     # s: packets of two
+    (array([-0.05,  0.05,  0.15,  0.25,  0.35,  0.45]), 2)
+    """
+    t = np.asarray(t, dtype=float)
+    first = np.flatnonzero(np.r_[True, np.diff(t) != 0])
+    longest = int(np.diff(np.r_[first, t.size]).max()) if t.size else 0
+    if longest <= 1:
+        return t, 1
+    out = t.copy()
+    cuts = np.r_[0, first[1:][np.diff(t[first]) < 0], t.size]  # the clock's resets split the record
+    for a, b in itertools.pairwise(cuts):  # one per reset (few), not per sample
+        out[a:b] = _spread(t[a:b])
+    return out, longest
+
+
+def _spread(t: np.ndarray) -> np.ndarray:
+    """:func:`spread_repeats` on a stretch whose stamps do not go back (a copy; as it is with one stamp only)."""
+    first = np.flatnonzero(np.r_[True, np.diff(t) != 0])
+    if first.size < 2 or first.size == t.size:
+        return t.copy()
+    size = np.diff(np.r_[first, t.size])
+    centre = first + (size - 1) / 2.0
+    value = t[first]
+    idx = np.arange(t.size, dtype=float)
+    out = np.interp(idx, centre, value)
+    for end, near, rows in ((0, 1, idx < centre[0]), (-1, -2, idx > centre[-1])):
+        step = (value[end] - value[near]) / (centre[end] - centre[near])
+        out[rows] = value[end] + (idx[rows] - centre[end]) * step
+    return out
 
 
 def padding_rows(t: np.ndarray, stroke: np.ndarray, force: np.ndarray) -> int:
