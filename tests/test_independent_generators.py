@@ -1,10 +1,11 @@
 """The independent held-out generators (tools/holdout6_generator.py, holdout7_generator.py, holdout8_generator.py,
-holdout9_generator.py), checked alone.
+holdout9_generator.py, holdout10_generator.py), checked alone.
 
 The sixth set's machine: its fixture against a bracketed root of eq 6 and its clean machine (no loop, noise or
-fault) against the truth's moment.  The seventh, eighth and ninth sets' loop laws (on that machine): each dissipates
-on every cycle; the ninth set's loops are 2-6 % of the blocked moment.  All: deterministic, and every file read by
-bendpam with the pressure and sample count written (the ninth set's also processed).
+fault) against the truth's moment.  The seventh to tenth sets' loop laws (on that machine): each dissipates on every
+cycle; the ninth and tenth sets' loops are 2-6 % of the blocked moment.  All: deterministic, and every file read by
+bendpam with the pressure and sample count written (the ninth and tenth sets' also processed; the tenth set's
+re-sent and reduced rows are counted in the rows written).
 """
 
 import hashlib
@@ -21,6 +22,7 @@ import holdout6_generator as gen6  # noqa: E402
 import holdout7_generator as gen7  # noqa: E402
 import holdout8_generator as gen8  # noqa: E402
 import holdout9_generator as gen9  # noqa: E402
+import holdout10_generator as gen10  # noqa: E402
 
 from bendpam.lab import read_test  # noqa: E402
 from bendpam.lab.processing import process_tests  # noqa: E402
@@ -36,14 +38,15 @@ def test_the_sixth_sets_clean_machine_gives_the_truths_moment(name):
     assert gen6.check_clean_machine(gen6.CASES[name]) < 1e-6  # of the blocked moment
 
 
-@pytest.mark.parametrize("gen", [gen7, gen8, gen9])
-def test_every_seventh_eighth_and_ninth_set_law_dissipates_on_every_cycle(gen):
+@pytest.mark.parametrize("gen", [gen7, gen8, gen9, gen10])
+def test_every_seventh_to_tenth_set_law_dissipates_on_every_cycle(gen):
     for law, found in gen.check_laws().items():
         assert min(found["areas"]) > 0.0, law  # loop area over max |z|: positive, each cycle
 
 
-def test_the_ninth_sets_loops_are_two_to_six_percent_of_the_blocked_moment():
-    for law, found in gen9.check_laws(points=500).items():
+@pytest.mark.parametrize("gen", [gen9, gen10])
+def test_the_ninth_and_tenth_sets_loops_are_two_to_six_percent_of_the_blocked_moment(gen):
+    for law, found in gen.check_laws(points=500).items():
         assert found["dissipates"] and 0.02 <= found["half_width_mean"] <= 0.06, law
 
 
@@ -58,7 +61,9 @@ def _digest(folder: Path) -> str:
                                            (gen7, "h7-eyring-drift"), (gen7, "h7-dupont-ep"),
                                            (gen8, "h8-maxwellslip-tare"), (gen8, "h8-preisach-quant"),
                                            (gen8, "h8-boucwen-zero"), (gen9, "h9-gms-clock"),
-                                           (gen9, "h9-bodner-spikes"), (gen9, "h9-romasing-clamp")])
+                                           (gen9, "h9-bodner-spikes"), (gen9, "h9-romasing-clamp"),
+                                           (gen10, "h10-moore-packets"), (gen10, "h10-bliman-dups"),
+                                           (gen10, "h10-mullins-supply"), (gen10, "h10-kraus-reduction")])
 def test_it_is_deterministic_and_bendpam_reads_every_file(gen, name, tmp_path):
     case = gen.CASES[name]
     truth = gen.generate_set(case, 1, tmp_path / "a")
@@ -73,7 +78,7 @@ def test_it_is_deterministic_and_bendpam_reads_every_file(gen, name, tmp_path):
         assert rt.pressure_kpa == pytest.approx(test["pressure_kpa"], rel=1e-6)
         assert len(rt) == test["samples"]
         raws.append(rt)
-    if gen is gen9:  # read and processed (not fitted): the faults leave the files usable
+    if gen in (gen9, gen10):  # read and processed (not fitted): the faults leave the files usable
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             done = process_tests(raws, fixture=Fixture(d_mm=35.0, r_mm=2.5, t_mm=4.0, L0_mm=truth["fixture_L0_mm"]),

@@ -1,6 +1,6 @@
 """The calibration study of bendpam's error bars (issue 23): do the fit's standard errors hold?
 
-    python tools/calibration_study.py [--seeds 10] [--set main|holdout|...|holdout9] [--cases CASE ...] [--jobs 1]
+    python tools/calibration_study.py [--seeds 10] [--set main|holdout|...|holdout10] [--cases CASE ...] [--jobs 1]
                                       [--out FILE]
 
 For every case of :data:`raw_generators.CASES` (or of :data:`raw_generators.HOLDOUT` with ``--set holdout``:
@@ -47,6 +47,7 @@ import holdout6_generator as gen6  # noqa: E402
 import holdout7_generator as gen7  # noqa: E402
 import holdout8_generator as gen8  # noqa: E402
 import holdout9_generator as gen9  # noqa: E402
+import holdout10_generator as gen10  # noqa: E402
 import raw_generators as gen  # noqa: E402
 
 from bendpam.infra.atomic import atomic_write_text, json_safe  # noqa: E402
@@ -57,17 +58,20 @@ START, END = "<!-- calibration-table:start -->", "<!-- calibration-table:end -->
 #: ``holdout`` (:data:`raw_generators.HOLDOUT`, other parameters and combined faults, kept out of any tuning).
 SETS = {"main": gen.CASES, "holdout": gen.HOLDOUT, "holdout2": gen.HOLDOUT2, "holdout3": gen.HOLDOUT3,
         "holdout4": gen.HOLDOUT4, "holdout5": gen.HOLDOUT5, "holdout6": gen6.CASES, "holdout7": gen7.CASES,
-        "holdout8": gen8.CASES, "holdout9": gen9.CASES}
+        "holdout8": gen8.CASES, "holdout9": gen9.CASES, "holdout10": gen10.CASES}
 ALL_CASES = {**gen.CASES, **gen.HOLDOUT, **gen.HOLDOUT2, **gen.HOLDOUT3, **gen.HOLDOUT4, **gen.HOLDOUT5,
-             **gen6.CASES, **gen7.CASES, **gen8.CASES, **gen9.CASES}
+             **gen6.CASES, **gen7.CASES, **gen8.CASES, **gen9.CASES, **gen10.CASES}
 
 
 def generator(case):
-    """The module that makes ``case``'s raw tests: :mod:`holdout9_generator`, :mod:`holdout8_generator`,
+    """The module that makes ``case``'s raw tests: :mod:`holdout10_generator`, :mod:`holdout9_generator`,
+    :mod:`holdout8_generator`,
     :mod:`holdout7_generator` and
     :mod:`holdout6_generator` for
     theirs (a machine written independently), :mod:`raw_generators` for the others; each has ``generate_set``
     and ``start_actuator``."""
+    if isinstance(case, gen10.Case10):
+        return gen10
     if isinstance(case, gen9.Case9):
         return gen9
     if isinstance(case, gen8.Case8):
@@ -417,14 +421,18 @@ def main(argv=None) -> int:
                     "common loop laws with a lab's instrument faults on that machine (a tare offset, a warm-up drift, "
                     "a wandering offset, a stroke zero error, a quantised force; tools/holdout8_generator.py); "
                     "holdout9: further loop laws and faults on that machine (a channel skew, pressure crosstalk, a "
-                    "clock error, spikes, a slipping clamp, a pressure droop; tools/holdout9_generator.py)")
+                    "clock error, spikes, a slipping clamp, a pressure droop; tools/holdout9_generator.py); "
+                    "holdout10: loop laws of the actuator's own physics (braid friction, orifice damping, a "
+                    "thixotropic grease, a filler network, Bliman-Sorine, Mullins, Stoner-Wohlfarth, "
+                    "Prandtl-Tomlinson) and logging faults on that machine (a gain drift, a quantised stroke, packet "
+                    "time stamps, re-sent rows, a supply-pressure step, data reduction; tools/holdout10_generator.py)")
     ap.add_argument("--cases", nargs="+", choices=list(ALL_CASES), metavar="CASE",
                     help=f"cases to run (default: the whole set; main: {', '.join(gen.CASES)}; holdout: "
                     f"{', '.join(gen.HOLDOUT)}; holdout2: {', '.join(gen.HOLDOUT2)}; "
                     f"holdout3: {', '.join(gen.HOLDOUT3)}; holdout4: {', '.join(gen.HOLDOUT4)}; "
                     f"holdout5: {', '.join(gen.HOLDOUT5)}; holdout6: {', '.join(gen6.CASES)}; "
                     f"holdout7: {', '.join(gen7.CASES)}; holdout8: {', '.join(gen8.CASES)}; "
-                    f"holdout9: {', '.join(gen9.CASES)})")
+                    f"holdout9: {', '.join(gen9.CASES)}; holdout10: {', '.join(gen10.CASES)})")
     ap.add_argument("--jobs", type=int, default=1, help="processes (default 1; the machine may be shared)")
     ap.add_argument("--fit", dest="fit_options", action="append", default=[], metavar="KEY=VALUE",
                     help="a keyword of bendpam.identify.fitting.fit, as a Python literal (law_uncertainty=False, "
