@@ -9,6 +9,7 @@ is missing.  It also prints the page to PDF with ``chromium --headless --print-t
 
 import contextlib
 import io
+import json
 import os
 import re
 import shutil
@@ -524,3 +525,29 @@ def test_missing_output_folder_is_refused(tmp_path, raw_dir, capsys, monkeypatch
     assert code == 2, (stdout, err)
     assert err.count("\n") == 1 and err.startswith("bendpam: error: ") and "does not exist" in err, err
     assert not (tmp_path / "nodir").exists()
+
+
+@pytest.mark.slow
+def test_the_report_reads_as_process_does(tmp_path, raw_dir):
+    """``report`` takes the reader's options (--repair, --columns, --format-file, --rate-hz) and --drift, as
+    ``process`` does: a file with a sample out of order is refused in one line naming --repair, which reads it; the
+    drift is corrected when asked and the JSON says so."""
+    src = sorted(raw_dir.glob("*.csv"))[0]
+    lines = src.read_text(encoding="utf-8").splitlines(keepends=True)
+    k = len(lines) // 2
+    lines[k], lines[k + 1] = lines[k + 1], lines[k]  # two samples swapped in time
+    bad = tmp_path / src.name
+    bad.write_text("".join(lines), encoding="utf-8")
+    out = tmp_path / "r.html"
+    code, stdout, err = _cli("report", bad, "--preset", "be-pam", "--model", "energy", "--out", out, "--quiet")
+    assert code == 2 and err.count("\n") == 1 and "read with --repair to drop" in err, err
+    assert not out.exists()
+    code, stdout, err = _cli("report", bad, "--preset", "be-pam", "--model", "energy", "--out", out, "--quiet",
+                             "--repair", "--drift", "linear", "--columns", "time=time_s,stroke=stroke_mm,force=force_n",
+                             "--json")
+    assert code == 0, err
+    rec = json.loads(stdout)
+    (test,) = rec["table2"]["pressures"]
+    assert test["drift"]["corrected"] is True
+    assert any("out of order in time (1 sample(s), at line(s) " in n for n in test["notes"])
+    assert out.exists()

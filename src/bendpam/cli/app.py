@@ -317,10 +317,12 @@ def cli_words(text: str) -> str:
     >>> from bendpam.lab.declaration import DECLARATION_HINT
     >>> cli_words(f"x.csv:3: no header row; or {DECLARATION_HINT}")
     "x.csv:3: no header row; or describe the file's layout in a format declaration and give it with --format-file ..."
+    >>> cli_words("x.csv:503: time does not increase ... (read with repair=True to drop such samples)")
+    'x.csv:503: time does not increase ... (read with --repair to drop such samples)'
     """
     from bendpam.lab.declaration import DECLARATION_HINT
 
-    return text.replace(DECLARATION_HINT, DECLARATION_HINT_CLI)
+    return text.replace(DECLARATION_HINT, DECLARATION_HINT_CLI).replace("read with repair=True", "read with --repair")
 
 
 def root_help() -> str:

@@ -3,7 +3,6 @@
 # no ``from __future__ import annotations``: Typer reads the annotations of the commands as objects (start-up)
 
 import re
-from enum import Enum
 from pathlib import Path
 from typing import Annotated, Optional
 
@@ -12,13 +11,19 @@ import typer
 from bendpam.cli.app import app, cli_words
 from bendpam.cli.options import (
     ActuatorOpt,
+    ColumnsOpt,
+    DriftMethod,
+    DriftOpt,
     FigureFormatOpt,
     Format,
+    FormatFileOpt,
     ModelOpt,
     MultiValueCommand,
     PresetOpt,
     PressureOpt,
     QuietOpt,
+    RateOpt,
+    RepairOpt,
     UserError,
     collect_raw_files,
     deprecated_format,
@@ -34,18 +39,6 @@ from bendpam.cli.options import (
 from bendpam.errors import InputError, ProcessingError
 
 FixtureOpt = Annotated[str, typer.Option("--fixture", help="Fixture geometry d,r,t in mm.")]
-ColumnsOpt = Annotated[Optional[str], typer.Option(
-    "--columns", metavar="time=NAME,stroke=NAME,force=NAME",
-    help="Choose the file's channels by name (any of time, stroke, force); "
-         "default: chosen and reported by the reader.")]
-RateOpt = Annotated[Optional[float], typer.Option(
-    "--rate-hz", help="Sampling rate (Hz) for a file without a time column (default: from its metadata).")]
-FormatFileOpt = Annotated[Optional[Path], typer.Option(
-    "--format-file", metavar="PATH",
-    help="Read the files by this format declaration (TOML; docs/formats.md), with no detection; "
-         "'bendpam inspect FILE --suggest' drafts one.")]
-RepairOpt = Annotated[bool, typer.Option(
-    "--repair", help="Remove isolated spikes and non-increasing samples (reported) instead of refusing the file.")]
 
 #: SimulationSettings as named in the library's messages -> the options of ``simulate-test``.
 _FLAGS = {"rate_hz": "--rate-hz", "fewer cycles": "fewer --cycles", "dwell_s": "--dwell-s",
@@ -118,18 +111,6 @@ def _print_suggestions(paths: list[Path], as_json: bool) -> None:
         return
     for i, (_p, d) in enumerate(drafts):
         typer.echo(("\n" if i else "") + d, nl=False)
-
-
-class DriftMethod(str, Enum):
-    """``--drift``: the load-cell offset drift correction (:data:`bendpam.lab.drift.DRIFT_METHODS`)."""
-
-    none = "none"
-    linear = "linear"
-
-
-DriftOpt = Annotated[DriftMethod, typer.Option(
-    "--drift", help="Load-cell offset drift: none = estimate and report it; linear = also subtract the fitted "
-                    "linear offset before processing.")]
 
 
 @app.command()

@@ -40,10 +40,14 @@ __all__ = [
     "WROTE_LINES",
     "ActuatorOpt",
     "BendpamCommand",
+    "ColumnsOpt",
+    "DriftMethod",
+    "DriftOpt",
     "FigureFormat",
     "FigureFormatOpt",
     "ForceUncertaintyOpt",
     "Format",
+    "FormatFileOpt",
     "Model",
     "ModelOpt",
     "MultiValueCommand",
@@ -52,6 +56,8 @@ __all__ = [
     "PressureOpt",
     "PressureUncertaintyOpt",
     "QuietOpt",
+    "RateOpt",
+    "RepairOpt",
     "UserError",
     "as_given",
     "collect_raw_files",
@@ -717,6 +723,37 @@ PressureUncertaintyOpt = Annotated[float, typer.Option(
 QuietOpt = Annotated[
     bool, typer.Option("--quiet", "-q", help="No progress on stderr (neither the bar nor the progress lines).")
 ]
+
+#: The reader's options (``process``, ``inspect``, ``report``).
+ColumnsOpt = Annotated[Optional[str], typer.Option(
+    "--columns", metavar="time=NAME,stroke=NAME,force=NAME",
+    help="Choose the file's channels by name (any of time, stroke, force); "
+         "default: chosen and reported by the reader.")]
+RateOpt = Annotated[Optional[float], typer.Option(
+    "--rate-hz", help="Sampling rate (Hz) for a file without a time column (default: from its metadata).")]
+FormatFileOpt = Annotated[Optional[Path], typer.Option(
+    "--format-file", metavar="PATH",
+    help="Read the files by this format declaration (TOML; docs/formats.md), with no detection; "
+         "'bendpam inspect FILE --suggest' drafts one.")]
+RepairOpt = Annotated[bool, typer.Option(
+    "--repair", help="Remove isolated spikes and non-increasing samples (reported) instead of refusing the file.")]
+
+
+class DriftMethod(str, Enum):
+    """``--drift``: the load-cell offset drift correction (:data:`bendpam.lab.drift.DRIFT_METHODS`).
+
+    >>> DriftMethod("linear").value
+    'linear'
+    """
+
+    none = "none"
+    linear = "linear"
+
+
+DriftOpt = Annotated[DriftMethod, typer.Option(
+    "--drift", help="Load-cell offset drift: none = estimate and report it; linear = also subtract the fitted "
+                    "linear offset before processing.")]
+
 
 def deprecated_format(old: Any, new: Any, command: str, *, new_name: str = "--table-format") -> Any:
     """The value of ``new_name``, or of the old ``--format`` spelling with a one-line note on stderr.

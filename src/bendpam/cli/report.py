@@ -29,10 +29,16 @@ def register(app: typer.Typer) -> None:
     from bendpam.cli.options import (
         RANGE_HELP,
         ActuatorOpt,
+        ColumnsOpt,
+        DriftMethod,
+        DriftOpt,
         ForceUncertaintyOpt,
+        FormatFileOpt,
         PresetOpt,
         PressureUncertaintyOpt,
         QuietOpt,
+        RateOpt,
+        RepairOpt,
     )
 
     @app.command("report")
@@ -62,6 +68,11 @@ def register(app: typer.Typer) -> None:
         ] = None,
         force_uncertainty_pct: ForceUncertaintyOpt = 0.0,
         pressure_uncertainty_kpa: PressureUncertaintyOpt = 0.0,
+        columns: ColumnsOpt = None,
+        rate_hz: RateOpt = None,
+        repair: RepairOpt = False,
+        format_file: FormatFileOpt = None,
+        drift: DriftOpt = DriftMethod.none,
         quiet: QuietOpt = False,
         as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object (Table 2, the deadband, each "
                                               "model's parameters and NRMSEs, the warnings) instead of lines.")]
@@ -74,12 +85,13 @@ def register(app: typer.Typer) -> None:
         The page warns at the top when a fit is poor or the data do not match the actuator, and
         prints cleanly to PDF from a browser.
         """
+        read = {"columns": columns, "rate_hz": rate_hz, "repair": repair, "format_file": format_file}
         _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, model, progress and not quiet,
-                as_json, (force_uncertainty_pct, pressure_uncertainty_kpa))
+                as_json, (force_uncertainty_pct, pressure_uncertainty_kpa), read, DriftMethod(drift).value)
 
 
 def _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, model, progress,
-            as_json=False, instrument=(0.0, 0.0)) -> None:
+            as_json=False, instrument=(0.0, 0.0), read=None, drift="none") -> None:
     from bendpam.cli.options import (
         Model,
         UserError,
@@ -119,9 +131,15 @@ def _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, m
             f"--pressure-kpa: got {len(pressures)} pressure(s) for {len(files)} file(s); give one per file, in order"
         )
     fx = Fixture.from_string(fixture, L0_mm=act.L0_mm if l0_mm is None else l0_mm, name="--fixture")
-    with output_file(out, [*files, actuator]) as f:
+    if read and read.get("format_file") is not None:
+        from bendpam.lab import load_declaration
+
+        load_declaration(read["format_file"])  # refused before any file is read
+    with output_file(out, [*files, actuator, *([read["format_file"]] if read and read.get("format_file") else [])]
+                     ) as f:
         res = build_report(files, act, f.path, models=[m.value for m in models], free=free, pressure_kpa=pressures,
-                           fixture=fx, progress=progress, shown_as=str(out), instrument=Instrument(*instrument))
+                           fixture=fx, progress=progress, shown_as=str(out), instrument=Instrument(*instrument),
+                           processing_options={"drift": drift}, read_options=read)
 
     summ = res.summary
     if as_json:

@@ -85,14 +85,10 @@ class Report:
 
 
 def build_report(
-    inputs,
-    actuator: Actuator,
-    out_html,
-    *,
+    inputs, actuator: Actuator, out_html, *,
     models: Sequence[str] = ("energy", "force_balance"), free=("alpha0", "C10", "C01"), pressure_kpa=None,
-    fixture: Fixture | str | None = None,
-    processing_options=None,
-    progress: bool = True, shown_as: str | None = None, instrument=None,
+    fixture: Fixture | str | None = None, processing_options=None, progress: bool = True,
+    shown_as: str | None = None, instrument=None, read_options: dict | None = None,
 ) -> Report:
     """Raw test files -> processing -> fits -> checks -> ONE self-contained HTML page at ``out_html``.
 
@@ -113,6 +109,7 @@ def build_report(
     progress : report progress on stderr (:class:`bendpam.infra.progress.Progress`); False writes nothing.
     shown_as : the page's name in the progress lines (default ``out_html``'s; a temporary file's caller: the target).
     instrument : a declared calibration of the rig for the fits (:class:`~bendpam.identify.uncertainty.Instrument`).
+    read_options : :func:`bendpam.lab.read_tests`' ``columns``, ``rate_hz``, ``repair``, ``format_file`` (a dict).
 
     Returns
     -------
@@ -140,7 +137,7 @@ def build_report(
     out, model_names, free_names, files, pressures, fx, opts = _arguments(
         inputs, actuator, out_html, models, free, pressure_kpa, fixture, processing_options)
     with Progress(_steps(len(files), len(model_names)), "report", quiet=not progress) as bar:
-        tests, processed = _read_and_process(files, pressures, fx, opts, bar)
+        tests, processed = _read_and_process(files, pressures, fx, opts, bar, _read_options(read_options))
         summary = processed.summary()
         fits, failed = _fit_models(processed, actuator, model_names, free_names, bar, instrument)
         warnings = plausibility_warnings(processed) + _judge(processed, actuator, fits, failed, tests, model_names[0],
@@ -203,15 +200,26 @@ def _arguments(inputs, actuator, out_html, models, free, pressure_kpa, fixture, 
     return out, model_names, free_names, files, pressures, _fixture(fixture, actuator), _options(processing_options)
 
 
-def _read_and_process(files, pressures, fx: Fixture, opts, bar):
-    """Read every file (one step each) and process the cycles (one step): ``(tests, processed)``."""
+def _read_options(read_options) -> dict:
+    """``build_report``'s ``read_options``, checked: the keywords of :func:`bendpam.lab.read_tests` it passes on."""
+    allowed = ("columns", "rate_hz", "repair", "format_file")
+    if read_options is None:
+        return {}
+    if not isinstance(read_options, dict) or any(k not in allowed for k in read_options):
+        raise InputError(f"read_options = {read_options!r}: give a dict of {', '.join(allowed)}")
+    return {k: v for k, v in read_options.items() if v is not None}
+
+
+def _read_and_process(files, pressures, fx: Fixture, opts, bar, read: dict | None = None):
+    """Read every file (one step each; ``read``: :func:`bendpam.lab.read_tests`' keywords) and process the cycles
+    (one step): ``(tests, processed)``."""
     from bendpam.lab import read_tests
     from bendpam.lab.processing import process_tests
 
     tests = []
     for f, p in zip(files, pressures, strict=True):
         bar.advance(0, description=f"report: reading {f.name}")
-        tests.extend(read_tests(f, pressure_kpa=p))  # every specimen or block of the file
+        tests.extend(read_tests(f, pressure_kpa=p, **(read or {})))  # every specimen or block of the file
         bar.advance()
     bar.advance(0, description="report: processing the cycles")
     processed = process_tests(tests, fixture=fx, options=opts)
