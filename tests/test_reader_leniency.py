@@ -145,6 +145,19 @@ def test_two_end_records_back_at_time_zero_are_dropped(tmp_path):
     assert any("padding" in w and "32, 33" in w for w in raw.warnings)
 
 
+def test_rows_sent_twice_are_dropped_and_a_restart_is_kept(tmp_path):
+    """A logger's buffer sent again: time goes back three rows and those rows repeat exactly; they are dropped and
+    named.  Rows after time goes back that differ are a restart of the clock, kept as a segment."""
+    rows = _ramp(0.0, 8).splitlines(keepends=True)
+    raw = read_test(_write(tmp_path, "".join(rows[:6] + rows[3:6] + rows[6:])))  # lines 8-10 repeat lines 5-7
+    assert len(raw) == 8 and raw.segments == [(0, 8)]
+    assert np.allclose(raw.data["time_s"], np.arange(8) * 0.1)
+    assert any("dropped 3 row(s) sent twice" in w and "line(s) 8, 9, 10" in w for w in raw.warnings)
+    moved = [*rows[3:5], "0.5,0.06,9.9\n"]  # the third differs: not a copy
+    raw = read_test(_write(tmp_path, "".join(rows[:6] + moved + rows[6:]), name="u.csv"))
+    assert len(raw) == 11 and len(raw.segments) == 2 and not any("sent twice" in w for w in raw.warnings)
+
+
 @settings(max_examples=200, deadline=None)
 @given(step=st.floats(1e-3, 0.1), per=st.integers(2, 10), n=st.integers(30, 400), start=st.floats(0.0, 100.0),
        coarse=st.floats(0.5, 1.5))

@@ -38,7 +38,7 @@ from bendpam.lab.channels import (
     classify_column,
     unit_factor,
 )
-from bendpam.lab.checks import find_spikes, padding_rows, spread_repeats, time_structure
+from bendpam.lab.checks import find_spikes, padding_rows, resent_rows, spread_repeats, time_structure
 from bendpam.lab.parser import Block, ColumnData, Parsed, Parser
 from bendpam.lab.pressure import (
     PRESSURE_RANGE_TEXT,
@@ -289,6 +289,8 @@ def _check_time(samples: _Samples, channels: Channels, label: Path | str, repair
         samples.keep(k2)
         t = samples.values["time"]
         ts = time_structure(t)
+    if ts.resets.size:
+        t, ts = _drop_resent(samples, ts, warnings)
     if ts.repeats.size:
         t, ts = _spread_time(samples, ts, tname, warnings)
     lines = samples.lines
@@ -307,6 +309,19 @@ def _check_time(samples: _Samples, channels: Channels, label: Path | str, repair
             f"at line(s) {_lines_text(lines[ts.gaps].tolist())}); the series is split there"
         )
     return ts.segments(t.size)
+
+
+def _drop_resent(samples: _Samples, ts, warnings: list[str]):
+    """Rows sent twice (:func:`~bendpam.lab.checks.resent_rows`) dropped, with a warning naming their lines; returns
+    the times and their :func:`~bendpam.lab.checks.time_structure`."""
+    t = samples.values["time"]
+    drop = resent_rows(t, samples.values.values(), ts.resets)
+    if drop.any():
+        warnings.append(f"dropped {int(drop.sum())} row(s) sent twice (time goes back and the rows repeat the ones "
+                        f"before exactly), at line(s) {_lines_text(samples.lines[drop].tolist())}")
+        samples.keep(~drop)
+        t = samples.values["time"]
+    return t, time_structure(t)
 
 
 def _spread_time(samples: _Samples, ts, tname: str, warnings: list[str]):

@@ -11,6 +11,7 @@ after the samples.  They work on whole columns with NumPy (linear time, a few te
 from __future__ import annotations
 
 import itertools
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
@@ -24,6 +25,7 @@ __all__ = [
     "find_spikes",
     "noise_spikes",
     "padding_rows",
+    "resent_rows",
     "spread_repeats",
     "time_structure",
     "white_noise",
@@ -282,6 +284,50 @@ def time_structure(t: np.ndarray) -> TimeStructure:
     repeats = np.flatnonzero(dt == 0) + 1
     return TimeStructure(back[glitch].astype(np.int64), back[~glitch].astype(np.int64),
                          repeats.astype(np.int64), gaps.astype(np.int64), med)  # fmt: skip
+
+
+def resent_rows(t: np.ndarray, columns: Iterable[np.ndarray], resets: np.ndarray) -> np.ndarray:
+    """Rows sent twice: where time goes back (``resets``) into the stretch before and the rows from there repeat
+    that stretch's last rows exactly, in every column (a logger's buffer sent again after a lost acknowledgement).
+
+    Parameters
+    ----------
+    t : numpy.ndarray
+        Time in s.
+    columns : iterable of numpy.ndarray
+        Every column read (time included or not), each as long as ``t``.
+    resets : numpy.ndarray
+        Where time goes back and runs on (:attr:`TimeStructure.resets`).
+
+    Returns
+    -------
+    numpy.ndarray
+        A mask, True on the rows that repeat earlier ones (to be dropped); a restart of the clock (time back to
+        its start, or rows that differ) is not one.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.array([0.0, 0.1, 0.2, 0.3, 0.2, 0.3, 0.4])     # s: the rows at 0.2 and 0.3 sent again
+    >>> f = np.array([1.0, 2.0, 3.0, 4.0, 3.0, 4.0, 5.0])     # N
+    >>> resent_rows(t, [t, f], np.array([4])).nonzero()[0].tolist()
+    [4, 5]
+    >>> resent_rows(t, [t, f + (np.arange(7) == 5)], np.array([4])).any()   # one cell differs: a restart
+    np.False_
+    """
+    t = np.asarray(t, dtype=float)
+    cols = [np.asarray(c) for c in columns]
+    drop = np.zeros(t.size, dtype=bool)
+    starts = np.r_[0, np.asarray(resets, dtype=np.int64)]
+    for k, i in enumerate(starts[1:], start=1):  # one per reset (few), not per sample
+        a = int(starts[k - 1])
+        j = a + int(np.searchsorted(t[a:i], t[i], side="left"))  # the earlier row at the time gone back to
+        m = int(i) - j
+        if m <= 0 or j <= a or i + m > t.size or t[j] != t[i]:
+            continue
+        if all(np.array_equal(c[j:i], c[i:i + m]) for c in cols):
+            drop[i:i + m] = True
+    return drop
 
 
 def spread_repeats(t: np.ndarray) -> tuple[np.ndarray, int]:
