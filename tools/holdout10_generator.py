@@ -611,15 +611,10 @@ def _fault_record(case, tr, test, rec) -> dict:
 def generate_set(case: Case10, seed: int, folder) -> dict:
     """Write one raw machine file per pressure into ``folder``; returns the truth and the file names.
 
-    Runs hold-out 6's machine with this module's laws, faults and shut-off filter, for the call only.
+    Runs hold-out 6's machine with this module's laws, faults and shut-off filter, for the call only
+    (:func:`holdout8_generator.generate_logged`).
     """
-    log = []
-    out = gen8.described(_run(case, h6.generate_set, case, seed, folder, seed=seed, log=log), case, SOURCES,
-                         FAULT_SOURCES)
-    tr = h6._Truth(case)
-    for test, rec in zip(out["tests"], log, strict=True):
-        test.update(_fault_record(case, tr, test, rec))
-    return out
+    return gen8.generate_logged(case, seed, folder, _run, _fault_record, SOURCES, FAULT_SOURCES)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -639,22 +634,11 @@ def check_machine(case: Case10, seed: int = 0) -> dict:
 
 
 def _print_checks() -> None:
-    print(f"{'law':18s} {'areas/max|z| per cycle':30s} {'change c2-1, c3-2, c4-3':24s} hw mean/max (x M_b)  ok")
-    for law, r in check_laws().items():
-        a = " ".join(f"{v:6.3f}" for v in r["areas"])
-        c = " ".join(f"{v:7.4f}" for v in r["changes"])
-        ok = "yes" if r["dissipates"] and r["half_width_ok"] else "NO"
-        print(f"{law:18s} {a:30s} {c:24s} {r['half_width_mean']:.4f} / {r['half_width_max']:.4f}    {ok}")
-    print()
-    gen8.print_machine(CASES, check_machine)
+    gen8.print_checks(check_laws(), CASES, check_machine, 18)
 
 
 def main(argv=None) -> int:
-    argv = sys.argv[1:] if argv is None else argv
-    if argv[:1] == ["--check"]:
-        _print_checks()
-        return 0
-    return h6.write_all(CASES, generate_set, argv, "holdout10_generator.py")
+    return gen8.command(argv, CASES, generate_set, "holdout10_generator.py", _print_checks)
 
 
 if __name__ == "__main__":

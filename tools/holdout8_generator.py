@@ -578,6 +578,39 @@ def print_machine(cases, check) -> None:
             print(f"{case.name:22s} {P:6.0f} {r['detected_over_free']:8.3f}  {hw}")
 
 
+def generate_logged(case, seed: int, folder, run, fault_record, sources: dict, fault_sources: dict) -> dict:
+    """Hold-outs 9 and 10's ``generate_set``: hold-out 6's machine run by ``run`` (which logs each test's fault
+    record), the truth :func:`described`, and each test's ``fault_record(case, truth, test, record)`` added."""
+    log: list = []
+    out = described(run(case, h6.generate_set, case, seed, folder, seed=seed, log=log), case, sources, fault_sources)
+    tr = h6._Truth(case)
+    for test, rec in zip(out["tests"], log, strict=True):
+        test.update(fault_record(case, tr, test, rec))
+    return out
+
+
+def print_checks(checks: dict, cases, check, width: int = 16) -> None:
+    """Print the laws' checks (:func:`check_laws`' result, with whether each passes) and the clean machine's loops
+    (:func:`print_machine`): hold-outs 9 and 10's ``--check``."""
+    print(f"{'law':{width}s} {'areas/max|z| per cycle':30s} {'change c2-1, c3-2, c4-3':24s} hw mean/max (x M_b)  ok")
+    for law, r in checks.items():
+        a = " ".join(f"{v:6.3f}" for v in r["areas"])
+        c = " ".join(f"{v:7.4f}" for v in r["changes"])
+        ok = "yes" if r["dissipates"] and r["half_width_ok"] else "NO"
+        print(f"{law:{width}s} {a:30s} {c:24s} {r['half_width_mean']:.4f} / {r['half_width_max']:.4f}    {ok}")
+    print()
+    print_machine(cases, check)
+
+
+def command(argv, cases, generate_set, name: str, checks) -> int:
+    """A generator's command line: ``--check`` runs ``checks()``; else ``OUT [SEED]`` writes a seed of every case."""
+    argv = sys.argv[1:] if argv is None else argv
+    if argv[:1] == ["--check"]:
+        checks()
+        return 0
+    return h6.write_all(cases, generate_set, argv, name)
+
+
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     if argv[:1] == ["--check"]:
