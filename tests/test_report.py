@@ -551,3 +551,21 @@ def test_the_report_reads_as_process_does(tmp_path, raw_dir):
     assert test["drift"]["corrected"] is True
     assert any("out of order in time (1 sample(s), at line(s) " in n for n in test["notes"])
     assert out.exists()
+
+
+@pytest.mark.slow
+def test_a_drift_is_printed_once(tmp_path, raw_dir):
+    """A test's drift is both a processing warning and a line of the page's warning box: the command prints it once."""
+    raw = tmp_path / "raw"
+    raw.mkdir()
+    for src in sorted(raw_dir.glob("*.csv")):
+        df = read_test(src).data
+        t = df["time_s"].to_numpy()
+        df["force_n"] += 0.05 * df["force_n"].max() * (t - t[0]) / (t[-1] - t[0])  # 5 % of the force over the test
+        df.to_csv(raw / src.name, index=False)
+    code, stdout, err = _cli("report", raw, "--preset", "be-pam", "--model", "energy", "--out",
+                             tmp_path / "r.html", "--quiet")
+    assert code == 0, err
+    first = sorted(raw.glob("*.csv"))[0].name
+    lines = [line for line in err.splitlines() if first in line and "drifts" in line]
+    assert len(lines) == 1 and lines[0].startswith("bendpam: warning: Load-cell drift: "), err

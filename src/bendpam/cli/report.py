@@ -7,6 +7,7 @@ parses and prints; the work is :func:`bendpam.present.report.build_report`.
 Typer reads its annotations as objects.)
 """
 
+import warnings
 from pathlib import Path
 from typing import Annotated, Optional
 
@@ -101,6 +102,7 @@ def _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, m
         output_file,
         parse_values,
     )
+    from bendpam.errors import PlausibilityWarning
     from bendpam.identify.uncertainty import Instrument
     from bendpam.physics.fixture import Fixture
     from bendpam.present.report import build_report, fmt_value
@@ -136,10 +138,12 @@ def _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, m
 
         load_declaration(read["format_file"])  # refused before any file is read
     with output_file(out, [*files, actuator, *([read["format_file"]] if read and read.get("format_file") else [])]
-                     ) as f:
+                     ) as f, warnings.catch_warnings(record=True) as found:
+        warnings.simplefilter("always", PlausibilityWarning)
         res = build_report(files, act, f.path, models=[m.value for m in models], free=free, pressure_kpa=pressures,
                            fixture=fx, progress=progress, shown_as=str(out), instrument=Instrument(*instrument),
                            processing_options={"drift": drift}, read_options=read)
+    _rewarn(found, res.warnings)
 
     summ = res.summary
     if as_json:
@@ -161,6 +165,19 @@ def _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, m
     n_w = sum(w.severity == "warning" for w in res.warnings)
     box = f", {n_w} warning(s) and {len(res.warnings) - n_w} caution(s) at the top" if res.warnings else ""
     echo_wrote(f"wrote {out} ({res.bytes / 1024:.0f} KiB, {len(res.figures)} figures{box})")
+
+
+def _rewarn(found, boxed) -> None:
+    """The warnings raised while the report was built, again, but those the page's warning box repeats (a test's
+    plausibility finding is both; the command prints the box's titles): each once."""
+    from bendpam.errors import PlausibilityWarning
+
+    titles = [w.title for w in boxed]
+    for w in found:
+        text = str(w.message).strip()
+        if issubclass(w.category, PlausibilityWarning) and any(text[:100] in t for t in titles):
+            continue
+        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
 
 
 def _print_json(res, out) -> None:
