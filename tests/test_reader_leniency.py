@@ -94,6 +94,16 @@ def test_packet_time_stamps_are_spread_and_the_curves_do_not_change(tmp_path):
     assert b.free_curvature == pytest.approx(a.free_curvature, rel=2e-3)
 
 
+def test_a_run_of_repeated_stamps_before_a_pause_keeps_to_its_side():
+    from bendpam.lab.checks import spread_repeats
+
+    t = np.r_[np.repeat(np.arange(0.0, 2.0, 0.5), 5), 60.0 + np.repeat(np.arange(0.0, 2.0, 0.5), 5)]  # s: a pause
+    out, longest = spread_repeats(t)
+    assert longest == 5 and np.all(np.diff(out) > 0)
+    assert np.allclose(np.diff(out[:20]), 0.1) and np.allclose(np.diff(out[20:]), 0.1)  # s: 0.5 s per 5 samples
+    assert out[19] < 2.0 < 60.0 - 0.5 < out[20]  # no sample placed inside the pause
+
+
 def test_a_row_that_repeats_the_previous_row_exactly_is_kept_and_spread(tmp_path):
     """A coarse clock during a hold with a quantised force writes rows equal in every column: they are samples, kept
     (leaving them out would space the run's other samples wrongly)."""

@@ -338,7 +338,7 @@ def spread_repeats(t: np.ndarray) -> tuple[np.ndarray, int]:
     sample's time is interpolated over its index between the runs' centres (a run of ``m`` equal stamps
     becomes ``m`` times one step apart) and extrapolated at the ends with the nearest runs' step.  The
     times move by at most half a run, and as all channels share the clock the curves do not change;
-    a run at a reset of the clock (time going back) keeps to its own side.
+    a run at a reset of the clock (time going back) or at a gap (:data:`GAP_FACTOR`) keeps to its own side.
 
     Parameters
     ----------
@@ -364,8 +364,9 @@ def spread_repeats(t: np.ndarray) -> tuple[np.ndarray, int]:
     if longest <= 1:
         return t, 1
     out = t.copy()
-    cuts = np.r_[0, first[1:][np.diff(t[first]) < 0], t.size]  # the clock's resets split the record
-    for a, b in itertools.pairwise(cuts):  # one per reset (few), not per sample
+    back = first[1:][np.diff(t[first]) < 0]  # the clock's resets and the gaps split the record
+    cuts = np.union1d(np.r_[0, back, t.size], time_structure(t).gaps).astype(np.int64)
+    for a, b in itertools.pairwise(cuts):  # one per reset or gap (few), not per sample
         out[a:b] = _spread(t[a:b])
     return out, longest
 
