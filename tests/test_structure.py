@@ -6,6 +6,7 @@ modules it checks except through a fresh interpreter.
 """
 
 import ast
+import functools
 import json
 import re
 import subprocess
@@ -30,7 +31,9 @@ def module_name(path: Path) -> str:
 MODULES = {module_name(p): p for p in sorted(SRC.rglob("*.py"))}
 
 
+@functools.cache
 def parse(path: Path) -> ast.Module:
+    """The module's syntax tree, parsed once per test process (the checks only read it)."""
     return ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
 
 
