@@ -189,7 +189,6 @@ import itertools
 import math
 import sys
 from pathlib import Path
-from unittest import mock
 
 import numpy as np
 from scipy import special
@@ -471,9 +470,6 @@ start_actuator, truth_actuator = gen8.start_actuator, gen8.truth_actuator
 _blocked_force = gen8._blocked_force
 _PHYS0 = h6._physics
 _WRITE0 = h6._write
-#: the controller's force shut-off filter (s), as in hold-outs 7-9
-STOP_FILTER_S = 1.0
-_STOP0 = h6._controller_stop
 
 
 def _gain(case, ctx, t):
@@ -532,7 +528,6 @@ def _resent(n, fp, rng):
 
 
 def _patched(case, seed, log):
-    n = max(1, round(STOP_FILTER_S * case.rate_hz))
     last = {}
 
     def physics(c, ctx, t, x_act, noise, kappa):  # the force with the pressure step and the drifting gain
@@ -568,12 +563,7 @@ def _patched(case, seed, log):
         log.append(rec)
         return _WRITE0(c, P_nom, dict(sim, time_s=t, stroke_mm=x, force_n=F), folder, rep)
 
-    def stop(F, start, load):  # the force shut-off acts on a causal 1 s moving average of the reading
-        c = np.cumsum(np.concatenate([np.zeros(n), F]))
-        return _STOP0((c[n:] - c[:-n]) / n, start, load)
-
-    return [mock.patch.dict(h6._LAWS, _LAWS), mock.patch.object(h6, "_controller_stop", stop),
-            mock.patch.object(h6, "_physics", physics), mock.patch.object(h6, "_write", write)]
+    return gen8.machine_patches(case, _LAWS, physics, write)
 
 
 def _run(case, fn, *args, seed=0, log=None):

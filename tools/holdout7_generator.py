@@ -111,7 +111,7 @@ def _load_holdout6():
 
 h6 = _load_holdout6()
 
-__all__ = ["CASES", "Case7", "check_laws", "generate_set", "midpoint_in_u", "reference_cycles",
+__all__ = ["CASES", "Case7", "averaged_stop", "check_laws", "generate_set", "midpoint_in_u", "reference_cycles",
            "start_actuator", "truth_actuator"]
 
 
@@ -397,19 +397,26 @@ STOP_FILTER_S = 1.0
 _STOP0 = h6._controller_stop
 
 
+def averaged_stop(rate_hz: float):
+    """Hold-out 6's force shut-off reading a causal moving average of the force over ``STOP_FILTER_S`` (the
+    controller of hold-outs 7-10), for a log sampled at ``rate_hz``."""
+    n = max(1, round(STOP_FILTER_S * rate_hz))
+
+    def stop(F, start, load):
+        c = np.cumsum(np.concatenate([np.zeros(n), F]))
+        return _STOP0((c[n:] - c[:-n]) / n, start, load)
+
+    return stop
+
+
 def generate_set(case: Case7, seed: int, folder) -> dict:
     """Write one raw machine file per pressure into ``folder``; returns the truth and the file names.
 
     Runs hold-out 6's machine with this module's laws made known to it, and its force shut-off
-    reading a causal moving average of the force over ``STOP_FILTER_S``, for the call only.
+    reading a causal moving average of the force over ``STOP_FILTER_S`` (:func:`averaged_stop`), for the call
+    only.
     """
-    n = max(1, round(STOP_FILTER_S * case.rate_hz))
-
-    def stop(F, start, load):  # the force shut-off acts on a causal 1 s moving average of the reading
-        c = np.cumsum(np.concatenate([np.zeros(n), F]))
-        return _STOP0((c[n:] - c[:-n]) / n, start, load)
-
-    with mock.patch.dict(h6._LAWS, _LAWS), mock.patch.object(h6, "_controller_stop", stop):
+    with mock.patch.dict(h6._LAWS, _LAWS), mock.patch.object(h6, "_controller_stop", averaged_stop(case.rate_hz)):
         out = h6.generate_set(case, seed, folder)
     out["loop"] = case.loop
     out["loop_source"] = SOURCES[case.loop]

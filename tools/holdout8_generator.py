@@ -118,7 +118,7 @@ import numpy as np
 
 if str(Path(__file__).resolve().parent) not in sys.path:
     sys.path.insert(0, str(Path(__file__).resolve().parent))
-from holdout7_generator import h6, midpoint_in_u, reference_cycles
+from holdout7_generator import averaged_stop, h6, midpoint_in_u, reference_cycles
 
 __all__ = ["CASES", "Case8", "check_laws", "check_machine", "generate_set", "start_actuator", "truth_actuator"]
 
@@ -397,9 +397,6 @@ _FORCE_FAULTS = {"load-cell-tare": _fault_tare, "load-cell-warmup": _fault_warmu
 
 _PHYS0 = h6._physics
 _WRITE0 = h6._write
-#: the controller's force shut-off filter (s), as in hold-out 7
-STOP_FILTER_S = 1.0
-_STOP0 = h6._controller_stop
 
 
 def _physics(case, ctx, t, x_act, noise, kappa):
@@ -418,20 +415,21 @@ def _stroke_zero(case) -> float:
 
 
 def _patched(case, spans):
-    n = max(1, round(STOP_FILTER_S * case.rate_hz))
-
     def write(case, P_nom, sim, folder, rep):  # the logged stroke with the zero error; the logged length
         if "stroke-zero-pitch" in case.faults:
             sim = dict(sim, stroke_mm=sim["stroke_mm"] - _stroke_zero(case))
         spans.append(float(sim["time_s"][-1] - sim["time_s"][0]))
         return _WRITE0(case, P_nom, sim, folder, rep)
 
-    def stop(F, start, load):  # the force shut-off acts on a causal 1 s moving average of the reading
-        c = np.cumsum(np.concatenate([np.zeros(n), F]))
-        return _STOP0((c[n:] - c[:-n]) / n, start, load)
+    return machine_patches(case, _LAWS, _physics, write)
 
-    return [mock.patch.dict(h6._LAWS, _LAWS), mock.patch.object(h6, "_controller_stop", stop),
-            mock.patch.object(h6, "_physics", _physics), mock.patch.object(h6, "_write", write)]
+
+def machine_patches(case, laws: dict, physics, write) -> list:
+    """The patches of hold-out 6's machine for hold-outs 8-10: the module's ``laws`` made known to it, its force
+    shut-off reading a 1 s moving average (:func:`holdout7_generator.averaged_stop`), and its ``physics`` and
+    ``write`` steps."""
+    return [mock.patch.dict(h6._LAWS, laws), mock.patch.object(h6, "_controller_stop", averaged_stop(case.rate_hz)),
+            mock.patch.object(h6, "_physics", physics), mock.patch.object(h6, "_write", write)]
 
 
 def call_patched(patches, fn, *args):

@@ -170,7 +170,6 @@ import dataclasses
 import math
 import sys
 from pathlib import Path
-from unittest import mock
 
 import numpy as np
 from scipy import signal, special
@@ -543,9 +542,6 @@ def _slip_index(case, x):
 
 _PHYS0 = h6._physics
 _WRITE0 = h6._write
-#: the controller's force shut-off filter (s), as in hold-outs 7 and 8
-STOP_FILTER_S = 1.0
-_STOP0 = h6._controller_stop
 
 
 def _physics(case, ctx, t, x_act, noise, kappa):
@@ -568,7 +564,6 @@ def _physics(case, ctx, t, x_act, noise, kappa):
 
 
 def _patched(case, seed, log):
-    n = max(1, round(STOP_FILTER_S * case.rate_hz))
     fp = case.fault_sizes
 
     def write(c, P_nom, sim, folder, rep):  # the logged time and force with the export's faults
@@ -587,12 +582,7 @@ def _patched(case, seed, log):
         log.append(rec)
         return _WRITE0(c, P_nom, sim, folder, rep)
 
-    def stop(F, start, load):  # the force shut-off acts on a causal 1 s moving average of the reading
-        c = np.cumsum(np.concatenate([np.zeros(n), F]))
-        return _STOP0((c[n:] - c[:-n]) / n, start, load)
-
-    return [mock.patch.dict(h6._LAWS, _LAWS), mock.patch.object(h6, "_controller_stop", stop),
-            mock.patch.object(h6, "_physics", _physics), mock.patch.object(h6, "_write", write)]
+    return gen8.machine_patches(case, _LAWS, _physics, write)
 
 
 def _run(case, fn, *args, seed=0, log=None):
