@@ -133,12 +133,12 @@ def _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, m
             f"--pressure-kpa: got {len(pressures)} pressure(s) for {len(files)} file(s); give one per file, in order"
         )
     fx = Fixture.from_string(fixture, L0_mm=act.L0_mm if l0_mm is None else l0_mm, name="--fixture")
-    if read and read.get("format_file") is not None:
+    declared = (read or {}).get("format_file")
+    if declared is not None:
         from bendpam.lab import load_declaration
 
-        load_declaration(read["format_file"])  # refused before any file is read
-    with output_file(out, [*files, actuator, *([read["format_file"]] if read and read.get("format_file") else [])]
-                     ) as f, warnings.catch_warnings(record=True) as found:
+        load_declaration(declared)  # refused before any file is read
+    with output_file(out, [*files, actuator, declared]) as f, warnings.catch_warnings(record=True) as found:
         warnings.simplefilter("always", PlausibilityWarning)
         res = build_report(files, act, f.path, models=[m.value for m in models], free=free, pressure_kpa=pressures,
                            fixture=fx, progress=progress, shown_as=str(out), instrument=Instrument(*instrument),
