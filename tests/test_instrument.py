@@ -1,8 +1,11 @@
-"""A declared calibration of the rig (GUM type B): the load cell's and the pressure gauge's standard uncertainties.
+"""A declared calibration of the rig (GUM type B): the load cell's and the pressure gauge's standard uncertainties,
+and its zero and any force in proportion to the pressure, when the lab knows them.
 
 The curves cannot show a force reading a fixed fraction high or a pressure a few kPa off (every test moves
 alike); declared, each adds what it would move the fitted parameters by.  Checked against actual refits of
-the same raw tests read by a load cell 1 % high and at pressures 2 kPa off.
+the same raw tests read by a load cell 1 % high and at pressures 2 kPa off, 50 mN off zero, and with a force of
+0.5 mN/kPa reaching it.  A declared offset also leaves out the ensemble's members that fit it (checked on the
+calibration study's stiction case, where they take weight on clean data).
 """
 
 import json
@@ -27,20 +30,22 @@ BE = presets.be_pam()
 PRESSURES = (100.0, 150.0, 200.0)
 
 
-def raws(force_scale: float = 1.0, pressure_offset_kpa: float = 0.0) -> list[RawTest]:
-    """The same simulated tests (two cycles, a loop), read with a force scaled and pressures said off."""
+def raws(force_scale: float = 1.0, pressure_offset_kpa: float = 0.0, zero_n: float = 0.0,
+         force_per_kpa: float = 0.0) -> list[RawTest]:
+    """The same simulated tests (two cycles, a loop), read with a force scaled and pressures said off, off zero by
+    ``zero_n`` and with ``force_per_kpa`` times the pressure on the load cell."""
     out = []
     for p in PRESSURES:
         data, _ = simulate_test(BE, p, settings=SimulationSettings(cycles=2, rate_hz=5.0, seed=int(p)))
-        data = data.assign(force_n=data["force_n"] * force_scale)
+        data = data.assign(force_n=data["force_n"] * force_scale + zero_n + force_per_kpa * p)
         out.append(RawTest(data, Path(f"be_{p:g}kPa.csv"), "csv", pressure_kpa=p + pressure_offset_kpa))
     return out
 
 
-def fitted(force_scale=1.0, pressure_offset_kpa=0.0, instrument=None):
+def fitted(force_scale=1.0, pressure_offset_kpa=0.0, instrument=None, zero_n=0.0, force_per_kpa=0.0):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        ps = process_tests(raws(force_scale, pressure_offset_kpa), keep_series=False)
+        ps = process_tests(raws(force_scale, pressure_offset_kpa, zero_n, force_per_kpa), keep_series=False)
         return fit(ps, BE, profile_points=0, law_uncertainty=False, instrument=instrument)
 
 
@@ -63,6 +68,21 @@ def test_the_declared_parts_are_what_refits_with_the_errors_move(base):
     off = fitted(pressure_offset_kpa=2.0)
     part = fitted(instrument=Instrument(pressure_uncertainty_kpa=2.0)).uncertainty.instrument["alpha0_deg"]
     assert part == pytest.approx(abs(off.actuator.alpha0_deg - base.actuator.alpha0_deg), rel=0.15)
+
+
+@pytest.mark.parametrize(("declared", "moved"), [(Instrument(zero_uncertainty_n=0.05), {"zero_n": 0.05}),
+                                                 (Instrument(pressure_force_uncertainty_n_per_kpa=5e-4),
+                                                  {"force_per_kpa": 5e-4})])
+def test_a_declared_offset_is_what_a_refit_with_it_moves(base, declared, moved):
+    """50 mN off zero moves alpha0 by about 0.07 deg here; 0.5 mN/kPa (0.1 N at 200 kPa) by about 0.13 deg."""
+    shifted = fitted(**moved)
+    part = fitted(instrument=declared).uncertainty
+    assert abs(shifted.actuator.alpha0_deg - base.actuator.alpha0_deg) > 0.05  # the offset matters here
+    for key, now, then in (("alpha0_deg", shifted.actuator.alpha0_deg, base.actuator.alpha0_deg),
+                           ("shear_modulus_kpa", shifted.material.shear_modulus_kpa, base.material.shear_modulus_kpa)):
+        assert part.instrument[key] == pytest.approx(abs(now - then), rel=0.15), key
+    assert part.declared.startswith("the load cell's zero to 0.05 N" if "zero_n" in moved
+                                    else "a force in proportion to the pressure to 0.0005 N/kPa")
 
 
 def test_the_total_and_the_parameters_include_it(base):
@@ -91,6 +111,57 @@ def test_bad_declarations_are_refused():
         Instrument(force_uncertainty_pct=-1.0)
     with pytest.raises(InputError, match="pressure_uncertainty_kpa"):
         Instrument(pressure_uncertainty_kpa=float("nan"))
+    with pytest.raises(InputError, match="zero_uncertainty_n"):
+        Instrument(zero_uncertainty_n=-0.01)
+    with pytest.raises(InputError, match="pressure_force_uncertainty_n_per_kpa"):
+        Instrument(pressure_force_uncertainty_n_per_kpa=float("inf"))
+    assert Instrument(zero_uncertainty_n=0.0).declared and Instrument(zero_uncertainty_n=0.0).offsets_declared == (
+        "F_off",)
+
+
+@pytest.fixture(scope="module")
+def stiction():
+    """The calibration study's stiction case (seed 0): clean data on which the offset members take weight."""
+    import sys
+    import tempfile
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tools"))
+    import calibration_study as study
+
+    from bendpam.lab import read_test
+    from bendpam.physics.fixture import Fixture
+
+    case = study.ALL_CASES["stiction"]
+    with tempfile.TemporaryDirectory() as folder, warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        truth = study.generator(case).generate_set(case, 0, folder)
+        ps = process_tests([read_test(Path(folder) / n) for n in truth["files"]],
+                           fixture=Fixture(L0_mm=truth["fixture_L0_mm"]), keep_series=False)
+    return ps, study.generator(case).start_actuator(case), truth
+
+
+def offset_laws(result) -> set[str]:
+    return {m.law.split("+", 1)[1] for m in result.uncertainty.ensemble if "+" in m.law}
+
+
+def test_a_declared_tare_leaves_out_the_offset_members_and_says_why_they_were_wide(stiction):
+    ps, act, truth = stiction
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        plain = fit(ps, act, profile_points=0)
+        zero = fit(ps, act, profile_points=0, instrument=Instrument(zero_uncertainty_n=0.005))
+        tared = fit(ps, act, profile_points=0, instrument=Instrument(zero_uncertainty_n=0.005,
+                                                                      pressure_force_uncertainty_n_per_kpa=0.0))
+    assert offset_laws(plain) == {"offset", "pressure_offset", "both_offsets"}
+    assert offset_laws(zero) == {"pressure_offset"}  # the members with a zero offset are out
+    assert offset_laws(tared) == set()
+    said = [f for f in plain.flags if "offset members take" in f]
+    assert len(said) == 1 and "--zero-uncertainty-n" in said[0]
+    assert not any("offset members take" in f for f in tared.flags)
+    se_plain, se_tared = plain.parameters["alpha0"].stderr, tared.parameters["alpha0"].stderr
+    assert se_tared < 0.6 * se_plain  # the offset members' doubt is most of the bar on these data
+    assert tared.uncertainty.instrument["alpha0_deg"] > 0.0  # 5 mN of zero, counted
+    assert abs(tared.parameters["alpha0"].value - truth["alpha0_deg"]) <= 2.0 * se_tared
 
 
 def test_the_command_line_declares_it(tmp_path, capsys):
@@ -105,6 +176,15 @@ def test_the_command_line_declares_it(tmp_path, capsys):
                  "--force-uncertainty-pct", "-1"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--force-uncertainty-pct" in err[0]
+    assert main(["fit", str(tmp_path / "proc"), "--preset", "be-pam", "--out", str(tmp_path / "fit3"), "--no-figure",
+                 "--zero-uncertainty-n", "0.01", "--pressure-force-uncertainty-n-per-kpa", "0", "--json"]) == 0
+    unc = json.loads(capsys.readouterr().out)["uncertainty"]
+    assert "the load cell's zero to 0.01 N and no force in proportion to the pressure" in unc["declared"]
+    assert unc["instrument"]["alpha0_deg"] > 0
+    assert main(["fit", str(tmp_path / "proc"), "--preset", "be-pam", "--out", str(tmp_path / "fit4"),
+                 "--zero-uncertainty-n", "-0.01"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--zero-uncertainty-n" in err[0]
 
 
 def test_the_report_declares_it_too(tmp_path):

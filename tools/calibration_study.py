@@ -83,9 +83,15 @@ def generator(case):
 
 def markers(case_set: str) -> tuple[str, str]:
     """The docs page's markers of a case set's tables."""
-    return (START, END) if case_set == "main" else (f"<!-- calibration-{case_set}:start -->",
-                                                     f"<!-- calibration-{case_set}:end -->")
+    name = case_set.removeprefix("main-")  # "main-tared": the main set with --tared
+    return (START, END) if case_set == "main" else (f"<!-- calibration-{name}:start -->",
+                                                     f"<!-- calibration-{name}:end -->")
 COVERAGE_TARGET, RATIO_TARGET = 0.85, 3.0
+#: What ``--tared`` declares (:class:`~bendpam.identify.uncertainty.Instrument` ``(force %, pressure kPa, zero N,
+#: pressure force N/kPa)``): a lab that tared its load cell with the fixture as tested, to 5 mN (0.1 % of the study's
+#: smallest blocked force, about 4.4 N; the mean of a second of readings), and checked that no force in proportion
+#: to the pressure reaches it.
+TARED = (0.0, 0.0, 0.005, 0.0)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -433,6 +439,9 @@ def main(argv=None) -> int:
                     f"holdout5: {', '.join(gen.HOLDOUT5)}; holdout6: {', '.join(gen6.CASES)}; "
                     f"holdout7: {', '.join(gen7.CASES)}; holdout8: {', '.join(gen8.CASES)}; "
                     f"holdout9: {', '.join(gen9.CASES)}; holdout10: {', '.join(gen10.CASES)})")
+    ap.add_argument("--tared", action="store_true",
+                    help="every fit declares the load cell tared to 5 mN and no force in proportion to the pressure "
+                    f"(--fit instrument={TARED}); its own JSON and docs tables (calibration-tared)")
     ap.add_argument("--jobs", type=int, default=1, help="processes (default 1; the machine may be shared)")
     ap.add_argument("--fit", dest="fit_options", action="append", default=[], metavar="KEY=VALUE",
                     help="a keyword of bendpam.identify.fitting.fit, as a Python literal (law_uncertainty=False, "
@@ -445,9 +454,11 @@ def main(argv=None) -> int:
     if args.seeds < 2 or args.jobs < 1:
         ap.error("--seeds must be at least 2 and --jobs at least 1")
     cases = args.cases or list(SETS[args.case_set])
-    out = args.out or ROOT / "benchmarks" / "results" / (
-        "calibration.json" if args.case_set == "main" else f"calibration-{args.case_set}.json")
+    name = ("" if args.case_set == "main" else f"-{args.case_set}") + ("-tared" if args.tared else "")
+    out = args.out or ROOT / "benchmarks" / "results" / f"calibration{name}.json"
     fit_options = _fit_options(ap, args.fit_options)
+    if args.tared:
+        fit_options.setdefault("instrument", TARED)
     records, rows, meta = run_study(cases, args.seeds, args.jobs, args.first_seed, fit_options=fit_options)
     meta["set"] = args.case_set
     text = tables(rows, meta)
@@ -456,7 +467,7 @@ def main(argv=None) -> int:
     atomic_write_text(out, json.dumps(json_safe({"meta": meta, "summary": rows, "runs": records}), indent=1,
                                       allow_nan=False))
     if not args.no_docs:
-        write_docs(args.docs, text, args.case_set)
+        write_docs(args.docs, text, args.case_set + ("-tared" if args.tared else ""))
     print(f"wrote {out}" + ("" if args.no_docs else f" and the tables in {args.docs}"))
     return 0
 

@@ -15,9 +15,11 @@ from bendpam.cli.options import (
     ForceUncertaintyOpt,
     ModelOpt,
     PresetOpt,
+    PressureForceUncertaintyOpt,
     PressureUncertaintyOpt,
     QuietOpt,
     UserError,
+    ZeroUncertaintyOpt,
     echo_wrote,
     load_actuator,
     model_name,
@@ -85,6 +87,8 @@ def fit(
         "tested ones (the range it will predict).")] = (0.6, 1.6),
     force_uncertainty_pct: ForceUncertaintyOpt = 0.0,
     pressure_uncertainty_kpa: PressureUncertaintyOpt = 0.0,
+    zero_uncertainty_n: ZeroUncertaintyOpt = None,
+    pressure_force_uncertainty_n_per_kpa: PressureForceUncertaintyOpt = None,
     out: Annotated[Optional[Path], typer.Option("--out", help="Output folder.")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print fit.json to stdout.")] = False,
     fig_format: FigureFormatOpt = None,
@@ -110,7 +114,8 @@ def fit(
         res = run_fit(data, act, model_name(model), free=free, tension=tfit, tension_data=tdata,
                       fit_range=fit_range, hysteresis="auto" if hysteresis else None, hysteresis_law=hysteresis_law,
                       admissible_range=admissible_range,
-                      instrument=Instrument(force_uncertainty_pct, pressure_uncertainty_kpa))
+                      instrument=Instrument(force_uncertainty_pct, pressure_uncertainty_kpa, zero_uncertainty_n,
+                                            pressure_force_uncertainty_n_per_kpa))
         bar.advance(0, description="fit (writing)")
         with output_set(out, [processed_dir, actuator, tension]) as o:
             res.save(o.staging, processed=Path(processed_dir).resolve().name,

@@ -53,12 +53,14 @@ __all__ = [
     "MultiValueCommand",
     "Preset",
     "PresetOpt",
+    "PressureForceUncertaintyOpt",
     "PressureOpt",
     "PressureUncertaintyOpt",
     "QuietOpt",
     "RateOpt",
     "RepairOpt",
     "UserError",
+    "ZeroUncertaintyOpt",
     "as_given",
     "collect_raw_files",
     "command_inputs",
@@ -720,6 +722,14 @@ ForceUncertaintyOpt = Annotated[float, typer.Option(
 PressureUncertaintyOpt = Annotated[float, typer.Option(
     "--pressure-uncertainty-kpa", min=0.0, max=100.0,
     help="The pressure gauge's calibration, a standard uncertainty in kPa common to every test.")]
+ZeroUncertaintyOpt = Annotated[Optional[float], typer.Option(
+    "--zero-uncertainty-n", min=0.0, max=1e4,
+    help="The load cell's zero is known (a tare with the fixture as tested): its standard uncertainty in N, 0 for "
+    "exactly. The fit's members with a zero offset are left out and this doubt takes their place.")]
+PressureForceUncertaintyOpt = Annotated[Optional[float], typer.Option(
+    "--pressure-force-uncertainty-n-per-kpa", min=0.0, max=10.0,
+    help="No force in proportion to the pressure (a supply hose, a fitting's thrust) reaches the load cell beyond "
+    "this standard uncertainty in N/kPa, 0 for none. The fit's members with such a force are left out.")]
 QuietOpt = Annotated[
     bool, typer.Option("--quiet", "-q", help="No progress on stderr (neither the bar nor the progress lines).")
 ]

@@ -36,10 +36,12 @@ def register(app: typer.Typer) -> None:
         ForceUncertaintyOpt,
         FormatFileOpt,
         PresetOpt,
+        PressureForceUncertaintyOpt,
         PressureUncertaintyOpt,
         QuietOpt,
         RateOpt,
         RepairOpt,
+        ZeroUncertaintyOpt,
     )
 
     @app.command("report")
@@ -69,6 +71,8 @@ def register(app: typer.Typer) -> None:
         ] = None,
         force_uncertainty_pct: ForceUncertaintyOpt = 0.0,
         pressure_uncertainty_kpa: PressureUncertaintyOpt = 0.0,
+        zero_uncertainty_n: ZeroUncertaintyOpt = None,
+        pressure_force_uncertainty_n_per_kpa: PressureForceUncertaintyOpt = None,
         columns: ColumnsOpt = None,
         rate_hz: RateOpt = None,
         repair: RepairOpt = False,
@@ -88,11 +92,12 @@ def register(app: typer.Typer) -> None:
         """
         read = {"columns": columns, "rate_hz": rate_hz, "repair": repair, "format_file": format_file}
         _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, model, progress and not quiet,
-                as_json, (force_uncertainty_pct, pressure_uncertainty_kpa), read, DriftMethod(drift).value)
+                as_json, (force_uncertainty_pct, pressure_uncertainty_kpa, zero_uncertainty_n,
+                          pressure_force_uncertainty_n_per_kpa), read, DriftMethod(drift).value)
 
 
 def _report(inputs, preset, actuator, out, pressure_kpa, l0_mm, fixture, free, model, progress,
-            as_json=False, instrument=(0.0, 0.0), read=None, drift="none") -> None:
+            as_json=False, instrument=(0.0, 0.0, None, None), read=None, drift="none") -> None:
     from bendpam.cli.options import (
         Model,
         UserError,

@@ -105,8 +105,9 @@ from bendpam.identify.uncertainty import Uncertainty, lag1_autocorrelation, mate
 __all__ = ["BOTH_OFFSETS_SUFFIX", "MEMBER_EXTRA", "OFFSETS", "OFFSET_NOTE_WEIGHT", "OFFSET_PARAMETERS",
            "OFFSET_SUFFIX", "PRESSURE_OFFSET_SUFFIX", "SPAN_SCALED", "TWO_BRANCH", "WEIGHT_DRAWS",
            "MemberFit", "akaike_weights", "bootstrap_weights", "effective_points", "group_points", "group_ssr",
-           "member_weights", "model_average", "offset_average", "offset_note", "part_sds", "played_path",
-           "span_scaled_z", "spans_differ", "steady_z", "systematic_covariance", "uncertainty_budget"]
+           "is_offset_member", "member_weights", "model_average", "offset_average", "offset_note", "offset_widening",
+           "part_sds", "played_path", "span_scaled_z", "spans_differ", "steady_z", "systematic_covariance",
+           "uncertainty_budget", "widening_note"]
 
 #: The parameters a member of the ensemble adds to the reported fit's: the standard linear solid's second pair
 #: of amplitudes (its Maxwell branch; the first pair weighs the dashpot), the play's gap (deg), the breakaway
@@ -737,3 +738,51 @@ def offset_note(offset: float, sd: float, weight: float, name: str = "F_off") ->
             f"{weight:.2f}: the curves are described better with it, as they are when {cause}, or when the model "
             "misfits them in a way an offset absorbs (a shape at its bound, a loop no member has); the values "
             "reported are averaged with it")
+
+
+def is_offset_member(law: str) -> bool:
+    """Is ``law`` an offset member (:data:`OFFSETS`)?
+
+    >>> is_offset_member("dahl+both_offsets"), is_offset_member("dahl")
+    (True, False)
+    """
+    return any(law.endswith(suffix) for suffix in OFFSETS)
+
+
+def offset_widening(members) -> tuple[float, float, float]:
+    """How much the offset members widen one model parameter's error bar: ``(weight, SE with, SE without)``.
+
+    ``members``: ``(law, weight, value, standard error)`` of every member with its own covariance; the standard
+    errors are Burnham & Anderson's (:func:`model_average`) over them all, and over the members that are not offset
+    members (:func:`is_offset_member`), their weights renormalised; ``weight`` is the offset members'.
+
+    >>> w, with_, without = offset_widening([("pi", 0.8, 70.0, 0.01), ("pi+offset", 0.2, 70.1, 0.05)])
+    >>> round(w, 2), round(with_, 4), round(without, 4)       # sqrt(0.8 * 0.01^2 + 0.2 * 0.05^2 + spread 0.0016)
+    (0.2, 0.0467, 0.01)
+    """
+    off = np.array([is_offset_member(m[0]) for m in members], dtype=bool)
+    w, v, sd = (np.array([m[i] for m in members], dtype=float) for i in (1, 2, 3))
+
+    def se(keep: np.ndarray) -> float:
+        if not keep.any() or w[keep].sum() <= 0:
+            return math.nan
+        _, stat, sys_ = model_average(v[keep, None], (sd[keep] ** 2)[:, None, None], w[keep])
+        return math.sqrt(float(stat[0, 0] + sys_[0, 0]))
+
+    return float(w[off].sum() / max(w.sum(), 1e-300)), se(np.ones(off.size, dtype=bool)), se(~off)
+
+
+def widening_note(weight: float, se_with: float, se_without: float) -> str:
+    """The fit's words when the offset members widen alpha0's error bar (:func:`offset_widening`) and the curves show
+    no offset: the declaration that replaces them.
+
+    >>> widening_note(0.35, 0.050, 0.012).split(":")[0]
+    "the ensemble's offset members take 0.35 of the weight and widen alpha0's error bar from 0.012 to 0.05 deg"
+    """
+    return (f"the ensemble's offset members take {weight:.2f} of the weight and widen alpha0's error bar from "
+            f"{se_without:.2g} to {se_with:.2g} deg: the curves cannot tell a load-cell zero offset or a force in "
+            "proportion to the pressure from the actuator's constants; if the load cell was tared with the fixture "
+            "as tested and no pressure-driven force reaches it, declare it (Instrument(zero_uncertainty_n=..., "
+            "pressure_force_uncertainty_n_per_kpa=...); on the command line --zero-uncertainty-n and "
+            "--pressure-force-uncertainty-n-per-kpa)")
+

@@ -137,9 +137,11 @@ from bendpam.identify.ensemble import (
     member_weights,
     offset_average,
     offset_note,
+    offset_widening,
     part_sds,
     spans_differ,
     uncertainty_budget,
+    widening_note,
 )
 from bendpam.identify.metrics import score
 from bendpam.identify.problem import Problem, Tension
@@ -382,7 +384,7 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool, inst
                 continue
             run.nfev += n
         if "F_off" in run.bnd:
-            _offset_members(run, fits, solved, r)
+            _offset_members(run, fits, solved, r, instrument.offsets_declared if instrument is not None else ())
     if fits:  # each member's own statistical covariance, where it has weight (the others add nothing)
         w, _ = member_weights(fits, r, run.prob.groups)
         offsets: dict[str, list] = {n: [] for n in OFFSET_PARAMETERS}  # each offset's (weight, value, SE)
@@ -394,11 +396,15 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool, inst
                 run.nfev += u2.nfev
                 for name in (n for n in OFFSET_PARAMETERS if n in u2.names):
                     offsets[name].append((float(wk), u2.values[name], float(u2.sd[u2.names.index(name)])))
+        evident = False
         for name, found in offsets.items():
             if found and sum(o[0] for o in found) >= OFFSET_NOTE_WEIGHT:
                 mean, sd, weight = offset_average(found)
                 if abs(mean) >= 3.0 * sd:  # an offset the curves show, not the members' share of a misfit
                     run.notes.append(offset_note(mean, sd, weight, name))
+                    evident = True
+        if not evident:
+            run.notes += _widening_notes(fits, w)
     shape_bound = unc.at_bound.get("S_lo", False) or unc.at_bound.get("S_hi", False)
     budget = uncertainty_budget(unc, run.prob.actuator(unc.values), fits, r, run.prob.groups, run.law,
                                 0 if shape_bound else len(run.cycles))
@@ -411,7 +417,23 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool, inst
     if instrument is not None and instrument.declared:
         budget.instrument = part_sds(unc.cov_inst, unc.names, run.prob.actuator(unc.values))
         budget.declared = instrument.describe()
+        if instrument.offsets_declared and run.prob.d.lever is None:
+            run.notes.append("the declared offsets are not counted: the processed set keeps no fixture (its lever "
+                             "turns a force into a moment)")
     return unc, budget
+
+
+def _widening_notes(fits: dict, w: np.ndarray) -> list[str]:
+    """The fit's words when offset members the curves do not call for widen alpha0's error bar by half or more
+    (:func:`~bendpam.identify.ensemble.offset_widening`): a declared zero replaces them."""
+    members = []
+    for (law, f), wk in zip(fits.items(), w, strict=True):
+        names = tuple(getattr(f, "names", ()))
+        if getattr(f, "cov", None) is not None and "alpha0" in names and wk > 1e-4:
+            j = names.index("alpha0")
+            members.append((law, float(wk), float(f[0]["alpha0"]), math.sqrt(max(float(f.cov[j, j]), 0.0))))
+    weight, with_, without = offset_widening(members) if members else (0.0, math.nan, math.nan)
+    return [widening_note(weight, with_, without)] if weight >= 0.05 and with_ >= 1.5 * without else []
 
 
 def _bounds(actuator: Actuator, d: FitData, bounds) -> dict[str, tuple[float, float]]:
@@ -643,9 +665,17 @@ def _uncertainty(prob: Problem, bnd, nl_best, lin, corr_flag: float, cycles=(), 
     if instrument is not None and instrument.declared:  # the load cell's moments; the residuals' change per kPa
         p2 = copy.copy(prob)
         p2.d = dataclasses.replace(prob.d, Pc=prob.d.Pc + 1.0)
-        force = np.where(np.arange(m) < prob.d.kc.size, prob.w * prob.y, 0.0)
+        bending = np.arange(m) < prob.d.kc.size
+        force = np.where(bending, prob.w * prob.y, 0.0)
         Jf = np.where(np.asarray(at_bound, dtype=bool)[None, :], 0.0, J)  # a bound held moves nothing (refit)
-        unc.set_instrument(G @ instrument_covariance(Jf, force, p2.residual_full(x_int) - r, instrument) @ G.T)
+        offset_rows = {}
+        if prob.d.lever is not None:  # a declared offset's weighted moment per unit: eq 7's lever (times P)
+            n_b = prob.d.kc.size
+            offset_rows = {"F_off": np.zeros(m), "F_P": np.zeros(m)}
+            offset_rows["F_off"][:n_b] = prob.w[:n_b] * prob.d.lever
+            offset_rows["F_P"][:n_b] = offset_rows["F_off"][:n_b] * prob.d.Pc
+        unc.set_instrument(G @ instrument_covariance(Jf, force, p2.residual_full(x_int) - r, instrument,
+                                                     offset_rows) @ G.T)
     return unc
 
 
@@ -678,14 +708,19 @@ def _law_refit(prob: Problem, bnd, nl, alt: str):
     return member, nfev + n, (p2, nl2, lin2)
 
 
-def _offset_members(run: _Run, fits: dict, solved: dict, r: np.ndarray) -> None:
+def _offset_members(run: _Run, fits: dict, solved: dict, r: np.ndarray, declared: tuple[str, ...] = ()) -> None:
     """Add the offset members to ``fits`` (and their problems to ``solved``): the law of most weight refitted with
     each offset of :data:`~bendpam.identify.ensemble.OFFSETS` (:func:`_offset_refit`); when those members take most
     of the weight, every other law too, so that the offsets are part of every member and the laws' spread is the
-    systematic part again."""
+    systematic part again.  A member that fits an offset the instrument declares known (``declared``,
+    :attr:`~bendpam.identify.uncertainty.Instrument.offsets_declared`) is left out: the declared doubt replaces it."""
+    kinds = {suffix: names for suffix, names in OFFSETS.items() if not set(names) & set(declared)}
+    if not kinds:
+        return
+
     def add(law: str) -> None:
         prob, nl = solved[law][:2] if law in solved else (run.prob, run.nl)
-        for suffix, names in OFFSETS.items():
+        for suffix, names in kinds.items():
             try:
                 fits[law + suffix], n, solved[law + suffix] = _offset_refit(prob, run.bnd, nl, names)
                 run.nfev += n
@@ -696,7 +731,7 @@ def _offset_members(run: _Run, fits: dict, solved: dict, r: np.ndarray) -> None:
     top = laws[int(np.argmax(member_weights(fits, r, run.prob.groups)[0]))]
     add(top)
     w = dict(zip(fits, member_weights(fits, r, run.prob.groups)[0], strict=True))
-    if sum(w.get(top + suffix, 0.0) for suffix in OFFSETS) >= 0.5:
+    if sum(w.get(top + suffix, 0.0) for suffix in kinds) >= 0.5:
         for law in laws:
             if law != top:
                 add(law)

@@ -161,15 +161,26 @@ class Instrument:
         7500-1 class 1 (within 1 % of the reading) has ``1 / sqrt(3) = 0.58`` %.
     pressure_uncertainty_kpa : standard uncertainty of the pressure the actuator was held at (kPa); a
         gauge within 0.5 % of a 600 kPa span has ``3 / sqrt(3) = 1.7`` kPa.
+    zero_uncertainty_n : the load cell's zero is known (a tare with the fixture as tested, or its reading
+        with the actuator unloaded): the standard uncertainty (N) of the force it reads with no load, 0 for
+        exactly.  None (default): not known.  Declared, the fit's offset members that fit a zero offset are
+        left out (:mod:`bendpam.identify.ensemble`) and this doubt takes their place.
+    pressure_force_uncertainty_n_per_kpa : no force in proportion to the pressure reaches the load cell (a
+        supply hose, a fitting's thrust) beyond this standard uncertainty (N/kPa), 0 for none.  None
+        (default): not known.  Declared, the members that fit such a force are left out.
 
     >>> Instrument(force_uncertainty_pct=0.58).declared, Instrument().declared
     (True, False)
     >>> Instrument(0.58, 1.7).describe()
     'the force reading to 0.58 % and the pressure to 1.7 kPa (standard uncertainties, common to every test)'
+    >>> Instrument(zero_uncertainty_n=0.01, pressure_force_uncertainty_n_per_kpa=0.0).offsets_declared
+    ('F_off', 'F_P')
     """
 
     force_uncertainty_pct: float = 0.0
     pressure_uncertainty_kpa: float = 0.0
+    zero_uncertainty_n: float | None = None
+    pressure_force_uncertainty_n_per_kpa: float | None = None
 
     def __post_init__(self) -> None:
         from bendpam.validate import number
@@ -178,38 +189,72 @@ class Instrument:
                            number("force_uncertainty_pct", self.force_uncertainty_pct, 0.0, 20.0, unit="%"))
         object.__setattr__(self, "pressure_uncertainty_kpa",
                            number("pressure_uncertainty_kpa", self.pressure_uncertainty_kpa, 0.0, 100.0, unit="kPa"))
+        for name, hi, unit in (("zero_uncertainty_n", 1e4, "N"),
+                               ("pressure_force_uncertainty_n_per_kpa", 10.0, "N/kPa")):
+            if getattr(self, name) is not None:
+                object.__setattr__(self, name, number(name, getattr(self, name), 0.0, hi, unit=unit))
 
     @property
     def declared(self) -> bool:
-        """Is any part declared (non-zero)?"""
-        return self.force_uncertainty_pct > 0.0 or self.pressure_uncertainty_kpa > 0.0
+        """Is any part declared (a calibration non-zero, or an offset known)?"""
+        return self.force_uncertainty_pct > 0.0 or self.pressure_uncertainty_kpa > 0.0 or bool(self.offsets_declared)
+
+    @property
+    def offsets_declared(self) -> tuple[str, ...]:
+        """The offset forces declared known, by their names in the fit (``"F_off"``, ``"F_P"``)."""
+        return tuple(n for n, u in (("F_off", self.zero_uncertainty_n),
+                                    ("F_P", self.pressure_force_uncertainty_n_per_kpa)) if u is not None)
+
+    def offset_uncertainties(self) -> dict[str, float]:
+        """The declared offsets' standard uncertainties, by name (N for ``"F_off"``, N/kPa for ``"F_P"``)."""
+        return {n: float(u) for n, u in (("F_off", self.zero_uncertainty_n),
+                                         ("F_P", self.pressure_force_uncertainty_n_per_kpa)) if u is not None}
 
     def describe(self) -> str:
-        """The declaration in words."""
+        """The declaration in words.
+
+        >>> Instrument(zero_uncertainty_n=0.01, pressure_force_uncertainty_n_per_kpa=0.0).describe().split(" (")[0]
+        "the load cell's zero to 0.01 N and no force in proportion to the pressure"
+        """
         parts = ([f"the force reading to {self.force_uncertainty_pct:.3g} %"] if self.force_uncertainty_pct else []) + \
                 ([f"the pressure to {self.pressure_uncertainty_kpa:.3g} kPa"] if self.pressure_uncertainty_kpa else [])
+        if self.zero_uncertainty_n is not None:
+            parts.append(f"the load cell's zero to {self.zero_uncertainty_n:.3g} N" if self.zero_uncertainty_n
+                         else "the load cell's zero exactly")
+        if self.pressure_force_uncertainty_n_per_kpa is not None:
+            parts.append(f"a force in proportion to the pressure to {self.pressure_force_uncertainty_n_per_kpa:.3g} "
+                         "N/kPa" if self.pressure_force_uncertainty_n_per_kpa
+                         else "no force in proportion to the pressure")
         return " and ".join(parts) + " (standard uncertainties, common to every test)" if parts else "nothing"
 
 
 def instrument_covariance(J: np.ndarray, force_rows: np.ndarray, pressure_rows: np.ndarray,
-                          instrument: Instrument) -> np.ndarray:
+                          instrument: Instrument, offset_rows: dict[str, np.ndarray] | None = None) -> np.ndarray:
     """The covariance a declared calibration (:class:`Instrument`) adds to the parameters (linearised refits).
 
     A force reading high by a fraction ``e`` moves the weighted data by ``e * force_rows`` (``w M``, the
     weighted moments; zero on rows the load cell did not measure), a pressure off by ``p`` kPa moves the
-    weighted residuals by ``p * pressure_rows`` (their change per kPa); each moves the parameters by
-    :func:`offset_shift`'s linearised refit, ``dx``, and adds ``u^2 dx dx^T`` (``u`` its standard uncertainty).
+    weighted residuals by ``p * pressure_rows`` (their change per kPa), a declared offset ``F`` (a zero, N; a
+    force in proportion to the pressure, N/kPa) moves them by ``F * offset_rows[name]`` (its weighted moment per
+    unit: eq 7's lever, times the pressure for ``"F_P"``); each moves the parameters by :func:`offset_shift`'s
+    linearised refit, ``dx``, and adds ``u^2 dx dx^T`` (``u`` its standard uncertainty).
 
     >>> J = np.column_stack([np.ones(4), np.arange(4.0)])          # a line: offset and slope
     >>> y = np.array([1.0, 2.0, 3.0, 4.0])                          # data on y = 1 + x
     >>> cov = instrument_covariance(J, y, np.zeros(4), Instrument(force_uncertainty_pct=1.0))
     >>> np.sqrt(np.diag(cov)).round(6).tolist()                    # 1 % of the offset 1 and of the slope 1
     [0.01, 0.01]
+    >>> zero = Instrument(zero_uncertainty_n=0.2)                   # a zero known to 0.2 N, on a lever of 3 mm
+    >>> cov = instrument_covariance(J, y, np.zeros(4), zero, {"F_off": np.full(4, 3.0)})
+    >>> np.sqrt(np.diag(cov)).round(6).tolist()                    # the offset by 0.6, the slope not at all
+    [0.6, 0.0]
     """
     every = np.arange(J.shape[0])
-    dxs = [offset_shift(J, [(every, u * np.asarray(rows, dtype=float))])
-           for rows, u in ((force_rows, instrument.force_uncertainty_pct / 100.0),
-                           (pressure_rows, instrument.pressure_uncertainty_kpa)) if u > 0.0]
+    rows_of = offset_rows or {}
+    parts = [(force_rows, instrument.force_uncertainty_pct / 100.0),
+             (pressure_rows, instrument.pressure_uncertainty_kpa)]
+    parts += [(rows_of[n], u) for n, u in instrument.offset_uncertainties().items() if n in rows_of]
+    dxs = [offset_shift(J, [(every, u * np.asarray(rows, dtype=float))]) for rows, u in parts if u > 0.0]
     return sum((np.outer(dx, dx) for dx in dxs), np.zeros((J.shape[1], J.shape[1])))
 
 
