@@ -182,9 +182,15 @@ def test_study_recovers_the_generators_truths_and_flags_the_drift(small_study):
 def test_the_docs_page_names_the_command_that_regenerates_it():
     page = (ROOT / "docs" / "calibration.md").read_text(encoding="utf-8")
     assert "python tools/calibration_study.py" in page
-    for case_set in study.SETS:
+    for case_set in [*study.SETS, "main-tared"]:
         start, end = study.markers(case_set)
         assert page.index(start) < page.index(end)
+    assert "python tools/calibration_study.py --tared" in page
+    # --tared declares what the page says: a zero to 5 mN and no force in proportion to the pressure
+    from bendpam.identify.uncertainty import Instrument
+
+    tared = Instrument(*study.TARED)
+    assert tared.offset_uncertainties() == {"F_off": 0.005, "F_P": 0.0} and "zero known to 5 mN" in page
 
 
 def test_the_study_fits_as_the_commands_do(small_study, tmp_path):

@@ -788,7 +788,8 @@ class FitResult:
             lines.append(f"  instrument, its declared calibration: {b.declared}" if b.instrument else
                          "  not included: the rig's calibration (a load cell or pressure gauge off, an untared "
                          "self-weight: every test moved alike, unseen in the curves); declare it with "
-                         "--force-uncertainty-pct, --pressure-uncertainty-kpa (fit(instrument=...))")
+                         "--force-uncertainty-pct, --pressure-uncertainty-kpa; a known tare with "
+                         "--zero-uncertainty-n, --pressure-force-uncertainty-n-per-kpa (fit(instrument=...))")
             if b.ensemble:
                 lines.append("  loop laws (weight; the model parameters are their weighted average): "
                              + ", ".join(f"{m.law} {m.weight:.2f}" for m in b.ensemble))
