@@ -782,9 +782,13 @@ class FitResult:
             keys = [k for k in b.statistical if k in (*(v[0] for v in PARAMETERS.values()), "shear_modulus_kpa",
                                                       "shape")]
             inst = " / instrument" if b.instrument else ""
+
+            def part(x: float, k: str) -> str:  # a part below a millionth of the total is rounding: 0
+                return f"{x if x > 1e-6 * b.total.get(k, 0.0) else 0.0:.2g}"
+
             lines.append(f"  standard errors, statistical / systematic{inst}: " + ", ".join(
-                f"{k} {b.statistical[k]:.2g} / {b.systematic.get(k, 0.0):.2g}"
-                + (f" / {b.instrument.get(k, 0.0):.2g}" if b.instrument else "") for k in keys))
+                f"{k} {part(b.statistical[k], k)} / {part(b.systematic.get(k, 0.0), k)}"
+                + (f" / {part(b.instrument.get(k, 0.0), k)}" if b.instrument else "") for k in keys))
             lines.append(f"  instrument, its declared calibration: {b.declared}" if b.instrument else
                          "  not included: the rig's calibration (a load cell or pressure gauge off, an untared "
                          "self-weight: every test moved alike, unseen in the curves); declare it with "
