@@ -695,8 +695,9 @@ def uncertainty_budget(unc: Uncertainty, fitted, fits: dict, r: np.ndarray, grou
                      f"systematic: their weighted spread about the average); the loop's parameters are the {law} fit's")
     stat, sys_ = part_sds(unc.cov_stat, names, fitted), part_sds(unc.cov_sys, names, fitted)
     resampling = (f"the cycles of {n_resampled} test(s) resampled (a block bootstrap over cycles through the "
-                  "linearised fit, its covariance computed exactly); the sandwich with its AR(1) inflation for the "
-                  "curves of single-cycle tests and a tension test" if n_resampled else
+                  "linearised fit, its covariance computed exactly), with the curves' misfit beyond the cycles' "
+                  "scatter treated as correlated noise (its share of each curve's residuals); the sandwich with its "
+                  "AR(1) inflation for the curves of single-cycle tests and a tension test" if n_resampled else
                   "the sandwich with its AR(1) inflation for every curve (no cycles resampled: single-cycle tests, "
                   "or a shape at an admissibility bound, where the model's misfit is treated as noise)")
     return UncertaintyBudget(stat, sys_, resampling, weighting, members)

@@ -60,7 +60,9 @@ Uncertainty (both parts are reported separately: ``FitResult.uncertainty``)
     1. Statistical: a sandwich covariance ``B^-1 (sum meat) B^-1`` (:mod:`bendpam.identify.uncertainty`),
        ``B = J^T J``.  The meat of a test with two cycles or more is the exact covariance of
        resampling its cycles (a block bootstrap over cycles through the linearised fit, scaled for
-       few cycles); that of a single-cycle test or a tension test is its residual variance ``s_g^2``
+       few cycles), plus, where a curve's residuals exceed the cycles' scatter (lack of fit against the
+       cycles as replicates), that excess share of the sandwich's meat below (the misfit as correlated
+       noise); that of a single-cycle test or a tension test is its residual variance ``s_g^2``
        inflated by ``f_g = (1 + rho_g) / (1 - rho_g)`` for the lag-1 autocorrelation of its
        residuals; a drift correction adds its own doubt as an offset.
     2. Systematic (the loop law): no law is known to be the actuator's.  The fit is repeated with

@@ -7,8 +7,10 @@ variance, inflated for the lag-1 autocorrelation of its residuals
 resampling its cycles instead (a block bootstrap over cycles, through the linearised fit; its
 covariance is computed exactly rather than from random resamples): noise that is not white,
 slow drifts and creep from cycle to cycle widen it as they widen the seed-to-seed spread, while
-the model's own misfit, the same in every cycle, does not (the ensemble of loop laws,
-:mod:`bendpam.identify.ensemble`, answers for that).  :class:`Uncertainty` holds the covariance of
+the model's own misfit, the same in every cycle, does not.  That misfit is answered twice: by the
+ensemble of loop laws (:mod:`bendpam.identify.ensemble`), and, where a curve's residuals exceed what
+the cycles' scatter explains (a lack-of-fit test against the cycles as replicates), by treating that
+excess as correlated noise (:func:`sandwich_covariance`).  :class:`Uncertainty` holds the covariance of
 the varied parameters in their units, statistical and systematic; :func:`material_fit` propagates
 it to the bladder's shear modulus and shape.
 """
@@ -307,7 +309,12 @@ def sandwich_covariance(J: np.ndarray, r: np.ndarray, groups: np.ndarray,
     ``U^T U / (n (n - 1))``: its meat is ``G^T G / (n (n - 1))``, ``G = U J_rows``, the exact
     covariance of the cycle bootstrap through the linearised fit, and it replaces the sandwich's
     meat for the groups it covers.  With few cycles that estimate is itself uncertain: it is scaled
-    by ``(t_0.975(nu) / 1.96)^2``, ``nu = sum (n - 1)``, so that +-2 SE keep about 95 %.  Each entry
+    by ``(t_0.975(nu) / 1.96)^2``, ``nu = sum (n - 1)``, so that +-2 SE keep about 95 %.  The bootstrap
+    sees the noise, not a misfit that repeats in every cycle: a covered group whose residuals' sum of
+    squares ``SSR_g`` exceeds their pure error ``PE_g`` (the variance of its mean over the cycles,
+    ``sum U^2 / (n (n - 1))`` over its rows; a lack-of-fit test against replicates) also contributes
+    the sandwich's meat above times the misfit's share, ``1 - PE_g / SSR_g`` (0 where the model fits
+    to the noise): the misfit beyond the cycles' scatter is treated as correlated noise.  Each entry
     ``(rows, u)`` of ``offsets`` is an offset common to the rows ``rows`` with weighted standard
     deviations ``u`` (the drift correction's doubt): meat ``g^T g``, ``g = u J_rows``.
 
@@ -344,6 +351,15 @@ def sandwich_covariance(J: np.ndarray, r: np.ndarray, groups: np.ndarray,
     >>> cov, _ = sandwich_covariance(one, np.zeros(1), np.zeros(1, int), [(np.array([0]), np.array([[-1.0], [1.0]]))])
     >>> cov.round(2)
     array([[42.03]])
+
+    A line fitted to two cycles that agree (no pure error) but miss the data by a misfit the same in each:
+    the bootstrap sees nothing, the misfit counts as noise
+
+    >>> same = [(np.arange(4), np.zeros((2, 4)))]
+    >>> r = np.array([0.1, -0.1, -0.1, 0.1])
+    >>> cov, _ = sandwich_covariance(J, r, np.zeros(4, int), same)
+    >>> bool(np.all(np.diag(cov) > 0)), np.allclose(cov, sandwich_covariance(J, r, np.zeros(4, int))[0])
+    (True, True)
     """
     if not np.all(np.isfinite(J)):
         raise FitError("the data do not determine the parameters (the Jacobian is not finite at the optimum); "
@@ -351,7 +367,7 @@ def sandwich_covariance(J: np.ndarray, r: np.ndarray, groups: np.ndarray,
     m = r.size
     B = J.T @ J
     share = 1.0 - J.shape[1] / max(m, 1)
-    meat, covered = _cycle_meat(J, cycles)
+    meat, covered, pure = _cycle_meat(J, cycles)
     for rows, u in offsets:
         g = u @ J[rows]
         meat += np.outer(g, g)
@@ -361,31 +377,35 @@ def sandwich_covariance(J: np.ndarray, r: np.ndarray, groups: np.ndarray,
         ri = r[sel]
         rho_i = min(max(lag1_autocorrelation(ri, np.zeros(ri.size, int)), 0.0), 0.95)
         rhos.append(rho_i)
-        if covered[sel].all():
-            continue
-        var_i = float(ri @ ri) / max(share * ri.size, 1.0)
-        meat += (J[sel].T @ J[sel]) * var_i * (1.0 + rho_i) / (1.0 - rho_i)
+        ssr = float(ri @ ri)
+        misfit = (max(0.0, 1.0 - float(pure[sel].sum()) / ssr) if ssr > 0.0 else 0.0) if covered[sel].all() else 1.0
+        if misfit > 0.0:  # the residuals beyond the cycles' scatter (all of them where no cycles are resampled)
+            var_i = ssr / max(share * ri.size, 1.0)
+            meat += (J[sel].T @ J[sel]) * var_i * (1.0 + rho_i) / (1.0 - rho_i) * misfit
     rho = float(np.mean(rhos)) if rhos else 0.0
     Binv = np.linalg.pinv(B, rcond=1e-13)
     return Binv @ meat @ Binv, rho
 
 
-def _cycle_meat(J: np.ndarray, cycles) -> tuple[np.ndarray, np.ndarray]:
-    """The cycle bootstrap's meat, t-scaled (:func:`sandwich_covariance`), and which rows it covers."""
+def _cycle_meat(J: np.ndarray, cycles) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The cycle bootstrap's meat, t-scaled (:func:`sandwich_covariance`), which rows it covers, and each row's pure
+    error (the variance of its mean over the cycles, weighted)."""
     meat = np.zeros((J.shape[1], J.shape[1]))
     covered = np.zeros(J.shape[0], dtype=bool)
+    pure = np.zeros(J.shape[0])
     dof = 0
     for rows, U in cycles:
         n = U.shape[0]
         G = U @ J[rows]
         meat += G.T @ G / (n * (n - 1))
         covered[rows] = True
+        pure[rows] = np.sum(U**2, axis=0) / (n * (n - 1))
         dof += n - 1
     if dof:
         from scipy.special import stdtrit  # Student's t quantile (scipy.stats would cost 0.3 s to import)
 
         meat *= (float(stdtrit(dof, 0.975)) / 1.96) ** 2
-    return meat, covered
+    return meat, covered, pure
 
 
 def material_fit(fitted: Actuator, unc: Uncertainty, shape_bounds, stretch, at_bound: bool, held: str,
