@@ -48,3 +48,32 @@ def span():
 def curvature_span(actuator, frac=0.9, n=41):
     lim = bendpam.curvature_limits(actuator)
     return np.linspace(frac * lim.k_min, frac * lim.k_max, n)
+
+
+@pytest.fixture(scope="session")
+def study_case():
+    """``study_case(name, seed)``: a calibration-study case's raw tests (tools/calibration_study.py) read and
+    processed as the study does: ``(processed set, start actuator, truth)``."""
+    import sys
+    import tempfile
+    import warnings
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tools"))
+    import calibration_study as study
+
+    from bendpam.lab import read_test
+    from bendpam.lab.processing import process_tests
+    from bendpam.physics.fixture import Fixture
+
+    def make(name: str, seed: int = 0):
+        case = study.ALL_CASES[name]
+        with tempfile.TemporaryDirectory() as folder, warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            truth = study.generator(case).generate_set(case, seed, folder)
+            ps = process_tests([read_test(Path(folder) / n) for n in truth["files"]],
+                               fixture=Fixture(L0_mm=truth["fixture_L0_mm"]), keep_series=False)
+        return ps, study.generator(case).start_actuator(case), truth
+
+    return make
+

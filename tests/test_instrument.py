@@ -120,24 +120,9 @@ def test_bad_declarations_are_refused():
 
 
 @pytest.fixture(scope="module")
-def stiction():
+def stiction(study_case):
     """The calibration study's stiction case (seed 0): clean data on which the offset members take weight."""
-    import sys
-    import tempfile
-
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tools"))
-    import calibration_study as study
-
-    from bendpam.lab import read_test
-    from bendpam.physics.fixture import Fixture
-
-    case = study.ALL_CASES["stiction"]
-    with tempfile.TemporaryDirectory() as folder, warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        truth = study.generator(case).generate_set(case, 0, folder)
-        ps = process_tests([read_test(Path(folder) / n) for n in truth["files"]],
-                           fixture=Fixture(L0_mm=truth["fixture_L0_mm"]), keep_series=False)
-    return ps, study.generator(case).start_actuator(case), truth
+    return study_case("stiction", 0)
 
 
 def offset_laws(result) -> set[str]:

@@ -7,16 +7,14 @@ properties (nothing added where the model fits to the noise, more the larger the
 held-out set's braid friction, whose laws all share a bias the bootstrap alone did not cover.
 """
 
-import sys
-import tempfile
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from bendpam.identify.fitting import fit
 from bendpam.identify.uncertainty import sandwich_covariance
 
 J = np.column_stack([np.ones(4), np.arange(4.0)])  # a line: offset and slope
@@ -56,23 +54,12 @@ def test_more_misfit_never_narrows_the_bars(res, dev, grow):
 
 
 @pytest.fixture(scope="module")
-def braid():
+def braid(study_case):
     """The tenth held-out set's braid friction following the load (seed 0), fitted."""
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tools"))
-    import calibration_study as study
-
-    from bendpam.identify.fitting import fit
-    from bendpam.lab import read_test
-    from bendpam.lab.processing import process_tests
-    from bendpam.physics.fixture import Fixture
-
-    case = study.ALL_CASES["h10-braid-gaindrift"]
-    with tempfile.TemporaryDirectory() as folder, warnings.catch_warnings():
+    ps, act, truth = study_case("h10-braid-gaindrift", 0)
+    with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        truth = study.generator(case).generate_set(case, 0, folder)
-        ps = process_tests([read_test(Path(folder) / n) for n in truth["files"]],
-                           fixture=Fixture(L0_mm=truth["fixture_L0_mm"]), keep_series=False)
-        return fit(ps, study.generator(case).start_actuator(case), profile_points=0), truth
+        return fit(ps, act, profile_points=0), truth
 
 
 def test_a_loop_no_law_has_is_covered(braid):
