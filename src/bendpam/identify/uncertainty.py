@@ -364,13 +364,21 @@ def sandwich_covariance(J: np.ndarray, r: np.ndarray, groups: np.ndarray,
     if not np.all(np.isfinite(J)):
         raise FitError("the data do not determine the parameters (the Jacobian is not finite at the optimum); "
                        "hold some of them fixed")
-    m = r.size
-    B = J.T @ J
-    share = 1.0 - J.shape[1] / max(m, 1)
     meat, covered, pure = _cycle_meat(J, cycles)
     for rows, u in offsets:
         g = u @ J[rows]
         meat += np.outer(g, g)
+    group_meat, rho = _group_meat(J, r, groups, covered, pure, 1.0 - J.shape[1] / max(r.size, 1))
+    Binv = np.linalg.pinv(J.T @ J, rcond=1e-13)
+    return Binv @ (meat + group_meat) @ Binv, rho
+
+
+def _group_meat(J: np.ndarray, r: np.ndarray, groups: np.ndarray, covered: np.ndarray, pure: np.ndarray,
+                share: float) -> tuple[np.ndarray, float]:
+    """The residual groups' sandwich meat (:func:`sandwich_covariance`): each group's variance with its AR(1)
+    inflation, times the misfit's share ``1 - PE_g / SSR_g`` where the cycle bootstrap covers it (1 where not);
+    and the groups' mean lag-1 autocorrelation."""
+    meat = np.zeros((J.shape[1], J.shape[1]))
     rhos = []
     for g in np.unique(groups):
         sel = groups == g
@@ -382,9 +390,7 @@ def sandwich_covariance(J: np.ndarray, r: np.ndarray, groups: np.ndarray,
         if misfit > 0.0:  # the residuals beyond the cycles' scatter (all of them where no cycles are resampled)
             var_i = ssr / max(share * ri.size, 1.0)
             meat += (J[sel].T @ J[sel]) * var_i * (1.0 + rho_i) / (1.0 - rho_i) * misfit
-    rho = float(np.mean(rhos)) if rhos else 0.0
-    Binv = np.linalg.pinv(B, rcond=1e-13)
-    return Binv @ meat @ Binv, rho
+    return meat, (float(np.mean(rhos)) if rhos else 0.0)
 
 
 def _cycle_meat(J: np.ndarray, cycles) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
