@@ -70,3 +70,14 @@ def test_a_loop_no_law_has_is_covered(braid):
     assert a.value - truth["alpha0_deg"] < -0.1  # the bias is there
     assert abs(a.value - truth["alpha0_deg"]) <= 2.0 * a.stderr
     assert "misfit beyond the cycles' scatter" in result.uncertainty.resampling
+    said = [f for f in result.flags if "times what the scatter of their cycles explains" in f]
+    assert len(said) == 1 and "a bias that every loop law shares may remain" in said[0]
+
+
+def test_a_model_that_fits_to_the_noise_says_nothing(study_case):
+    """The main set's stiction case: the residuals 1-3 times the cycles' pure error, below the note's 4."""
+    ps, act, _ = study_case("stiction", 0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        result = fit(ps, act, profile_points=0)
+    assert not any("scatter of their cycles" in f for f in result.flags)

@@ -163,6 +163,7 @@ from bendpam.identify.uncertainty import (
     Instrument,
     Uncertainty,
     instrument_covariance,
+    lack_of_fit,
     material_fit,
     offset_shift,
     sandwich_covariance,
@@ -375,6 +376,8 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool, inst
     run.nfev += unc.nfev
     fits: dict[str, MemberFit] = {}
     r = run.prob.residual_full(np.concatenate([[run.nl[p] for p in run.prob.nonlin], run.lin]))
+    run.notes += misfit_note(lack_of_fit(r, [(rows, run.prob.w[rows][None, :] * E) for rows, E in run.cycles]),
+                             run.law)
     if run.law and law_uncertainty:
         fits[run.law] = MemberFit(dict(unc.values), float(r @ r), tuple(unc.names), unc.cov_stat.copy(),
                                   len(run.prob.free), group_ssr(r, run.prob.groups))
@@ -423,6 +426,29 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool, inst
             run.notes.append("the declared offsets are not counted: the processed set keeps no fixture (its lever "
                              "turns a force into a moment)")
     return unc, budget
+
+
+#: The ratio of the residuals' sum of squares to the cycles' pure error (:func:`~bendpam.identify.uncertainty.
+#: lack_of_fit`) from which the fit says its model misfits the curves: three quarters of the sum of squares is misfit.
+#: On the calibration study's main set the ratio is 1-3; on the tenth held-out set's braid friction 15-36.
+MISFIT_NOTE_RATIO = 4.0
+
+
+def misfit_note(ratio: float, law: str | None) -> list[str]:
+    """The fit's words when the curves' misfit is well beyond what the cycles' scatter explains (``ratio`` at least
+    :data:`MISFIT_NOTE_RATIO`).
+
+    >>> misfit_note(23.4, "pi")[0].split(":")[0]
+    "the curves' residuals are 23 times what the scatter of their cycles explains (lack of fit against the cycles)"
+    >>> misfit_note(1.4, "pi")
+    []
+    """
+    if not (ratio >= MISFIT_NOTE_RATIO):
+        return []
+    model = f"the model with its {law} loop" if law else "the model"
+    return [f"the curves' residuals are {ratio:.0f} times what the scatter of their cycles explains (lack of fit "
+            f"against the cycles): {model} does not follow them to their noise; the error bars count the excess "
+            "misfit as correlated noise (docs/calibration.md), but a bias that every loop law shares may remain"]
 
 
 def _widening_notes(fits: dict, w: np.ndarray) -> list[str]:

@@ -28,9 +28,8 @@ from bendpam.identify.diagnose import shape_identified, study_coverage
 from bendpam.identify.result import MaterialFit
 from bendpam.physics.actuator import Actuator
 
-__all__ = ["Instrument", "Uncertainty", "instrument_covariance", "lag1_autocorrelation", "material_fit",
-           "material_gradients", "offset_shift",
-           "sandwich_covariance"]
+__all__ = ["Instrument", "Uncertainty", "instrument_covariance", "lack_of_fit", "lag1_autocorrelation",
+           "material_fit", "material_gradients", "offset_shift", "sandwich_covariance"]
 
 
 class Uncertainty:
@@ -258,6 +257,28 @@ def instrument_covariance(J: np.ndarray, force_rows: np.ndarray, pressure_rows: 
     parts += [(rows_of[n], u) for n, u in instrument.offset_uncertainties().items() if n in rows_of]
     dxs = [offset_shift(J, [(every, u * np.asarray(rows, dtype=float))]) for rows, u in parts if u > 0.0]
     return sum((np.outer(dx, dx) for dx in dxs), np.zeros((J.shape[1], J.shape[1])))
+
+
+def lack_of_fit(r: np.ndarray, cycles) -> float:
+    """The residuals' sum of squares over their pure error, on the rows whose cycles are resampled.
+
+    ``r``: weighted residuals; ``cycles``: ``(rows, U)`` with ``U`` the weighted deviation of each of a test's ``n``
+    cycles from their mean (:func:`sandwich_covariance`).  The pure error, ``sum U^2 / (n (n - 1))``, is what the
+    sum of squares of a model that fits to the noise would be; their ratio is about 1 then, and the misfit's
+    share of the residuals is ``1 - 1 / ratio``.  NaN without cycles.
+
+    >>> U = np.array([[0.1, -0.1], [-0.1, 0.1]])              # two cycles: pure error 2 * 0.02 / 2 = 0.02
+    >>> lack_of_fit(np.array([0.1, 0.1]), [(np.arange(2), U)])   # a sum of squares of 0.02: all noise
+    1.0
+    >>> lack_of_fit(np.array([0.4, 0.2]), [(np.arange(2), U)])   # 0.2: ten times, 90 % misfit
+    10.0
+    """
+    ssr = pe = 0.0
+    for rows, U in cycles:
+        n = U.shape[0]
+        ssr += float(np.sum(np.asarray(r)[rows] ** 2))
+        pe += float(np.sum(np.asarray(U) ** 2)) / (n * (n - 1))
+    return round(ssr / pe, 12) if pe > 0.0 else math.nan
 
 
 def lag1_autocorrelation(resid: np.ndarray, seg: np.ndarray) -> float:
