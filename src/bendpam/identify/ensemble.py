@@ -786,4 +786,3 @@ def widening_note(weight: float, se_with: float, se_without: float) -> str:
             "as tested and no pressure-driven force reaches it, declare it (Instrument(zero_uncertainty_n=..., "
             "pressure_force_uncertainty_n_per_kpa=...); on the command line --zero-uncertainty-n and "
             "--pressure-force-uncertainty-n-per-kpa)")
-

@@ -445,10 +445,11 @@ def misfit_note(ratio: float, law: str | None) -> list[str]:
     """
     if not (ratio >= MISFIT_NOTE_RATIO):
         return []
-    model = f"the model with its {law} loop" if law else "the model"
+    model, shared = ((f"the model with its {law} loop", "a bias that every loop law shares") if law else
+                     ("the model of the mean curves", "a bias"))
     return [f"the curves' residuals are {ratio:.0f} times what the scatter of their cycles explains (lack of fit "
             f"against the cycles): {model} does not follow them to their noise; the error bars count the excess "
-            "misfit as correlated noise (docs/calibration.md), but a bias that every loop law shares may remain"]
+            f"misfit as correlated noise (docs/calibration.md), but {shared} may remain"]
 
 
 def _widening_notes(fits: dict, w: np.ndarray) -> list[str]:
