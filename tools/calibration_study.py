@@ -453,6 +453,8 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     if args.seeds < 2 or args.jobs < 1:
         ap.error("--seeds must be at least 2 and --jobs at least 1")
+    if args.tared and args.case_set != "main" and not args.no_docs:
+        ap.error("--tared has docs tables for the main set only: add --no-docs (and --out) for another set")
     cases = args.cases or list(SETS[args.case_set])
     name = ("" if args.case_set == "main" else f"-{args.case_set}") + ("-tared" if args.tared else "")
     out = args.out or ROOT / "benchmarks" / "results" / f"calibration{name}.json"
