@@ -268,17 +268,24 @@ def lack_of_fit(r: np.ndarray, cycles) -> float:
     share of the residuals is ``1 - 1 / ratio``.  NaN without cycles.
 
     >>> U = np.array([[0.1, -0.1], [-0.1, 0.1]])              # two cycles: pure error 2 * 0.02 / 2 = 0.02
-    >>> lack_of_fit(np.array([0.1, 0.1]), [(np.arange(2), U)])   # a sum of squares of 0.02: all noise
+    >>> round(lack_of_fit(np.array([0.1, 0.1]), [(np.arange(2), U)]), 9)   # a sum of squares of 0.02: all noise
     1.0
-    >>> lack_of_fit(np.array([0.4, 0.2]), [(np.arange(2), U)])   # 0.2: ten times, 90 % misfit
+    >>> round(lack_of_fit(np.array([0.4, 0.2]), [(np.arange(2), U)]), 9)   # 0.2: ten times, 90 % misfit
     10.0
     """
     ssr = pe = 0.0
     for rows, U in cycles:
-        n = U.shape[0]
         ssr += float(np.sum(np.asarray(r)[rows] ** 2))
-        pe += float(np.sum(np.asarray(U) ** 2)) / (n * (n - 1))
-    return round(ssr / pe, 12) if pe > 0.0 else math.nan
+        pe += float(_pure_error(U).sum())
+    return ssr / pe if pe > 0.0 else math.nan
+
+
+def _pure_error(U: np.ndarray) -> np.ndarray:
+    """Each row's pure error: the variance of its mean over the ``n`` cycles, ``sum_cycles U^2 / (n (n - 1))``
+    (``U``: cycles x rows, each cycle's deviation from their mean)."""
+    U = np.asarray(U, dtype=float)
+    n = U.shape[0]
+    return np.sum(U**2, axis=0) / (n * (n - 1))
 
 
 def lag1_autocorrelation(resid: np.ndarray, seg: np.ndarray) -> float:
@@ -426,7 +433,7 @@ def _cycle_meat(J: np.ndarray, cycles) -> tuple[np.ndarray, np.ndarray, np.ndarr
         G = U @ J[rows]
         meat += G.T @ G / (n * (n - 1))
         covered[rows] = True
-        pure[rows] = np.sum(U**2, axis=0) / (n * (n - 1))
+        pure[rows] = _pure_error(U)
         dof += n - 1
     if dof:
         from scipy.special import stdtrit  # Student's t quantile (scipy.stats would cost 0.3 s to import)
