@@ -1,6 +1,6 @@
 """The calibration study of bendpam's error bars (issue 23): do the fit's standard errors hold?
 
-    python tools/calibration_study.py [--seeds 10] [--set main|holdout|...|holdout10] [--cases CASE ...] [--jobs 1]
+    python tools/calibration_study.py [--seeds 10] [--set main|holdout|...|holdout11] [--cases CASE ...] [--jobs 1]
                                       [--out FILE]
 
 For every case of :data:`raw_generators.CASES` (or of :data:`raw_generators.HOLDOUT` with ``--set holdout``:
@@ -48,6 +48,7 @@ import holdout7_generator as gen7  # noqa: E402
 import holdout8_generator as gen8  # noqa: E402
 import holdout9_generator as gen9  # noqa: E402
 import holdout10_generator as gen10  # noqa: E402
+import holdout11_generator as gen11  # noqa: E402
 import raw_generators as gen  # noqa: E402
 
 from bendpam.infra.atomic import atomic_write_text, json_safe  # noqa: E402
@@ -58,18 +59,22 @@ START, END = "<!-- calibration-table:start -->", "<!-- calibration-table:end -->
 #: ``holdout`` (:data:`raw_generators.HOLDOUT`, other parameters and combined faults, kept out of any tuning).
 SETS = {"main": gen.CASES, "holdout": gen.HOLDOUT, "holdout2": gen.HOLDOUT2, "holdout3": gen.HOLDOUT3,
         "holdout4": gen.HOLDOUT4, "holdout5": gen.HOLDOUT5, "holdout6": gen6.CASES, "holdout7": gen7.CASES,
-        "holdout8": gen8.CASES, "holdout9": gen9.CASES, "holdout10": gen10.CASES}
+        "holdout8": gen8.CASES, "holdout9": gen9.CASES, "holdout10": gen10.CASES,
+        "holdout11": gen11.CASES}
 ALL_CASES = {**gen.CASES, **gen.HOLDOUT, **gen.HOLDOUT2, **gen.HOLDOUT3, **gen.HOLDOUT4, **gen.HOLDOUT5,
-             **gen6.CASES, **gen7.CASES, **gen8.CASES, **gen9.CASES, **gen10.CASES}
+             **gen6.CASES, **gen7.CASES, **gen8.CASES, **gen9.CASES, **gen10.CASES, **gen11.CASES}
 
 
 def generator(case):
-    """The module that makes ``case``'s raw tests: :mod:`holdout10_generator`, :mod:`holdout9_generator`,
+    """The module that makes ``case``'s raw tests: :mod:`holdout11_generator`, :mod:`holdout10_generator`,
+    :mod:`holdout9_generator`,
     :mod:`holdout8_generator`,
     :mod:`holdout7_generator` and
     :mod:`holdout6_generator` for
     theirs (a machine written independently), :mod:`raw_generators` for the others; each has ``generate_set``
     and ``start_actuator``."""
+    if isinstance(case, gen11.Case11):
+        return gen11
     if isinstance(case, gen10.Case10):
         return gen10
     if isinstance(case, gen9.Case9):
@@ -431,14 +436,18 @@ def main(argv=None) -> int:
                     "holdout10: loop laws of the actuator's own physics (braid friction, orifice damping, a "
                     "thixotropic grease, a filler network, Bliman-Sorine, Mullins, Stoner-Wohlfarth, "
                     "Prandtl-Tomlinson) and logging faults on that machine (a gain drift, a quantised stroke, packet "
-                    "time stamps, re-sent rows, a supply-pressure step, data reduction; tools/holdout10_generator.py)")
+                    "time stamps, re-sent rows, a supply-pressure step, data reduction; tools/holdout10_generator.py); "
+                    "holdout11: lubricant, adhesion, wrinkling, contact, crystallisation and stick-slip loops with a "
+                    "lab's handling faults on that machine (load-cell creep and hysteresis, a pause, a results table, "
+                    "thermal expansion, regulator hysteresis, a mis-set speed; tools/holdout11_generator.py)")
     ap.add_argument("--cases", nargs="+", choices=list(ALL_CASES), metavar="CASE",
                     help=f"cases to run (default: the whole set; main: {', '.join(gen.CASES)}; holdout: "
                     f"{', '.join(gen.HOLDOUT)}; holdout2: {', '.join(gen.HOLDOUT2)}; "
                     f"holdout3: {', '.join(gen.HOLDOUT3)}; holdout4: {', '.join(gen.HOLDOUT4)}; "
                     f"holdout5: {', '.join(gen.HOLDOUT5)}; holdout6: {', '.join(gen6.CASES)}; "
                     f"holdout7: {', '.join(gen7.CASES)}; holdout8: {', '.join(gen8.CASES)}; "
-                    f"holdout9: {', '.join(gen9.CASES)}; holdout10: {', '.join(gen10.CASES)})")
+                    f"holdout9: {', '.join(gen9.CASES)}; holdout10: {', '.join(gen10.CASES)}; "
+                    f"holdout11: {', '.join(gen11.CASES)})")
     ap.add_argument("--tared", action="store_true",
                     help="every fit declares the load cell tared to 5 mN and no force in proportion to the pressure "
                     f"(--fit instrument={TARED}); its own JSON and docs tables (calibration-tared)")
