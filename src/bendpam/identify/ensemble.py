@@ -773,16 +773,27 @@ def offset_widening(members) -> tuple[float, float, float]:
     return float(w[off].sum() / max(w.sum(), 1e-300)), se(np.ones(off.size, dtype=bool)), se(~off)
 
 
-def widening_note(weight: float, se_with: float, se_without: float) -> str:
+def widening_note(weight: float, se_with: float, se_without: float, misfit: bool = False) -> str:
     """The fit's words when the offset members widen alpha0's error bar (:func:`offset_widening`) and the curves show
-    no offset: the declaration that replaces them.
+    no offset: the declaration that replaces them.  With ``misfit`` (the curves' residuals well beyond their cycles'
+    scatter, :func:`bendpam.identify.fitting.misfit_note`) the offsets absorb part of the model's misfit too, so the
+    wider bar may be covering a bias of the model: the words say what a declaration would give up.
 
     >>> widening_note(0.35, 0.050, 0.012).split(":")[0]
     "the ensemble's offset members take 0.35 of the weight and widen alpha0's error bar from 0.012 to 0.05 deg"
+    >>> widening_note(0.35, 0.050, 0.012, misfit=True).split("; ")[1][:60]
+    'the model misfits the curves, and the offsets absorb part of'
     """
+    declare = ("declare it (Instrument(zero_uncertainty_n=..., pressure_force_uncertainty_n_per_kpa=...); on the "
+               "command line --zero-uncertainty-n and --pressure-force-uncertainty-n-per-kpa)")
+    if misfit:
+        advice = ("the model misfits the curves, and the offsets absorb part of that misfit, so the wider bar may "
+                  "also be covering a bias of the model (docs/calibration.md); a load cell tared with the fixture as "
+                  "tested, with no pressure-driven force on it, may still be declared, but the bar then loses that "
+                  "cover: " + declare)
+    else:
+        advice = ("if the load cell was tared with the fixture as tested and no pressure-driven force reaches it, "
+                  + declare)
     return (f"the ensemble's offset members take {weight:.2f} of the weight and widen alpha0's error bar from "
             f"{se_without:.2g} to {se_with:.2g} deg: the curves cannot tell a load-cell zero offset or a force in "
-            "proportion to the pressure from the actuator's constants; if the load cell was tared with the fixture "
-            "as tested and no pressure-driven force reaches it, declare it (Instrument(zero_uncertainty_n=..., "
-            "pressure_force_uncertainty_n_per_kpa=...); on the command line --zero-uncertainty-n and "
-            "--pressure-force-uncertainty-n-per-kpa)")
+            f"proportion to the pressure from the actuator's constants; {advice}")

@@ -376,8 +376,8 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool, inst
     run.nfev += unc.nfev
     fits: dict[str, MemberFit] = {}
     r = run.prob.residual_full(np.concatenate([[run.nl[p] for p in run.prob.nonlin], run.lin]))
-    run.notes += misfit_note(lack_of_fit(r, [(rows, run.prob.w[rows][None, :] * E) for rows, E in run.cycles]),
-                             run.law)
+    misfit = lack_of_fit(r, [(rows, run.prob.w[rows][None, :] * E) for rows, E in run.cycles])
+    run.notes += misfit_note(misfit, run.law)
     if run.law and law_uncertainty:
         fits[run.law] = MemberFit(dict(unc.values), float(r @ r), tuple(unc.names), unc.cov_stat.copy(),
                                   len(run.prob.free), group_ssr(r, run.prob.groups))
@@ -409,7 +409,7 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool, inst
                     run.notes.append(offset_note(mean, sd, weight, name))
                     evident = True
         if not evident:
-            run.notes += _widening_notes(fits, w)
+            run.notes += _widening_notes(fits, w, misfit >= MISFIT_NOTE_RATIO)
     shape_bound = unc.at_bound.get("S_lo", False) or unc.at_bound.get("S_hi", False)
     budget = uncertainty_budget(unc, run.prob.actuator(unc.values), fits, r, run.prob.groups, run.law,
                                 0 if shape_bound else len(run.cycles))
@@ -452,9 +452,10 @@ def misfit_note(ratio: float, law: str | None) -> list[str]:
             f"misfit as correlated noise (docs/calibration.md), but {shared} may remain"]
 
 
-def _widening_notes(fits: dict, w: np.ndarray) -> list[str]:
+def _widening_notes(fits: dict, w: np.ndarray, misfit: bool = False) -> list[str]:
     """The fit's words when offset members the curves do not call for widen alpha0's error bar by half or more
-    (:func:`~bendpam.identify.ensemble.offset_widening`): a declared zero replaces them."""
+    (:func:`~bendpam.identify.ensemble.offset_widening`): a declared zero replaces them (``misfit``: the curves'
+    misfit is well beyond their cycles' scatter, and the wider bar may be covering it)."""
     members = []
     for (law, f), wk in zip(fits.items(), w, strict=True):
         names = tuple(getattr(f, "names", ()))
@@ -462,7 +463,7 @@ def _widening_notes(fits: dict, w: np.ndarray) -> list[str]:
             j = names.index("alpha0")
             members.append((law, float(wk), float(f[0]["alpha0"]), math.sqrt(max(float(f.cov[j, j]), 0.0))))
     weight, with_, without = offset_widening(members) if members else (0.0, math.nan, math.nan)
-    return [widening_note(weight, with_, without)] if weight >= 0.05 and with_ >= 1.5 * without else []
+    return [widening_note(weight, with_, without, misfit)] if weight >= 0.05 and with_ >= 1.5 * without else []
 
 
 def _bounds(actuator: Actuator, d: FitData, bounds) -> dict[str, tuple[float, float]]:
