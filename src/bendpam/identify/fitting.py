@@ -376,8 +376,8 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool, inst
     run.nfev += unc.nfev
     fits: dict[str, MemberFit] = {}
     r = run.prob.residual_full(np.concatenate([[run.nl[p] for p in run.prob.nonlin], run.lin]))
-    misfit = lack_of_fit(r, [(rows, run.prob.w[rows][None, :] * E) for rows, E in run.cycles])
-    run.notes += misfit_note(misfit, run.law)
+    misfit_ratio = lack_of_fit(r, [(rows, run.prob.w[rows][None, :] * E) for rows, E in run.cycles])
+    run.notes += misfit_note(misfit_ratio, run.law)
     if run.law and law_uncertainty:
         fits[run.law] = MemberFit(dict(unc.values), float(r @ r), tuple(unc.names), unc.cov_stat.copy(),
                                   len(run.prob.free), group_ssr(r, run.prob.groups))
@@ -409,7 +409,7 @@ def _uncertainty_stages(run: _Run, corr_flag: float, law_uncertainty: bool, inst
                     run.notes.append(offset_note(mean, sd, weight, name))
                     evident = True
         if not evident:
-            run.notes += _widening_notes(fits, w, misfit >= MISFIT_NOTE_RATIO)
+            run.notes += _widening_notes(fits, w, misfit_ratio >= MISFIT_NOTE_RATIO)
     shape_bound = unc.at_bound.get("S_lo", False) or unc.at_bound.get("S_hi", False)
     budget = uncertainty_budget(unc, run.prob.actuator(unc.values), fits, r, run.prob.groups, run.law,
                                 0 if shape_bound else len(run.cycles))
