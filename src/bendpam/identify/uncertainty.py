@@ -203,8 +203,7 @@ class Instrument:
     @property
     def offsets_declared(self) -> tuple[str, ...]:
         """The offset forces declared known, by their names in the fit (``"F_off"``, ``"F_P"``)."""
-        return tuple(n for n, u in (("F_off", self.zero_uncertainty_n),
-                                    ("F_P", self.pressure_force_uncertainty_n_per_kpa)) if u is not None)
+        return tuple(self.offset_uncertainties())
 
     def offset_uncertainties(self) -> dict[str, float]:
         """The declared offsets' standard uncertainties, by name (N for ``"F_off"``, N/kPa for ``"F_P"``)."""
